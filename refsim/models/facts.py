@@ -1,0 +1,94 @@
+"""The facts about a model that ``refsim info`` prints and the report lists."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from refsim.models.mesh import Mesh
+
+
+@dataclass(frozen=True)
+class ModelFacts:
+    name: str
+    triangles: int
+    vertices: int
+    objects: int
+    convex: bool
+    closed: bool
+    degenerate_triangles: int
+    bounds_lo: tuple[float, float, float]
+    bounds_hi: tuple[float, float, float]
+    centroid_vertex_average: tuple[float, float, float]
+    centroid_volume: tuple[float, float, float] | None
+    volume: float | None
+    max_neighbors: int
+    #: |vertex-average centroid - volume centroid| / box diagonal; None when
+    #: open. The seed takes the vertex average as the centre of mass (S9).
+    centroid_offset: float | None
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def _triple(a) -> tuple[float, float, float]:
+    return tuple(float(x) for x in a)
+
+
+def describe(mesh: Mesh, name: str | None = None) -> ModelFacts:
+    lo, hi = mesh.bounds
+    degree = np.diff(mesh.neighbor_offsets)
+    return ModelFacts(
+        name=name or mesh.name or "mesh",
+        triangles=mesh.n_faces,
+        vertices=mesh.n_vertices,
+        objects=len(mesh.objects),
+        convex=bool(mesh.is_convex),
+        closed=bool(mesh.is_closed),
+        degenerate_triangles=int(len(mesh.degenerate_faces)),
+        bounds_lo=_triple(lo),
+        bounds_hi=_triple(hi),
+        centroid_vertex_average=_triple(mesh.centroid_vertex_average),
+        centroid_volume=None if mesh.centroid_volume is None else _triple(mesh.centroid_volume),
+        volume=mesh.volume,
+        max_neighbors=int(degree.max()),
+        centroid_offset=centroid_offset(mesh),
+    )
+
+
+def centroid_offset(mesh: Mesh) -> float | None:
+    """How far the seed's centroid (vertex average) is from the centre of mass
+    of the uniform solid, relative to the diagonal of the mesh's box."""
+    if mesh.centroid_volume is None:
+        return None
+    lo, hi = mesh.bounds
+    gap = np.linalg.norm(mesh.centroid_vertex_average - mesh.centroid_volume)
+    return float(gap / np.linalg.norm(hi - lo))
+
+
+def format_facts(facts: ModelFacts) -> str:
+    """Plain text, one fact a line (``refsim info``)."""
+
+    def vec(v):
+        return "n/a (open mesh)" if v is None else "(" + ", ".join(f"{x:.6g}" for x in v) + ")"
+
+    rows = [
+        ("model", facts.name),
+        ("triangles", facts.triangles),
+        ("vertices", facts.vertices),
+        ("objects", facts.objects),
+        ("convex", "yes" if facts.convex else "no"),
+        ("closed", "yes" if facts.closed else "no"),
+        ("degenerate triangles", facts.degenerate_triangles),
+        ("bounds min", vec(facts.bounds_lo)),
+        ("bounds max", vec(facts.bounds_hi)),
+        ("centroid (vertex average, seed)", vec(facts.centroid_vertex_average)),
+        ("centroid (volume)", vec(facts.centroid_volume)),
+        ("volume", "n/a (open mesh)" if facts.volume is None else f"{facts.volume:.6g}"),
+        ("centroid offset / diagonal", "n/a (open mesh)" if facts.centroid_offset is None
+         else f"{facts.centroid_offset:.3g}"),
+        ("most neighbours of a vertex", facts.max_neighbors),
+    ]
+    width = max(len(k) for k, _ in rows)
+    return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)

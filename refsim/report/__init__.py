@@ -1,0 +1,1 @@
+"""The HTML accuracy report: one self-contained page plus results.json."""

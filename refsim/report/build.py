@@ -1,0 +1,192 @@
+"""Build the accuracy report: ``reports/out/index.html`` and ``results.json``.
+
+The page is self-contained: inline CSS, charts as inline SVG, no scripts
+fetched, no network. Each area contributes a section from
+``refsim.report.sections.<area>``; an area whose section module does not exist
+yet is shown as a plain "not measured yet" section. The claims table collects
+the verdicts the sections return; a claim without one says so.
+
+Both files are rendered in memory first and then written atomically (a
+temporary file in the output directory, then ``os.replace``), so a failed run
+never leaves a half-written page.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import json
+import os
+import platform
+import subprocess
+import tempfile
+from dataclasses import asdict, dataclass
+from importlib import metadata
+from pathlib import Path
+
+from refsim.paths import REPO_ROOT, TEMPLATES_DIR
+from refsim.report.claims import CLAIMS, TERMINOLOGY
+from refsim.report.progress import Progress
+from refsim.report.section import Section
+
+#: The seed every random choice in the report derives from.
+REPORT_SEED = 20260522
+
+# (key, title, what the section will measure once its work lands)
+AREAS: tuple[tuple[str, str, str], ...] = (
+    ("models", "Models", ""),
+    ("bounds", "Bounding boxes and the world cube",
+     "Linear against incremental AABB update (S2) against trimesh's bounds, cost "
+     "against mesh size (C1), the incremental box on non-convex meshes (C2), and the "
+     "world cube test (S3)."),
+    ("collision", "Body-body collision",
+     "The four levels of accuracy (S4) against python-fcl and trimesh: false positives "
+     "and time per level (C3), near-parallel triangles (C4), and the hierarchy's speed "
+     "against FCL."),
+    ("solvers", "ODE solvers and the particle system",
+     "Observed orders against scipy's DOP853 (C10), stability regions and limits, "
+     "work-precision with scipy's adaptive methods, jitter in resting contact (C6, C7), "
+     "drag models (C5), the particle system (C8, C9)."),
+    ("dynamics", "Rigid-body dynamics",
+     "Wall bounces against pybullet and the analytic answer, the seed's rotation model "
+     "against the corrected one (C12), body-body interpenetration (C11)."),
+)
+
+PACKAGES = ("numpy", "scipy", "trimesh", "python-fcl", "pybullet", "matplotlib", "jinja2",
+            "numba", "hypothesis")
+
+
+@dataclass(frozen=True)
+class ReportContext:
+    quick: bool
+    seed: int
+    progress: Progress
+
+
+def build_report(out_dir: Path, *, quick: bool = False, stream=None) -> Path:
+    """Measure, render and write the report; return the path of index.html."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)  # fail before the long work, not after
+    sections: list[Section] = []
+    with Progress(len(AREAS) + 1, stream=stream) as progress:
+        ctx = ReportContext(quick=quick, seed=REPORT_SEED, progress=progress)
+        for key, title, pending in AREAS:
+            progress.announce(title)
+            sections.append(_build_section(key, title, pending, ctx))
+            progress.step(title)
+        environment = collect_environment()
+        html = render(sections, environment, quick=quick)
+        results = {
+            "quick": quick,
+            "seed": REPORT_SEED,
+            "environment": environment,
+            "claims": claim_rows(sections),
+            "sections": {s.key: {"status": s.status, "results": s.results} for s in sections},
+        }
+        payload = json.dumps(results, indent=2, sort_keys=True, default=_json_default)
+        write_atomic(out_dir / "results.json", payload + "\n")
+        write_atomic(out_dir / "index.html", html)
+        progress.step("written")
+    return out_dir / "index.html"
+
+
+def _build_section(key: str, title: str, pending: str, ctx: ReportContext) -> Section:
+    module_name = f"refsim.report.sections.{key}"
+    if importlib.util.find_spec(module_name) is None:
+        return Section(key=key, title=title, status="pending",
+                       pending=f"Not measured yet. This section will show: {pending}")
+    return importlib.import_module(module_name).build(ctx)
+
+
+def claim_rows(sections: list[Section]) -> list[dict]:
+    """One row per claim C1..C12: the seed's words, the measurement, the verdict."""
+    verdicts = {v.claim: v for s in sections for v in s.verdicts}
+    rows = []
+    for claim, (area, text) in CLAIMS.items():
+        v = verdicts.get(claim)
+        rows.append({
+            "claim": claim, "area": area, "text": text,
+            "measured": v.measured if v else "",
+            "verdict": v.verdict if v else "not measured yet",
+            "evidence": v.evidence if v else "",
+            "command": v.command if v else "",
+        })
+    return rows
+
+
+def collect_environment() -> dict:
+    versions = {"python": platform.python_version()}
+    for package in PACKAGES:
+        try:
+            versions[package] = metadata.version(package)
+        except metadata.PackageNotFoundError:
+            versions[package] = "not installed"
+    return {
+        "versions": versions,
+        "machine": {
+            "platform": platform.platform(),
+            "processor": platform.processor() or platform.machine(),
+            "cpus": os.cpu_count(),
+        },
+        "commit": _git_commit(),
+        "seed": REPORT_SEED,
+    }
+
+
+def _git_commit() -> str:
+    try:
+        commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPO_ROOT, text=True,
+                                capture_output=True, check=True, timeout=10).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                               cwd=REPO_ROOT, text=True, capture_output=True,
+                               timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return "unknown (not a git checkout)"
+    return commit + (" (with uncommitted changes)" if dirty else "")
+
+
+def render(sections: list[Section], environment: dict, *, quick: bool) -> str:
+    import jinja2
+
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES_DIR),
+                             autoescape=True, undefined=jinja2.StrictUndefined,
+                             keep_trailing_newline=True)
+    template = env.get_template("index.html.j2")
+    css = (TEMPLATES_DIR / "style.css").read_text()
+    return template.render(sections=sections, claims=claim_rows(sections),
+                           terminology=TERMINOLOGY, environment=environment,
+                           quick=quick, css=css)
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` so that readers see the old or the new file,
+    never a part of one."""
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        os.chmod(tmp, 0o666 & ~_umask())   # mkstemp makes 0600; give what open() would
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _json_default(value):
+    import numpy as np
+
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Path):
+        return str(value)
+    if hasattr(value, "__dataclass_fields__"):
+        return asdict(value)
+    raise TypeError(f"not serializable: {type(value).__name__}")

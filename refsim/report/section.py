@@ -1,0 +1,57 @@
+"""What a report section is made of: figures, tables, claim verdicts, numbers.
+
+Each area of refsim contributes one :class:`Section`, built from its
+``measure_*`` functions. The report computes nothing of its own (STYLE.md,
+rule 9): a section only arranges numbers that a measurement returned, and
+``results`` holds those numbers for results.json.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+VERDICTS = ("confirmed", "refuted", "partly", "not measured yet")
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A chart, as inline SVG text."""
+
+    id: str
+    title: str
+    svg: str
+    caption: str = ""
+
+
+@dataclass(frozen=True)
+class Table:
+    id: str
+    title: str
+    columns: tuple[str, ...]
+    rows: tuple[tuple[Any, ...], ...]
+    caption: str = ""
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """A measured verdict on one of the seed's claims C1..C12."""
+
+    claim: str          # "C1"
+    measured: str       # what refsim measured, in a sentence with the figures
+    verdict: str        # one of VERDICTS
+    evidence: str       # id of the figure or table that shows it
+    command: str = ""   # the one command that reproduces the figure
+
+
+@dataclass
+class Section:
+    key: str
+    title: str
+    status: str = "measured"        # "measured" or "pending"
+    intro: str = ""                 # HTML-safe text (escaped by the template)
+    pending: str = ""               # what is not measured yet, said plainly
+    figures: list[Figure] = field(default_factory=list)
+    tables: list[Table] = field(default_factory=list)
+    verdicts: list[Verdict] = field(default_factory=list)
+    results: dict[str, Any] = field(default_factory=dict)

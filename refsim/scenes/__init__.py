@@ -1,0 +1,1 @@
+"""Scene files (seed S11): schema and loader."""

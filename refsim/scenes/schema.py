@@ -1,0 +1,187 @@
+"""The scene file schema (seed S11: "fully configurable simulation script files").
+
+A scene is a TOML file with the tables ``[world]``, ``[integration]``,
+``[collision]``, ``[dynamics]`` and an array ``[[body]]`` (DESIGN.md, Scene
+files). This module declares every key once: its type, default and allowed
+range, as :class:`Field` rows. :mod:`refsim.scenes.loader` walks a parsed file
+against these rows; an unknown key, a wrong type or a value out of range is a
+:class:`~refsim.errors.SceneError` naming the file and the key path.
+
+The configuration objects are frozen dataclasses, so a loaded scene cannot
+change under a running simulation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+SOLVER_NAMES = ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4")
+COLLISION_LEVELS = ("none", "sphere", "aabb", "triangle-aabb", "exact")
+AABB_MODES = ("linear", "incremental", "auto")
+ROTATION_MODELS = ("off", "seed", "impulse")
+RESPONSE_MODELS = ("off", "seed", "impulse")
+DRAG_MODELS = ("linear", "quadratic")
+
+#: At most this many steps in one scene (duration / step): a guard against a
+#: typo such as ``step = 1e-9`` that would otherwise run for days.
+MAX_STEPS = 100_000_000
+
+
+# -- the configuration objects -------------------------------------------------
+
+
+@dataclass(frozen=True)
+class WorldConfig:
+    half_size: float = 5.0
+    gravity: float = 9.81
+    drag: float = 0.0
+    drag_model: str = "linear"
+    restitution: float = 0.8
+    friction: float = 0.0
+
+
+@dataclass(frozen=True)
+class IntegrationConfig:
+    solver: str = "rk4"
+    step: float = 0.001
+    duration: float = 5.0
+
+    @property
+    def n_steps(self) -> int:
+        return int(round(self.duration / self.step))
+
+
+@dataclass(frozen=True)
+class CollisionConfig:
+    level: str = "exact"
+    aabb: str = "auto"
+
+
+@dataclass(frozen=True)
+class DynamicsConfig:
+    rotation: str = "seed"
+    body_response: str = "seed"
+
+
+@dataclass(frozen=True)
+class BodyConfig:
+    """One ``[[body]]`` entry; ``model`` is resolved to an existing file."""
+
+    name: str
+    model: Path
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    angular_velocity: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    orientation: tuple[tuple[float, ...], ...] = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0),
+                                                  (0.0, 0.0, 1.0))
+    mass: float = 1.0
+    scale: float = 1.0
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene. ``meshes`` maps each model path to its loaded mesh."""
+
+    path: Path | None
+    world: WorldConfig = field(default_factory=WorldConfig)
+    integration: IntegrationConfig = field(default_factory=IntegrationConfig)
+    collision: CollisionConfig = field(default_factory=CollisionConfig)
+    dynamics: DynamicsConfig = field(default_factory=DynamicsConfig)
+    bodies: tuple[BodyConfig, ...] = ()
+    meshes: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def mesh(self, body: BodyConfig):
+        """The loaded mesh of ``body`` (shared between bodies of one model)."""
+        return self.meshes[body.model]
+
+
+# -- the schema rows -------------------------------------------------------------
+
+Check = Callable[[Any], str | None]
+
+
+@dataclass(frozen=True)
+class Field:
+    """One key: its kind ("float", "str", "vec3", "mat3"), default and check.
+
+    ``check`` returns None when the (already type-checked) value is allowed,
+    or a phrase saying what is required.
+    """
+
+    name: str
+    kind: str
+    default: Any = None
+    check: Check | None = None
+    required: bool = False
+
+
+def positive(value) -> str | None:
+    return None if value > 0 else "must be > 0"
+
+
+def non_negative(value) -> str | None:
+    return None if value >= 0 else "must be >= 0"
+
+
+def unit_interval(value) -> str | None:
+    return None if 0.0 <= value <= 1.0 else "must be in [0, 1]"
+
+
+def one_of(*choices: str) -> Check:
+    def check(value):
+        return None if value in choices else "must be one of " + ", ".join(
+            repr(c) for c in choices)
+    return check
+
+
+def orthonormal(value) -> str | None:
+    from refsim.types import ORTHONORMAL_TOL
+
+    r = np.asarray(value, dtype=np.float64)
+    if np.abs(r.T @ r - np.eye(3)).max() > ORTHONORMAL_TOL:
+        return "must be an orthonormal 3x3 matrix (its columns are the body's axes)"
+    if np.linalg.det(r) < 0:
+        return "must be a rotation (determinant +1), not a reflection"
+    return None
+
+
+TABLES: dict[str, tuple[type, tuple[Field, ...]]] = {
+    "world": (WorldConfig, (
+        Field("half_size", "float", 5.0, positive),
+        Field("gravity", "float", 9.81, non_negative),
+        Field("drag", "float", 0.0, non_negative),
+        Field("drag_model", "str", "linear", one_of(*DRAG_MODELS)),
+        Field("restitution", "float", 0.8, unit_interval),
+        Field("friction", "float", 0.0, unit_interval),
+    )),
+    "integration": (IntegrationConfig, (
+        Field("solver", "str", "rk4", one_of(*SOLVER_NAMES)),
+        Field("step", "float", 0.001, positive),
+        Field("duration", "float", 5.0, positive),
+    )),
+    "collision": (CollisionConfig, (
+        Field("level", "str", "exact", one_of(*COLLISION_LEVELS)),
+        Field("aabb", "str", "auto", one_of(*AABB_MODES)),
+    )),
+    "dynamics": (DynamicsConfig, (
+        Field("rotation", "str", "seed", one_of(*ROTATION_MODELS)),
+        Field("body_response", "str", "seed", one_of(*RESPONSE_MODELS)),
+    )),
+}
+
+BODY_FIELDS: tuple[Field, ...] = (
+    Field("name", "str", None),
+    Field("model", "str", None, required=True),
+    Field("position", "vec3", (0.0, 0.0, 0.0)),
+    Field("velocity", "vec3", (0.0, 0.0, 0.0)),
+    Field("angular_velocity", "vec3", (0.0, 0.0, 0.0)),
+    Field("orientation", "mat3", ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
+          orthonormal),
+    Field("mass", "float", 1.0, positive),
+    Field("scale", "float", 1.0, positive),
+)

@@ -1,0 +1,97 @@
+"""The report page: self-contained, complete, deterministic, written atomically."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import pytest
+
+from refsim.paths import bundled_models
+from refsim.report import build as report_build
+from refsim.report.build import AREAS, build_report
+from refsim.report.claims import CLAIMS
+
+
+@pytest.fixture(scope="module")
+def quick_report(tmp_path_factory):
+    out = tmp_path_factory.mktemp("report")
+    page = build_report(out, quick=True, stream=open("/dev/null", "w"))
+    return out, page.read_text(), json.loads((out / "results.json").read_text())
+
+
+def test_every_area_has_a_section(quick_report):
+    _, html, results = quick_report
+    for key, title, _ in AREAS:
+        assert f'<section id="{key}">' in html
+        assert f"<h2>{title}</h2>" in html
+        assert key in results["sections"]
+
+
+def test_pending_sections_say_so_plainly(quick_report):
+    _, html, results = quick_report
+    for key, status in ((k, v["status"]) for k, v in results["sections"].items()):
+        section = html.split(f'<section id="{key}">', 1)[1].split("</section>", 1)[0]
+        assert ("Not measured yet" in section) == (status == "pending")
+
+
+def test_models_section_lists_every_bundled_model(quick_report):
+    _, html, results = quick_report
+    listed = {m["name"] for m in results["sections"]["models"]["results"]["models"]}
+    assert listed == {p.name for p in bundled_models()}
+    for name in listed:
+        assert f"<td>{name}</td>" in html
+
+
+def test_every_claim_has_a_row_and_a_verdict(quick_report):
+    _, html, results = quick_report
+    assert [c["claim"] for c in results["claims"]] == list(CLAIMS)
+    for claim in CLAIMS:
+        assert f'id="claim-{claim}"' in html
+    for row in results["claims"]:
+        assert row["verdict"] in {"confirmed", "refuted", "partly", "not measured yet"}
+        if row["verdict"] != "not measured yet":
+            assert row["measured"] and row["evidence"]
+            assert f'id="{row["evidence"]}"' in html  # the evidence exists on the page
+
+
+def test_page_is_self_contained(quick_report):
+    _, html, _ = quick_report
+    assert "<style>" in html
+    assert not re.search(r'(src|href)\s*=\s*"(https?:)?//', html)
+    assert "<script" not in html and "<link" not in html
+
+
+def test_results_are_deterministic(tmp_path, quick_report):
+    _, _, first = quick_report
+    build_report(tmp_path, quick=True, stream=open("/dev/null", "w"))
+    second = json.loads((tmp_path / "results.json").read_text())
+    assert _without_timings(first) == _without_timings(second)
+
+
+def _without_timings(value):
+    if isinstance(value, dict):
+        return {k: _without_timings(v) for k, v in value.items()
+                if not any(word in k for word in ("time", "seconds", "per_second", "ratio"))}
+    if isinstance(value, list):
+        return [_without_timings(v) for v in value]
+    return value
+
+
+def test_a_failed_build_leaves_no_file(tmp_path, monkeypatch):
+    def broken(*args, **kwargs):
+        raise RuntimeError("rendering failed")
+
+    monkeypatch.setattr(report_build, "render", broken)
+    with pytest.raises(RuntimeError):
+        build_report(tmp_path, quick=True, stream=open("/dev/null", "w"))
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_write_atomic_replaces_whole_file(tmp_path):
+    target = tmp_path / "page.html"
+    target.write_text("old")
+    report_build.write_atomic(target, "new")
+    assert target.read_text() == "new"
+    assert [p.name for p in tmp_path.iterdir()] == ["page.html"]
+    assert target.stat().st_mode & 0o044 == 0o044   # readable by others, as open() makes it

@@ -1,0 +1,70 @@
+"""The command line: facts for a model, one clear line for a user's mistake."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from refsim.cli import EXIT_USER_ERROR, main
+from refsim.errors import ModelError
+from refsim.paths import models_dir
+
+
+def test_info_prints_the_facts(capsys):
+    assert main(["info", str(models_dir() / "cube.ac")]) == 0
+    out = capsys.readouterr().out
+    facts = dict(line.split("  ", 1) for line in out.splitlines())
+    assert facts["triangles"].strip() == "12"
+    assert facts["vertices"].strip() == "8"
+    assert facts["convex"].strip() == "yes"
+    assert facts["closed"].strip() == "yes"
+    assert facts["bounds min"].strip() == "(-0.5, -0.5, -0.5)"
+    assert facts["centroid (volume)"].strip() == "(0, 0, 0)"
+
+
+def test_info_on_a_nonconvex_model(capsys):
+    assert main(["info", str(models_dir() / "torus.ac")]) == 0
+    out = capsys.readouterr().out
+    assert "convex" in out and "no" in out.split("convex", 1)[1].splitlines()[0]
+
+
+def test_missing_file_is_one_line_without_traceback(tmp_path, capsys):
+    missing = tmp_path / "absent.ac"
+    assert main(["info", str(missing)]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and str(missing) in err and "Traceback" not in err
+
+
+def test_malformed_file_names_the_line(tmp_path, capsys):
+    bad = tmp_path / "bad.ac"
+    bad.write_text("AC3Db\nOBJECT poly\nnumvert 1\n0 0 zero\n")
+    assert main(["info", str(bad)]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith("refsim: error: ") and f"{bad}:4" in err
+    assert err.count("\n") == 1
+
+
+def test_debug_shows_the_exception(tmp_path):
+    bad = tmp_path / "bad.ac"
+    bad.write_text("not an ac3d file\n")
+    with pytest.raises(ModelError):
+        main(["--debug", "info", str(bad)])
+
+
+def test_console_script_exit_status_and_stderr(tmp_path):
+    # The installed entry point, in a fresh interpreter: what a user sees.
+    result = subprocess.run([sys.executable, "-m", "refsim.cli", "info",
+                             str(tmp_path / "absent.ac")], capture_output=True, text=True)
+    assert result.returncode == EXIT_USER_ERROR
+    assert result.stdout == ""
+    assert result.stderr.startswith("refsim: error: ") and "Traceback" not in result.stderr
+
+
+def test_report_into_an_unwritable_place_is_a_user_error(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    assert main(["report", "--quick", "-o", str(blocker / "out")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert "cannot write the report" in err and "Traceback" not in err
