@@ -41,6 +41,11 @@ class ModelError(RefsimError):
         super().__init__(f"{where}: {message}")
 
 
+class ModelWarning(UserWarning):
+    """A model file that loads, but with something left out (e.g. AC3D line
+    surfaces, which have no area and become no triangles)."""
+
+
 class SceneError(RefsimError):
     """A scene file that does not follow the schema.
 

@@ -96,8 +96,11 @@ class Mesh:
                  source: str | None = None):
         self.name = name
         self.source = source
-        vertices = np.asarray(vertices, dtype=np.float64)
-        faces = np.asarray(faces)
+        try:
+            vertices = np.asarray(vertices, dtype=np.float64)
+            faces = np.asarray(faces)
+        except (TypeError, ValueError) as exc:  # ragged or non-numeric input
+            raise self._error(f"vertices and faces must be numeric arrays: {exc}") from None
         if vertices.ndim != 2 or vertices.shape[1] != 3:
             raise self._error(f"vertices must have shape (n, 3), got {vertices.shape}")
         if faces.ndim != 2 or faces.shape[1] != 3 or faces.shape[0] == 0:
@@ -110,14 +113,21 @@ class Mesh:
         faces = faces.astype(np.int64)
         if faces.min() < 0 or faces.max() >= len(vertices):
             raise self._error(f"face index out of range [0, {len(vertices)})")
-        if weld_tolerance < 0 or not np.isfinite(weld_tolerance):
+        if not isinstance(weld_tolerance, int | float | np.integer | np.floating) \
+                or weld_tolerance < 0 or not np.isfinite(weld_tolerance):
             raise self._error("weld_tolerance must be finite and >= 0")
 
         m = len(faces)
         per_face = {}
         for key, value in (("face_material", face_material), ("face_flags", face_flags),
                            ("face_object", face_object)):
-            array = np.zeros(m, np.int64) if value is None else np.asarray(value, np.int64)
+            try:
+                array = np.zeros(m, np.int64) if value is None else np.asarray(value)
+            except (TypeError, ValueError) as exc:
+                raise self._error(f"{key} must be an integer array: {exc}") from None
+            if not (np.issubdtype(array.dtype, np.integer) or array.size == 0):
+                raise self._error(f"{key} must hold integers, got dtype {array.dtype}")
+            array = array.astype(np.int64)
             if array.shape != (m,):
                 raise self._error(f"{key} must have shape ({m},), got {array.shape}")
             per_face[key] = _readonly(array)
@@ -132,6 +142,15 @@ class Mesh:
         self.materials = tuple(materials) or (Material(),)
         self.objects = tuple(objects) or (name or "mesh",)
         self.neighbor_offsets, self.neighbor_indices = _neighbor_csr(self.edges, len(vertices))
+
+    def derived(self, key: str, build):
+        """A structure derived from this mesh (e.g. a triangle hierarchy),
+        built by ``build(mesh)`` on first use and kept: the mesh is immutable,
+        so the structure stays valid for the mesh's lifetime."""
+        cache = self.__dict__.setdefault("_derived", {})
+        if key not in cache:
+            cache[key] = build(self)
+        return cache[key]
 
     def _error(self, message: str) -> ModelError:
         return ModelError(message, path=self.source or self.name)

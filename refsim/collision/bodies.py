@@ -1,0 +1,125 @@
+"""Body-body collision at the seed's four levels of accuracy (seed S4).
+
+``bodies_collide`` answers "do these two bodies collide?" at one level:
+
+============== ====================================================== ========
+level          test                                                   answers
+============== ====================================================== ========
+sphere         bounding spheres about the centroids overlap           coarsest
+aabb           world boxes of the bodies overlap (seed test 1)
+triangle-aabb  some pair of triangle boxes overlaps (seed test 2)
+exact          some pair of triangles intersects (seed test 3)        exact
+============== ====================================================== ========
+
+``intersecting_pairs`` lists the triangle pairs at the two finest levels.
+Every level is conservative: it never says "apart" where the exact test says
+"touching". The box levels nest (exact pairs are a subset of triangle-aabb
+pairs, which exist only when the object boxes overlap); the sphere level is
+conservative too but does not nest with the box levels.
+
+``method`` picks how the triangle-box pairs are found, with identical
+answers: "seed" tests the triangle boxes pairwise as the seed does
+(:mod:`refsim.collision.seed_levels`); "bvh" (the default) descends a
+triangle hierarchy (:mod:`refsim.collision.bvh`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from refsim.collision.boxes import boxes_overlap, world_vertices
+from refsim.collision.bvh import (
+    check_kernel,
+    prepare_body,
+    tree_box_pairs,
+    tree_first_exact_hit,
+)
+from refsim.collision.seed_levels import exact_pairs, triangle_box_pairs
+from refsim.collision.spheres import spheres_overlap
+from refsim.types import as_pose
+
+LEVELS = ("sphere", "aabb", "triangle-aabb", "exact")
+PAIR_LEVELS = ("triangle-aabb", "exact")
+METHODS = ("bvh", "seed")
+
+#: Candidate pairs tested per batch by the boolean exact query, which stops at
+#: the first batch with a hit: small enough to stop early, large enough that
+#: numpy's per-call overhead is amortized.
+BOOLEAN_BATCH = 256
+
+
+def _check(level: str, allowed: tuple[str, ...], method: str) -> None:
+    if level not in allowed:
+        raise ValueError(f"level must be one of {allowed}, got {level!r}")
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+
+
+def intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
+                       method: str = "bvh", *, kernel: str | None = None) -> np.ndarray:
+    """Face-index pairs (i of ``mesh_a``, j of ``mesh_b``) that collide.
+
+    Parameters
+    ----------
+    mesh_a, mesh_b : Mesh
+    pose_a, pose_b : (rotation (3, 3), translation (3,))
+    level : "exact" (triangles intersect, touching counts) or
+        "triangle-aabb" (their world boxes overlap)
+    method : "bvh" (hierarchy) or "seed" (pairwise triangle boxes)
+    kernel : "numba" (compiled traversal and exact filter; the default when
+        numba is installed) or "python" (readable traversal, numpy filter)
+
+    Returns
+    -------
+    (k, 2) int64 array, rows sorted.
+    """
+    _check(level, PAIR_LEVELS, method)
+    kernel = check_kernel(kernel)
+    pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
+    if method == "seed":
+        world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
+        pairs = triangle_box_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces)
+    else:
+        pa, pb = prepare_body(mesh_a, pose_a, kernel), prepare_body(mesh_b, pose_b, kernel)
+        world_a, world_b = pa.world, pb.world
+        pairs = tree_box_pairs(pa, pb, kernel)
+    if level == "exact":
+        pairs = exact_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces, pairs, kernel)
+    return pairs
+
+
+def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
+                   method: str = "bvh", *, kernel: str | None = None) -> bool:
+    """Whether two bodies collide at ``level`` (see the module's table)."""
+    _check(level, LEVELS, method)
+    kernel = check_kernel(kernel)
+    pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
+    if level == "sphere":
+        return spheres_overlap(mesh_a, pose_a, mesh_b, pose_b)
+    if level == "aabb" or method == "seed":
+        world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
+        if level == "aabb":
+            return boxes_overlap(world_a.min(axis=0), world_a.max(axis=0),
+                                 world_b.min(axis=0), world_b.max(axis=0))
+        candidates = triangle_box_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces)
+        if level == "triangle-aabb":
+            return len(candidates) > 0
+        return _any_exact(world_a, mesh_a, world_b, mesh_b, candidates, kernel)
+    pa, pb = prepare_body(mesh_a, pose_a, kernel), prepare_body(mesh_b, pose_b, kernel)
+    if level == "triangle-aabb":
+        return len(tree_box_pairs(pa, pb, kernel, first_only=True)) > 0
+    if kernel == "numba":
+        hit, uncertain = tree_first_exact_hit(pa, pb)
+        return hit or _any_exact(pa.world, mesh_a, pb.world, mesh_b, uncertain, kernel)
+    return _any_exact(pa.world, mesh_a, pb.world, mesh_b, tree_box_pairs(pa, pb, kernel),
+                      kernel)
+
+
+def _any_exact(world_a, mesh_a, world_b, mesh_b, candidates, kernel) -> bool:
+    """Whether any candidate pair intersects, testing in batches and stopping
+    at the first batch with a hit."""
+    for start in range(0, len(candidates), BOOLEAN_BATCH):
+        batch = candidates[start:start + BOOLEAN_BATCH]
+        if len(exact_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces, batch, kernel)):
+            return True
+    return False

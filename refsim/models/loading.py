@@ -1,0 +1,79 @@
+"""Loading a model file of any supported format into a Mesh (seed S1).
+
+The seed "loads arbitrary triangle soup models with per-triangle
+information". :func:`load_model` picks the reader by the file's suffix:
+
+- ``.ac``: refsim's own AC3D reader (:mod:`refsim.models.ac3d`), which keeps
+  materials, surface flags and objects per triangle;
+- ``.obj``, ``.stl``, ``.ply``, ``.off``: trimesh (``trimesh.load`` with
+  ``force="mesh", process=False``, so trimesh neither merges nor reorders
+  anything; refsim's :class:`Mesh` does the welding). Per-triangle data is
+  the default (material 0, flags 0, object 0).
+
+Every failure (missing file, unknown suffix, a file the reader rejects) is a
+one-line :class:`~refsim.errors.ModelError` naming the path.
+
+Cost: that of the reader, O(file size), plus the O(n log n) weld.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from refsim.errors import ModelError
+from refsim.models.ac3d import read_ac3d
+from refsim.models.mesh import Mesh
+
+#: Suffixes read by trimesh (the formats DESIGN.md names for the trimesh oracle).
+TRIMESH_SUFFIXES = (".obj", ".stl", ".ply", ".off")
+SUFFIXES = (".ac",) + TRIMESH_SUFFIXES
+
+
+def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
+    """Load the model at ``path`` as a :class:`Mesh` in shared-vertex form.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        A ``.ac``, ``.obj``, ``.stl``, ``.ply`` or ``.off`` file (suffix in any case).
+    weld_tolerance : float
+        Passed to :class:`Mesh`: 0 welds exactly equal vertices only.
+
+    Raises
+    ------
+    ModelError
+        When the file is missing, its suffix is not supported, or it cannot
+        be read as a triangle mesh.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in SUFFIXES:
+        raise ModelError(f"unknown model format {path.suffix or '(no suffix)'!r}; "
+                         f"supported: {', '.join(SUFFIXES)}", path=path)
+    if not path.is_file():
+        raise ModelError("no such file", path=path)
+    if suffix == ".ac":
+        return read_ac3d(path, weld_tolerance=weld_tolerance)
+    return _load_with_trimesh(path, weld_tolerance)
+
+
+def _load_with_trimesh(path: Path, weld_tolerance: float) -> Mesh:
+    import trimesh  # lazy: only these formats need it
+
+    try:
+        loaded = trimesh.load(path, force="mesh", process=False)
+    except Exception as exc:  # trimesh raises many types for bad files
+        raise ModelError(f"trimesh cannot read it: {_one_line(exc)}", path=path) from None
+    faces = getattr(loaded, "faces", None)
+    vertices = getattr(loaded, "vertices", None)
+    if faces is None or vertices is None or len(faces) == 0:
+        raise ModelError("the file holds no triangles", path=path)
+    return Mesh(np.asarray(vertices, dtype=np.float64), np.asarray(faces),
+                weld_tolerance=weld_tolerance, name=path.stem, source=str(path))
+
+
+def _one_line(exc: Exception) -> str:
+    text = " ".join(str(exc).split()) or type(exc).__name__
+    return text[:200]

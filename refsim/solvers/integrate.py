@@ -1,0 +1,175 @@
+"""Fixed-step integration of ``y' = f(t, y)`` with one of the seed's solvers.
+
+What: repeat a solver's step from ``t0`` to ``t1`` with a constant step ``h``,
+the way the seed's simulation advances its state vector, and count the
+evaluations of ``f`` (``nfev``) as scipy's ``solve_ivp`` does.
+
+Seed section: S6 (DESIGN.md, Public API: ``refsim.integrate``).
+
+Reference: E. Hairer, S. P. Norsett, G. Wanner, *Solving Ordinary Differential
+Equations I*, 2nd ed., section II.3 (convergence of one-step methods with a
+constant step). Bookkeeping after scipy ``integrate/_ivp/base.py``.
+
+Cost: ``steps * stages`` evaluations of ``f``, O(steps * d) memory for the
+returned trajectory.
+
+The number of steps is ``n = (t1 - t0) / h``. When that is an integer to
+within :data:`STEP_COUNT_RTOL` the grid is ``t_i = t0 + i h`` and the last time
+is set to ``t1`` exactly. Otherwise the choice is explicit, ``last_step=``:
+``"error"`` (the default) raises :class:`refsim.errors.StateError`, because a
+silently shortened final step changes the method; ``"short"`` takes
+``floor(n)`` steps of ``h`` and one shorter step to land on ``t1``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from refsim.errors import DivergenceError, StateError
+from refsim.solvers.explicit_rk import ExplicitRungeKutta
+from refsim.solvers.methods import SEED_LITERAL_VARIANTS, SOLVERS
+
+#: How far ``(t1 - t0) / h`` may be from an integer, relative to it, and still
+#: count as that integer. A step read from text (0.001) times a step count
+#: (5000) misses the duration by a few ulps; 1e-9 admits that rounding and
+#: nothing a user would call a different step.
+STEP_COUNT_RTOL = 1e-9
+
+
+@dataclass(frozen=True)
+class FixedStepResult:
+    """What :func:`solve_fixed_step` returns.
+
+    Attributes
+    ----------
+    t : numpy.ndarray
+        (steps + 1,) times, ``t[0] = t0``, ``t[-1] = t1``.
+    y : numpy.ndarray
+        (steps + 1, d) states; ``y[0] = y0``.
+    nfev : int
+        Evaluations of ``f`` made (``steps * stages``).
+    steps : int
+    method : str
+        The solver's key.
+    """
+
+    t: np.ndarray
+    y: np.ndarray
+    nfev: int
+    steps: int
+    method: str
+
+
+def resolve_method(method) -> ExplicitRungeKutta:
+    """A solver from its key (in SOLVERS or SEED_LITERAL_VARIANTS) or itself."""
+    if isinstance(method, ExplicitRungeKutta):
+        return method
+    if method in SOLVERS:
+        return SOLVERS[method]
+    if method in SEED_LITERAL_VARIANTS:
+        return SEED_LITERAL_VARIANTS[method]
+    known = ", ".join(sorted(SOLVERS))
+    raise StateError(f"unknown solver {method!r}; expected one of {known}")
+
+
+def step_grid(t0: float, t1: float, h: float,
+              last_step: str = "error") -> tuple[np.ndarray, np.ndarray]:
+    """The times ``t_0 .. t_n`` of a fixed-step run and the ``n`` steps taken.
+
+    Every step is ``h`` exactly except, with ``last_step="short"``, the last
+    one (``t1 - t_{n-1}``); see the module docstring.
+    """
+    for name, value in (("t0", t0), ("t1", t1), ("h", h)):
+        if not math.isfinite(value):
+            raise StateError(f"{name} is not finite: {value!r}")
+    if not h > 0.0:
+        raise StateError(f"step h must be positive, got {h!r}")
+    if t1 < t0:
+        raise StateError(f"t1 = {t1!r} is before t0 = {t0!r}")
+    if last_step not in ("error", "short"):
+        raise StateError(f"last_step must be 'error' or 'short', got {last_step!r}")
+    ratio = (t1 - t0) / h
+    n = round(ratio)
+    if abs(ratio - n) <= STEP_COUNT_RTOL * max(n, 1):
+        t = t0 + h * np.arange(n + 1, dtype=np.float64)
+        t[-1] = t1
+        return t, np.full(n, h)
+    elif last_step == "error":
+        raise StateError(f"(t1 - t0) / h = {ratio!r} is not an integer; choose h to divide "
+                         "the interval or pass last_step='short'")
+    else:
+        n = math.floor(ratio)
+        t = np.append(t0 + h * np.arange(n + 1, dtype=np.float64), t1)
+        steps = np.full(n + 1, h)
+        steps[-1] = t1 - t[-2]
+        return t, steps
+
+
+def solve_fixed_step(f, y0, t0: float, t1: float, h: float, method="rk4", *,
+                     last_step: str = "error") -> FixedStepResult:
+    """Integrate ``y' = f(t, y)`` from ``t0`` to ``t1`` with constant step ``h``.
+
+    Parameters
+    ----------
+    f : callable
+        ``f(t, y) -> dy/dt`` for ``y`` of shape (d,).
+    y0 : array_like
+        (d,) initial state; a scalar is taken as d = 1.
+    t0, t1 : float
+    h : float
+        The step, > 0.
+    method : str or ExplicitRungeKutta
+        A key of :data:`refsim.SOLVERS` (or of ``SEED_LITERAL_VARIANTS``).
+    last_step : {"error", "short"}
+        What to do when ``h`` does not divide ``t1 - t0`` (module docstring).
+
+    Raises
+    ------
+    StateError
+        Non-finite ``y0``, ``t0``, ``t1`` or ``h``; ``h <= 0``; ``t1 < t0``;
+        ``f`` returning the wrong shape; an unknown method.
+    DivergenceError
+        The state became non-finite; ``partial`` holds the result so far.
+    """
+    solver = resolve_method(method)
+    y0 = np.atleast_1d(np.asarray(y0, dtype=np.float64))
+    if y0.ndim != 1:
+        raise StateError(f"y0 must be a vector, got shape {y0.shape}")
+    if not np.isfinite(y0).all():
+        raise StateError("y0 has a non-finite value")
+    t, hs = step_grid(t0, t1, h, last_step)
+    steps = len(hs)
+
+    nfev = 0
+
+    def counted_f(t_, y_):
+        nonlocal nfev
+        nfev += 1
+        dy = np.asarray(f(t_, y_), dtype=np.float64)
+        if dy.shape != y0.shape:
+            raise StateError(f"f returned shape {dy.shape}, expected {y0.shape}")
+        return dy
+
+    y = np.empty((steps + 1, y0.size), dtype=np.float64)
+    y[0] = y0
+    for i in range(steps):
+        y[i + 1] = solver.step(counted_f, t[i], y[i], hs[i])
+        if not np.isfinite(y[i + 1]).all():
+            partial = FixedStepResult(t[:i + 1], y[:i + 1], nfev, i, solver.name)
+            raise DivergenceError("state is not finite", step=i + 1, time=float(t[i + 1]),
+                                  partial=partial)
+    return FixedStepResult(t, y, nfev, steps, solver.name)
+
+
+def integrate(f, y0, t0: float, t1: float, h: float, method="rk4", *,
+              last_step: str = "error") -> tuple[np.ndarray, np.ndarray]:
+    """``t, y`` of :func:`solve_fixed_step` (DESIGN.md, Public API).
+
+    ``t`` has shape (steps + 1,) and ``y`` (steps + 1, d). Use
+    :func:`solve_fixed_step` for the evaluation count as well.
+    """
+    result = solve_fixed_step(f, y0, t0, t1, h, method, last_step=last_step)
+    return result.t, result.y

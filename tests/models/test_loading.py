@@ -1,0 +1,144 @@
+"""load_model across formats (refsim.models.loading, seed S1).
+
+The same shape is written as AC3D by refsim and as OBJ, STL, PLY and OFF by
+trimesh, loaded back through :func:`refsim.load_model`, and compared.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+from scipy.spatial import cKDTree
+
+import refsim
+from refsim.errors import ModelError
+from refsim.models.ac3d import write_ac3d
+from refsim.models.mesh import Mesh
+
+#: How far each format may move a coordinate of the unit-scale test shape
+#: (|x| <= 1.5), with the reason:
+#: - .ac: refsim writes ``repr`` floats, which read back exactly.
+#: - .off: trimesh writes 10 decimal places: at most 0.5e-10 off.
+#: - .obj: trimesh writes 8 decimal places: at most 0.5e-8 off.
+#: - .stl, .ply: trimesh stores float32: rounding to 24 significant bits moves
+#:   a coordinate by at most 2**-24 relative, i.e. <= 1.5 * 2**-24 ~ 9e-8 here.
+COORD_ATOL = {
+    ".ac": 0.0,
+    ".off": 0.5e-10,
+    ".obj": 0.5e-8,
+    ".stl": 1.5 * 2.0 ** -24,
+    ".ply": 1.5 * 2.0 ** -24,
+}
+
+
+def _shape():
+    """A non-convex closed torus, as plain arrays (trimesh's generator)."""
+    t = trimesh.creation.torus(major_radius=1.0, minor_radius=0.4, major_sections=24,
+                               minor_sections=12)
+    return np.asarray(t.vertices, dtype=np.float64), np.asarray(t.faces, dtype=np.int64)
+
+
+@pytest.fixture(scope="module")
+def files(tmp_path_factory):
+    vertices, faces = _shape()
+    folder = tmp_path_factory.mktemp("formats")
+    paths = {".ac": folder / "torus.ac"}
+    write_ac3d(Mesh(vertices, faces, objects=["torus"]), paths[".ac"])
+    source = trimesh.Trimesh(vertices, faces, process=False)
+    for suffix in (".obj", ".stl", ".ply", ".off"):
+        paths[suffix] = folder / f"torus{suffix}"
+        source.export(paths[suffix])
+    return vertices, faces, paths
+
+
+@pytest.mark.parametrize("suffix", sorted(COORD_ATOL))
+def test_every_format_gives_the_same_geometry(files, suffix):
+    vertices, faces, paths = files
+    reference = Mesh(vertices, faces)
+    mesh = refsim.load_model(paths[suffix])
+    atol = COORD_ATOL[suffix]
+    # Welded vertex sets: the same count, each loaded vertex within atol of
+    # one reference vertex, and that match one-to-one (STL's three copies per
+    # triangle have been welded back to one).
+    assert mesh.n_vertices == reference.n_vertices == len(vertices)
+    distance, match = cKDTree(reference.vertices).query(mesh.vertices)
+    assert distance.max() <= atol * np.sqrt(3.0)
+    assert len(set(match.tolist())) == mesh.n_vertices
+    # The same triangles in the same order (no format reorders faces).
+    assert mesh.n_faces == len(faces)
+    assert match[mesh.faces].tolist() == reference.faces.tolist()
+    # The same volume: moving each vertex by at most d changes the volume by
+    # at most (surface area) * d, to first order.
+    d = atol * np.sqrt(3.0)
+    area = reference.face_areas.sum()
+    assert mesh.is_closed
+    assert abs(mesh.volume - reference.volume) <= 2.0 * area * d + 1e-12 * reference.volume
+    assert reference.volume == pytest.approx(trimesh.Trimesh(vertices, faces).volume,
+                                             rel=1e-12)
+    assert mesh.source == str(paths[suffix])
+
+
+def test_ac_keeps_per_triangle_data(files):
+    _, faces, paths = files
+    mesh = refsim.load_model(paths[".ac"])
+    assert mesh.objects == ("torus",)
+    assert mesh.face_object.tolist() == [0] * len(faces)
+
+
+def test_suffix_is_case_insensitive(files, tmp_path):
+    _, faces, paths = files
+    upper = tmp_path / "TORUS.STL"
+    upper.write_bytes(paths[".stl"].read_bytes())
+    assert refsim.load_model(upper).n_faces == len(faces)
+
+
+def test_weld_tolerance_is_passed_on(tmp_path):
+    # Two triangles whose shared corner differs by 1e-6 (kept by OBJ's 8
+    # decimals): welded only with a tolerance.
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1 + 1e-6, 0, 0], [1, 1, 0], [0, 1, 0]])
+    path = tmp_path / "two.obj"
+    trimesh.Trimesh(v, [[0, 1, 2], [3, 4, 5]], process=False).export(path)
+    assert refsim.load_model(path).n_vertices == 5
+    assert refsim.load_model(path, weld_tolerance=1e-5).n_vertices == 4
+
+
+def test_missing_file(tmp_path):
+    path = tmp_path / "absent.obj"
+    with pytest.raises(ModelError, match="no such file") as info:
+        refsim.load_model(path)
+    assert info.value.path == str(path)
+    assert str(info.value) == f"{path}: no such file"
+
+
+@pytest.mark.parametrize("name", ["model.3ds", "model", "model.ac.bak"])
+def test_unknown_suffix(tmp_path, name):
+    path = tmp_path / name
+    path.write_text("whatever")
+    with pytest.raises(ModelError, match="unknown model format") as info:
+        refsim.load_model(path)
+    assert info.value.path == str(path)
+    assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("name, content", [
+    ("broken.stl", b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0\n"),
+    ("empty.obj", b""),
+    ("garbage.ply", b"ply\nformat nonsense\n"),
+    ("points.off", b"OFF\n3 0 0\n0 0 0\n1 0 0\n0 1 0\n"),
+])
+def test_files_trimesh_cannot_read_are_model_errors(tmp_path, name, content):
+    path = tmp_path / name
+    path.write_bytes(content)
+    with pytest.raises(ModelError) as info:
+        refsim.load_model(path)
+    assert info.value.path == str(path)
+    assert "\n" not in str(info.value)
+
+
+def test_broken_ac_file_goes_through_our_reader(tmp_path):
+    path = tmp_path / "bad.ac"
+    path.write_text("AC3Db\nOBJECT poly\nnumvert x\n")
+    with pytest.raises(ModelError) as info:
+        refsim.load_model(path)
+    assert info.value.line == 3

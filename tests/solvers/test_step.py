@@ -1,0 +1,70 @@
+"""One step of each solver against its formula in the seed's words, and nfev."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import refsim
+
+#: Evaluations of f per step (the seed's cost ranking, C9).
+NFEV_PER_STEP = {"euler": 1, "averaged-euler": 2, "backwards-euler": 2, "midpoint": 2, "rk4": 4}
+
+
+def f(t, y):
+    """A non-autonomous, nonlinear right-hand side, so that a wrong stage
+    time or a wrong weight shows."""
+    return np.array([np.sin(t) * y[1] + y[0] ** 2, -y[0] + t**2])
+
+
+def by_hand(name, t0, y0, h):
+    """The seed's sentences, written out."""
+    if name == "euler":
+        return y0 + h * f(t0, y0)
+    k1 = f(t0, y0)
+    if name == "averaged-euler":
+        k2 = f(t0 + h, y0 + h * k1)
+        return y0 + h * (k1 + k2) / 2
+    if name == "backwards-euler":
+        k2 = f(t0 + h, y0 + h * k1)
+        return y0 + h * k2
+    if name == "midpoint":
+        k2 = f(t0 + h / 2, y0 + h / 2 * k1)
+        return y0 + h * k2
+    k2 = f(t0 + h / 2, y0 + h / 2 * k1)
+    k3 = f(t0 + h / 2, y0 + h / 2 * k2)
+    k4 = f(t0 + h, y0 + h * k3)
+    return y0 + h * (k1 + 2 * k2 + 2 * k3 + k4) / 6
+
+
+#: The generic step sums term by term; by_hand groups differently. A few
+#: ulps of the O(1) values here.
+ROUNDING = 1e-14
+
+
+@pytest.mark.parametrize("name", sorted(NFEV_PER_STEP))
+def test_step_matches_the_formula(name):
+    y0 = np.array([0.3, -0.7])
+    got = refsim.SOLVERS[name].step(f, 0.4, y0, 0.1)
+    np.testing.assert_allclose(got, by_hand(name, 0.4, y0, 0.1), rtol=0, atol=ROUNDING)
+
+
+@pytest.mark.parametrize("name", sorted(NFEV_PER_STEP))
+def test_nfev_per_step(name):
+    result = refsim.solve_fixed_step(f, [0.3, -0.7], 0.0, 1.0, 0.125, name)
+    assert result.steps == 8
+    assert result.nfev == 8 * NFEV_PER_STEP[name]
+    assert refsim.SOLVERS[name].stages == NFEV_PER_STEP[name]
+
+
+@pytest.mark.parametrize("name", sorted(NFEV_PER_STEP))
+def test_step_does_not_modify_y(name):
+    y0 = np.array([0.3, -0.7])
+    refsim.SOLVERS[name].step(f, 0.0, y0, 0.1)
+    np.testing.assert_array_equal(y0, [0.3, -0.7])
+
+
+def test_seed_literal_rk4_step_is_five_thirds_of_rk4_increment_for_constant_f():
+    literal = refsim.SEED_LITERAL_VARIANTS["rk4-seed-literal"]
+    y1 = literal.step(lambda t, y: np.array([2.0]), 0.0, np.array([1.0]), 0.3)
+    np.testing.assert_allclose(y1, [1.0 + 5 / 3 * 0.3 * 2.0], rtol=ROUNDING)
