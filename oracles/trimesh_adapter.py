@@ -1,0 +1,121 @@
+"""trimesh as the oracle for boxes of transformed meshes, convexity and mass
+properties (seeds S1, S2).
+
+trimesh (M. Dawson-Haggerty et al., https://trimesh.org) is an independent
+mesh library: its bounds come from its own transform code, its convexity test
+from its own face-adjacency projections, its volume and centre of mass from
+the integrals of D. Eberly, "Polyhedral Mass Properties (Revisited)", 2002.
+
+Conventions converted here and nowhere else:
+
+- ``trimesh.Trimesh(vertices, faces, process=False)``: the default
+  ``process=True`` merges duplicate vertices and drops degenerate faces,
+  which would change the mesh being checked.
+- A pose ``(R, t)`` becomes the homogeneous 4x4 ``[[R, t], [0, 1]]``, applied
+  with ``Trimesh.apply_transform``; ``.bounds`` is the (2, 3) array
+  ``[lo, hi]``. trimesh computes ``matrix @ [v, 1]`` with BLAS (fused
+  multiply-adds, its own summation order), so its coordinates may differ
+  from refsim's in the last bits: ``BOUNDS_ARITHMETIC_ULPS`` below bounds by
+  how much.
+- trimesh skips a transform within 1e-8 of the identity (every entry; its
+  ``apply_transform`` returns early), so for such poses its box is the
+  untransformed one. :func:`trimesh_skips_transform` tells when.
+- ``is_convex``, ``volume``, ``center_mass`` are trimesh's (the solid's
+  centroid, not refsim's vertex average).
+
+Cost: building a Trimesh is O(n + m); a transform is O(n); convexity is
+O(m) after trimesh's adjacency (O(m log m)).
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from oracles import import_engine
+
+#: trimesh's identity shortcut: ``apply_transform`` returns early when every
+#: entry of the 4x4 is within this of the identity's (trimesh.base, 4.x).
+TRIMESH_IDENTITY_ATOL = 1e-8
+
+#: How far trimesh's world coordinate may be from refsim's, in units of
+#: ``u * (sum_j |R_kj v_j| + |t_k|)`` (u = 2**-53). Each is the exact value
+#: rounded through at most four operations (refsim: three for ``r_k`` plus the
+#: translation; trimesh: a length-4 dot product), so each is within
+#: ``gamma_4 ~ 4u`` of exact and the two within 8u; 16 doubles that for a
+#: rotation orthonormal only to ``ORTHONORMAL_TOL``.
+BOUNDS_ARITHMETIC_ULPS = 16.0
+
+
+class BoundsOracle(Protocol):
+    """The query refsim's box updates are checked with."""
+
+    def transformed_bounds(self, vertices, faces, pose) -> tuple[np.ndarray, np.ndarray]: ...
+
+
+class MeshFactsOracle(Protocol):
+    """The queries refsim's mesh facts are checked with."""
+
+    def is_convex(self, vertices, faces) -> bool: ...
+
+    def volume(self, vertices, faces) -> float: ...
+
+    def center_mass(self, vertices, faces) -> np.ndarray: ...
+
+
+def pose_matrix(pose) -> np.ndarray:
+    """The homogeneous 4x4 of refsim's pose ``(R, t)``."""
+    rotation, translation = pose
+    matrix = np.eye(4)
+    matrix[:3, :3] = rotation
+    matrix[:3, 3] = translation
+    return matrix
+
+
+def trimesh_skips_transform(pose) -> bool:
+    """Whether trimesh would treat ``pose`` as the identity and not apply it."""
+    return bool(np.abs(pose_matrix(pose) - np.eye(4)).max() < TRIMESH_IDENTITY_ATOL)
+
+
+def bounds_tolerance(vertices, pose) -> np.ndarray:
+    """(3,) per-axis bound on |trimesh's box - refsim's box| from arithmetic alone.
+
+    ``BOUNDS_ARITHMETIC_ULPS * u * (max_v sum_j |R_kj v_j| + |t_k|)``; when
+    trimesh skips the transform (:func:`trimesh_skips_transform`) the
+    difference is instead that of the whole (tiny) transform, which this
+    does not cover.
+    """
+    rotation, translation = (np.asarray(a, dtype=np.float64) for a in pose)
+    size = (np.abs(np.asarray(vertices, dtype=np.float64)) @ np.abs(rotation).T).max(axis=0)
+    return BOUNDS_ARITHMETIC_ULPS * 2.0 ** -53 * (size + np.abs(translation))
+
+
+class TrimeshOracle:
+    """trimesh behind refsim's bounds and mesh-facts interfaces (lazy import).
+
+    Raises :class:`oracles.OracleUnavailable` when trimesh is not installed.
+    """
+
+    def __init__(self):
+        self.trimesh = import_engine("trimesh", "trimesh")
+
+    def _mesh(self, vertices, faces):
+        return self.trimesh.Trimesh(vertices=np.asarray(vertices, dtype=np.float64),
+                                    faces=np.asarray(faces, dtype=np.int64), process=False)
+
+    def transformed_bounds(self, vertices, faces, pose) -> tuple[np.ndarray, np.ndarray]:
+        """World box ``(lo, hi)`` of the mesh under ``pose``, by trimesh."""
+        mesh = self._mesh(vertices, faces)
+        mesh.apply_transform(pose_matrix(pose))
+        bounds = np.asarray(mesh.bounds, dtype=np.float64)
+        return bounds[0].copy(), bounds[1].copy()
+
+    def is_convex(self, vertices, faces) -> bool:
+        return bool(self._mesh(vertices, faces).is_convex)
+
+    def volume(self, vertices, faces) -> float:
+        return float(self._mesh(vertices, faces).volume)
+
+    def center_mass(self, vertices, faces) -> np.ndarray:
+        return np.asarray(self._mesh(vertices, faces).center_mass, dtype=np.float64)

@@ -1,0 +1,425 @@
+"""Claims C1 and C2 measured: the cost and the convexity need of the incremental box.
+
+C1 (seed): "The linear and incremental approaches were nearly equal in
+performance until the size of the models became quite large. The incremental
+approach performed noticeably faster on simulations containing 2000 triangles
+each." :func:`measure_update_cost` times both updates, per update, over a
+sweep of mesh sizes, in coherent motion (a fixed turn per frame about a fixed
+axis) and in random jumps, and counts the vertices each examines.
+
+C2 (seed): "an incremental approach requires a convex decomposition of the
+model". :func:`measure_incremental_error` runs the tracker on non-convex meshes
+anyway and measures how often and by how much its box is too small.
+
+:func:`measure_numba_compile_cost` measures what the compiled kernels cost on
+first use, cold and from numba's cache, in fresh interpreters.
+
+Every function takes a seed and returns frozen dataclasses of plain numbers
+(tests gate on them; the report draws them). Timings are medians over repeats
+of ``time.perf_counter``; they are this machine's, not a law.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from refsim.bounds.aabb_incremental import IncrementalAABB, numba_available
+from refsim.bounds.aabb_linear import LinearAABB
+from refsim.models import shapes
+from refsim.models.mesh import Mesh
+from refsim.types import as_pose, random_rotation, rotation_about_axis
+
+#: The sweep of C1: box (12 triangles), icosahedron (20) and geodesic spheres
+#: of 20 f^2 triangles, f = 2 .. 64 (80 .. 81920 triangles).
+SWEEP_FREQUENCIES = (2, 3, 5, 7, 10, 16, 23, 32, 45, 64)
+
+METHODS = ("scan-numpy", "scan-numba", "incremental-python", "incremental-numba")
+
+
+def sweep_meshes(frequencies=SWEEP_FREQUENCIES, *, include_small: bool = True) -> list[Mesh]:
+    """The C1 meshes: box, icosahedron, then geodesic spheres (all convex)."""
+    meshes = [shapes.box(), shapes.icosahedron()] if include_small else []
+    return meshes + [shapes.geodesic_sphere(f) for f in frequencies]
+
+
+def perturbed_sphere(frequency: int = 10, amplitude: float = 0.05, seed: int = 0) -> Mesh:
+    """A geodesic sphere with each vertex moved radially by ``amplitude * U(-1, 1)``.
+
+    Non-convex for any amplitude large against rounding: bumps and dents are
+    local extremes a hill climb can stop at.
+    """
+    base = shapes.geodesic_sphere(frequency)
+    rng = np.random.default_rng(seed)
+    radius = 1.0 + amplitude * rng.uniform(-1.0, 1.0, base.n_vertices)
+    return Mesh(base.vertices * radius[:, None], base.faces,
+                name=f"perturbed-sphere-{frequency}-{amplitude:g}")
+
+
+def pose_sequence(frames: int, motion: str = "coherent", *, degrees_per_frame: float = 1.0,
+                  seed: int = 0) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Poses for ``frames`` frames.
+
+    ``"coherent"``: a random start orientation turned by ``degrees_per_frame``
+    per frame about one random axis (the seed's simulations, where bodies
+    turn a little per step). ``"jump"``: an independent uniformly random
+    orientation every frame (no coherence at all). The translation is one
+    random vector for all frames (it does not change which vertex is extreme).
+    """
+    rng = np.random.default_rng(seed)
+    start = random_rotation(rng)
+    axis = rng.standard_normal(3)
+    translation = rng.uniform(-1.0, 1.0, 3)
+    if motion == "coherent":
+        step = np.radians(degrees_per_frame)
+        rotations = [rotation_about_axis(axis, i * step) @ start for i in range(frames)]
+    elif motion == "jump":
+        rotations = [random_rotation(rng) for _ in range(frames)]
+    else:
+        raise ValueError(f"motion must be 'coherent' or 'jump', got {motion!r}")
+    return [(r, translation.copy()) for r in rotations]
+
+
+def make_method(mesh: Mesh, method: str, *, allow_nonconvex: bool = False):
+    """The box updater named by ``method`` (one of ``METHODS``)."""
+    kind, kernel = method.split("-")
+    if kind == "scan":
+        return LinearAABB(mesh, kernel=kernel)
+    return IncrementalAABB(mesh, kernel=kernel, allow_nonconvex=allow_nonconvex)
+
+
+# -- C1: cost per update ------------------------------------------------------------
+
+@dataclass(frozen=True)
+class UpdateCost:
+    """One (mesh, motion, method) cell of the C1 sweep.
+
+    ``seconds_per_update`` is the median over repeats of (block time / frames)
+    of the unchecked update (the pose check, the same for every method, is
+    :attr:`UpdateCostStudy.pose_check_seconds`). ``visits_per_update`` and
+    ``evaluations_per_update`` are means over the timed frames, ``max_visits``
+    their maximum; the first update (a full scan for the tracker) is not timed
+    or counted.
+    """
+
+    mesh: str
+    n_triangles: int
+    n_vertices: int
+    motion: str
+    method: str
+    seconds_per_update: float
+    visits_per_update: float
+    max_visits: int
+    evaluations_per_update: float
+
+
+@dataclass(frozen=True)
+class UpdateCostStudy:
+    """The C1 sweep.
+
+    ``crossovers[(motion, incremental, scan)]`` is the smallest triangle count
+    of the sweep from which ``incremental`` is faster than ``scan`` at that
+    size and every larger one (None if never). ``speedups`` gives, per the same
+    key, the list of (n_triangles, scan seconds / incremental seconds).
+    """
+
+    rows: tuple[UpdateCost, ...]
+    degrees_per_frame: float
+    frames: int
+    repeats: int
+    seed: int
+    pose_check_seconds: float
+    crossovers: dict = field(default_factory=dict)
+    speedups: dict = field(default_factory=dict)
+
+    def row(self, mesh: str, motion: str, method: str) -> UpdateCost:
+        for r in self.rows:
+            if (r.mesh, r.motion, r.method) == (mesh, motion, method):
+                return r
+        raise KeyError((mesh, motion, method))
+
+
+def measure_update_cost(meshes=None, *, motions=("coherent", "jump"), methods=None,
+                        frames: int = 200, repeats: int = 5,
+                        degrees_per_frame: float = 1.0, seed: int = 0) -> UpdateCostStudy:
+    """Cost of the linear scan and the incremental update per update (claim C1).
+
+    Parameters
+    ----------
+    meshes : list of Mesh, optional
+        Default :func:`sweep_meshes` (12 to 81920 triangles).
+    motions : tuple of {"coherent", "jump"}
+    methods : tuple of str, optional
+        Subset of ``METHODS``; default all that are available (the numba
+        ones need the extra ``fast``).
+    frames, repeats : int
+        Each repeat times ``frames`` consecutive updates; the pose sequence
+        continues across repeats (``frames * repeats + 1`` poses).
+    degrees_per_frame : float
+        The turn per frame of the coherent motion.
+    """
+    if meshes is None:
+        meshes = sweep_meshes()
+    if methods is None:
+        methods = METHODS if numba_available() else ("scan-numpy", "incremental-python")
+    rows = []
+    for motion in motions:
+        poses = [as_pose(p) for p in pose_sequence(
+            frames * repeats + 1, motion, degrees_per_frame=degrees_per_frame, seed=seed)]
+        for mesh in meshes:
+            for method in methods:
+                rows.append(_time_method(mesh, method, motion, poses, frames, repeats))
+    study = UpdateCostStudy(rows=tuple(rows), degrees_per_frame=degrees_per_frame,
+                            frames=frames, repeats=repeats, seed=seed,
+                            pose_check_seconds=_time_pose_check(poses[0]))
+    _fill_crossovers(study, meshes, motions, methods)
+    return study
+
+
+def _time_method(mesh, method, motion, poses, frames, repeats) -> UpdateCost:
+    tracker = make_method(mesh, method)
+    update = tracker._update_unchecked
+    update(*poses[0])  # the tracker's initial full scan (and numba's compile)
+    block_times = []
+    for rep in range(repeats):
+        block = poses[1 + rep * frames: 1 + (rep + 1) * frames]
+        start = time.perf_counter()
+        for rotation, translation in block:
+            update(rotation, translation)
+        block_times.append((time.perf_counter() - start) / frames)
+    # The counts, from an untimed replay of the same poses on a twin (reading
+    # the counters inside the timed loop would add to the time).
+    twin = make_method(mesh, method)
+    twin._update_unchecked(*poses[0])
+    visits, evaluations = [], []
+    for rotation, translation in poses[1:frames * repeats + 1]:
+        twin._update_unchecked(rotation, translation)
+        visits.append(twin.visits)
+        evaluations.append(twin.evaluations)
+    return UpdateCost(mesh=mesh.name, n_triangles=mesh.n_faces, n_vertices=mesh.n_vertices,
+                      motion=motion, method=method,
+                      seconds_per_update=statistics.median(block_times),
+                      visits_per_update=float(np.mean(visits)), max_visits=int(max(visits)),
+                      evaluations_per_update=float(np.mean(evaluations)))
+
+
+def _time_pose_check(pose, repeats: int = 2000) -> float:
+    start = time.perf_counter()
+    for _ in range(repeats):
+        as_pose(pose)
+    return (time.perf_counter() - start) / repeats
+
+
+def _fill_crossovers(study, meshes, motions, methods):
+    sizes = sorted({m.n_faces for m in meshes})
+    by_size = {m.n_faces: m.name for m in meshes}
+    for motion in motions:
+        for inc in (m for m in methods if m.startswith("incremental")):
+            for scan in (m for m in methods if m.startswith("scan")):
+                ratios = []
+                for s in sizes:
+                    t_scan = study.row(by_size[s], motion, scan).seconds_per_update
+                    t_inc = study.row(by_size[s], motion, inc).seconds_per_update
+                    ratios.append((s, t_scan / t_inc))
+                crossover = None
+                for i, (s, _) in enumerate(ratios):
+                    if all(r > 1.0 for _, r in ratios[i:]):
+                        crossover = s
+                        break
+                study.crossovers[(motion, inc, scan)] = crossover
+                study.speedups[(motion, inc, scan)] = ratios
+
+
+# -- C2: error on non-convex meshes ----------------------------------------------------
+
+@dataclass(frozen=True)
+class IncrementalError:
+    """How wrong the incremental box is on one mesh (claim C2).
+
+    ``frames`` updates are compared with the linear scan (the first update, a
+    full scan in both, is excluded). ``wrong_fraction``: frames whose box
+    differs at all; ``wrong_side_fraction``: of the ``6 * frames`` box sides,
+    the fraction that differ. The deficit of a frame is the largest, over the
+    six sides, of (scan side - incremental side, outward) divided by the
+    scan box's extent on that axis; it is >= 0 always (the tracker's extremes
+    are real vertices, so its box lies inside the true one).
+    ``max_deficit`` is over all frames, ``median_deficit`` over wrong frames
+    only (0 when none is wrong).
+    """
+
+    mesh: str
+    n_triangles: int
+    convex: bool
+    motion: str
+    frames: int
+    wrong_frames: int
+    wrong_fraction: float
+    wrong_side_fraction: float
+    max_deficit: float
+    median_deficit: float
+    visits_per_update: float
+
+
+def default_error_meshes() -> list[Mesh]:
+    """The C2 meshes: torus, L-beam, star prism, perturbed spheres, and a
+    convex sphere as the control."""
+    return [shapes.torus(), shapes.l_beam(), shapes.star_prism(),
+            perturbed_sphere(10, 0.01, seed=1), perturbed_sphere(10, 0.05, seed=1),
+            perturbed_sphere(23, 0.01, seed=1), shapes.geodesic_sphere(10)]
+
+
+def measure_incremental_error(meshes=None, *, motion: str = "coherent", frames: int = 720,
+                              degrees_per_frame: float = 1.0, seed: int = 0,
+                              kernel: str | None = None) -> list[IncrementalError]:
+    """Run the tracker on (non-convex) meshes and compare with the scan (C2)."""
+    if meshes is None:
+        meshes = default_error_meshes()
+    poses = [as_pose(p) for p in pose_sequence(frames + 1, motion,
+                                               degrees_per_frame=degrees_per_frame, seed=seed)]
+    results = []
+    for mesh in meshes:
+        tracker = IncrementalAABB(mesh, kernel=kernel, allow_nonconvex=True)
+        scan = LinearAABB(mesh)
+        tracker._update_unchecked(*poses[0])
+        deficits, wrong_sides, visits = [], 0, []
+        for rotation, translation in poses[1:]:
+            lo_i, hi_i = tracker._update_unchecked(rotation, translation)
+            lo_s, hi_s = scan._update_unchecked(rotation, translation)
+            extent = hi_s - lo_s
+            outward = np.concatenate([(lo_i - lo_s) / extent, (hi_s - hi_i) / extent])
+            wrong_sides += int((outward != 0.0).sum())
+            deficits.append(float(outward.max()))
+            visits.append(tracker.visits)
+        deficits = np.array(deficits)
+        wrong = deficits[deficits != 0.0]
+        results.append(IncrementalError(
+            mesh=mesh.name, n_triangles=mesh.n_faces, convex=bool(mesh.is_convex),
+            motion=motion, frames=frames, wrong_frames=int(len(wrong)),
+            wrong_fraction=len(wrong) / frames, wrong_side_fraction=wrong_sides / (6 * frames),
+            max_deficit=float(deficits.max()),
+            median_deficit=float(np.median(wrong)) if len(wrong) else 0.0,
+            visits_per_update=float(np.mean(visits))))
+    return results
+
+
+# -- numba's first-call cost ------------------------------------------------------------
+
+@dataclass(frozen=True)
+class CompileCost:
+    """What the numba kernels cost on first use, in seconds, in a fresh process.
+
+    ``import_numba``: ``import numba``. ``cold_first_call``: the first tracker
+    update pair (initial scan + a walk) and the first compiled scan with an
+    empty cache (compiles and writes the cache). ``cached_first_call``: the
+    same in a second fresh process that loads the cache. ``steady_call``: one
+    later tracker update (2000-triangle sphere, 1 degree per frame).
+    """
+
+    import_numba: float
+    cold_first_call: float
+    cached_first_call: float
+    steady_call: float
+
+
+_COMPILE_PROBE = r"""
+import json, time
+t0 = time.perf_counter()
+import numba  # noqa: F401
+t1 = time.perf_counter()
+import numpy as np
+from refsim.bounds.aabb_incremental import IncrementalAABB
+from refsim.bounds.aabb_linear import aabb_linear
+from refsim.models.shapes import geodesic_sphere
+from refsim.types import rotation_about_axis
+mesh = geodesic_sphere(10)
+tracker = IncrementalAABB(mesh, kernel="numba")
+poses = [(rotation_about_axis([1.0, 2.0, 3.0], np.radians(i)), np.zeros(3)) for i in range(50)]
+t2 = time.perf_counter()
+tracker.update(poses[0]); tracker.update(poses[1])
+aabb_linear(mesh, poses[0], kernel="numba")
+t3 = time.perf_counter()
+steady = []
+for pose in poses[2:]:
+    s = time.perf_counter(); tracker.update(pose); steady.append(time.perf_counter() - s)
+steady.sort()
+print(json.dumps({"import": t1 - t0, "first": t3 - t2, "steady": steady[len(steady) // 2]}))
+"""
+
+
+def measure_numba_compile_cost() -> CompileCost:
+    """First-call cost of the numba kernels, cold and cached (two fresh processes)."""
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        runs = []
+        for _ in range(2):
+            out = subprocess.run([sys.executable, "-c", _COMPILE_PROBE], env=env,
+                                 capture_output=True, text=True, check=True)
+            runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
+    return CompileCost(import_numba=runs[0]["import"], cold_first_call=runs[0]["first"],
+                       cached_first_call=runs[1]["first"], steady_call=runs[1]["steady"])
+
+
+# -- one command per figure ---------------------------------------------------------------
+
+def _print_update_cost(study: UpdateCostStudy) -> None:
+    print(f"C1: seconds per update (median of {study.repeats} x {study.frames} frames), "
+          f"{study.degrees_per_frame} deg/frame or random jumps; pose check "
+          f"{study.pose_check_seconds * 1e6:.1f} us extra per public call")
+    methods = list(dict.fromkeys(r.method for r in study.rows))
+    for motion in dict.fromkeys(r.motion for r in study.rows):
+        print(f"\n{motion}: microseconds per update | visits per update (max)")
+        print(f"{'triangles':>9} {'vertices':>8} " + " ".join(f"{m:>19}" for m in methods)
+              + "   visits(incr)  max")
+        for r0 in (r for r in study.rows if r.motion == motion and r.method == methods[0]):
+            cells = [study.row(r0.mesh, motion, m) for m in methods]
+            inc = [c for c in cells if c.method.startswith("incremental")]
+            visits = f"{inc[0].visits_per_update:12.1f} {inc[0].max_visits:5d}" if inc else ""
+            print(f"{r0.n_triangles:9d} {r0.n_vertices:8d} "
+                  + " ".join(f"{c.seconds_per_update * 1e6:19.2f}" for c in cells)
+                  + f"   {visits}")
+    print("\ncrossover (smallest size from which incremental is faster at every larger size):")
+    for key, value in study.crossovers.items():
+        ratios = ", ".join(f"{s}:{q:.2f}" for s, q in study.speedups[key])
+        print(f"  {key}: {value}   [scan/incremental: {ratios}]")
+
+
+def _print_errors(results) -> None:
+    print(f"{'mesh':>26} {'tri':>6} {'convex':>6} {'motion':>8} {'wrong':>7} {'sides':>7} "
+          f"{'max def':>8} {'med def':>8} {'visits':>7}")
+    for r in results:
+        print(f"{r.mesh:>26} {r.n_triangles:6d} {r.convex!s:>6} {r.motion:>8} "
+              f"{r.wrong_fraction:7.3f} {r.wrong_side_fraction:7.3f} {r.max_deficit:8.4f} "
+              f"{r.median_deficit:8.4f} {r.visits_per_update:7.1f}")
+
+
+def main(argv=None) -> None:
+    """``python -m refsim.bounds.measure {c1,c2,compile}``: print one figure."""
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="python -m refsim.bounds.measure")
+    parser.add_argument("figure", choices=["c1", "c2", "compile"])
+    parser.add_argument("--frames", type=int, default=None)
+    parser.add_argument("--repeats", type=int, default=5)
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args(argv)
+    if args.figure == "c1":
+        _print_update_cost(measure_update_cost(frames=args.frames or 200,
+                                               repeats=args.repeats, seed=args.seed))
+    elif args.figure == "c2":
+        for motion in ("coherent", "jump"):
+            _print_errors(measure_incremental_error(motion=motion, frames=args.frames or 720,
+                                                    seed=args.seed))
+    else:
+        print(measure_numba_compile_cost())
+
+
+if __name__ == "__main__":
+    main()
