@@ -369,6 +369,62 @@ def measure_numba_compile_cost() -> CompileCost:
 
 # -- one command per figure ---------------------------------------------------------------
 
+# -- agreement: incremental against scan, scan against trimesh ------------------------
+
+@dataclass(frozen=True)
+class BoundsAgreement:
+    """How the boxes agree on one mesh over random poses.
+
+    ``incremental_exact``: poses where the incremental box equals the scan's
+    bit for bit (convex meshes only, None otherwise; the poses are random
+    jumps, the hardest case for the walk). ``trimesh_bitwise``: poses where
+    trimesh's box equals the scan's bit for bit; ``trimesh_within``: poses
+    within the arithmetic bound ``oracles.trimesh_adapter.bounds_tolerance``;
+    ``max_difference_over_tolerance``: the largest difference seen as a
+    fraction of that bound.
+    """
+
+    mesh: str
+    n_triangles: int
+    poses: int
+    incremental_exact: int | None
+    trimesh_bitwise: int
+    trimesh_within: int
+    max_difference_over_tolerance: float
+
+
+def measure_bounds_agreement(meshes=None, *, poses: int = 200, seed: int = 0):
+    """Agreement counts for the bundled-style meshes (list of BoundsAgreement)."""
+    from oracles.trimesh_adapter import TrimeshOracle, bounds_tolerance
+    from refsim.bounds.aabb_linear import aabb_linear
+
+    oracle = TrimeshOracle()
+    meshes = meshes or [shapes.box(), shapes.icosahedron(), shapes.geodesic_sphere(10),
+                        shapes.torus(), shapes.l_beam()]
+    rows = []
+    for mesh in meshes:
+        rng = np.random.default_rng(seed)
+        sequence = [(random_rotation(rng), rng.uniform(-3.0, 3.0, 3)) for _ in range(poses)]
+        tracker = IncrementalAABB(mesh) if mesh.is_convex else None
+        exact = bitwise = within = 0
+        worst = 0.0
+        for pose in sequence:
+            lo, hi = aabb_linear(mesh, pose)
+            if tracker is not None:
+                ilo, ihi = tracker.update(pose)
+                exact += bool(np.array_equal(ilo, lo) and np.array_equal(ihi, hi))
+            tlo, thi = oracle.transformed_bounds(mesh.vertices, mesh.faces, pose)
+            difference = np.maximum(np.abs(tlo - lo), np.abs(thi - hi))
+            tolerance = bounds_tolerance(mesh.vertices, pose)
+            bitwise += bool(not difference.any())
+            within += bool((difference <= tolerance).all())
+            worst = max(worst, float((difference / tolerance).max()))
+        rows.append(BoundsAgreement(mesh.name, mesh.n_faces, poses,
+                                    exact if tracker is not None else None,
+                                    bitwise, within, worst))
+    return rows
+
+
 def _print_update_cost(study: UpdateCostStudy) -> None:
     print(f"C1: seconds per update (median of {study.repeats} x {study.frames} frames), "
           f"{study.degrees_per_frame} deg/frame or random jumps; pose check "

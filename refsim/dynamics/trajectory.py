@@ -1,0 +1,92 @@
+"""What a simulation returns: per-frame arrays for every body, and events.
+
+The same type comes back from refsim's own loop (``refsim.simulate``) and from
+the pybullet oracle, so that the two can be compared array for array.
+
+Shapes, for F frames and B bodies:
+
+- ``t`` (F,): time of each frame, seconds;
+- ``position``, ``velocity``, ``angular_velocity`` (F, B, 3): the body's
+  reference point (its mesh's origin), its velocity, and its angular velocity
+  in radians per second, world frame;
+- ``orientation`` (F, B, 3, 3): columns are the body's axes in world space.
+
+``events`` lists wall hits and body contacts. ``stages`` names the stages of
+the loop that ran; ``stage_seconds`` the wall time spent in each.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Event:
+    """A wall hit (``kind="wall"``, ``other`` is the wall, e.g. "y-") or a
+    body contact (``kind="body"``, ``other`` is the other body's name)."""
+
+    kind: str
+    step: int
+    time: float
+    body: str
+    other: str
+
+
+@dataclass
+class Trajectory:
+    t: np.ndarray
+    position: np.ndarray
+    velocity: np.ndarray
+    angular_velocity: np.ndarray
+    orientation: np.ndarray
+    names: tuple[str, ...]
+    events: list[Event] = field(default_factory=list)
+    stages: tuple[str, ...] = ()
+    stage_seconds: dict[str, float] = field(default_factory=dict)
+    settings: dict = field(default_factory=dict)
+
+    @property
+    def n_frames(self) -> int:
+        return len(self.t)
+
+    def save(self, path) -> Path:
+        """Write the trajectory as .npz, atomically (never half a file)."""
+        path = Path(path)
+        events = json.dumps([e.__dict__ for e in self.events])
+        fd, tmp = tempfile.mkstemp(dir=path.parent or ".", prefix=f".{path.name}.",
+                                   suffix=".npz")
+        os.close(fd)
+        try:
+            np.savez_compressed(
+                tmp, t=self.t, position=self.position, velocity=self.velocity,
+                angular_velocity=self.angular_velocity, orientation=self.orientation,
+                names=np.array(self.names), events=np.array(events),
+                stages=np.array(self.stages),
+                stage_seconds=np.array(json.dumps(self.stage_seconds)),
+                settings=np.array(json.dumps(self.settings, default=str)))
+            mask = os.umask(0)
+            os.umask(mask)
+            os.chmod(tmp, 0o666 & ~mask)
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        return path
+
+    @classmethod
+    def load(cls, path) -> Trajectory:
+        with np.load(path) as data:
+            return cls(
+                t=data["t"], position=data["position"], velocity=data["velocity"],
+                angular_velocity=data["angular_velocity"], orientation=data["orientation"],
+                names=tuple(str(n) for n in data["names"]),
+                events=[Event(**e) for e in json.loads(str(data["events"]))],
+                stages=tuple(str(s) for s in data["stages"]),
+                stage_seconds=json.loads(str(data["stage_seconds"])),
+                settings=json.loads(str(data["settings"])))
