@@ -110,6 +110,7 @@ def claim_rows(sections: list[Section]) -> list[dict]:
             "verdict": v.verdict if v else "not measured yet",
             "evidence": v.evidence if v else "",
             "command": v.command if v else "",
+            "timing": v.timing if v else False,
         })
     return rows
 

@@ -4,6 +4,11 @@ Each area of refsim contributes one :class:`Section`, built from its
 ``measure_*`` functions. The report computes nothing of its own (STYLE.md,
 rule 9): a section only arranges numbers that a measurement returned, and
 ``results`` holds those numbers for results.json.
+
+Timings vary from run to run; everything else must not. A results key that
+holds a timing or a figure derived from timings has one of the words in
+``TIMING_WORDS`` in its name, and a verdict that rests on timings says so
+(``Verdict.timing``), so that the determinism test knows what may differ.
 """
 
 from __future__ import annotations
@@ -12,6 +17,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 VERDICTS = ("confirmed", "refuted", "partly", "not measured yet")
+
+TIMING_WORDS = ("time", "seconds", "per_second", "rate", "ratio", "crossover", "speedup",
+                "throughput")
 
 
 @dataclass(frozen=True)
@@ -42,6 +50,7 @@ class Verdict:
     verdict: str        # one of VERDICTS
     evidence: str       # id of the figure or table that shows it
     command: str = ""   # the one command that reproduces the figure
+    timing: bool = False  # rests on wall-clock measurements (varies run to run)
 
 
 @dataclass

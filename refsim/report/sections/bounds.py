@@ -157,7 +157,7 @@ def _c1_verdict(study) -> Verdict:
                 f"Readable Python against numpy's scan: faster only from {python} "
                 f"triangles, because each vertex the walk visits costs interpreter time.")
     verdict = "confirmed" if compiled is not None and compiled <= 2000 else "refuted"
-    return Verdict("C1", sentence, verdict, "bounds-cost-coherent", C1_COMMAND)
+    return Verdict("C1", sentence, verdict, "bounds-cost-coherent", C1_COMMAND, timing=True)
 
 
 def _c2_verdict(errors) -> Verdict:
