@@ -81,7 +81,8 @@ def build_report(out_dir: Path, *, quick: bool = False, stream=None) -> Path:
             "seed": REPORT_SEED,
             "environment": environment,
             "claims": claim_rows(sections),
-            "sections": {s.key: {"status": s.status, "results": s.results} for s in sections},
+            "agreements": agreement_rows(sections),
+            "sections": {s.key: section_json(s) for s in sections},
         }
         payload = json.dumps(results, indent=2, sort_keys=True, default=_json_default)
         write_atomic(out_dir / "results.json", payload + "\n")
@@ -113,6 +114,24 @@ def claim_rows(sections: list[Section]) -> list[dict]:
             "timing": v.timing if v else False,
         })
     return rows
+
+
+def agreement_rows(sections: list[Section]) -> list[dict]:
+    """The summary at the top of the page: every section's oracle agreements."""
+    return [{"section": s.key, **asdict(a)} for s in sections for a in s.agreements]
+
+
+def section_json(section: Section) -> dict:
+    """A section as results.json records it: its measured numbers, and every
+    table and chart exactly as the page shows them (cells as displayed)."""
+    return {
+        "status": section.status,
+        "results": section.results,
+        "tables": [{"id": t.id, "title": t.title, "columns": list(t.columns),
+                    "rows": [[str(cell) for cell in row] for row in t.rows]}
+                   for t in section.tables],
+        "figures": [{"id": f.id, "title": f.title} for f in section.figures],
+    }
 
 
 def collect_environment() -> dict:
@@ -155,6 +174,7 @@ def render(sections: list[Section], environment: dict, *, quick: bool) -> str:
     template = env.get_template("index.html.j2")
     css = (TEMPLATES_DIR / "style.css").read_text()
     return template.render(sections=sections, claims=claim_rows(sections),
+                           agreements=agreement_rows(sections),
                            terminology=TERMINOLOGY, environment=environment,
                            quick=quick, css=css)
 

@@ -53,6 +53,16 @@ class Verdict:
     timing: bool = False  # rests on wall-clock measurements (varies run to run)
 
 
+@dataclass(frozen=True)
+class Agreement:
+    """One line of the page's summary: how refsim agrees with an oracle."""
+
+    oracle: str         # "python-fcl", "trimesh", "scipy solve_ivp", "pybullet", "analytic"
+    check: str          # what is compared
+    result: str         # the figure, e.g. "20000 / 20000 agree"
+    command: str        # the one command that reproduces it
+
+
 @dataclass
 class Section:
     key: str
@@ -63,4 +73,5 @@ class Section:
     figures: list[Figure] = field(default_factory=list)
     tables: list[Table] = field(default_factory=list)
     verdicts: list[Verdict] = field(default_factory=list)
+    agreements: list[Agreement] = field(default_factory=list)
     results: dict[str, Any] = field(default_factory=dict)

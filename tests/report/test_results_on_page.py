@@ -1,0 +1,67 @@
+"""Every figure recorded in results.json appears on the page, as displayed,
+and every claim with a verdict is backed by a figure of its section.
+
+"Figure" here means what a reader sees: each table (every cell) and each chart.
+The raw arrays in a section's ``results`` are the data behind them.
+"""
+
+from __future__ import annotations
+
+from markupsafe import escape
+
+
+def _table_html(html: str, table_id: str) -> str:
+    head = f'<h3 id="{table_id}">'
+    assert html.count(head) == 1, table_id
+    return html.split(head, 1)[1].split("</table>", 1)[0]
+
+
+def test_every_table_cell_is_on_the_page(quick_report):
+    _, html, results = quick_report
+    tables = [t for s in results["sections"].values() for t in s["tables"]]
+    assert tables
+    for table in tables:
+        block = _table_html(html, table["id"])
+        for column in table["columns"]:
+            assert f"<th>{escape(column)}</th>" in block, (table["id"], column)
+        for row in table["rows"]:
+            for cell in row:
+                assert f">{escape(cell)}</td>" in block, (table["id"], cell)
+
+
+def test_every_chart_is_on_the_page(quick_report):
+    _, html, results = quick_report
+    figures = [f for s in results["sections"].values() for f in s["figures"]]
+    assert figures
+    for figure in figures:
+        block = html.split(f'<figure id="{figure["id"]}">', 1)[1].split("</figure>", 1)[0]
+        assert "<svg" in block and escape(figure["title"]) in block
+
+
+def test_ids_are_unique(quick_report):
+    _, _, results = quick_report
+    ids = [x["id"] for s in results["sections"].values() for x in s["tables"] + s["figures"]]
+    assert len(ids) == len(set(ids))
+
+
+def test_every_verdict_is_backed_by_a_figure_of_its_section(quick_report):
+    _, html, results = quick_report
+    measured = [c for c in results["claims"] if c["verdict"] != "not measured yet"]
+    assert measured
+    for claim in measured:
+        section = results["sections"][claim["area"]]
+        evidence = {x["id"] for x in section["tables"] + section["figures"]}
+        assert claim["evidence"] in evidence, claim["claim"]
+        assert claim["measured"] and claim["command"], claim["claim"]
+        row = html.split(f'id="claim-{claim["claim"]}"', 1)[1].split("</tr>", 1)[0]
+        assert f">{escape(claim['verdict'])}</td>" in row
+        assert escape(claim["measured"]) in row
+
+
+def test_every_agreement_is_on_the_page_with_its_command(quick_report):
+    _, html, results = quick_report
+    assert results["agreements"]
+    summary = html.split('<section id="agreement">', 1)[1].split("</section>", 1)[0]
+    for row in results["agreements"]:
+        for key in ("oracle", "check", "result", "command"):
+            assert escape(row[key]) in summary, (row["oracle"], key)
