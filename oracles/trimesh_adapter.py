@@ -59,6 +59,8 @@ class MeshFactsOracle(Protocol):
 
     def is_convex(self, vertices, faces) -> bool: ...
 
+    def is_watertight(self, vertices, faces) -> bool: ...
+
     def volume(self, vertices, faces) -> float: ...
 
     def center_mass(self, vertices, faces) -> np.ndarray: ...
@@ -113,6 +115,10 @@ class TrimeshOracle:
 
     def is_convex(self, vertices, faces) -> bool:
         return bool(self._mesh(vertices, faces).is_convex)
+
+    def is_watertight(self, vertices, faces) -> bool:
+        """Closed: every edge shared by exactly two consistently wound faces."""
+        return bool(self._mesh(vertices, faces).is_watertight)
 
     def volume(self, vertices, faces) -> float:
         return float(self._mesh(vertices, faces).volume)
