@@ -335,3 +335,141 @@ def particle_configs(draw, max_count: int = 30):
         solver=draw(SOLVER_NAMES),
         step=draw(_st.floats(min_value=1e-4, max_value=0.05)),
     )
+
+
+# ===========================================================================
+# Collision: posed pairs of bundled models (refsim.collision.bodies, seed S4)
+# ===========================================================================
+# Two small bundled models (scaled copies included, so that one can sit
+# inside the other), each at a pose. Rotations come from ``rotations`` above
+# (random, identity or signed permutations: the last two keep the models'
+# faces axis-aligned). Translations are either generic (a random direction
+# and a distance from 0 to 1.1 times the sum of the bounding radii) or
+# dyadic (multiples of 1/8, exact): with axis-aligned rotations the dyadic
+# ones make faces, edges and corners touch exactly, the case every level must
+# still report.
+
+POSED_MODELS = (("cube", 1.0), ("icosahedron", 1.0), ("star", 1.0), ("l-beam", 1.0),
+                ("long-box", 1.0), ("tetrahedron", 1.0), ("cube", 0.5), ("icosahedron", 0.5))
+
+
+@_st.composite
+def posed_model_pairs(draw, models=POSED_MODELS):
+    """``(mesh_a, pose_a, mesh_b, pose_b, label)`` for two bundled models."""
+    from refsim.collision.measure_levels import bundled_mesh, model_label
+    from refsim.collision.spheres import bounding_sphere
+
+    (name_a, scale_a), (name_b, scale_b) = draw(_st.sampled_from(models)), \
+        draw(_st.sampled_from(models))
+    mesh_a, mesh_b = bundled_mesh(name_a, scale_a), bundled_mesh(name_b, scale_b)
+    rot_a, rot_b = draw(rotations()), draw(rotations())
+    if draw(_st.sampled_from(["generic", "dyadic"])) == "generic":
+        rng = _np.random.default_rng(draw(_SEEDS))
+        direction = rng.standard_normal(3)
+        direction /= _np.linalg.norm(direction)
+        reach = bounding_sphere(mesh_a)[1] + bounding_sphere(mesh_b)[1]
+        t_b = direction * draw(_st.floats(min_value=0.0, max_value=1.1 * reach))
+    else:
+        t_b = _np.array([draw(_st.integers(min_value=-16, max_value=16)) / 8.0
+                         for _ in range(3)])
+    label = f"{model_label(name_a, scale_a)} / {model_label(name_b, scale_b)}"
+    return mesh_a, (rot_a, _np.zeros(3)), mesh_b, (rot_b, t_b), label
+
+
+# ===========================================================================
+# Dynamics: contacts, wall hits and random states (refsim.dynamics, S5-S9)
+# ===========================================================================
+# Contact pairs are two bodies with random masses, symmetric positive definite
+# inertia tensors, velocities and spins, one contact point near the middle and
+# a random unit normal. Wall hits put a regular polyhedron (isotropic inertia,
+# so free rotation conserves energy exactly) just above the floor, approaching
+# it at >= 0.5 m/s (a bounce, not resting contact). Random states cover
+# velocities and spins over 300 orders of magnitude.
+
+_DYN_FLOAT = _st.floats(min_value=-3.0, max_value=3.0, allow_nan=False, allow_infinity=False)
+_DYN_VEC = _st.tuples(_DYN_FLOAT, _DYN_FLOAT, _DYN_FLOAT).map(
+    lambda t: _np.array(t, dtype=_np.float64))
+
+
+@_st.composite
+def dynamic_bodies(draw):
+    """``(m, I, x, v, w)``: mass, (3, 3) SPD inertia, position, velocity, spin."""
+    m = draw(_st.floats(min_value=0.1, max_value=10.0))
+    A = _np.array([draw(_DYN_VEC) for _ in range(3)])
+    I = A @ A.T + draw(_st.floats(min_value=0.05, max_value=2.0)) * _np.eye(3)
+    return m, I, draw(_DYN_VEC), draw(_DYN_VEC), draw(_DYN_VEC)
+
+
+@_st.composite
+def contact_pairs(draw):
+    """``(body_a, body_b, p, n, e, mu)`` with bodies from :func:`dynamic_bodies`."""
+    a, b = draw(dynamic_bodies()), draw(dynamic_bodies())
+    p = 0.5 * (a[2] + b[2]) + 0.2 * draw(_DYN_VEC)
+    n = draw(_DYN_VEC.filter(lambda d: _np.linalg.norm(d) > 0.1))
+    e = draw(_st.floats(min_value=0.0, max_value=1.0))
+    mu = draw(_st.floats(min_value=0.0, max_value=1.0))
+    return a, b, p, n / _np.linalg.norm(n), e, mu
+
+
+@_st.composite
+def wall_hit_scenes(draw):
+    """A one-body scene dict whose body will cross the floor within one step.
+
+    The body (cube, tetrahedron or icosahedron; mass and rotation random) sits
+    with its lowest vertex above the floor of a 4 m cube by at most 40 % of
+    what one step covers, and moves down at 0.5 to 8 m/s, with any spin and lateral velocity; the rotation
+    model is "impulse", gravity on or off, restitution and friction random.
+    """
+    model = draw(_st.sampled_from(["cube.ac", "tetrahedron.ac", "icosahedron.ac"]))
+    R = draw(rotations(kinds=("random", "identity", "signed-permutation")))
+    import refsim
+    from refsim.paths import models_dir
+
+    vertices = refsim.load_model(models_dir() / model).vertices
+    lowest = float((vertices @ R.T)[:, 1].min())
+    half = 4.0
+    v = draw(_DYN_VEC)
+    v[1] = -draw(_st.floats(min_value=0.5, max_value=8.0))
+    # at most 40 % of the way one step (1 ms) covers: the floor is crossed
+    gap = draw(_st.floats(min_value=0.0, max_value=0.4)) * 1e-3 * -v[1]
+    return {
+        "world": {"half_size": half, "gravity": draw(_st.sampled_from([0.0, 9.81])),
+                  "restitution": draw(_st.floats(min_value=0.0, max_value=1.0)),
+                  "friction": draw(_st.floats(min_value=0.0, max_value=1.0))},
+        "integration": {"solver": "rk4", "step": 1e-3, "duration": 1e-3},
+        "collision": {"level": "none"},
+        "dynamics": {"rotation": "impulse", "body_response": "off"},
+        "body": [{"name": "body", "model": model, "orientation": R.tolist(),
+                  "position": [0.0, -half - lowest + gap, 0.0], "velocity": v.tolist(),
+                  "angular_velocity": draw(_DYN_VEC).tolist(),
+                  "mass": draw(_st.floats(min_value=0.1, max_value=10.0))}],
+    }
+
+
+_WILD = _st.floats(min_value=-1e150, max_value=1e150, allow_nan=False, allow_infinity=False)
+
+
+@_st.composite
+def random_two_body_scenes(draw):
+    """Two small bodies anywhere in a 3 m cube with wild velocities and spins
+    (up to 1e150), any solver, models and step; for "no silent non-finite"."""
+    from refsim.scenes.schema import RESPONSE_MODELS, ROTATION_MODELS, SOLVER_NAMES
+
+    def body(name):
+        return {"name": name, "model": draw(_st.sampled_from(["cube.ac", "tetrahedron.ac"])),
+                "position": [draw(_st.floats(min_value=-2.0, max_value=2.0))
+                             for _ in range(3)],
+                "velocity": [draw(_WILD) for _ in range(3)],
+                "angular_velocity": [draw(_WILD) for _ in range(3)]}
+
+    return {
+        "world": {"half_size": 3.0, "drag": draw(_st.sampled_from([0.0, 0.5, 1e3])),
+                  "drag_model": draw(_st.sampled_from(["linear", "quadratic"]))},
+        "integration": {"solver": draw(_st.sampled_from(SOLVER_NAMES)),
+                        "step": draw(_st.sampled_from([1e-3, 1e-2, 0.1])),
+                        "duration": 1.0},
+        "collision": {"level": draw(_st.sampled_from(["none", "aabb"]))},
+        "dynamics": {"rotation": draw(_st.sampled_from(ROTATION_MODELS)),
+                     "body_response": draw(_st.sampled_from(RESPONSE_MODELS))},
+        "body": [body("a"), body("b")],
+    }

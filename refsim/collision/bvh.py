@@ -165,11 +165,9 @@ def _compiled():
     """``(prepare, traverse)`` compiled with numba, or None without numba.
 
     The same steps as ``world_vertices``, ``triangle_boxes``, ``refit`` and
-    ``_pairs_python`` in plain loops, with refsim's one transform arithmetic
-    ((R[k,0] x + R[k,1] y) + R[k,2] z + t[k], see refsim.bounds.aabb_linear),
-    so the boxes are the same floats. ``cache=True`` keeps the machine code
-    on disk: the compile cost (measured in the collision benchmarks) is paid
-    once per machine.
+    ``_pairs_python`` in plain loops (:mod:`refsim.collision._numba_kernels`),
+    with refsim's one transform arithmetic ((R[k,0] x + R[k,1] y) + R[k,2] z
+    + t[k], see refsim.bounds.aabb_linear), so the boxes are the same floats.
 
     DEVIATION from a lazier design, measured and rejected: carrying each
     node's body-space box to the world at every visit (the box of the rotated
@@ -178,132 +176,10 @@ def _compiled():
     benchmarks, slower in every configuration.
     """
     try:
-        import numba
+        from refsim.collision import _numba_kernels as nk
     except ImportError:
         return None
-    from refsim.collision.triangle_numba import compiled_kernels
-
-    certify_pair = compiled_kernels()[0]
-    jit = numba.njit(cache=True)
-
-    @jit
-    def prepare(vertices, faces, rotation, translation, left, right, start, count, order):
-        n = vertices.shape[0]
-        world = np.empty((n, 3))
-        for i in range(n):
-            x, y, z = vertices[i, 0], vertices[i, 1], vertices[i, 2]
-            for k in range(3):
-                world[i, k] = ((rotation[k, 0] * x + rotation[k, 1] * y)
-                               + rotation[k, 2] * z) + translation[k]
-        m = faces.shape[0]
-        tri_lo = np.empty((m, 3))
-        tri_hi = np.empty((m, 3))
-        for t in range(m):
-            for k in range(3):
-                a = world[faces[t, 0], k]
-                b = world[faces[t, 1], k]
-                c = world[faces[t, 2], k]
-                tri_lo[t, k] = min(a, min(b, c))
-                tri_hi[t, k] = max(a, max(b, c))
-        nodes = left.shape[0]
-        lo = np.empty((nodes, 3))
-        hi = np.empty((nodes, 3))
-        for node in range(nodes - 1, -1, -1):                 # children before parents
-            if left[node] < 0:
-                for k in range(3):
-                    lo[node, k] = np.inf
-                    hi[node, k] = -np.inf
-                for s in range(start[node], start[node] + count[node]):
-                    t = order[s]
-                    for k in range(3):
-                        lo[node, k] = min(lo[node, k], tri_lo[t, k])
-                        hi[node, k] = max(hi[node, k], tri_hi[t, k])
-            else:
-                a, b = left[node], right[node]
-                for k in range(3):
-                    lo[node, k] = min(lo[a, k], lo[b, k])
-                    hi[node, k] = max(hi[a, k], hi[b, k])
-        return world, lo, hi, tri_lo, tri_hi
-
-    @jit
-    def apart(lo1, hi1, i, lo2, hi2, j):
-        for k in range(3):
-            if lo1[i, k] > hi2[j, k] or lo2[j, k] > hi1[i, k]:
-                return True
-        return False
-
-    @jit
-    def push(stack, top, a, b):
-        if top == stack.shape[0]:
-            bigger = np.empty((2 * top, 2), dtype=np.int64)
-            bigger[:top] = stack[:top]
-            stack = bigger
-        stack[top, 0] = a
-        stack[top, 1] = b
-        return stack, top + 1
-
-    @jit
-    def traverse(left_a, right_a, start_a, count_a, order_a, lo_a, hi_a, tlo_a, thi_a,
-                 world_a, faces_a,
-                 left_b, right_b, start_b, count_b, order_b, lo_b, hi_b, tlo_b, thi_b,
-                 world_b, faces_b, mode):
-        """Returns (pairs, hit): the triangle-box pairs found (modes 0, 1), or
-        the pairs the exact filter could not certify (mode 2), and whether
-        mode 2 found a certified intersecting pair."""
-        out = np.empty((64, 2), dtype=np.int64)
-        found = 0
-        stack = np.empty((64, 2), dtype=np.int64)
-        stack, top = push(stack, 0, 0, 0)
-        ta = np.empty((3, 3))
-        tb = np.empty((3, 3))
-        while top > 0:
-            top -= 1
-            a = stack[top, 0]
-            b = stack[top, 1]
-            if apart(lo_a, hi_a, a, lo_b, hi_b, b):
-                continue
-            leaf_a = left_a[a] < 0
-            leaf_b = left_b[b] < 0
-            if leaf_a and leaf_b:
-                for s in range(start_a[a], start_a[a] + count_a[a]):
-                    i = order_a[s]
-                    for r in range(start_b[b], start_b[b] + count_b[b]):
-                        j = order_b[r]
-                        if apart(tlo_a, thi_a, i, tlo_b, thi_b, j):
-                            continue
-                        if mode == 2:
-                            for v in range(3):
-                                for k in range(3):
-                                    ta[v, k] = world_a[faces_a[i, v], k]
-                                    tb[v, k] = world_b[faces_b[j, v], k]
-                            answer, certain = certify_pair(ta, tb)
-                            if certain:
-                                if answer:
-                                    return out[:found], True
-                                continue
-                        if found == out.shape[0]:
-                            grown = np.empty((2 * found, 2), dtype=np.int64)
-                            grown[:found] = out
-                            out = grown
-                        out[found, 0] = i
-                        out[found, 1] = j
-                        found += 1
-                        if mode == 1:
-                            return out[:found], False
-                continue
-            size_a = (hi_a[a, 0] - lo_a[a, 0]) + (hi_a[a, 1] - lo_a[a, 1]) \
-                + (hi_a[a, 2] - lo_a[a, 2])
-            size_b = (hi_b[b, 0] - lo_b[b, 0]) + (hi_b[b, 1] - lo_b[b, 1]) \
-                + (hi_b[b, 2] - lo_b[b, 2])
-            if leaf_b or (not leaf_a and size_a >= size_b):     # open the bigger node
-                stack, top = push(stack, top, right_a[a], b)
-                stack, top = push(stack, top, left_a[a], b)
-            else:
-                stack, top = push(stack, top, a, right_b[b])
-                stack, top = push(stack, top, a, left_b[b])
-        return out[:found], False
-
-    return prepare, traverse
+    return nk.prepare, nk.traverse
 
 
 KERNELS = ("numba", "python")

@@ -43,5 +43,5 @@ def spheres_overlap(mesh_a, pose_a: Pose, mesh_b, pose_b: Pose) -> bool:
     wb = pose_b[0] @ cb + pose_b[1]
     gap = float(np.linalg.norm(wa - wb))
     reach = ra + rb
-    return gap <= reach * (1.0 + SPHERE_PAD) + SPHERE_PAD * float(
-        np.abs(wa).max() + np.abs(wb).max())
+    return bool(gap <= reach * (1.0 + SPHERE_PAD) + SPHERE_PAD * float(
+        np.abs(wa).max() + np.abs(wb).max()))

@@ -128,7 +128,8 @@ def section_json(section: Section) -> dict:
         "status": section.status,
         "results": section.results,
         "tables": [{"id": t.id, "title": t.title, "columns": list(t.columns),
-                    "rows": [[str(cell) for cell in row] for row in t.rows]}
+                    "rows": [[str(cell) for cell in row] for row in t.rows],
+                    "timing": t.timing}
                    for t in section.tables],
         "figures": [{"id": f.id, "title": f.title} for f in section.figures],
     }

@@ -8,7 +8,8 @@ rule 9): a section only arranges numbers that a measurement returned, and
 Timings vary from run to run; everything else must not. A results key that
 holds a timing or a figure derived from timings has one of the words in
 ``TIMING_WORDS`` in its name, and a verdict that rests on timings says so
-(``Verdict.timing``), so that the determinism test knows what may differ.
+(``Verdict.timing``), and so does a table with timings in its cells
+(``Table.timing``), so that the determinism test knows what may differ.
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ class Table:
     columns: tuple[str, ...]
     rows: tuple[tuple[Any, ...], ...]
     caption: str = ""
+    timing: bool = False  # some cells are timings (they vary run to run)
 
 
 @dataclass(frozen=True)

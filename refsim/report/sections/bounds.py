@@ -108,6 +108,7 @@ def _cost_table(study, methods) -> Table:
     return Table(
         id="bounds-cost-table", title="C1: microseconds per update at 1 degree per frame",
         columns=("triangles", *methods, "visits (mean)", "visits (max)"), rows=tuple(rows),
+        timing=True,
         caption="Medians of timed blocks of consecutive updates; the public call adds the "
                 f"pose check ({1e6 * study.pose_check_seconds:.1f} us). "
                 f"Reproduce: {C1_COMMAND}")

@@ -1,0 +1,302 @@
+"""The four levels of body-body collision (claim C3) on constructed
+configurations, the oracles' body-level answers classified, and the
+hierarchy benchmark's configurations (refsim.collision.measure_levels).
+
+Known answers come from exactly representable geometry: cube.ac is
+[-0.5, 0.5]^3, so a translation by (1, 0, 0) makes two cubes share the face
+x = 0.5 with no rounding anywhere, and (1, 1, 1) makes them share one corner.
+
+Measured (seed 0, 10 random poses per model pair; reproduce with
+``python -m refsim.collision.measure_levels --quick``): zero false negatives
+at every level; FCL's face pairs and boolean answers equal refsim's on every
+query; trimesh's CollisionManager differs only by "containment" (a small
+convex body inside a convex one: a solid for trimesh, two surfaces apart for
+refsim) and "touching" (cubes sharing a face or a corner: GJK on two
+fcl.Convex says apart).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from oracles.fcl_adapter import FCLOracle
+from oracles.trimesh_collision import TrimeshCollisionOracle, float32_pose
+from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
+from refsim.collision.measure_levels import (
+    CONFIGURATIONS,
+    SPEED_CONFIGURATIONS,
+    BodyOracle,
+    bundled_mesh,
+    classify_body_disagreement,
+    measure_body_oracles,
+    measure_hierarchy_speed,
+    measure_levels,
+    solid_contains,
+)
+
+IDENTITY = (np.eye(3), np.zeros(3))
+
+
+def at(x, y=0.0, z=0.0):
+    return np.eye(3), np.array([x, y, z], dtype=np.float64)
+
+
+def answers(mesh_a, pose_a, mesh_b, pose_b, method="bvh", kernel=None):
+    return {level: bool(bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level=level,
+                                       method=method, kernel=kernel)) for level in LEVELS}
+
+
+def level_answers(sphere, aabb, triangle_aabb, exact):
+    return dict(zip(LEVELS, (sphere, aabb, triangle_aabb, exact), strict=True))
+
+
+# Every constructed configuration's answers at (sphere, aabb, triangle-aabb,
+# exact), worked out from the geometry in CONFIGURATIONS' descriptions.
+EXPECTED = {
+    "far": level_answers(False, False, False, False),
+    "spheres-2.1": level_answers(False, True, True, False),       # spheres 2.1 > 2 apart
+    "tori-2.72": level_answers(False, True, True, False),         # 2.72 > 2 * 1.35
+    "l-beams-nested": level_answers(True, True, False, False),
+    "cubes-face": level_answers(True, True, True, True),
+    "cubes-corner": level_answers(True, True, True, True),
+    "spheres-1.99": level_answers(True, True, True, True),
+    "tori-2.66": level_answers(True, True, True, True),
+    "spheres-1.0": level_answers(True, True, True, True),
+    "tori-1.0": level_answers(True, True, True, True),
+    "icosahedron-in-sphere": level_answers(True, True, False, False),
+    "cube-in-torus-hole": level_answers(True, True, True, False),
+    "cube-in-cube": level_answers(True, True, False, False),
+}
+
+
+@pytest.fixture(scope="module")
+def levels():
+    # One repeat per timing and 10 random poses per model pair: the answers
+    # and counts are what is tested here, not the times.
+    return measure_levels(repeats=1, random_per_pair=10, seed=0)
+
+
+@pytest.fixture
+def fcl(oracle):
+    return oracle(FCLOracle)
+
+
+@pytest.fixture
+def trimesh_oracle(oracle):
+    return oracle(TrimeshCollisionOracle)
+
+
+def trimesh_body_oracle(tm):
+    return BodyOracle("trimesh", tm.bodies_collide, pose_used=tm.pose_used,
+                      is_solid=tm.uses_convex)
+
+
+# -- known answers ---------------------------------------------------------------------
+
+def test_expected_table_covers_every_configuration():
+    assert set(EXPECTED) == {c.name for c in CONFIGURATIONS}
+
+
+@pytest.mark.parametrize("method", ["bvh", "seed"])
+@pytest.mark.parametrize("config", CONFIGURATIONS, ids=lambda c: c.name)
+def test_constructed_configurations(config, method):
+    (mesh_a, mesh_b), (pose_a, pose_b) = config.meshes(), config.poses()
+    got = answers(mesh_a, pose_a, mesh_b, pose_b, method=method)
+    assert got == EXPECTED[config.name]
+    assert got["exact"] == config.intended
+
+
+def test_cubes_sharing_a_face_touch():
+    cube = bundled_mesh("cube")
+    assert answers(cube, IDENTITY, cube, at(1.0)) == level_answers(True, True, True, True)
+    # The touching pairs are the faces on x = 0.5 of A and x = -0.5 of B (two
+    # triangles each, coplanar) and the side faces meeting along that square.
+    pairs = intersecting_pairs(cube, IDENTITY, cube, at(1.0))
+    world_a = cube.vertices[cube.faces[pairs[:, 0]]]
+    world_b = cube.vertices[cube.faces[pairs[:, 1]]] + [1.0, 0.0, 0.0]
+    # every reported pair has a point on the shared plane x = 0.5
+    assert (world_a[:, :, 0] == 0.5).any(axis=1).all()
+    assert (world_b[:, :, 0] == 0.5).any(axis=1).all()
+    np.testing.assert_array_equal(pairs, intersecting_pairs(cube, IDENTITY, cube, at(1.0),
+                                                            method="seed"))
+
+
+def test_cubes_one_float_apart_do_not_touch():
+    cube = bundled_mesh("cube")
+    # The next double after 1: B's face is at -0.5 + (1 + 2**-52) = 0.5 + 2**-52
+    # (exact), so even the boxes are apart; only the spheres still overlap.
+    gap = np.nextafter(1.0, 2.0)
+    assert answers(cube, IDENTITY, cube, at(gap)) == level_answers(True, False, False, False)
+
+
+def test_cubes_sharing_a_corner_touch():
+    cube = bundled_mesh("cube")
+    assert answers(cube, IDENTITY, cube, at(1.0, 1.0, 1.0)) == level_answers(True, True, True,
+                                                                             True)
+    # All pairs meet at the one corner (0.5, 0.5, 0.5).
+    pairs = intersecting_pairs(cube, IDENTITY, cube, at(1.0, 1.0, 1.0))
+    assert len(pairs) > 0
+    corner = np.array([0.5, 0.5, 0.5])
+    for i, j in pairs:
+        assert (cube.vertices[cube.faces[i]] == corner).all(axis=1).any()
+        assert (cube.vertices[cube.faces[j]] + 1.0 == corner).all(axis=1).any()
+
+
+def test_containment_is_not_a_collision_for_refsim():
+    # A cube of side 0.5 at the centre of the unit cube: the surfaces are 0.25
+    # apart everywhere. The coarse levels say "collide" (their volumes
+    # overlap); the exact level, which intersects surfaces, says no.
+    cube, small = bundled_mesh("cube"), bundled_mesh("cube", 0.5)
+    assert answers(cube, IDENTITY, small, IDENTITY) == level_answers(True, True, False, False)
+
+
+@pytest.mark.oracle
+def test_containment_collides_for_trimesh(trimesh_oracle):
+    # Documented difference: trimesh makes both convex cubes fcl.Convex solids,
+    # so the small one inside the big one collides; refsim says False.
+    cube, small = bundled_mesh("cube"), bundled_mesh("cube", 0.5)
+    assert trimesh_oracle.bodies_collide(cube, IDENTITY, small, IDENTITY) is True
+    kind = classify_body_disagreement(cube, IDENTITY, small, IDENTITY, False,
+                                      trimesh_body_oracle(trimesh_oracle))
+    assert kind == "containment"
+
+
+@pytest.mark.oracle
+def test_containment_in_a_non_convex_body_is_not_found_by_trimesh(trimesh_oracle):
+    # The torus is a surface (BVHModel) for trimesh: a cube in its hole does
+    # not collide there either.
+    config = next(c for c in CONFIGURATIONS if c.name == "cube-in-torus-hole")
+    (torus, cube), (pose_a, pose_b) = config.meshes(), config.poses()
+    assert trimesh_oracle.uses_convex(torus) is False
+    assert trimesh_oracle.bodies_collide(torus, pose_a, cube, pose_b) is False
+
+
+def test_solid_contains():
+    cube = bundled_mesh("cube")
+    assert solid_contains(cube, IDENTITY, [0.1, -0.2, 0.3]) is True
+    assert solid_contains(cube, IDENTITY, [0.6, 0.0, 0.0]) is False
+    torus = bundled_mesh("torus")
+    assert solid_contains(torus, IDENTITY, [1.0, 0.0, 0.0]) is True     # in the tube
+    assert solid_contains(torus, IDENTITY, [0.0, 0.0, 0.0]) is False    # in the hole
+
+
+# -- the classifier ----------------------------------------------------------------------
+
+@pytest.mark.oracle
+def test_float32_transform_is_classified(trimesh_oracle):
+    # Two L-beams (non-convex: BVHModels for trimesh) a gap of 2**-30 apart
+    # along z. float32(0.5 + 2**-30) == 0.5: trimesh sees them touching.
+    beam = bundled_mesh("l-beam")
+    pose_b = at(0.0, 0.0, 0.5 + 2.0 ** -30)
+    assert bodies_collide(beam, IDENTITY, beam, pose_b) is False
+    assert bodies_collide(beam, IDENTITY, beam, float32_pose(pose_b)) is True
+    assert trimesh_oracle.bodies_collide(beam, IDENTITY, beam, pose_b) is True
+    kind = classify_body_disagreement(beam, IDENTITY, beam, pose_b, False,
+                                      trimesh_body_oracle(trimesh_oracle))
+    assert kind == "float32 transform"
+
+
+@pytest.mark.oracle
+def test_touching_cubes_are_classified(trimesh_oracle):
+    cube = bundled_mesh("cube")
+    assert trimesh_oracle.bodies_collide(cube, IDENTITY, cube, at(1.0)) is False
+    kind = classify_body_disagreement(cube, IDENTITY, cube, at(1.0), True,
+                                      trimesh_body_oracle(trimesh_oracle))
+    assert kind == "touching"
+
+
+def test_tolerance_and_bug_classes():
+    # An engine that always says "apart": on cubes overlapping by 2**-24 it is
+    # within tolerance (moving B away by 1e-6 separates them); on cubes
+    # overlapping by 0.25 it is a bug.
+    apart = BodyOracle("apart", lambda *args: False)
+    cube = bundled_mesh("cube")
+    shallow = at(0.25, 0.125, 1.0 - 2.0 ** -24)
+    assert classify_body_disagreement(cube, IDENTITY, cube, shallow, True, apart) == "tolerance"
+    deep = at(0.25, 0.125, 0.75)
+    assert classify_body_disagreement(cube, IDENTITY, cube, deep, True, apart) == "bug"
+    # An engine that always says "collide" on bodies 0.5 apart: a bug.
+    always = BodyOracle("always", lambda *args: True)
+    assert classify_body_disagreement(cube, IDENTITY, cube, at(1.5), False, always) == "bug"
+
+
+# -- the measurement ---------------------------------------------------------------------
+
+def test_no_false_negatives(levels):
+    assert levels.false_negatives == 0
+    for s in levels.summary:
+        assert s.false_negatives == 0, s.level
+    for r in levels.random:
+        assert all(count == 0 for count in r.false_negatives.values()), r
+    assert levels.level("exact").false_positives == 0
+
+
+def test_coarse_levels_have_false_positives(levels):
+    # Each coarse level answers "collide" on some configuration where the
+    # surfaces do not meet (so C3's trade is real), and finer box levels
+    # never have more false positives than coarser box levels.
+    fp = {s.level: s.false_positives for s in levels.summary}
+    assert fp["sphere"] > 0 and fp["aabb"] > 0 and fp["triangle-aabb"] > 0
+    assert fp["aabb"] >= fp["triangle-aabb"] >= fp["exact"] == 0
+
+
+def test_measured_configurations(levels):
+    for c in levels.configurations:
+        assert c.answers == EXPECTED[c.name], c.name
+        assert c.seed_answers_equal, c.name
+        assert c.exact_pairs <= c.candidate_pairs
+        assert (c.exact_pairs > 0) == c.answers["exact"]
+        assert all(t > 0 for t in c.seconds.values())
+    for r in levels.random:
+        assert r.seed_mismatches == 0
+        assert r.exact_pairs <= r.candidate_pairs
+
+
+def test_levels_are_deterministic():
+    a = measure_levels(CONFIGURATIONS[:2], repeats=1, random_per_pair=3, seed=5)
+    b = measure_levels(CONFIGURATIONS[:2], repeats=1, random_per_pair=3, seed=5)
+    assert a.random == b.random
+    assert [c.answers for c in a.configurations] == [c.answers for c in b.configurations]
+
+
+@pytest.mark.oracle
+def test_oracle_agreement_has_no_bug(fcl, trimesh_oracle):
+    result = measure_body_oracles(
+        (BodyOracle("fcl", fcl.collide), trimesh_body_oracle(trimesh_oracle)),
+        fcl.intersecting_pairs, random_per_pair=10, seed=0)
+    for b in result.bodies:
+        print(f"\n{b.oracle} {b.source}: n={b.n} agree={b.agree} {b.counts}")
+    for p in result.pairs:
+        print(f"\nfcl pairs {p.source}: {p.queries_equal}/{p.queries} equal {p.counts}")
+    assert result.bugs == 0
+    # FCL (two BVHModels: surfaces, like refsim) agrees on every query.
+    for p in result.pairs:
+        assert p.queries_equal == p.queries
+    for source in ("constructed", "random"):
+        assert result.body("fcl", source).agree == result.body("fcl", source).n
+    # trimesh on the constructed configurations: exactly the documented cases.
+    found = {(d.case, d.kind) for d in result.body("trimesh", "constructed").disagreements}
+    assert found == {("cubes-face", "touching"), ("cubes-corner", "touching"),
+                     ("icosahedron-in-sphere", "containment"),
+                     ("cube-in-cube", "containment")}
+    random = result.body("trimesh", "random")
+    assert set(d.kind for d in random.disagreements) <= {"containment", "touching",
+                                                         "float32 transform", "tolerance"}
+
+
+# -- the benchmark configurations --------------------------------------------------------
+
+@pytest.mark.oracle
+def test_speed_configurations_are_what_they_say(fcl):
+    speed = measure_hierarchy_speed(fcl, repeats=1, compile_cost=False)
+    assert len(speed.cases) == len(SPEED_CONFIGURATIONS)
+    for c in speed.cases:
+        assert c.fcl_pairs == c.exact_pairs
+        assert c.seed_seconds > 0 and c.bvh_seconds > 0 and c.fcl_seconds > 0
+        if c.kind == "separated-boxes-overlap":
+            assert c.exact_pairs == 0 and c.candidate_pairs > 0
+        elif c.kind == "grazing":
+            assert 1 <= c.exact_pairs <= 50        # "a handful" (measured: 18, 20)
+        else:
+            assert c.exact_pairs >= 100            # "hundreds" (measured: 198, 264)
