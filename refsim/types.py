@@ -22,6 +22,8 @@ ORTHONORMAL_TOL = 1e-6
 
 IDENTITY_POSE: Pose = (np.eye(3), np.zeros(3))
 
+_EYE = np.eye(3)
+
 
 def as_pose(pose, *, what: str = "pose") -> Pose:
     """Check a pose and return it as two float64 arrays.
@@ -41,9 +43,13 @@ def as_pose(pose, *, what: str = "pose") -> Pose:
     if rotation.shape != (3, 3) or translation.shape != (3,):
         raise StateError(f"{what}: expected shapes (3, 3) and (3,), got "
                          f"{rotation.shape} and {translation.shape}")
-    if not (np.isfinite(rotation).all() and np.isfinite(translation).all()):
-        raise StateError(f"{what}: non-finite value")
-    if np.abs(rotation.T @ rotation - np.eye(3)).max() > ORTHONORMAL_TOL:
+    # One reduction checks orthonormality and, for free, finiteness: a NaN or
+    # infinity in the rotation makes the Gram matrix's error NaN or infinite,
+    # and NaN fails every comparison. The message is chosen only on failure.
+    error = np.abs(rotation.T @ rotation - _EYE).max()
+    if not (error <= ORTHONORMAL_TOL and np.isfinite(translation).all()):
+        if not (np.isfinite(rotation).all() and np.isfinite(translation).all()):
+            raise StateError(f"{what}: non-finite value")
         raise StateError(f"{what}: rotation is not orthonormal")
     return rotation, translation
 
