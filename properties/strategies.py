@@ -417,8 +417,9 @@ def wall_hit_scenes(draw):
 
     The body (cube, tetrahedron or icosahedron; mass and rotation random) sits
     with its lowest vertex above the floor of a 4 m cube by at most 40 % of
-    what one step covers, and moves down at 0.5 to 8 m/s, with any spin and lateral velocity; the rotation
-    model is "impulse", gravity on or off, restitution and friction random.
+    what one step covers, and moves down at 0.5 to 8 m/s, with any spin and
+    lateral velocity; the rotation model is "impulse", gravity on or off,
+    restitution and friction random.
     """
     model = draw(_st.sampled_from(["cube.ac", "tetrahedron.ac", "icosahedron.ac"]))
     R = draw(rotations(kinds=("random", "identity", "signed-permutation")))

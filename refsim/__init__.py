@@ -44,6 +44,9 @@ _EXPORTS = {
     "FixedStepResult": "refsim.solvers.integrate",
     "ParticleConfig": "refsim.particles.config",
     "ParticleSystem": "refsim.particles.system",
+    "simulate": "refsim.dynamics.simulation",
+    "Simulation": "refsim.dynamics.simulation",
+    "Trajectory": "refsim.dynamics.trajectory",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -46,7 +46,8 @@ def as_pose(pose, *, what: str = "pose") -> Pose:
     # One reduction checks orthonormality and, for free, finiteness: a NaN or
     # infinity in the rotation makes the Gram matrix's error NaN or infinite,
     # and NaN fails every comparison. The message is chosen only on failure.
-    error = np.abs(rotation.T @ rotation - _EYE).max()
+    with np.errstate(invalid="ignore", over="ignore"):   # bad input raises below
+        error = np.abs(rotation.T @ rotation - _EYE).max()
     if not (error <= ORTHONORMAL_TOL and np.isfinite(translation).all()):
         if not (np.isfinite(rotation).all() and np.isfinite(translation).all()):
             raise StateError(f"{what}: non-finite value")

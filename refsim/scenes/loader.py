@@ -3,7 +3,8 @@
 ``load_scene(path)`` parses TOML with the standard library's ``tomllib``,
 checks every key against :mod:`refsim.scenes.schema`, resolves each body's
 model (relative to the scene file first, then the bundled ``models/``), loads
-each distinct model once, and returns a frozen :class:`Scene`.
+each distinct model once, builds the particle configuration of a
+``[particles]`` table, and returns a frozen :class:`Scene`.
 
 Every mistake is a :class:`~refsim.errors.SceneError` whose message names the
 file and the key path (``world.restitution``, ``body[1].position``); a broken
@@ -24,9 +25,12 @@ from refsim.paths import models_dir
 from refsim.scenes.schema import (
     BODY_FIELDS,
     MAX_STEPS,
+    PARTICLE_FIELDS_FROM,
+    PARTICLE_KEYS,
     TABLES,
     BodyConfig,
     Field,
+    ParticleConfig,
     Scene,
 )
 
@@ -50,7 +54,7 @@ def load_scene(path) -> Scene:
 def scene_from_dict(data: dict, path: Path | None = None) -> Scene:
     """Validate an already parsed scene (``path`` is for messages and for
     resolving relative model paths; None resolves against the bundled models)."""
-    known = set(TABLES) | {"body"}
+    known = set(TABLES) | {"body", "particles"}
     for key in data:
         if key not in known:
             raise SceneError(f"unknown key (expected one of {', '.join(sorted(known))})",
@@ -83,11 +87,49 @@ def scene_from_dict(data: dict, path: Path | None = None) -> Scene:
     for i, name in enumerate(names):
         if name in names[:i]:
             raise SceneError(f"duplicate body name {name!r}", path, f"body[{i}].name")
-    if not bodies:
-        raise SceneError("a scene needs at least one [[body]]", path, "body")
+    particles = None
+    if "particles" in data:
+        particles = _particle_config(data["particles"], configs, path)
+    if not bodies and particles is None:
+        raise SceneError("a scene needs at least one [[body]] or a [particles] table",
+                         path, "body")
 
     meshes = _load_meshes(bodies)
-    return Scene(path=path, bodies=tuple(bodies), meshes=meshes, **configs)
+    return Scene(path=path, bodies=tuple(bodies), meshes=meshes, particles=particles,
+                 **configs)
+
+
+def _particle_config(raw, configs: dict, path) -> ParticleConfig:
+    """The ParticleConfig of a ``[particles]`` table, with the world's forces
+    and cube and the integration's solver and step (schema.PARTICLE_FIELDS_FROM).
+
+    Values are validated by ParticleConfig itself; its errors name
+    ``particles.<field>`` (or the ``world.``/``integration.`` key the field
+    came from) and get the file added here.
+    """
+    if not isinstance(raw, dict):
+        raise SceneError("must be a table", path, "particles")
+    for key in raw:
+        if key in PARTICLE_FIELDS_FROM:
+            raise SceneError(f"set in [{PARTICLE_FIELDS_FROM[key].split('.')[0]}] "
+                             f"({PARTICLE_FIELDS_FROM[key]}), not in [particles]",
+                             path, f"particles.{key}")
+        if key not in PARTICLE_KEYS:
+            raise SceneError(f"unknown key (expected one of {', '.join(PARTICLE_KEYS)})",
+                             path, f"particles.{key}")
+    values = dict(raw)
+    for key in ("box_lo", "box_hi"):
+        if key in values:   # element-wise messages: particles.box_lo[1]
+            values[key] = _convert(values[key], "vec3", path, f"particles.{key}")
+    for name, scene_key in PARTICLE_FIELDS_FROM.items():
+        table, table_key = scene_key.split(".")
+        values[name] = getattr(configs[table], table_key)
+    try:
+        return ParticleConfig(**values)
+    except SceneError as exc:
+        field = (exc.key or "").removeprefix("particles.")
+        raise SceneError(exc.message, path,
+                         PARTICLE_FIELDS_FROM.get(field, exc.key)) from None
 
 
 def _read_fields(raw: dict, fields: tuple[Field, ...], where: str, path) -> dict:

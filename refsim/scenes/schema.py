@@ -1,14 +1,26 @@
 """The scene file schema (seed S11: "fully configurable simulation script files").
 
 A scene is a TOML file with the tables ``[world]``, ``[integration]``,
-``[collision]``, ``[dynamics]`` and an array ``[[body]]`` (DESIGN.md, Scene
-files). This module declares every key once: its type, default and allowed
+``[collision]``, ``[dynamics]``, an array ``[[body]]`` (DESIGN.md, Scene
+files) and an optional ``[particles]`` table (S10); it needs at least one
+body or the particles table. This module declares every key once: its type, default and allowed
 range, as :class:`Field` rows. :mod:`refsim.scenes.loader` walks a parsed file
 against these rows; an unknown key, a wrong type or a value out of range is a
 :class:`~refsim.errors.SceneError` naming the file and the key path.
 
 The configuration objects are frozen dataclasses, so a loaded scene cannot
 change under a running simulation.
+
+Particles. A particle system is configured by
+:class:`refsim.particles.config.ParticleConfig`, and each of its fields is set
+in exactly one table, never two: the forces and the cube come from
+``[world]`` (:data:`PARTICLE_FIELDS_FROM`: gravity, drag, drag_model,
+restitution, friction, half_size), the solver and step from ``[integration]``
+(solver, step; ``duration`` is how long ``refsim run`` simulates), and the
+rest from ``[particles]`` (:data:`PARTICLE_KEYS`: count, seed, box_lo, box_hi,
+speed_min, speed_max, mass, walls). So bodies and particles in one scene
+share one world and one solver. The values of ``[particles]`` are checked by
+``ParticleConfig`` itself, which names the key ``particles.<field>``.
 """
 
 from __future__ import annotations
@@ -19,6 +31,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+from refsim.particles.config import ParticleConfig
 
 SOLVER_NAMES = ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4")
 COLLISION_LEVELS = ("none", "sphere", "aabb", "triangle-aabb", "exact")
@@ -85,7 +99,12 @@ class BodyConfig:
 
 @dataclass(frozen=True)
 class Scene:
-    """A validated scene. ``meshes`` maps each model path to its loaded mesh."""
+    """A validated scene. ``meshes`` maps each model path to its loaded mesh.
+
+    ``particles`` is the complete particle configuration (``[particles]``
+    with ``[world]`` and ``[integration]`` filled in), or None when the scene
+    has no ``[particles]`` table.
+    """
 
     path: Path | None
     world: WorldConfig = field(default_factory=WorldConfig)
@@ -94,6 +113,7 @@ class Scene:
     dynamics: DynamicsConfig = field(default_factory=DynamicsConfig)
     bodies: tuple[BodyConfig, ...] = ()
     meshes: dict = field(default_factory=dict, compare=False, repr=False)
+    particles: ParticleConfig | None = None
 
     def mesh(self, body: BodyConfig):
         """The loaded mesh of ``body`` (shared between bodies of one model)."""
@@ -185,3 +205,21 @@ BODY_FIELDS: tuple[Field, ...] = (
     Field("mass", "float", 1.0, positive),
     Field("scale", "float", 1.0, positive),
 )
+
+#: ParticleConfig fields that other tables set, and the scene key of each.
+#: A particle system lives in the scene's world and uses the scene's solver.
+PARTICLE_FIELDS_FROM: dict[str, str] = {
+    "gravity": "world.gravity",
+    "drag": "world.drag",
+    "drag_model": "world.drag_model",
+    "restitution": "world.restitution",
+    "friction": "world.friction",
+    "half_size": "world.half_size",
+    "solver": "integration.solver",
+    "step": "integration.step",
+}
+
+#: The keys of ``[particles]``: every other ParticleConfig field, with its
+#: default from ParticleConfig.
+PARTICLE_KEYS: tuple[str, ...] = tuple(
+    name for name in ParticleConfig.field_names() if name not in PARTICLE_FIELDS_FROM)
