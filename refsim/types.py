@@ -43,12 +43,14 @@ def as_pose(pose, *, what: str = "pose") -> Pose:
     if rotation.shape != (3, 3) or translation.shape != (3,):
         raise StateError(f"{what}: expected shapes (3, 3) and (3,), got "
                          f"{rotation.shape} and {translation.shape}")
-    # One reduction checks orthonormality and, for free, finiteness: a NaN or
-    # infinity in the rotation makes the Gram matrix's error NaN or infinite,
-    # and NaN fails every comparison. The message is chosen only on failure.
-    with np.errstate(invalid="ignore", over="ignore"):   # bad input raises below
-        error = np.abs(rotation.T @ rotation - _EYE).max()
-    if not (error <= ORTHONORMAL_TOL and np.isfinite(translation).all()):
+    # Entries of an orthonormal matrix are at most 1 in magnitude; checking
+    # that first rejects NaN (which fails every comparison), infinities and
+    # huge values before the Gram product, which then cannot overflow. The
+    # message is chosen only on failure.
+    ok = np.abs(rotation).max() <= 1.0 + ORTHONORMAL_TOL
+    if ok:
+        ok = np.abs(rotation.T @ rotation - _EYE).max() <= ORTHONORMAL_TOL
+    if not (ok and np.isfinite(translation).all()):
         if not (np.isfinite(rotation).all() and np.isfinite(translation).all()):
             raise StateError(f"{what}: non-finite value")
         raise StateError(f"{what}: rotation is not orthonormal")
