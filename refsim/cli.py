@@ -35,6 +35,11 @@ EXIT_DIVERGED = 3
 #: are 96 MB of float64.
 DEFAULT_FRAMES = 200
 
+#: ``refsim run`` refuses to store more frame data than this (positions and
+#: velocities, 48 bytes a particle a frame) and asks for a larger ``--every``:
+#: the frames are held in memory until the file is written.
+MAX_FRAME_BYTES = 4 * 10**9
+
 
 def _info(args) -> int:
     from refsim.models.facts import describe, format_facts
@@ -184,6 +189,11 @@ def _run(args) -> int:
         raise RefsimError(f"--every must be at least 1, got {args.every}")
     else:
         every = args.every
+    n_frames = math.ceil(n_steps / every) + 1
+    if n_frames * config.count * 48 > MAX_FRAME_BYTES:
+        raise RefsimError(f"{n_frames} frames of {config.count} particles would take "
+                          f"{n_frames * config.count * 48 / 1e9:.1f} GB; store fewer with "
+                          f"--every (at most {MAX_FRAME_BYTES / 1e9:g} GB)")
     out = Path(args.output) if args.output else Path(Path(args.scene).stem + ".npz")
     if not out.parent.is_dir():
         raise RefsimError(f"{out}: cannot write: no directory {out.parent}")

@@ -1,0 +1,233 @@
+"""``refsim run``: a particle scene's frames in an .npz; one line for a mistake,
+a diverging run or a rigid-body scene; never a partial file."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from refsim.cli import EXIT_DIVERGED, EXIT_USER_ERROR, main
+from refsim.particles.config import ParticleConfig
+from refsim.paths import SCENES_DIR
+
+TINY = """
+[world]
+half_size = 1.0
+drag = 0.1
+restitution = 0.7
+friction = 0.2
+
+[integration]
+solver = "rk4"
+step = 0.01
+duration = 1.0
+
+[particles]
+count = 12
+seed = 5
+box_lo = [-0.5, -0.5, -0.5]
+box_hi = [0.5, 0.5, 0.5]
+speed_min = 1.0
+speed_max = 4.0
+"""
+
+#: Quadratic drag k/m = 50 with speeds of 5 m/s and a 0.1 s Euler step:
+#: h k |v| / m = 25, far outside Euler's stable h k/m <= 2; the speed squares
+#: every step and overflows within ten steps.
+DIVERGING = """
+[world]
+drag = 50.0
+drag_model = "quadratic"
+
+[integration]
+solver = "euler"
+step = 0.1
+duration = 10.0
+
+[particles]
+count = 5
+speed_min = 5.0
+"""
+
+
+def write(tmp_path, text, name="scene.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def files(directory):
+    return sorted(p.name for p in directory.iterdir())
+
+
+def test_run_writes_the_frames(tmp_path, capsys):
+    scene = write(tmp_path, TINY)
+    out = tmp_path / "out.npz"
+    assert main(["run", str(scene), "-o", str(out), "--every", "10"]) == 0
+    assert "wrote" in capsys.readouterr().out
+    with np.load(out) as data:
+        t, position, velocity = data["t"], data["position"], data["velocity"]
+        settings = json.loads(str(data["scene"]))
+        status = str(data["status"])
+        step = data["step"]
+    # 100 steps, every 10th stored, plus the initial state
+    assert t.shape == (11,) and position.shape == (11, 12, 3) and velocity.shape == (11, 12, 3)
+    assert np.array_equal(step, np.arange(0, 101, 10))
+    assert np.allclose(t, step * 0.01, rtol=0, atol=1e-15) and t[-1] == pytest.approx(1.0)
+    assert position.dtype == np.float64 and velocity.dtype == np.float64
+    assert status == "complete"
+    # the first frame is the configured initial state, bit for bit
+    config = ParticleConfig(**settings["particles"])
+    x0, v0 = config.initial_state()
+    assert np.array_equal(position[0], x0) and np.array_equal(velocity[0], v0)
+    # the wall response keeps every particle inside the closed cube
+    assert np.abs(position).max() <= 1.0
+    assert settings["world"]["half_size"] == 1.0 and settings["integration"]["solver"] == "rk4"
+    assert settings["every"] == 10
+    assert files(tmp_path) == ["out.npz", "scene.toml"]
+
+
+def test_default_stride_stores_about_200_frames(tmp_path):
+    scene = write(tmp_path, TINY.replace("step = 0.01", "step = 0.001"))   # 1000 steps
+    out = tmp_path / "out.npz"
+    assert main(["run", str(scene), "-o", str(out)]) == 0
+    with np.load(out) as data:
+        t, step = data["t"], data["step"]
+    assert 100 <= len(t) <= 200
+    assert step[0] == 0 and step[-1] == 1000       # the last step is always stored
+
+
+def test_frames_match_the_particle_system(tmp_path):
+    from refsim.particles.system import ParticleSystem
+    from refsim.scenes.loader import load_scene
+
+    scene = write(tmp_path, TINY)
+    out = tmp_path / "out.npz"
+    assert main(["run", str(scene), "-o", str(out), "--every", "30"]) == 0
+    system = ParticleSystem(load_scene(scene).particles)
+    system.run(100)
+    with np.load(out) as data:
+        assert list(data["step"]) == [0, 30, 60, 90, 100]
+        assert np.array_equal(data["position"][-1], system.positions)
+        assert np.array_equal(data["velocity"][-1], system.velocities)
+
+
+def test_bundled_particle_scene_is_runnable(tmp_path):
+    # The bundled scene, shortened to 20 steps: the same tables, the same checks.
+    text = (SCENES_DIR / "particles.toml").read_text().replace("duration = 4.0",
+                                                               "duration = 0.04")
+    out = tmp_path / "p.npz"
+    assert main(["run", str(write(tmp_path, text)), "-o", str(out)]) == 0
+    with np.load(out) as data:
+        assert data["position"].shape == (21, 10_000, 3)
+
+
+def test_a_bad_scene_is_one_line_and_no_file(tmp_path, capsys):
+    scene = write(tmp_path, TINY.replace("count = 12", "count = 0"))
+    out = tmp_path / "out.npz"
+    assert main(["run", str(scene), "-o", str(out)]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "particles.count" in err and str(scene) in err
+    assert "Traceback" not in err
+    assert files(tmp_path) == ["scene.toml"]
+
+
+def test_a_rigid_body_scene_is_not_run_yet(tmp_path, capsys):
+    out = tmp_path / "out.npz"
+    assert main(["run", str(SCENES_DIR / "bounce.toml"), "-o", str(out)]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "rigid-body simulation is not implemented yet (issue 6)" in err
+    assert files(tmp_path) == []
+
+
+def test_a_duration_that_is_not_whole_steps_names_the_key(tmp_path, capsys):
+    scene = write(tmp_path, TINY.replace("duration = 1.0", "duration = 1.005"))
+    assert main(["run", str(scene), "-o", str(tmp_path / "out.npz")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "integration.duration" in err
+    assert files(tmp_path) == ["scene.toml"]
+
+
+def test_every_must_be_positive(tmp_path, capsys):
+    scene = write(tmp_path, TINY)
+    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz"), "--every", "0"]) == \
+        EXIT_USER_ERROR
+    assert "--every" in capsys.readouterr().err
+    assert files(tmp_path) == ["scene.toml"]
+
+
+def test_a_missing_output_directory_is_one_line(tmp_path, capsys):
+    scene = write(tmp_path, TINY)
+    out = tmp_path / "absent" / "out.npz"
+    assert main(["run", str(scene), "-o", str(out)]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot write" in err
+
+
+def test_divergence_names_step_and_time_and_keeps_the_frames(tmp_path, capsys):
+    scene = write(tmp_path, DIVERGING)
+    out = tmp_path / "out.npz"
+    assert main(["run", str(scene), "-o", str(out), "--every", "3"]) == EXIT_DIVERGED
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err and "warning" not in err
+    assert "diverged at step" in err and "t = " in err and str(out) in err
+    with np.load(out) as data:
+        step, position, status = data["step"], data["position"], str(data["status"])
+    diverged_at = int(err.split("diverged at step ", 1)[1].split(",", 1)[0])
+    assert status.startswith(f"diverged at step {diverged_at}")
+    # every stored frame is finite and before the divergence, at the stride
+    assert np.isfinite(position).all() and step[-1] < diverged_at
+    assert list(step) == list(range(0, step[-1] + 1, 3))
+    assert diverged_at - step[-1] <= 3
+    assert files(tmp_path) == ["out.npz", "scene.toml"]
+
+
+def test_an_interrupted_write_leaves_no_file(tmp_path, monkeypatch):
+    import refsim.cli as cli
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(np, "savez", interrupted)
+    scene = write(tmp_path, TINY)
+    out = tmp_path / "out.npz"
+    assert cli.main(["run", str(scene), "-o", str(out)]) == 130
+    assert files(tmp_path) == ["scene.toml"]
+
+
+def test_an_existing_output_survives_a_failed_run(tmp_path):
+    scene = write(tmp_path, TINY.replace("count = 12", "count = -3"))
+    out = tmp_path / "out.npz"
+    out.write_bytes(b"old")
+    assert main(["run", str(scene), "-o", str(out)]) == EXIT_USER_ERROR
+    assert out.read_bytes() == b"old"
+
+
+def test_console_script_run(tmp_path):
+    scene = write(tmp_path, TINY)
+    result = subprocess.run([sys.executable, "-m", "refsim.cli", "run", str(scene), "-o",
+                             str(tmp_path / "o.npz")], capture_output=True, text=True)
+    assert result.returncode == 0 and result.stderr == ""
+    assert result.stdout.startswith("wrote ")
+
+
+def test_a_scene_with_bodies_and_particles_is_not_run_yet(tmp_path, capsys):
+    scene = write(tmp_path, TINY + '\n[[body]]\nmodel = "cube.ac"\n')
+    assert main(["run", str(scene), "-o", str(tmp_path / "out.npz")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "not implemented yet (issue 6)" in err
+    assert files(tmp_path) == ["scene.toml"]
+
+
+def test_too_many_frames_is_refused_before_running(tmp_path, capsys):
+    scene = write(tmp_path, TINY.replace("count = 12", "count = 2000000"))
+    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz"), "--every", "1"]) == \
+        EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--every" in err and "GB" in err
+    assert files(tmp_path) == ["scene.toml"]
