@@ -65,6 +65,8 @@ class MeshFactsOracle(Protocol):
 
     def center_mass(self, vertices, faces) -> np.ndarray: ...
 
+    def moment_inertia(self, vertices, faces, mass: float) -> np.ndarray: ...
+
 
 def pose_matrix(pose) -> np.ndarray:
     """The homogeneous 4x4 of refsim's pose ``(R, t)``."""
@@ -125,3 +127,10 @@ class TrimeshOracle:
 
     def center_mass(self, vertices, faces) -> np.ndarray:
         return np.asarray(self._mesh(vertices, faces).center_mass, dtype=np.float64)
+
+    def moment_inertia(self, vertices, faces, mass: float) -> np.ndarray:
+        """(3, 3) inertia tensor about the centre of mass of the uniform solid
+        of total ``mass`` (trimesh works with a density: converted here)."""
+        mesh = self._mesh(vertices, faces)
+        mesh.density = mass / mesh.volume
+        return np.asarray(mesh.moment_inertia, dtype=np.float64)

@@ -255,9 +255,12 @@ class IncrementalAABB:
     def update(self, pose: Pose) -> tuple[np.ndarray, np.ndarray]:
         """The box ``(lo, hi)`` of the mesh under ``pose``, each (3,)."""
         rotation, translation = as_pose(pose)
-        return self._update_unchecked(rotation, translation)
+        return self.update_unchecked(rotation, translation)
 
-    def _update_unchecked(self, rotation: np.ndarray, translation: np.ndarray):
+    def update_unchecked(self, rotation: np.ndarray, translation: np.ndarray):
+        """:meth:`update` without the pose check, for a loop whose poses are
+        known to be finite float64 (3, 3) orthonormal and (3,) (the check
+        costs more than the compiled update itself)."""
         if self.kernel == "numba":
             return self._update_numba(rotation, translation)
         return self._update_python(rotation, translation)

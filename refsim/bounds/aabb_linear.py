@@ -178,9 +178,12 @@ class LinearAABB:
     def update(self, pose: Pose) -> tuple[np.ndarray, np.ndarray]:
         """The box ``(lo, hi)`` of the mesh under ``pose``, each (3,)."""
         rotation, translation = as_pose(pose)
-        return self._update_unchecked(rotation, translation)
+        return self.update_unchecked(rotation, translation)
 
-    def _update_unchecked(self, rotation, translation):
+    def update_unchecked(self, rotation, translation):
+        """:meth:`update` without the pose check, for a loop whose poses are
+        known to be finite float64 (3, 3) orthonormal and (3,) (the check
+        costs more than the compiled update itself)."""
         if self.kernel == "numpy":
             return aabb_linear_kernel(self._vertices_t, rotation, translation)
         return self._kernel_numba(self._vertices_t, rotation, translation)

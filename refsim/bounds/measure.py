@@ -186,7 +186,7 @@ def measure_update_cost(meshes=None, *, motions=("coherent", "jump"), methods=No
 
 def _time_method(mesh, method, motion, poses, frames, repeats) -> UpdateCost:
     tracker = make_method(mesh, method)
-    update = tracker._update_unchecked
+    update = tracker.update_unchecked
     update(*poses[0])  # the tracker's initial full scan (and numba's compile)
     block_times = []
     for rep in range(repeats):
@@ -198,10 +198,10 @@ def _time_method(mesh, method, motion, poses, frames, repeats) -> UpdateCost:
     # The counts, from an untimed replay of the same poses on a twin (reading
     # the counters inside the timed loop would add to the time).
     twin = make_method(mesh, method)
-    twin._update_unchecked(*poses[0])
+    twin.update_unchecked(*poses[0])
     visits, evaluations = [], []
     for rotation, translation in poses[1:frames * repeats + 1]:
-        twin._update_unchecked(rotation, translation)
+        twin.update_unchecked(rotation, translation)
         visits.append(twin.visits)
         evaluations.append(twin.evaluations)
     return UpdateCost(mesh=mesh.name, n_triangles=mesh.n_faces, n_vertices=mesh.n_vertices,
@@ -288,11 +288,11 @@ def measure_incremental_error(meshes=None, *, motion: str = "coherent", frames: 
     for mesh in meshes:
         tracker = IncrementalAABB(mesh, kernel=kernel, allow_nonconvex=True)
         scan = LinearAABB(mesh)
-        tracker._update_unchecked(*poses[0])
+        tracker.update_unchecked(*poses[0])
         deficits, wrong_sides, visits = [], 0, []
         for rotation, translation in poses[1:]:
-            lo_i, hi_i = tracker._update_unchecked(rotation, translation)
-            lo_s, hi_s = scan._update_unchecked(rotation, translation)
+            lo_i, hi_i = tracker.update_unchecked(rotation, translation)
+            lo_s, hi_s = scan.update_unchecked(rotation, translation)
             extent = hi_s - lo_s
             outward = np.concatenate([(lo_i - lo_s) / extent, (hi_s - hi_i) / extent])
             wrong_sides += int((outward != 0.0).sum())

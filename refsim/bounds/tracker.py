@@ -31,6 +31,9 @@ class AABBTracker(Protocol):
 
     def update(self, pose: Pose) -> tuple[np.ndarray, np.ndarray]: ...
 
+    def update_unchecked(self, rotation: np.ndarray,
+                         translation: np.ndarray) -> tuple[np.ndarray, np.ndarray]: ...
+
 
 def make_aabb_tracker(mesh: Mesh, mode: str = "auto", *, kernel: str | None = None
                       ) -> AABBTracker:

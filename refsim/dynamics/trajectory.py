@@ -8,7 +8,10 @@ Shapes, for F frames and B bodies:
 - ``t`` (F,): time of each frame, seconds;
 - ``position``, ``velocity``, ``angular_velocity`` (F, B, 3): the body's
   reference point (its mesh's origin), its velocity, and its angular velocity
-  in radians per second, world frame;
+  in radians per second, world frame (refsim's loop reports the velocity of
+  the body's centroid, the seed's Vel; for a mesh whose centroid is its
+  origin, as for every bundled model but the l-beam and the star, the two
+  coincide);
 - ``orientation`` (F, B, 3, 3): columns are the body's axes in world space.
 
 ``events`` lists wall hits and body contacts. ``stages`` names the stages of

@@ -33,7 +33,7 @@ def _method_or_skip(mesh, method):
     if method.endswith("numba") and not numba_available():
         pytest.skip("numba (extra 'fast') not installed")
     tracker = make_method(mesh, method)
-    tracker._update_unchecked(*POSES[0])  # the tracker's first scan; numba's compile
+    tracker.update_unchecked(*POSES[0])  # the tracker's first scan; numba's compile
     return tracker
 
 
@@ -43,7 +43,7 @@ def test_bench_aabb_update(benchmark, triangles, method):
     mesh = shapes.geodesic_sphere(FREQUENCIES[triangles])
     tracker = _method_or_skip(mesh, method)
     frames = itertools.cycle(POSES[1:] + POSES[:1])
-    update = tracker._update_unchecked
+    update = tracker.update_unchecked
 
     def one_frame():
         return update(*next(frames))

@@ -1,0 +1,426 @@
+"""pybullet as the oracle for wall bounces: the same scene, run by Bullet.
+
+pybullet (E. Coumans and Y. Bai, https://pybullet.org; Bullet's
+``btSequentialImpulseConstraintSolver``, a projected Gauss-Seidel solver of
+velocity-level contact constraints, E. Catto, "Iterative Dynamics with
+Temporal Coherence", GDC 2005) is an independent rigid-body engine. Here it
+runs a refsim :class:`~refsim.scenes.schema.Scene`: the world cube's six walls
+as static boxes, each body as the convex hull of its mesh with its true mass
+properties, gravity along -y, the scene's time step. The result is a
+:class:`~refsim.dynamics.trajectory.Trajectory`, frame for frame comparable
+with ``refsim.simulate``.
+
+Conventions converted here and nowhere else
+-------------------------------------------
+
+- Frames: refsim's orientation is a 3x3 matrix whose columns are the body's
+  axes; pybullet's is a quaternion ``[x, y, z, w]`` (scipy's scalar-last
+  order). pybullet's base pose and velocity are those of the *inertial* frame
+  (centre of mass, principal axes); refsim's are those of the mesh's origin.
+  :meth:`PybulletOracle.simulate` converts both ways:
+  ``R_link = R_inertial R_i^T``, ``p_link = p_com - R_link c`` and
+  ``v_link = v_com + w x (p_link - p_com)``, where ``c`` and ``R_i`` are the
+  centre of mass and principal axes in the mesh frame.
+- Mass properties: pybullet's mesh shapes get the inertia of their bounding
+  box (padded by the margin) unless told otherwise. Each body's principal
+  moments (uniform solid of the body's mass, from trimesh's integrals, see
+  :mod:`oracles.trimesh_adapter`) are passed with ``changeDynamics(mass=...,
+  localInertiaDiagonal=...)``, and its centre of mass and principal axes as
+  ``baseInertialFramePosition/Orientation`` of ``createMultiBody``.
+  :func:`mass_properties` computes them (scale applied).
+- Shape: ``createCollisionShape(GEOM_MESH, vertices=..., meshScale=...)``
+  without indices builds a ``btConvexHullShape`` of the vertices, so a
+  non-convex body (l-beam, star, torus) collides as its convex hull while its
+  mass properties stay those of the mesh's solid. The bounce studies use
+  convex bodies only.
+- Angular velocity is in rad/s in both.
+
+Every setting, and why (:class:`PybulletSettings` holds them)
+--------------------------------------------------------------
+
+- ``useMaximalCoordinates=True``: a single free body is a plain
+  ``btRigidBody``, not a ``btMultiBody``. Measured here (sphere, e = 0.8,
+  h = 1e-3, :func:`refsim.dynamics.bounce.measure_pybullet_settings`): the
+  multibody path returns apex ratios 12% above e^2, the rigid-body path
+  0.04% below.
+- ``setTimeStep(scene.integration.step)``, ``numSubSteps=0``: one Bullet step
+  per refsim step. Bullet integrates semi-implicit (symplectic) Euler:
+  ``v += h F/m`` then ``x += h v``.
+- ``contactProcessingThreshold=0`` (``changeDynamics``, every body and wall):
+  Bullet otherwise hands the solver every contact point within the breaking
+  threshold (0.02 m) and treats those still apart as *speculative*: the
+  approach is stopped so that the gap closes exactly, with no restitution.
+  High bounces are unaffected, but once a bounce travels less than the
+  threshold per step it is swallowed: measured (e = 0.8), the apexes fall
+  below 1e-3 of the drop height after bounce 9 instead of 17 (analytic 16).
+  With 0 a contact is solved only once the shapes touch or overlap, as
+  refsim's wall test does.
+- ``useSplitImpulse=1`` and ``splitImpulsePenetrationThreshold=1e9``: Bullet
+  corrects penetration with a Baumgarte term folded into the velocity (adding
+  energy: ``erp * depth / h`` of extra rebound speed) whenever
+  ``penetration > threshold``; penetration is negative when overlapping, so
+  with Bullet's default threshold (-0.04) every overlap shallower than 4 cm
+  takes the energy-adding path (measured: apex ratios 11% above e^2 without
+  split impulse). A huge positive threshold sends every overlap through the
+  split impulse, a separate pseudo-velocity that moves the body out without
+  changing its velocity. (pybullet ignores negative values of this
+  parameter.)
+- Restitution: Bullet's contact restitution is the *product* of the two
+  bodies' (``btManifoldResult::calculateCombinedRestitution``). Walls get 1,
+  bodies ``scene.world.restitution``, so the product is the scene's ``e``.
+- Friction likewise multiplies (``calculateCombinedFriction``): walls get 1,
+  bodies ``scene.world.friction`` as the Coulomb coefficient ``mu``. This is a
+  different law from the seed's: the seed keeps ``(1 - friction)`` of the
+  lateral velocity at every bounce; Coulomb friction removes at most
+  ``mu (1 + e) |v_n|`` of it and stops at sticking
+  (:mod:`refsim.dynamics.analytic`). Rolling and spinning friction are 0.
+- ``restitutionVelocityThreshold=1e-3`` m/s: below this approach speed Bullet
+  sets the restitution to 0 (an inelastic, resting contact). Bullet's default
+  (0.2 m/s) would end a bounce sequence at apex heights of about 2 mm, where
+  the analytic series still has bounces. 1e-3 m/s keeps the restitution law
+  down to apex heights of 5e-8 m, far below what the studies measure, while a
+  body at rest (approach speed ``g h`` per step, 1e-2 m/s at h = 1e-3 s)
+  still micro-bounces; the bounce study's rest criterion (apexes below 1e-3
+  of the drop height) does not count those. At 0.2 the same first bounces
+  and the same settling bounce are measured; only the micro-bounces stop.
+- ``contactBreakingThreshold``: process-global in pybullet (a static of
+  Bullet's ``gContactBreakingThreshold``), so a value set by one client leaks
+  into every other client in the process. It is set explicitly, to the same
+  value (0.02, Bullet's default), every time a client is configured and before
+  every ``simulate``.
+- Linear and angular damping 0 (``changeDynamics``): pybullet's defaults are
+  0.04, a velocity decay ``(1 - 0.04)^h`` per step that is not in the scene
+  (measured: apex ratios 3.5% below e^2 with it).
+- ``numSolverIterations=50`` (pybullet's default, kept explicit): a single
+  body against a wall converges in a few; 50 covers a cube's four face
+  contacts and the benchmark's many bodies.
+- ``enableConeFriction=1``: asks for a friction cone instead of Bullet's
+  two-direction pyramid. Measured: no effect in this maximal-coordinates
+  rigid-body path (oblique bounces give the same velocities to the last bit
+  with 0 or 1; the option acts in the multibody solver). Harmless here,
+  because Bullet aligns its first friction direction with the sliding
+  velocity, so one sliding contact sees the Coulomb law either way.
+- ``collisionMargin=0`` for the hull shapes (``changeDynamics``): pybullet
+  reports a margin of 1e-3 for mesh hulls, an inflation that would make the
+  body touch the wall 1 mm early; set to 0 for definiteness (measured: no
+  difference in the bounces at 1e-3 either, so the hull's contact appears
+  not to use it). Box walls keep Bullet's margin, which lies inside the
+  box's extents and so does not move the wall.
+- Drag: the scene's drag is applied each step as an external force at the
+  centre of mass (``applyExternalForce``, world frame): ``F = -k v`` (linear)
+  or ``F = -k |v| v`` (quadratic), with ``v`` the velocity at the start of the
+  step. Bullet folds external forces into its symplectic Euler step, so this
+  is a first-order drag integration whatever refsim's solver does.
+- ``deterministicOverlappingPairs=1``: the broadphase's pairs are sorted, so
+  the solver visits contacts in the same order on every run (the report's
+  numbers are the same bytes each time).
+- Sleeping (deactivation) is disabled per body (``activationState``), so a
+  body near rest is still stepped, as in refsim.
+
+Cost: building is O(vertices) per body for the hull; a step is Bullet's
+broadphase plus GJK/EPA per overlapping pair plus the solver's iterations.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from oracles import import_engine
+
+
+@dataclass(frozen=True)
+class PybulletSettings:
+    """The pybullet settings the oracle uses (module docstring: why each)."""
+
+    use_maximal_coordinates: bool = True
+    contact_processing_threshold: float = 0.0
+    contact_breaking_threshold: float = 0.02
+    use_split_impulse: int = 1
+    split_impulse_penetration_threshold: float = 1e9
+    restitution_velocity_threshold: float = 1e-3
+    num_solver_iterations: int = 50
+    enable_cone_friction: int = 1
+    linear_damping: float = 0.0
+    angular_damping: float = 0.0
+    hull_collision_margin: float = 0.0
+    wall_restitution: float = 1.0
+    wall_friction: float = 1.0
+    #: Wall boxes are this thick (as a fraction of the half size): thick
+    #: enough that no step carries a body through one.
+    wall_thickness: float = 1.0
+
+
+@dataclass(frozen=True)
+class MassProperties:
+    """A body's mass properties in its (scaled) mesh frame.
+
+    ``inertia`` (3,) principal moments about the centre of mass,
+    ``axes`` (3, 3) whose columns are the principal axes (a rotation),
+    ``center`` (3,) the centre of mass, ``mass`` the body's mass.
+    """
+
+    mass: float
+    center: np.ndarray
+    inertia: np.ndarray
+    axes: np.ndarray
+
+
+def mass_properties(vertices, faces, mass: float, scale: float = 1.0) -> MassProperties:
+    """Uniform-solid mass properties of the closed mesh, by trimesh's integrals.
+
+    The density is chosen so that the solid weighs ``mass``; the mesh is
+    scaled by ``scale`` first. The inertia tensor about the centre of mass is
+    diagonalised (``numpy.linalg.eigh``); its eigenvectors become the columns
+    of ``axes``, made right-handed.
+    """
+    trimesh = import_engine("trimesh", "trimesh")
+    mesh = trimesh.Trimesh(vertices=np.asarray(vertices, dtype=np.float64) * scale,
+                           faces=np.asarray(faces, dtype=np.int64), process=False)
+    volume = float(mesh.volume)
+    if not volume > 0:
+        raise ValueError("mass properties need a closed mesh of positive volume")
+    mesh.density = mass / volume
+    tensor = np.asarray(mesh.moment_inertia, dtype=np.float64)   # about the centre of mass
+    inertia, axes = np.linalg.eigh(0.5 * (tensor + tensor.T))
+    if np.linalg.det(axes) < 0:
+        axes[:, 2] = -axes[:, 2]
+    return MassProperties(mass=float(mass), center=np.asarray(mesh.center_mass, dtype=np.float64),
+                          inertia=inertia, axes=axes)
+
+
+def _quat(rotation) -> list[float]:
+    from scipy.spatial.transform import Rotation
+
+    return [float(q) for q in Rotation.from_matrix(np.asarray(rotation, float)).as_quat()]
+
+
+def _matrix(quat) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_quat(np.asarray(quat, float)).as_matrix()
+
+
+class PybulletOracle:
+    """pybullet behind the wall-bounce queries (own DIRECT client, lazy import).
+
+    Use as a context manager or call :meth:`close`. Raises
+    :class:`oracles.OracleUnavailable` when pybullet is not installed.
+    """
+
+    def __init__(self, settings: PybulletSettings | None = None):
+        self.p = import_engine("pybullet", "pybullet")
+        self.settings = settings or PybulletSettings()
+        self.client = self.p.connect(self.p.DIRECT)
+        self.bodies: list[int] = []
+        self.walls: list[int] = []
+        self.properties: list[MassProperties] = []
+        self._scene = None
+
+    # -- lifetime -----------------------------------------------------------------
+
+    def close(self) -> None:
+        if self.client is not None:
+            self.p.disconnect(physicsClientId=self.client)
+            self.client = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:  # noqa: BLE001 - interpreter shutdown: nothing to report to
+            pass
+
+    # -- building -----------------------------------------------------------------
+
+    def _configure(self, scene) -> None:
+        p, s, c = self.p, self.settings, self.client
+        p.resetSimulation(physicsClientId=c)
+        p.setGravity(0.0, -scene.world.gravity, 0.0, physicsClientId=c)
+        p.setPhysicsEngineParameter(
+            fixedTimeStep=scene.integration.step, numSubSteps=0,
+            numSolverIterations=s.num_solver_iterations,
+            useSplitImpulse=s.use_split_impulse,
+            splitImpulsePenetrationThreshold=s.split_impulse_penetration_threshold,
+            restitutionVelocityThreshold=s.restitution_velocity_threshold,
+            enableConeFriction=s.enable_cone_friction,
+            contactBreakingThreshold=s.contact_breaking_threshold,
+            deterministicOverlappingPairs=1,
+            physicsClientId=c)
+
+    def _add_walls(self, half_size: float) -> None:
+        p, s, c = self.p, self.settings, self.client
+        t = s.wall_thickness * half_size                 # half thickness of a wall box
+        span = half_size + 2.0 * t                       # walls overlap at the edges
+        self.walls = []
+        for axis in range(3):
+            for sign in (-1.0, 1.0):
+                extents = [span, span, span]
+                extents[axis] = t
+                center = [0.0, 0.0, 0.0]
+                center[axis] = sign * (half_size + t)
+                shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=extents,
+                                               physicsClientId=c)
+                wall = p.createMultiBody(0.0, shape, basePosition=center,
+                                         useMaximalCoordinates=s.use_maximal_coordinates,
+                                         physicsClientId=c)
+                p.changeDynamics(wall, -1, restitution=s.wall_restitution,
+                                 lateralFriction=s.wall_friction, rollingFriction=0.0,
+                                 spinningFriction=0.0,
+                                 contactProcessingThreshold=s.contact_processing_threshold,
+                                 physicsClientId=c)
+                self.walls.append(wall)
+
+    def _add_body(self, scene, body) -> int:
+        p, s, c = self.p, self.settings, self.client
+        mesh = scene.mesh(body)
+        props = mass_properties(mesh.vertices, mesh.faces, body.mass, body.scale)
+        shape = p.createCollisionShape(p.GEOM_MESH, vertices=mesh.vertices.tolist(),
+                                       meshScale=[body.scale] * 3, physicsClientId=c)
+        r = np.asarray(body.orientation, dtype=np.float64)
+        x = np.asarray(body.position, dtype=np.float64)
+        uid = p.createMultiBody(
+            baseMass=body.mass, baseCollisionShapeIndex=shape, basePosition=x.tolist(),
+            baseOrientation=_quat(r),
+            baseInertialFramePosition=props.center.tolist(),
+            baseInertialFrameOrientation=_quat(props.axes),
+            useMaximalCoordinates=s.use_maximal_coordinates, physicsClientId=c)
+        p.changeDynamics(uid, -1, mass=body.mass, localInertiaDiagonal=props.inertia.tolist(),
+                         restitution=scene.world.restitution,
+                         lateralFriction=scene.world.friction, rollingFriction=0.0,
+                         spinningFriction=0.0, linearDamping=s.linear_damping,
+                         angularDamping=s.angular_damping,
+                         contactProcessingThreshold=s.contact_processing_threshold,
+                         collisionMargin=s.hull_collision_margin,
+                         activationState=p.ACTIVATION_STATE_DISABLE_SLEEPING,
+                         physicsClientId=c)
+        # Initial velocity: the scene gives the mesh origin's; pybullet wants
+        # the centre of mass's, v_com = v + w x (p_com - p_link).
+        w = np.asarray(body.angular_velocity, dtype=np.float64)
+        v = np.asarray(body.velocity, dtype=np.float64) + np.cross(w, r @ props.center)
+        p.resetBaseVelocity(uid, v.tolist(), w.tolist(), physicsClientId=c)
+        self.properties.append(props)
+        return uid
+
+    def load(self, scene) -> None:
+        """Build ``scene`` in this client (replacing whatever was there)."""
+        self._configure(scene)
+        self._add_walls(scene.world.half_size)
+        self.bodies = []
+        self.properties = []
+        for body in scene.bodies:
+            self.bodies.append(self._add_body(scene, body))
+        self._scene = scene
+
+    # -- stepping and reading ------------------------------------------------------
+
+    def _apply_drag(self) -> None:
+        world = self._scene.world
+        if world.drag == 0.0:
+            return
+        p, c = self.p, self.client
+        for uid in self.bodies:
+            v = np.asarray(p.getBaseVelocity(uid, physicsClientId=c)[0])
+            k = world.drag * (np.linalg.norm(v) if world.drag_model == "quadratic" else 1.0)
+            com = p.getBasePositionAndOrientation(uid, physicsClientId=c)[0]
+            p.applyExternalForce(uid, -1, (-k * v).tolist(), com, p.WORLD_FRAME,
+                                 physicsClientId=c)
+
+    def step(self) -> None:
+        """One Bullet step of the loaded scene (drag applied first)."""
+        self._apply_drag()
+        self.p.stepSimulation(physicsClientId=self.client)
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(B, 3) positions and velocities of the mesh origins, (B, 3) angular
+        velocities, (B, 3, 3) orientations (columns are the body axes)."""
+        p, c = self.p, self.client
+        n = len(self.bodies)
+        x = np.empty((n, 3))
+        v = np.empty((n, 3))
+        w = np.empty((n, 3))
+        r = np.empty((n, 3, 3))
+        for i, (uid, props) in enumerate(zip(self.bodies, self.properties, strict=True)):
+            com, quat = p.getBasePositionAndOrientation(uid, physicsClientId=c)
+            v_com, w_i = p.getBaseVelocity(uid, physicsClientId=c)
+            r_link = _matrix(quat) @ props.axes.T
+            com = np.asarray(com)
+            x[i] = com - r_link @ props.center
+            w[i] = w_i
+            v[i] = np.asarray(v_com) + np.cross(w[i], x[i] - com)
+            r[i] = r_link
+        return x, v, w, r
+
+    def simulate(self, scene, *, every: int = 1):
+        """Run ``scene`` for its duration; a frame every ``every`` steps (and
+        the first). Returns a :class:`~refsim.dynamics.trajectory.Trajectory`
+        whose events are the wall contacts that began in a step;
+        ``stage_seconds`` splits the wall time into "step" (``stepSimulation``
+        and the drag forces) and "record" (reading state and contacts)."""
+        from refsim.dynamics.trajectory import Event, Trajectory
+
+        self.load(scene)
+        p, c = self.p, self.client
+        p.setPhysicsEngineParameter(
+            contactBreakingThreshold=self.settings.contact_breaking_threshold,
+            physicsClientId=c)
+        h = scene.integration.step
+        n = scene.integration.n_steps
+        names = tuple(b.name for b in scene.bodies)
+        wall_names = ("x-", "x+", "y-", "y+", "z-", "z+")
+        frames = [self.state()]
+        times = [0.0]
+        events = []
+        touching: set[tuple[int, int]] = set()
+        stepping = 0.0
+        start = time.perf_counter()
+        for k in range(1, n + 1):
+            before = time.perf_counter()
+            self.step()
+            stepping += time.perf_counter() - before
+            now = set()
+            for i, uid in enumerate(self.bodies):
+                for j, wall in enumerate(self.walls):
+                    points = p.getContactPoints(uid, wall, physicsClientId=c)
+                    if any(point[8] <= 0.0 for point in points):    # distance <= 0: touching
+                        now.add((i, j))
+            for i, j in sorted(now - touching):
+                events.append(Event("wall", k, k * h, names[i], wall_names[j]))
+            touching = now
+            if k % every == 0 or k == n:
+                frames.append(self.state())
+                times.append(k * h)
+        elapsed = time.perf_counter() - start
+        x, v, w, r = (np.stack([f[i] for f in frames]) for i in range(4))
+        return Trajectory(t=np.asarray(times), position=x, velocity=v, angular_velocity=w,
+                          orientation=r, names=names, events=events, stages=("step", "record"),
+                          stage_seconds={"step": stepping, "record": elapsed - stepping},
+                          settings={"engine": "pybullet", **asdict(self.settings)})
+
+    def step_time(self, scene, steps: int, warmup: int = 0) -> float:
+        """Seconds per step of ``scene`` (mean over ``steps`` steps after
+        loading and ``warmup`` untimed steps; reading no state)."""
+        self.load(scene)
+        self.p.setPhysicsEngineParameter(
+            contactBreakingThreshold=self.settings.contact_breaking_threshold,
+            physicsClientId=self.client)
+        for _ in range(warmup):
+            self.step()
+        start = time.perf_counter()
+        for _ in range(steps):
+            self.step()
+        return (time.perf_counter() - start) / steps
+
+    def dynamics_info(self, index: int) -> dict:
+        """pybullet's own view of body ``index``: mass and inertia diagonal."""
+        info = self.p.getDynamicsInfo(self.bodies[index], -1, physicsClientId=self.client)
+        return {"mass": info[0], "lateral_friction": info[1],
+                "inertia": np.asarray(info[2], dtype=np.float64), "restitution": info[5],
+                "collision_margin": info[11]}

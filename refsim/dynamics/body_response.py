@@ -1,0 +1,147 @@
+"""Response between two colliding bodies: the seed's velocity exchange (S8)
+and the corrected impulse with positional correction.
+
+The seed ("Translational Collision Response Between Bodies"): "We then
+create a contact plane using the vector formed between the object's
+centroids as the normal to the plane. All exchange and reflection of normals
+occurred about this plane. Perfectly inelastic collision responses were
+performed; so, if two objects are moving towards each other during contact,
+they exchange velocities (the objects are assumed to have equal mass)."
+
+:func:`exchange_velocities_seed`: with ``N = (c_a - c_b) / |c_a - c_b|``
+(from B to A), the bodies approach when ``(v_a - v_b) . N < 0``; then they
+swap the components of their velocities along N and keep the lateral ones.
+
+AMBIGUITY: "exchange velocities" "about this plane": the normal components
+are exchanged (what "exchange and reflection of normals ... about this
+plane" says, and what an elastic collision of equal masses along N does);
+for a head-on collision this is the exchange of the whole velocities.
+
+Terminology: this is a perfectly *elastic* collision of equal masses
+(momentum and kinetic energy both conserved, relative normal velocity
+reversed: restitution 1). A perfectly inelastic collision would leave both
+with the common velocity ``(v_a + v_b) / 2`` along N. The seed's
+"perfectly inelastic" is a misnomer (DESIGN.md asks us to record it). The
+seed ignores the masses: with unequal masses the exchange conserves neither
+momentum nor energy.
+
+Why bodies interpenetrate (claim C11): the response changes only
+velocities, never positions, and acts only while the bodies approach. A
+collision is found after the bodies overlap (by up to ``|v_rel| h``); after
+the exchange they separate at the old relative speed, so the overlap lasts
+at least one more step; if they approach slowly, or move the same way (a
+chaser that, after the exchange, is pushed on by gravity or by a wall), the
+overlap persists for many steps. Nothing pushes them apart.
+
+:func:`separate_bodies` and the impulse of :mod:`refsim.dynamics.impulse`
+are the corrected response (``body_response = "impulse"``). DEVIATION (D4,
+D5): the contact normal is the axis of least overlap of the two bodies' projections among the
+centroid line and the bodies' own axes; the impulse uses masses and inertia
+and acts only when approaching; and the bodies are moved apart along the
+normal until their projections no longer overlap, so the normal is a
+separating axis and no interpenetration persists into the next frame.
+
+Seed section: S8 (and claim C11).
+
+References: B. Mirtich, *Impulse-based Dynamic Simulation of Rigid Body
+Systems*, PhD thesis, UC Berkeley 1996, chapter 3; positional correction by
+projection as in M. Mueller et al., "Position Based Dynamics", 2007
+(distribution by inverse mass); the separating axis test as in S. Gottschalk,
+M. C. Lin, D. Manocha, "OBBTree", SIGGRAPH 1996 (which the seed cites).
+
+Cost: O(1) for the exchange; O(n_a + n_b) per candidate axis for the
+corrected normal, depth and contact point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Extra separation after the positional correction, relative to the bodies'
+#: size (the sum of their projection extents along n): the exact collision
+#: test counts touching as colliding, so bodies left exactly touching would
+#: still "interpenetrate". 1e-9 is far above the rounding of the projections
+#: (~1e-15 relative) and far below anything visible.
+SEPARATION_SLOP = 1e-9
+
+
+def exchange_velocities_seed(c_a, c_b, v_a, v_b) -> tuple[np.ndarray, np.ndarray, bool]:
+    """The seed's response: ``(v_a', v_b', approaching)``; new arrays."""
+    N = np.asarray(c_a, dtype=np.float64) - c_b
+    length = np.linalg.norm(N)
+    v_a, v_b = np.array(v_a, dtype=np.float64), np.array(v_b, dtype=np.float64)
+    if length == 0.0:
+        return v_a, v_b, False                     # no contact plane: the seed is silent
+    N /= length
+    va_n, vb_n = np.dot(v_a, N), np.dot(v_b, N)
+    if va_n - vb_n >= 0.0:                          # moving apart (or not approaching)
+        return v_a, v_b, False
+    # exchange the normal components, keep the lateral ones
+    return v_a + (vb_n - va_n) * N, v_b + (va_n - vb_n) * N, True
+
+
+@dataclass(frozen=True)
+class ContactGeometry:
+    """The corrected model's contact: normal n (from B into A), overlap depth
+    along n, and contact point p (world)."""
+
+    n: np.ndarray
+    depth: float
+    point: np.ndarray
+    extent: float
+
+
+def contact_geometry(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a, axes_b
+                     ) -> ContactGeometry:
+    """Normal, depth and point of two overlapping bodies' vertex sets.
+
+    A negative depth means the normal separates the bodies (no contact).
+
+    Candidate axes: the centroid line (the seed's normal) and each body's
+    three axes (the columns of its orientation: the face normals of a box).
+    On each, the overlap of the projections ``[min_A, max_A]`` and
+    ``[min_B, max_B]`` is the translation along it that separates them; the
+    axis of least overlap is the normal (a reduced separating-axis test; the
+    exact one would add every face normal and edge-pair cross product). The
+    point is the midpoint of the centroids of the two bodies' vertices lying
+    in the overlap slab (for a face on a face, the middle of the shared part).
+    """
+    d = np.asarray(c_a, dtype=np.float64) - c_b
+    candidates = [d] + [axes_a[:, k] for k in range(3)] + [axes_b[:, k] for k in range(3)]
+    best = None
+    for axis in candidates:
+        length = np.linalg.norm(axis)
+        if length == 0.0:
+            continue
+        n = axis / length
+        if np.dot(n, d) < 0.0:
+            n = -n                                   # from B into A
+        pa, pb = world_a @ n, world_b @ n
+        depth = pb.max() - pa.min()                  # A lies above B along n
+        if best is None or depth < best[1]:
+            best = (n, depth, pa, pb)
+    n, depth, pa, pb = best
+    if depth < 0.0:
+        # a separating axis: the bodies do not touch (their boxes, or spheres,
+        # overlapped at a coarse collision level); the nearest points
+        point = 0.5 * (world_a[pa.argmin()] + world_b[pb.argmax()])
+    else:
+        slab_lo, slab_hi = pa.min(), pb.max()
+        point = 0.5 * (world_a[pa <= slab_hi].mean(axis=0)
+                       + world_b[pb >= slab_lo].mean(axis=0))
+    extent = float((pa.max() - pa.min()) + (pb.max() - pb.min()))
+    return ContactGeometry(n=n, depth=float(depth), point=point, extent=extent)
+
+
+def separate_bodies(geometry: ContactGeometry, m_inv_a: float, m_inv_b: float
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """Translations ``(dx_a, dx_b)`` that end the overlap along the normal,
+    shared in proportion to the inverse masses (the lighter body moves more;
+    momentum is untouched). Zero when the projections do not overlap."""
+    gap = geometry.depth + SEPARATION_SLOP * geometry.extent
+    if geometry.depth < 0.0 or m_inv_a + m_inv_b == 0.0:
+        return np.zeros(3), np.zeros(3)
+    share = gap / (m_inv_a + m_inv_b)
+    return share * m_inv_a * geometry.n, -share * m_inv_b * geometry.n

@@ -1,0 +1,783 @@
+"""Bounce studies: refsim's wall response against the analytic answer and pybullet.
+
+What: a body dropped onto the floor of the world cube (seed S5, S7), run by
+``refsim.simulate`` and by the pybullet oracle (:mod:`oracles.pybullet_adapter`)
+on the same scene, and compared with the closed forms of
+:mod:`refsim.dynamics.analytic`:
+
+- :func:`measure_apexes`: apex heights and times of the first bounces, and
+  the apex ratio (ideal ``e^2``), for a sphere-like body (``sphere-2k.ac``,
+  rotation "off": translation only) and the cube (face down);
+- :func:`measure_oblique`: the lateral velocity after one oblique bounce
+  (the seed's ``(1 - friction) v_t`` against Coulomb's
+  ``v_t - mu (1 + e) |v_n|``);
+- :func:`measure_rest`: the time until the bounces die out (Zeno time);
+- :func:`measure_energy`: mechanical energy over time;
+- :func:`measure_cost`: apex-ratio error against wall time per simulated
+  second over step sizes 1/30 .. 1/4000 s, for refsim's solvers and pybullet,
+  in the manner of the work-precision comparisons of T. Erez, Y. Tassa and
+  E. Todorov, "Simulation tools for model-based robotics: comparison of
+  Bullet, Havok, MuJoCo, ODE and PhysX", ICRA 2015;
+- :func:`measure_pybullet_settings`: the oracle's bounce with one pybullet
+  setting at a time put back to its default (why each setting);
+- :func:`measure_step_cost`: seconds per step of 1, 10 and 40 cubes
+  (:func:`cubes_scene`), refsim's ``Simulation.step()`` against pybullet's
+  ``stepSimulation`` (the benchmarks in tests/benchmarks/test_bench_dynamics.py
+  time the same scenes).
+
+How heights are read from a trajectory: the height is the body's lowest
+point above the floor, ``y - y_touch`` with ``y_touch = -half_size + d`` and
+``d`` the depth of the (rotated, scaled) mesh below its origin, for a body
+that does not rotate. A bounce is a frame where the vertical velocity turns
+from downward to upward; an apex is the largest height between two bounces,
+refined by the parabola through it and its two neighbours (so that coarse
+steps do not read a low apex just because no frame fell on it). The apex
+ratio over K bounces is the geometric mean ``(h_K / h_0)^(1/K)``.
+
+Run ``python -m refsim.dynamics.bounce`` to print every figure
+(``--quick`` for the short version the quick report uses).
+
+Cost: each study is a few simulations of 10^3 - 10^4 steps.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from refsim.dynamics import analytic
+
+#: The sphere-like body and the cube of the studies (bundled models).
+SPHERE = "sphere-2k.ac"
+CUBE = "cube.ac"
+#: Restitutions of the apex study.
+RESTITUTIONS = (0.5, 0.8, 0.9)
+HALF_SIZE = 5.0
+GRAVITY = 9.81
+#: Drop height above the touching height, metres.
+DROP_HEIGHT = 4.0
+#: Bounces whose apex ratios are averaged.
+BOUNCES = 3
+#: The reference step and solver (the issue's target: apex ratio within
+#: APEX_RATIO_TARGET of e^2 at this step with this solver).
+STEP = 1e-3
+SOLVER = "rk4"
+APEX_RATIO_TARGET = 0.005
+#: Steps of the speed-vs-accuracy study, seconds.
+COST_STEPS = (1 / 30, 1 / 60, 1 / 125, 1 / 250, 1 / 500, 1 / 1000, 1 / 2000, 1 / 4000)
+COST_STEPS_QUICK = (1 / 30, 1 / 125, 1 / 500)
+COST_SOLVERS = ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4")
+COST_SOLVERS_QUICK = ("euler", "backwards-euler", "rk4")
+#: A bounce sequence has come to rest once every later apex is below this
+#: fraction of the drop height (4 mm of 4 m): the measurable version of the
+#: Zeno time, which needs infinitely many bounces.
+REST_FRACTION = 1e-3
+
+
+# -- scenes -----------------------------------------------------------------------
+
+
+def _touch_depth(model: str, orientation=None, scale: float = 1.0) -> float:
+    """How far the mesh reaches below its origin (rotated, scaled)."""
+    from refsim.models.loading import load_model
+    from refsim.paths import models_dir
+
+    mesh = load_model(models_dir() / model)
+    r = np.eye(3) if orientation is None else np.asarray(orientation, dtype=np.float64)
+    return float(-(mesh.vertices @ r.T)[:, 1].min() * scale)
+
+
+def drop_scene(model: str, e: float, *, step: float = STEP, solver: str = SOLVER,
+               duration: float = 3.0, rotation: str = "off", friction: float = 0.0,
+               height: float = DROP_HEIGHT, velocity=(0.0, 0.0, 0.0)):
+    """A scene with one body of ``model`` whose lowest point is ``height`` above
+    the floor, moving with ``velocity``."""
+    from refsim.scenes.loader import scene_from_dict
+
+    y = -HALF_SIZE + _touch_depth(model) + height
+    return scene_from_dict({
+        "world": {"half_size": HALF_SIZE, "gravity": GRAVITY, "drag": 0.0,
+                  "restitution": e, "friction": friction},
+        "integration": {"solver": solver, "step": step, "duration": duration},
+        "collision": {"level": "aabb"},
+        "dynamics": {"rotation": rotation, "body_response": "off"},
+        "body": [{"name": "body", "model": model, "position": [0.0, y, 0.0],
+                  "velocity": [float(c) for c in velocity]}],
+    })
+
+
+def touch_height(scene, index: int = 0) -> float:
+    """``y`` of the body's origin when its lowest point touches the floor."""
+    body = scene.bodies[index]
+    mesh = scene.mesh(body)
+    r = np.asarray(body.orientation, dtype=np.float64)
+    return -scene.world.half_size - float((mesh.vertices @ r.T)[:, 1].min() * body.scale)
+
+
+def duration_for(e: float, bounces: int, height: float = DROP_HEIGHT) -> float:
+    """Long enough for ``bounces`` bounces and the apex after the last one."""
+    # The margin covers coarse steps whose bounces come late (Euler at 1/30 s
+    # gains height, and so flight time, at every bounce).
+    return float(analytic.apex_times(height, GRAVITY, e, bounces)[-1]
+                 + 0.5 * analytic.fall_time(height, GRAVITY) + 0.1)
+
+
+def run_refsim(scene, wall_speed: str = "wall"):
+    """``refsim.simulate(scene, every=1)`` and its wall time, seconds.
+
+    ``wall_speed``: "wall" (refsim's default: the normal speed the body had at
+    the wall, energy-consistent) or "seed" (the seed's literal speed at the
+    penetrated position); see :mod:`refsim.dynamics.walls`."""
+    from refsim.dynamics.simulation import simulate
+
+    start = time.perf_counter()
+    trajectory = simulate(scene, every=1, wall_speed=wall_speed)
+    return trajectory, time.perf_counter() - start
+
+
+def run_pybullet(scene, oracle=None):
+    """The pybullet oracle's trajectory of ``scene`` and its stepping time,
+    seconds (``stepSimulation`` alone, not the reading of state)."""
+    from oracles.pybullet_adapter import PybulletOracle
+
+    own = oracle is None
+    oracle = oracle or PybulletOracle()
+    try:
+        trajectory = oracle.simulate(scene)
+    finally:
+        if own:
+            oracle.close()
+    return trajectory, trajectory.stage_seconds["step"]
+
+
+# -- reading a trajectory -----------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Bounces:
+    """Bounces read from one body's trajectory: bounce times (B,), apex
+    heights (A,) above the touching height with ``apex[0]`` the release
+    height, apex times (A,)."""
+
+    bounce_times: np.ndarray
+    apex_heights: np.ndarray
+    apex_times: np.ndarray
+
+
+def _parabola_peak(t3, y3) -> tuple[float, float]:
+    """Vertex of the parabola through three points (the middle one highest)."""
+    (t0, t1, t2), (y0, y1, y2) = t3, y3
+    denom = (t0 - t1) * (t0 - t2) * (t1 - t2)
+    a = (t2 * (y1 - y0) + t1 * (y0 - y2) + t0 * (y2 - y1)) / denom
+    b = (t2 * t2 * (y0 - y1) + t1 * t1 * (y2 - y0) + t0 * t0 * (y1 - y2)) / denom
+    if a >= 0:
+        return float(t1), float(y1)
+    tp = -b / (2 * a)
+    c = y1 - a * t1 * t1 - b * t1
+    return float(tp), float(a * tp * tp + b * tp + c)
+
+
+def read_bounces(t, y, vy, y_touch: float) -> Bounces:
+    """Bounces and apexes of the height ``y - y_touch`` (frames ``t``)."""
+    t = np.asarray(t, dtype=np.float64)
+    h = np.asarray(y, dtype=np.float64) - y_touch
+    vy = np.asarray(vy, dtype=np.float64)
+    up = np.flatnonzero((vy[:-1] < 0.0) & (vy[1:] > 0.0)) + 1     # first frame moving up
+    apex_h = [float(h[0])]
+    apex_t = [float(t[0])]
+    for i, start in enumerate(up):
+        stop = up[i + 1] if i + 1 < len(up) else len(h)
+        if stop - start < 3:
+            continue
+        m = start + int(np.argmax(h[start:stop]))
+        if m <= start or m >= stop - 1:            # still rising at the end: no apex yet
+            continue
+        tp, hp = _parabola_peak(t[m - 1:m + 2], h[m - 1:m + 2])
+        apex_h.append(hp)
+        apex_t.append(tp)
+    return Bounces(bounce_times=t[up], apex_heights=np.asarray(apex_h),
+                   apex_times=np.asarray(apex_t))
+
+
+def apex_ratio(apexes: np.ndarray, k: int = BOUNCES) -> float:
+    """Geometric mean of the first ``k`` successive apex ratios, ``(h_k/h_0)^(1/k)``."""
+    if len(apexes) <= k:
+        return math.nan
+    return float((apexes[k] / apexes[0]) ** (1.0 / k))
+
+
+def mechanical_energy(trajectory, y_touch: float, gravity: float, mass: float = 1.0,
+                      inertia: float | None = None) -> np.ndarray:
+    """(F,) energy of body 0 above the touching height: ``m g (y - y_touch)
+    + m |v|^2 / 2`` plus ``I |w|^2 / 2`` when a (scalar, isotropic) inertia is given."""
+    y = trajectory.position[:, 0, 1]
+    v = trajectory.velocity[:, 0]
+    e = mass * gravity * (y - y_touch) + 0.5 * mass * np.einsum("ij,ij->i", v, v)
+    if inertia is not None:
+        w = trajectory.angular_velocity[:, 0]
+        e = e + 0.5 * inertia * np.einsum("ij,ij->i", w, w)
+    return e
+
+
+# -- the studies --------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ApexRow:
+    """Apexes of one body and restitution: refsim, pybullet and analytic.
+
+    ``*_heights``/``*_times``: the first ``BOUNCES + 1`` apexes (release
+    included); ``*_ratio``: geometric mean apex ratio; ``*_error``: its
+    relative error against ``e^2``; ``*_first_ratio``: h_1 / h_0.
+    ``refsim_*`` is refsim's default wall response (the normal speed at the
+    wall), ``seed_speed_*`` the seed's literal one (the speed at the
+    penetrated position, ``wall_speed="seed"``).
+    """
+
+    body: str
+    rotation: str
+    e: float
+    step: float
+    solver: str
+    analytic_heights: list[float]
+    analytic_times: list[float]
+    refsim_heights: list[float]
+    refsim_times: list[float]
+    pybullet_heights: list[float]
+    pybullet_times: list[float]
+    analytic_ratio: float
+    refsim_ratio: float
+    pybullet_ratio: float
+    refsim_first_ratio: float
+    pybullet_first_ratio: float
+    refsim_error: float
+    pybullet_error: float
+    seed_speed_heights: list[float]
+    seed_speed_ratio: float
+    seed_speed_first_ratio: float
+    seed_speed_error: float
+    refsim_max_spin: float
+    pybullet_max_spin: float
+
+
+def _first(values, k) -> list[float]:
+    values = [float(v) for v in values[:k]]
+    return values + [math.nan] * (k - len(values))
+
+
+def measure_apex_row(model: str, e: float, *, rotation: str = "off", step: float = STEP,
+                     solver: str = SOLVER, bounces: int = BOUNCES,
+                     with_pybullet: bool = True) -> ApexRow:
+    scene = drop_scene(model, e, step=step, solver=solver, rotation=rotation,
+                       duration=duration_for(e, bounces))
+    y_touch = touch_height(scene)
+    h0 = DROP_HEIGHT
+    ours, _ = run_refsim(scene)
+    b = read_bounces(ours.t, ours.position[:, 0, 1], ours.velocity[:, 0, 1], y_touch)
+    literal, _ = run_refsim(scene, wall_speed="seed")
+    s = read_bounces(literal.t, literal.position[:, 0, 1], literal.velocity[:, 0, 1], y_touch)
+    s_ratio = apex_ratio(s.apex_heights, bounces)
+    if with_pybullet:
+        theirs, _ = run_pybullet(scene)
+        p = read_bounces(theirs.t, theirs.position[:, 0, 1], theirs.velocity[:, 0, 1], y_touch)
+        p_heights, p_times = p.apex_heights, p.apex_times
+        p_spin = float(np.abs(theirs.angular_velocity).max())
+    else:
+        p_heights, p_times, p_spin = np.array([]), np.array([]), math.nan
+    k = bounces + 1
+    a_heights = analytic.apex_heights(h0, e, bounces)
+    a_times = np.concatenate([[0.0], analytic.apex_times(h0, GRAVITY, e, bounces)])
+    ideal = analytic.apex_ratio(e)
+    r_ratio = apex_ratio(b.apex_heights, bounces)
+    p_ratio = apex_ratio(p_heights, bounces)
+    return ApexRow(
+        body=model, rotation=rotation, e=e, step=step, solver=solver,
+        analytic_heights=_first(a_heights, k), analytic_times=_first(a_times, k),
+        refsim_heights=_first(b.apex_heights, k), refsim_times=_first(b.apex_times, k),
+        pybullet_heights=_first(p_heights, k), pybullet_times=_first(p_times, k),
+        analytic_ratio=ideal, refsim_ratio=r_ratio, pybullet_ratio=p_ratio,
+        refsim_first_ratio=apex_ratio(b.apex_heights, 1),
+        pybullet_first_ratio=apex_ratio(p_heights, 1),
+        refsim_error=abs(r_ratio - ideal) / ideal, pybullet_error=abs(p_ratio - ideal) / ideal,
+        seed_speed_heights=_first(s.apex_heights, k), seed_speed_ratio=s_ratio,
+        seed_speed_first_ratio=apex_ratio(s.apex_heights, 1),
+        seed_speed_error=abs(s_ratio - ideal) / ideal,
+        refsim_max_spin=float(np.abs(ours.angular_velocity).max()), pybullet_max_spin=p_spin)
+
+
+def _variants(models) -> list[tuple[str, str]]:
+    """(model, rotation) pairs studied: the sphere-like body translating only
+    ("off"); every other body with rotation "off" and the seed's model."""
+    return [(m, r) for m in models for r in (("off",) if m == SPHERE else ("off", "seed"))]
+
+
+def measure_apexes(models=(SPHERE, CUBE), restitutions=RESTITUTIONS, *, step: float = STEP,
+                   solver: str = SOLVER, with_pybullet: bool = True) -> list[ApexRow]:
+    """Apex rows for each model and restitution: the sphere-like body with
+    rotation "off"; the cube with rotation "off" and with the seed's model."""
+    rows = []
+    for model, rotation in _variants(models):
+        for e in restitutions:
+            rows.append(measure_apex_row(model, e, rotation=rotation, step=step,
+                                         solver=solver, with_pybullet=with_pybullet))
+    return rows
+
+
+@dataclass(frozen=True)
+class ObliqueRow:
+    """Lateral velocity after one oblique bounce (v_t along +x, v_n into the floor)."""
+
+    body: str
+    rotation: str
+    e: float
+    friction: float
+    v_t: float
+    v_n: float
+    seed_analytic: float          # (1 - friction) v_t
+    coulomb_point: float          # max(v_t - mu (1 + e) v_n, 0)
+    coulomb_ball: float           # point mass unless the ball reaches rolling (5/7 v_t)
+    ball_slides: bool             # the ball slides through the impact
+    refsim: float
+    pybullet: float
+    pybullet_spin: float          # |w| after the bounce, rad/s
+
+
+#: The oblique bounces: (v_t, v_n). With mu = 0.3 and e = 0.8 the first keeps
+#: a ball sliding through the impact (mu (1+e) v_n = 1.08 <= 2/7 * 5), the
+#: second does not (the ball leaves rolling at 5/7 v_t).
+OBLIQUE_CASES = ((5.0, 2.0), (2.0, 2.0))
+OBLIQUE_FRICTION = 0.3
+OBLIQUE_E = 0.8
+
+
+def measure_oblique(models=(SPHERE, CUBE), cases=OBLIQUE_CASES, *, friction=OBLIQUE_FRICTION,
+                    e=OBLIQUE_E, step: float = STEP, solver: str = SOLVER,
+                    with_pybullet: bool = True) -> list[ObliqueRow]:
+    """Lateral velocity after the first bounce of a body released 5 cm above
+    the floor moving at ``(v_t, -v_n, 0)``; read at the apex after it."""
+    rows = []
+    for model, rotation in _variants(models):
+        for v_t, v_n in cases:
+            # Falls 5 cm (v_n grows a little: use the speed at impact).
+            height = 0.05
+            v_impact = math.sqrt(v_n * v_n + 2 * GRAVITY * height)
+            duration = (v_impact - v_n) / GRAVITY + e * v_impact / GRAVITY + 0.02
+            scene = drop_scene(model, e, step=step, solver=solver, rotation=rotation,
+                               friction=friction, height=height, duration=duration,
+                               velocity=(v_t, -v_n, 0.0))
+            ours, _ = run_refsim(scene)
+            after_ours = float(ours.velocity[-1, 0, 0])
+            if with_pybullet:
+                theirs, _ = run_pybullet(scene)
+                after_theirs = float(theirs.velocity[-1, 0, 0])
+                # The centre's velocity (the mesh origin's includes w x r).
+                spin = float(np.linalg.norm(theirs.angular_velocity[-1, 0]))
+            else:
+                after_theirs, spin = math.nan, math.nan
+            rows.append(ObliqueRow(
+                body=model, rotation=rotation, e=e, friction=friction, v_t=v_t,
+                v_n=v_impact,
+                seed_analytic=analytic.lateral_velocity_seed(v_t, friction),
+                coulomb_point=analytic.lateral_velocity_coulomb(v_t, v_impact, friction, e),
+                coulomb_ball=analytic.lateral_velocity_coulomb_ball(v_t, v_impact, friction, e),
+                ball_slides=analytic.sliding_throughout(v_t, v_impact, friction, e),
+                refsim=after_ours, pybullet=after_theirs, pybullet_spin=spin))
+    return rows
+
+
+@dataclass(frozen=True)
+class RestRow:
+    """Time until the bounces die out: the analytic Zeno time, the analytic
+    time of the bounce after which apexes stay below ``REST_FRACTION h0``,
+    and that time measured in refsim and pybullet."""
+
+    body: str
+    e: float
+    zeno: float
+    analytic_settle: float
+    refsim_settle: float
+    pybullet_settle: float
+    refsim_bounces: int
+    pybullet_bounces: int
+    analytic_bounces: int
+
+
+def settle_time(bounces: Bounces, h0: float, fraction: float = REST_FRACTION) -> tuple[float, int]:
+    """Time of the first bounce after which every apex is below ``fraction
+    h0``, and the number of that bounce (nan, 0 if it never settles)."""
+    h = bounces.apex_heights[1:]                  # apex after bounce 1, 2, ...
+    above = np.flatnonzero(h >= fraction * h0)
+    k = 0 if len(above) == 0 else int(above[-1]) + 1      # bounces before settling
+    if k >= len(bounces.bounce_times) or k >= len(h):
+        return math.nan, 0
+    return float(bounces.bounce_times[k]), k + 1
+
+
+def measure_rest(model: str = SPHERE, restitutions=(0.5, 0.8), *, step: float = STEP,
+                 solver: str = SOLVER, with_pybullet: bool = True) -> list[RestRow]:
+    rows = []
+    for e in restitutions:
+        h0 = DROP_HEIGHT
+        zeno = analytic.time_to_rest(h0, GRAVITY, e)
+        scene = drop_scene(model, e, step=step, solver=solver, duration=zeno + 0.5)
+        y_touch = touch_height(scene)
+        ours, _ = run_refsim(scene)
+        r_t, r_k = settle_time(read_bounces(ours.t, ours.position[:, 0, 1],
+                                            ours.velocity[:, 0, 1], y_touch), h0)
+        if with_pybullet:
+            theirs, _ = run_pybullet(scene)
+            p_t, p_k = settle_time(read_bounces(theirs.t, theirs.position[:, 0, 1],
+                                                theirs.velocity[:, 0, 1], y_touch), h0)
+        else:
+            p_t, p_k = math.nan, 0
+        rows.append(RestRow(body=model, e=e, zeno=zeno,
+                            analytic_settle=analytic.time_to_settle(h0, GRAVITY, e,
+                                                                    REST_FRACTION),
+                            refsim_settle=r_t, pybullet_settle=p_t, refsim_bounces=r_k,
+                            pybullet_bounces=p_k,
+                            analytic_bounces=analytic.bounces_until(e, REST_FRACTION)))
+    return rows
+
+
+@dataclass(frozen=True)
+class EnergySeries:
+    """Height and energy over time for one drop (every ``stride``-th frame)."""
+
+    body: str
+    e: float
+    t: list[float]
+    refsim_height: list[float]
+    pybullet_height: list[float]
+    analytic_height: list[float]
+    refsim_energy: list[float]
+    pybullet_energy: list[float]
+    analytic_energy: list[float]
+
+
+def measure_energy(model: str = SPHERE, e: float = 0.8, *, duration: float = 6.0,
+                   step: float = STEP, solver: str = SOLVER, stride: int = 10,
+                   with_pybullet: bool = True) -> EnergySeries:
+    """Height above the touching height and mechanical energy (per unit
+    weight ``m g``: metres) over time."""
+    scene = drop_scene(model, e, step=step, solver=solver, duration=duration)
+    y_touch = touch_height(scene)
+    ours, _ = run_refsim(scene)
+    t = ours.t[::stride]
+    g = GRAVITY
+    r_h = ours.position[::stride, 0, 1] - y_touch
+    r_e = mechanical_energy(ours, y_touch, g)[::stride] / g
+    if with_pybullet:
+        theirs, _ = run_pybullet(scene)
+        p_h = theirs.position[::stride, 0, 1] - y_touch
+        p_e = mechanical_energy(theirs, y_touch, g)[::stride] / g
+    else:
+        p_h = p_e = np.full(len(t), math.nan)
+    return EnergySeries(
+        body=model, e=e, t=t.tolist(), refsim_height=r_h.tolist(),
+        pybullet_height=list(map(float, p_h)),
+        analytic_height=analytic.height(t, DROP_HEIGHT, g, e).tolist(),
+        refsim_energy=r_e.tolist(), pybullet_energy=list(map(float, p_e)),
+        analytic_energy=(analytic.energy(t, DROP_HEIGHT, g, e) / g).tolist())
+
+
+#: The cost study's series of RK4 with the seed's literal wall speed.
+SEED_SPEED_SERIES = "rk4, seed wall speed"
+
+
+@dataclass(frozen=True)
+class CostPoint:
+    """One point of the speed-vs-accuracy study."""
+
+    engine: str            # "refsim" or "pybullet"
+    solver: str            # refsim's solver, or "pybullet"
+    step: float
+    ratio: float           # measured apex ratio (geometric mean over BOUNCES)
+    error: float           # |ratio - e^2| / e^2
+    seconds_per_second: float   # wall time per simulated second
+
+
+@dataclass(frozen=True)
+class CostStudy:
+    e: float
+    body: str
+    bounces: int
+    points: list[CostPoint] = field(default_factory=list)
+
+
+def measure_cost(steps=COST_STEPS, solvers=COST_SOLVERS, *, model: str = SPHERE,
+                 e: float = 0.8, bounces: int = BOUNCES,
+                 with_pybullet: bool = True) -> CostStudy:
+    """Apex-ratio error against wall time per simulated second, per step size.
+
+    refsim runs each solver with its default wall response and, as the
+    series ``SEED_SPEED_SERIES``, RK4 with the seed's literal wall speed.
+    refsim's time is the whole ``refsim.simulate`` call (its loop, its wall
+    test and recording the frames); pybullet's is its ``stepSimulation``
+    calls alone (not the reading of state through the Python API, which
+    would otherwise dominate).
+    """
+    ideal = analytic.apex_ratio(e)
+    duration = duration_for(e, bounces)
+    points = []
+    engines = ([("refsim", s) for s in solvers] + [("refsim", SEED_SPEED_SERIES)]
+               + ([("pybullet", "pybullet")] if with_pybullet else []))
+    for engine, solver in engines:
+        for h in steps:
+            method = SOLVER if solver in ("pybullet", SEED_SPEED_SERIES) else solver
+            scene = drop_scene(model, e, step=h, solver=method, duration=duration)
+            y_touch = touch_height(scene)
+            if engine == "pybullet":
+                traj, seconds = run_pybullet(scene)
+            else:
+                traj, seconds = run_refsim(
+                    scene, wall_speed="seed" if solver == SEED_SPEED_SERIES else "wall")
+            b = read_bounces(traj.t, traj.position[:, 0, 1], traj.velocity[:, 0, 1], y_touch)
+            ratio = apex_ratio(b.apex_heights, bounces)
+            points.append(CostPoint(engine=engine, solver=solver, step=float(h), ratio=ratio,
+                                    error=abs(ratio - ideal) / ideal,
+                                    seconds_per_second=seconds / traj.t[-1]))
+    return CostStudy(e=e, body=model, bounces=bounces, points=points)
+
+
+# -- pybullet's settings, one at a time ---------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SettingRow:
+    """The sphere's bounce in pybullet with one setting changed from the oracle's."""
+
+    change: str
+    ratio: float                # apex ratio over BOUNCES bounces
+    error: float                # (ratio - e^2) / e^2, signed
+    settle_bounce: int          # bounce after which apexes stay below REST_FRACTION h0
+    bounces: int                # bounces detected in the run
+    analytic_settle_bounce: int     # the same for the analytic series
+
+
+def measure_pybullet_settings(e: float = 0.8, duration: float = 9.0) -> list[SettingRow]:
+    """Why each setting of :class:`oracles.pybullet_adapter.PybulletSettings`:
+    the oracle's bounce, then the same with one setting back at (or near)
+    pybullet's default."""
+    from dataclasses import replace
+
+    from oracles.pybullet_adapter import PybulletOracle, PybulletSettings
+
+    base = PybulletSettings()
+    changes = (
+        ("none (the oracle's settings)", base),
+        ("useMaximalCoordinates=False (multibody)", replace(base, use_maximal_coordinates=False)),
+        ("contactProcessingThreshold=1e30 (Bullet's default: all)",
+         replace(base, contact_processing_threshold=1e30)),
+        ("useSplitImpulse=0", replace(base, use_split_impulse=0)),
+        ("restitutionVelocityThreshold=0.2 (Bullet's default)",
+         replace(base, restitution_velocity_threshold=0.2)),
+        ("linear/angular damping 0.04 (pybullet's default)",
+         replace(base, linear_damping=0.04, angular_damping=0.04)),
+    )
+    scene = drop_scene(SPHERE, e, duration=duration)
+    y_touch = touch_height(scene)
+    ideal = analytic.apex_ratio(e)
+    rows = []
+    for label, settings in changes:
+        with PybulletOracle(settings) as oracle:
+            traj = oracle.simulate(scene)
+        b = read_bounces(traj.t, traj.position[:, 0, 1], traj.velocity[:, 0, 1], y_touch)
+        ratio = apex_ratio(b.apex_heights, BOUNCES)
+        _, k = settle_time(b, DROP_HEIGHT)
+        rows.append(SettingRow(change=label, ratio=ratio, error=(ratio - ideal) / ideal,
+                               settle_bounce=k, bounces=len(b.bounce_times),
+                               analytic_settle_bounce=analytic.bounces_until(e, REST_FRACTION)))
+    return rows
+
+
+# -- step cost against pybullet ---------------------------------------------------------
+
+#: Body counts and rotation models of the step benchmarks (the seed's
+#: "1 to 40 in this simulation").
+BENCH_COUNTS = (1, 10, 40)
+BENCH_ROTATIONS = ("off", "seed")
+#: Steps before timing the "late" phase: by then the cubes have settled on
+#: the floor (restitution 0.8, friction 0.1) and Bullet has many contacts.
+LATE_WARMUP = 3000
+#: Seed of the benchmark scenes' random velocities.
+BENCH_SEED = 20260522
+
+
+def cubes_scene(count: int, rotation: str = "off", *, seed: int = BENCH_SEED,
+                step: float = STEP, duration: float = 10.0, solver: str = SOLVER):
+    """``count`` unit cubes on a grid in the world cube (spacing 2.2, at
+    least 1.2 between faces), random velocities in [-3, 3]^3 m/s (seeded),
+    collision level "aabb", the seed's body response."""
+    from refsim.scenes.loader import scene_from_dict
+
+    rng = np.random.default_rng(seed)
+    side = math.ceil(count ** (1.0 / 3.0) - 1e-9)
+    spacing = 2.2
+    offset = -spacing * (side - 1) / 2.0
+    cells = [(i, j, k) for j in range(side) for i in range(side) for k in range(side)]
+    bodies = []
+    for n, (i, j, k) in enumerate(cells[:count]):
+        bodies.append({"name": f"cube{n}", "model": CUBE,
+                       "position": [offset + spacing * i, offset + spacing * j,
+                                    offset + spacing * k],
+                       "velocity": [float(x) for x in rng.uniform(-3.0, 3.0, 3)]})
+    return scene_from_dict({
+        "world": {"half_size": HALF_SIZE, "gravity": GRAVITY, "restitution": 0.8,
+                  "friction": 0.1},
+        "integration": {"solver": solver, "step": step, "duration": duration},
+        "collision": {"level": "aabb"},
+        "dynamics": {"rotation": rotation, "body_response": "seed"},
+        "body": bodies,
+    })
+
+
+@dataclass(frozen=True)
+class StepCost:
+    """Mean seconds per step of one scene: refsim's ``Simulation.step()``
+    and pybullet's ``stepSimulation``, and their ratio (refsim / pybullet)."""
+
+    bodies: int
+    rotation: str
+    warmup: int                         # steps taken before the timed ones
+    refsim_seconds: float
+    pybullet_seconds: float
+    ratio: float
+    refsim_stage_seconds: dict          # per step, by stage of refsim's loop
+
+
+def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: int = 200,
+                      warmup: int = 20, repeats: int = 5,
+                      with_pybullet: bool = True) -> list[StepCost]:
+    """Seconds per step of each cubes scene in refsim and pybullet.
+
+    Each engine runs the scene ``repeats`` times from its start: ``warmup``
+    untimed steps (they also pay any first-call compilation), then ``steps``
+    timed ones; the fastest repeat's mean is kept (the least disturbed by
+    other processes on a shared machine). The stage breakdown is refsim's
+    ``stage_seconds`` over the timed steps of that repeat.
+    """
+    from refsim.dynamics.simulation import Simulation
+
+    rows = []
+    oracle = None
+    if with_pybullet:
+        from oracles.pybullet_adapter import PybulletOracle
+
+        oracle = PybulletOracle()
+    try:
+        for count in counts:
+            for rotation in rotations:
+                scene = cubes_scene(count, rotation)
+                ours, stages = math.inf, {}
+                for _ in range(repeats):
+                    sim = Simulation(scene)
+                    for _ in range(warmup):
+                        sim.step()
+                    before = dict(sim.stage_seconds)
+                    start = time.perf_counter()
+                    for _ in range(steps):
+                        sim.step()
+                    mean = (time.perf_counter() - start) / steps
+                    if mean < ours:
+                        ours = mean
+                        stages = {k: (sim.stage_seconds[k] - before[k]) / steps
+                                  for k in before}
+                theirs = math.nan
+                if oracle is not None:
+                    theirs = min(oracle.step_time(scene, steps, warmup) for _ in range(repeats))
+                rows.append(StepCost(bodies=count, rotation=rotation, warmup=warmup,
+                                     refsim_seconds=ours,
+                                     pybullet_seconds=theirs, ratio=ours / theirs,
+                                     refsim_stage_seconds=stages))
+    finally:
+        if oracle is not None:
+            oracle.close()
+    return rows
+
+
+# -- command line -------------------------------------------------------------------
+
+
+def _fmt(x: float, digits: int = 5) -> str:
+    return "nan" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{digits}g}"
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(prog="python -m refsim.dynamics.bounce",
+                                     description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer step sizes and solvers")
+    parser.add_argument("--no-pybullet", action="store_true", help="refsim and analytic only")
+    args = parser.parse_args(argv)
+    pb = not args.no_pybullet
+
+    print(f"Apex ratios (geometric mean of the first {BOUNCES}; ideal e^2), "
+          f"step {STEP}, solver {SOLVER}:")
+    print(f"{'body':14} {'rot':5} {'e':>4} {'e^2':>8} {'refsim':>9} {'err':>8} "
+          f"{'pybullet':>9} {'err':>8} {'refsim h1/h0':>12} {'pyb h1/h0':>10}")
+    for r in measure_apexes(with_pybullet=pb):
+        print(f"{r.body:14} {r.rotation:5} {r.e:4} {r.analytic_ratio:8.5f} "
+              f"{r.refsim_ratio:9.5f} {r.refsim_error:8.2%} {r.pybullet_ratio:9.5f} "
+              f"{r.pybullet_error:8.2%} {r.refsim_first_ratio:12.5f} "
+              f"{r.pybullet_first_ratio:10.5f}")
+        print(f"    seed's literal wall speed: ratio {r.seed_speed_ratio:.5f} "
+              f"(error {r.seed_speed_error:.2%}), h1/h0 {r.seed_speed_first_ratio:.5f}")
+        print(f"    apex heights analytic {[round(x, 4) for x in r.analytic_heights]}")
+        print(f"                 refsim   {[round(x, 4) for x in r.refsim_heights]}")
+        print(f"                 pybullet {[round(x, 4) for x in r.pybullet_heights]}")
+        print(f"                 seed spd {[round(x, 4) for x in r.seed_speed_heights]}")
+        print(f"    apex times   analytic {[round(x, 4) for x in r.analytic_times]}")
+        print(f"                 refsim   {[round(x, 4) for x in r.refsim_times]}")
+        print(f"                 pybullet {[round(x, 4) for x in r.pybullet_times]}")
+        print(f"    max |w| refsim {_fmt(r.refsim_max_spin)} pybullet "
+              f"{_fmt(r.pybullet_max_spin)} rad/s")
+    print(f"\nOblique bounce (friction {OBLIQUE_FRICTION}, e {OBLIQUE_E}): lateral "
+          "velocity after the bounce, m/s")
+    for r in measure_oblique(with_pybullet=pb):
+        print(f"  {r.body:14} v_t {r.v_t} v_n {r.v_n:.3f}: seed {r.seed_analytic:.4f} "
+              f"coulomb(point) {r.coulomb_point:.4f} coulomb(ball) {r.coulomb_ball:.4f} "
+              f"(ball slides: {r.ball_slides}) | refsim {r.refsim:.4f} "
+              f"pybullet {r.pybullet:.4f} (|w| {r.pybullet_spin:.3f})")
+    print(f"\nTime to rest (sphere; settled once apexes stay below {REST_FRACTION} h0), s")
+    for r in measure_rest(with_pybullet=pb):
+        print(f"  e {r.e}: Zeno {r.zeno:.4f}; settle analytic {r.analytic_settle:.4f} "
+              f"(bounce {r.analytic_bounces}) refsim {_fmt(r.refsim_settle)} "
+              f"(bounce {r.refsim_bounces}) pybullet {_fmt(r.pybullet_settle)} "
+              f"(bounce {r.pybullet_bounces})")
+    if pb:
+        print(f"\npybullet settings, one at a time (sphere, e {OBLIQUE_E}; analytic settling "
+              f"bounce {analytic.bounces_until(OBLIQUE_E, REST_FRACTION)}):")
+        for r in measure_pybullet_settings():
+            print(f"  {r.change:58} ratio {r.ratio:.5f} ({r.error:+.2%}) settles after "
+                  f"bounce {r.settle_bounce}, {r.bounces} bounces")
+    print("\nStep cost, cubes in the world cube (collision aabb), seconds per step:")
+    for r in measure_step_cost(with_pybullet=pb):
+        print(f"  {r.bodies:3d} bodies, rotation {r.rotation:4}: refsim {r.refsim_seconds:.3e} "
+              f"pybullet {r.pybullet_seconds:.3e} ratio {r.ratio:.2f}")
+        print("      refsim by stage (us): " + ", ".join(
+            f"{k} {1e6 * v:.1f}" for k, v in r.refsim_stage_seconds.items()))
+    print(f"  after {LATE_WARMUP} steps (the cubes settled on the floor, in contact):")
+    for r in measure_step_cost(counts=(BENCH_COUNTS[-1],), warmup=LATE_WARMUP, repeats=3,
+                               with_pybullet=pb):
+        print(f"  {r.bodies:3d} bodies, rotation {r.rotation:4}: refsim {r.refsim_seconds:.3e} "
+              f"pybullet {r.pybullet_seconds:.3e} ratio {r.ratio:.2f}")
+    steps = COST_STEPS_QUICK if args.quick else COST_STEPS
+    solvers = COST_SOLVERS_QUICK if args.quick else COST_SOLVERS
+    study = measure_cost(steps, solvers, with_pybullet=pb)
+    print(f"\nSpeed vs accuracy (sphere, e {study.e}, apex ratio over {study.bounces} bounces):")
+    print(f"  {'engine':9} {'solver':16} {'step':>9} {'ratio':>9} {'error':>10} {'s/s':>10}")
+    for pt in study.points:
+        print(f"  {pt.engine:9} {pt.solver:16} {pt.step:9.6f} {pt.ratio:9.5f} "
+              f"{pt.error:10.3e} {pt.seconds_per_second:10.3e}")
+
+
+def as_dict(obj) -> dict:
+    """A study's dataclass as JSON-able data."""
+    return asdict(obj)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,269 @@
+"""Measurements of the dynamics for the report: claims C11 and C12, and the
+energy of a bouncing body, the seed's model against the corrected one.
+
+- :func:`measure_spin` (C12, "the angular velocity does not properly dampen
+  and come to a rest"): |w| and the rotational energy over time of a cube
+  dropped with spin (``scenes/spinning-cube.toml``), ``rotation = "seed"``
+  against ``"impulse"``; an external trajectory (pybullet's, from the
+  oracle) can be passed in and is measured the same way.
+- :func:`measure_interpenetration` (C11, "sometimes objects will
+  interpenetrate when they are moving slowly or in the same direction"):
+  the number of frames in which two bodies intersect (the exact triangle
+  test, :func:`refsim.bodies_collide` at level "exact") for a chase (same
+  direction), a slow approach and a body falling onto another, with
+  ``body_response = "seed"`` against ``"impulse"``.
+- :func:`measure_energy`: the mechanical energy over time of a bouncing,
+  spinning cube, seed against corrected.
+
+Every function returns frozen dataclasses of numbers; the report draws them
+and computes nothing itself. ``python -m refsim.dynamics.measure`` prints them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from refsim.dynamics.simulation import Simulation, simulate
+from refsim.dynamics.trajectory import Trajectory
+
+#: Below these, a body counts as at rest (the corrected model's resting
+#: cube jitters at ~1e-5 m/s and rad/s: gravity's g h per step undone by the
+#: contact impulses; a visible motion is > 1e-2).
+REST_SPEED = 1e-3          # m/s
+REST_SPIN = 1e-3           # rad/s
+
+
+def _scene(name: str):
+    from refsim.paths import SCENES_DIR
+    from refsim.scenes.loader import load_scene
+
+    return load_scene(SCENES_DIR / name)
+
+
+def _scene_from(data: dict):
+    from refsim.scenes.loader import scene_from_dict
+
+    return scene_from_dict(data)
+
+
+def trajectory_energy(scene, traj: Trajectory) -> tuple[np.ndarray, np.ndarray]:
+    """Per frame, the total translational + potential energy and the
+    rotational energy ``w . I w / 2`` (with each body's inertia tensor), both
+    (F,), for a trajectory of ``scene`` (refsim's or an oracle's)."""
+    sim = Simulation(scene)
+    R = traj.orientation
+    I_world = np.einsum("fbij,bjk,fblk->fbil", R, sim.I_body, R)
+    rotational = 0.5 * np.einsum("fbi,fbij,fbj->f", traj.angular_velocity, I_world,
+                                 traj.angular_velocity)
+    centroid = traj.position + np.einsum("fbij,bj->fbi", R, sim.center)
+    world = scene.world
+    kinetic = 0.5 * np.einsum("b,fbi,fbi->f", sim.mass, traj.velocity, traj.velocity)
+    potential = world.gravity * np.einsum("b,fb->f", sim.mass,
+                                          centroid[:, :, 1] + world.half_size)
+    return kinetic + potential, rotational
+
+
+# -- C12 -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SpinSeries:
+    """One model's spin over time (body 0)."""
+
+    model: str                  # "seed", "impulse" or the external label
+    t: np.ndarray               # (F,) s
+    spin: np.ndarray            # (F,) |w|, rad/s
+    spin_normal: np.ndarray     # (F,) w_y, the component along the floor's normal
+    rotational_energy: np.ndarray   # (F,) J
+    speed: np.ndarray           # (F,) |v|, m/s
+    final_spin: float           # mean |w| over the last second
+    final_speed: float          # mean |v| over the last second
+    at_rest: bool               # final_spin < REST_SPIN and final_speed < REST_SPEED
+
+
+def _spin_series(label: str, scene, traj: Trajectory) -> SpinSeries:
+    _, rotational = trajectory_energy(scene, traj)
+    w = traj.angular_velocity[:, 0]
+    v = traj.velocity[:, 0]
+    spin = np.linalg.norm(w, axis=1)
+    speed = np.linalg.norm(v, axis=1)
+    last = traj.t >= traj.t[-1] - 1.0
+    final_spin, final_speed = float(spin[last].mean()), float(speed[last].mean())
+    return SpinSeries(model=label, t=traj.t, spin=spin, spin_normal=w[:, 1].copy(),
+                      rotational_energy=rotational, speed=speed, final_spin=final_spin,
+                      final_speed=final_speed,
+                      at_rest=final_spin < REST_SPIN and final_speed < REST_SPEED)
+
+
+def measure_spin(scene=None, *, duration: float | None = None,
+                 external: Trajectory | None = None, external_label: str = "pybullet"
+                 ) -> list[SpinSeries]:
+    """C12: a cube dropped with spin, seed rotation against the corrected one.
+
+    ``scene`` defaults to ``scenes/spinning-cube.toml``; its ``rotation`` is
+    replaced by "seed" and by "impulse". ``external`` is another engine's
+    trajectory of the same scene, measured the same way.
+    """
+    scene = scene or _scene("spinning-cube.toml")
+    rows = []
+    for model in ("seed", "impulse"):
+        s = replace(scene, dynamics=replace(scene.dynamics, rotation=model))
+        rows.append(_spin_series(model, s, simulate(s, duration=duration)))
+    if external is not None:
+        rows.append(_spin_series(external_label, scene, external))
+    return rows
+
+
+# -- C11 -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class InterpenetrationRow:
+    case: str                   # one of C11_CASES
+    response: str               # body_response: "seed" or "impulse"
+    frames: int                 # frames examined (one per step)
+    interpenetrating: int       # frames in which the exact test finds an intersection
+    longest_run: int            # the longest run of consecutive such frames
+    contacts: int               # body-contact onsets (events)
+
+
+def c11_scene(case: str, response: str, *, duration: float = 2.0, step: float = 1e-3):
+    """The scene of one C11 case.
+
+    - "chase": two unit cubes on the x axis without gravity, the back one at
+      2 m/s chasing the front one at 0.5 m/s (same direction);
+    - "slow": two icosahedra approaching head-on at 0.05 m/s each, without
+      gravity (slower than one step's overlap can resolve);
+    - "stack": an icosahedron dropped from 0.8 m onto another resting on the
+      floor (slow contact under gravity, e = 0.5);
+    - "glancing": a unit cube at 1 m/s passing a resting one offset by 0.8 m
+      sideways (their corners overlap; the centroid line is oblique).
+    """
+    base = {"integration": {"solver": "rk4", "step": step, "duration": duration},
+            "collision": {"level": "exact", "aabb": "auto"},
+            "dynamics": {"rotation": "off", "body_response": response}}
+    if case == "chase":
+        base["world"] = {"gravity": 0.0, "restitution": 1.0, "half_size": 5.0}
+        base["body"] = [
+            {"name": "chaser", "model": "cube.ac", "position": [-2.0, 0.0, 0.0],
+             "velocity": [2.0, 0.0, 0.0]},
+            {"name": "leader", "model": "cube.ac", "position": [-0.5, 0.0, 0.0],
+             "velocity": [0.5, 0.0, 0.0]}]
+    elif case == "slow":
+        base["world"] = {"gravity": 0.0, "restitution": 1.0, "half_size": 5.0}
+        base["body"] = [
+            {"name": "left", "model": "icosahedron.ac", "position": [-0.9, 0.0, 0.0],
+             "velocity": [0.05, 0.0, 0.0]},
+            {"name": "right", "model": "icosahedron.ac", "position": [0.9, 0.0, 0.0],
+             "velocity": [-0.05, 0.0, 0.0]}]
+    elif case == "stack":
+        base["world"] = {"gravity": 9.81, "restitution": 0.5, "half_size": 3.0}
+        base["body"] = [
+            {"name": "bottom", "model": "icosahedron.ac", "position": [0.0, -2.149, 0.0]},
+            {"name": "top", "model": "icosahedron.ac", "position": [0.0, 0.5, 0.0]}]
+    elif case == "glancing":
+        base["world"] = {"gravity": 0.0, "restitution": 1.0, "half_size": 5.0}
+        base["body"] = [
+            {"name": "mover", "model": "cube.ac", "position": [-2.0, 0.0, 0.0],
+             "velocity": [1.0, 0.0, 0.0]},
+            {"name": "rester", "model": "cube.ac", "position": [0.0, 0.8, 0.0]}]
+    else:
+        raise ValueError(f"unknown C11 case {case!r}")
+    return _scene_from(base)
+
+
+C11_CASES = ("chase", "slow", "stack", "glancing")
+
+
+def count_interpenetrating(scene, traj: Trajectory) -> tuple[int, int]:
+    """``(frames with an exact intersection of bodies 0 and 1, longest run)``."""
+    from refsim.collision.bodies import bodies_collide
+
+    sim = Simulation(scene)
+    mesh_a, mesh_b = sim.bodies[0].mesh, sim.bodies[1].mesh
+    count = run = longest = 0
+    for f in range(traj.n_frames):
+        pose_a = (traj.orientation[f, 0], traj.position[f, 0])
+        pose_b = (traj.orientation[f, 1], traj.position[f, 1])
+        if bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level="exact"):
+            count += 1
+            run += 1
+            longest = max(longest, run)
+        else:
+            run = 0
+    return count, longest
+
+
+def measure_interpenetration(cases=C11_CASES, responses=("seed", "impulse"), *,
+                             duration: float = 2.0, step: float = 1e-3
+                             ) -> list[InterpenetrationRow]:
+    """C11: interpenetrating frames per case and body response."""
+    rows = []
+    for case in cases:
+        for response in responses:
+            scene = c11_scene(case, response, duration=duration, step=step)
+            traj = simulate(scene, every=1)
+            count, longest = count_interpenetrating(scene, traj)
+            contacts = sum(1 for e in traj.events if e.kind == "body")
+            rows.append(InterpenetrationRow(case=case, response=response,
+                                            frames=traj.n_frames, interpenetrating=count,
+                                            longest_run=longest, contacts=contacts))
+    return rows
+
+
+# -- energy of a bouncing body -------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class EnergySeries:
+    model: str                  # rotation model
+    t: np.ndarray               # (F,) s
+    energy: np.ndarray          # (F,) kinetic + rotational + potential, J
+    rotational: np.ndarray      # (F,) J
+    increases: int              # frames where the energy rose by more than ENERGY_SLACK
+    max_rise: float             # largest rise between consecutive frames, J
+
+
+#: A rise of the energy between frames smaller than this (J, for a 1 kg
+#: body) is the resting jitter of the wall push-back (m g h^2 / 2 ~ 5e-6 J
+#: per step at h = 1e-3), not a gain.
+ENERGY_SLACK = 1e-4
+
+
+def measure_energy(scene=None, *, duration: float | None = None,
+                   models=("seed", "impulse")) -> list[EnergySeries]:
+    """Energy over time of the bouncing, spinning cube (default
+    ``scenes/spinning-cube.toml``), one series per rotation model."""
+    scene = scene or _scene("spinning-cube.toml")
+    rows = []
+    for model in models:
+        s = replace(scene, dynamics=replace(scene.dynamics, rotation=model))
+        traj = simulate(s, duration=duration, every=10)
+        translational, rotational = trajectory_energy(s, traj)
+        energy = translational + rotational
+        rise = np.diff(energy)
+        rows.append(EnergySeries(model=model, t=traj.t, energy=energy, rotational=rotational,
+                                 increases=int((rise > ENERGY_SLACK).sum()),
+                                 max_rise=float(rise.max(initial=0.0))))
+    return rows
+
+
+def main() -> None:  # pragma: no cover - printing only
+    for row in measure_spin():
+        print(f"C12 {row.model:8s} final |w| {row.final_spin:.3g} rad/s, |v| "
+              f"{row.final_speed:.3g} m/s, w_y {row.spin_normal[-1]:.3g}, "
+              f"at rest {row.at_rest}, E_rot {row.rotational_energy[0]:.3g} -> "
+              f"{row.rotational_energy[-1]:.3g} J")
+    for row in measure_interpenetration():
+        print(f"C11 {row.case:6s} {row.response:8s} {row.interpenetrating:5d} / "
+              f"{row.frames} frames interpenetrating, longest run {row.longest_run}, "
+              f"{row.contacts} contacts")
+    for row in measure_energy():
+        print(f"energy {row.model:8s} {row.energy[0]:.4g} -> {row.energy[-1]:.4g} J, "
+              f"{row.increases} rises > {ENERGY_SLACK} J, max rise {row.max_rise:.3g} J")
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -1,0 +1,617 @@
+"""The simulation loop: every body of a scene stepped through the seed's
+stages, each run only when the scene needs it (seed S5-S9, S11).
+
+One step (:meth:`Simulation.step`), as an outline:
+
+1. integrate   forces (S5) and the scene's solver (S6) for the centroids'
+               positions and velocities of all B bodies at once;
+2. rotation    the orientation step: the seed's Euler step of the axes (S9)
+               or the exact rotation with angular momentum (corrected);
+3. bounds      each body's world box (S2: the linear scan, or the incremental
+               tracker for convex bodies, ``collision.aabb``; small meshes
+               batched, see ``boxes``);
+4. walls       the world-cube test (S3) and the response (S7, plus S9's
+               change of w at the contact vertex; or the corrected impulses);
+5. broad-phase sort and sweep over the B boxes (S4 test 1; compiled by numba);
+6. narrow-phase the scene's collision level on the pairs that pass (S4);
+7. body-response  the seed's velocity exchange (S8) or the corrected impulse;
+8. check       divergence: a non-finite state, or energy beyond all bounds.
+
+Stages 2, 5-7 run only when needed: no rotation work with ``rotation =
+"off"``; no body-body work for one body, ``collision.level = "none"`` or
+``body_response = "off"``; no narrow phase at level "aabb" (the boxes are
+the answer). ``Trajectory.stages`` lists the stages that ran and
+``Trajectory.stage_seconds`` the wall time of each.
+
+State, for B bodies (structure of arrays): ``x`` (B, 3) centroid positions,
+``v`` (B, 3) centroid velocities (the seed's Pos and Vel), ``w`` (B, 3)
+angular velocities in rad/s (world frame), ``R`` (B, 3, 3) orientations
+(columns: the body's axes). The reported position is the body's reference
+point, its mesh's origin, ``x - R c`` for the body-space centroid ``c``.
+
+Divergence: the step stops with :class:`~refsim.errors.DivergenceError`
+when the state is not finite, or when the mechanical energy ``E`` (kinetic,
+potential above the floor, and rotational, bounded above by
+``lambda_max |w|^2 / 2`` with the body's largest principal moment, so that
+the check costs O(B)) exceeds ``DIVERGENCE_FACTOR * (E_0 + E_scale)``, with ``E_scale = sum_b m_b
+(g 2H + (2H / 1 s)^2 / 2)`` (every body raised across the cube, and moving
+across it in one second), so that a scene starting at rest has a sensible
+scale. The frames recorded so far are in the error's ``partial``.
+
+Seed sections: S5-S9; the choices where the seed is silent or wrong are
+listed in :mod:`refsim.dynamics.choices`.
+
+Cost per step: O(s B) for the solver with s stages, O(B) for the rotation,
+O(B) box updates (O(1) each, incremental; O(n) each, linear), O(B log B + k)
+for the broad phase and the narrow-phase cost of the k candidate pairs.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from refsim.bounds.aabb_linear import transform_vertices
+from refsim.bounds.tracker import make_aabb_tracker
+from refsim.bounds.world_cube import world_cube_test
+from refsim.dynamics import impulse
+from refsim.dynamics.body_response import (
+    contact_geometry,
+    exchange_velocities_seed,
+    separate_bodies,
+)
+from refsim.dynamics.boxes import boxes_compiled
+from refsim.dynamics.broad_phase import overlapping_pairs_compiled
+from refsim.dynamics.forces import translational_rhs
+from refsim.dynamics.mass_properties import mass_properties, point_mass_properties
+from refsim.dynamics.rotation_impulse import (
+    orientation_step_exact,
+    wall_contacts,
+    world_inertia,
+)
+from refsim.dynamics.rotation_seed import (
+    contact_spin_seed,
+    contact_vertex_seed,
+    orientation_step_seed_compiled,
+)
+from refsim.dynamics.trajectory import Event, Trajectory
+from refsim.dynamics.walls import SPEEDS, wall_name, wall_response_seed, wall_speed
+from refsim.errors import DivergenceError, StateError
+from refsim.models.mesh import Mesh
+from refsim.solvers.integrate import resolve_method
+
+#: At most about this many frames by default (``every`` is chosen so).
+MAX_FRAMES = 1000
+
+#: Energy growth that counts as divergence (see the module docstring): far
+#: beyond anything a bounded scene with restitution <= 1 reaches (the seed's
+#: rotation model pumps energy, but by factors of a few), far below overflow.
+DIVERGENCE_FACTOR = 1e6
+
+#: Meshes with at most this many vertices get their boxes from one batched
+#: linear scan over all their bodies under ``boxes="auto"``: for a cube (8
+#: vertices) the batched scan of 40 bodies costs less than two calls of the
+#: compiled incremental tracker (whose per-call overhead, ~3-5 us, dominates
+#: when the walk visits a handful of vertices). Larger meshes keep the scene's
+#: choice of tracker (``collision.aabb``), where the incremental walk pays off
+#: (claim C1).
+BATCH_VERTICES = 64
+
+BOXES = ("auto", "trackers", "batched")
+
+STAGES = ("integrate", "rotation", "bounds", "walls", "broad-phase", "narrow-phase",
+          "body-response", "check")
+
+
+@dataclass(frozen=True)
+class Body:
+    """What the loop knows of one body that does not change: its (scaled)
+    mesh, box tracker, mass properties and centroid in body space."""
+
+    name: str
+    mesh: Mesh
+    tracker: object
+    mass: float
+    center: np.ndarray          # body-space centroid the body rotates about
+    inertia: np.ndarray         # (3, 3) body-space, about the solid's centre of mass
+
+
+def _scaled_mesh(mesh: Mesh, scale: float) -> Mesh:
+    if scale == 1.0:
+        return mesh
+    return mesh.derived(f"scaled:{scale!r}",
+                        lambda m: Mesh(m.vertices * scale, m.faces, name=m.name,
+                                       source=m.source))
+
+
+class Simulation:
+    """The bodies of a scene and their state; :meth:`step` advances all of them.
+
+    Parameters
+    ----------
+    scene : refsim.Scene
+    wall_speed : {"wall", "seed"}
+        The normal speed the seed's wall response flips (see
+        :mod:`refsim.dynamics.walls`): at the wall (energy-consistent, the
+        default) or the seed's literal one.
+    boxes : {"auto", "trackers", "batched"}
+        How the bounds stage gets each body's box. "trackers": each body's own
+        :func:`refsim.make_aabb_tracker` (``collision.aabb``: the incremental
+        walk for convex meshes, the linear scan otherwise), one call per body
+        (the plain path). "batched": the linear scan's arithmetic for all the
+        bodies of one mesh at once. "auto" (default): batched for meshes of at
+        most ``BATCH_VERTICES`` vertices, trackers otherwise. All three give
+        the same boxes, bit for bit (the incremental walk finds the linear
+        scan's extreme vertex on a convex mesh and adds the translation the
+        same way); only the cost differs.
+
+    Attributes
+    ----------
+    x, v, w : (B, 3) float64
+        Centroid positions, velocities, angular velocities (rad/s); views that
+        tests may write to construct states.
+    R : (B, 3, 3) float64
+        Orientations.
+    t : float; steps : int
+    events : list of Event (onsets of wall and body contacts)
+    stages : tuple of str (the stages this scene runs)
+    stage_seconds : dict of str -> float
+    """
+
+    def __init__(self, scene, *, wall_speed: str = "wall", boxes: str = "auto"):
+        if wall_speed not in SPEEDS:
+            raise StateError(f"wall_speed must be one of {SPEEDS}, got {wall_speed!r}")
+        if boxes not in BOXES:
+            raise StateError(f"boxes must be one of {BOXES}, got {boxes!r}")
+        self.boxes = boxes
+        self.scene = scene
+        self.wall_speed = wall_speed
+        world, dyn, col = scene.world, scene.dynamics, scene.collision
+        self.h = scene.integration.step
+        self.method = resolve_method(scene.integration.solver)
+        self.rotation = dyn.rotation
+        self.body_response = dyn.body_response
+        self.level = col.level
+        B = len(scene.bodies)
+        if B == 0:
+            raise StateError("the scene has no [[body]] to simulate (a particle-only "
+                             "scene runs with refsim.ParticleSystem)")
+        self.body_body = B >= 2 and col.level != "none" and dyn.body_response != "off"
+
+        bodies = []
+        for cfg in scene.bodies:
+            mesh = _scaled_mesh(scene.mesh(cfg), cfg.scale)
+            if mesh.is_closed and (mesh.volume or 0.0) > 0.0:
+                props = mass_properties(mesh.vertices, mesh.faces, cfg.mass)
+            else:
+                props = point_mass_properties(mesh.vertices, cfg.mass)
+            # AMBIGUITY (seed S9): the seed's centroid is the vertex average
+            # ("assuming equal masses for each vertex"); the corrected model
+            # rotates about the solid's centre of mass. Equal for every
+            # bundled model but the l-beam and the star.
+            center = (props.center if "impulse" in (dyn.rotation, dyn.body_response)
+                      else mesh.centroid_vertex_average)
+            bodies.append(Body(name=cfg.name, mesh=mesh,
+                               tracker=make_aabb_tracker(mesh, col.aabb), mass=cfg.mass,
+                               center=np.array(center), inertia=props.inertia))
+        self.bodies = tuple(bodies)
+        self.names = tuple(b.name for b in bodies)
+        self.mass = np.array([b.mass for b in bodies])
+        self.inv_mass = 1.0 / self.mass
+        self.center = np.array([b.center for b in bodies])                  # (B, 3)
+        self._centred = not self.center.any()          # every centroid at the mesh origin
+        self.I_body = np.array([b.inertia for b in bodies])                 # (B, 3, 3)
+        self.I_body_inv = np.linalg.inv(self.I_body)
+
+        # Bodies whose boxes come from the batched scan, one group per mesh;
+        # the others call their own tracker (see ``boxes``).
+        groups: dict[int, list[int]] = {}
+        self._tracked = []
+        for i, b in enumerate(bodies):
+            batched = boxes == "batched" or (
+                boxes == "auto" and b.mesh.n_vertices <= BATCH_VERTICES)
+            if batched:
+                groups.setdefault(id(b.mesh), []).append(i)
+            else:
+                self._tracked.append(i)
+        # a group of all bodies indexes by a slice (a view, no copy)
+        self._linear_groups = [(slice(None) if len(idx) == B else np.array(idx),
+                                np.ascontiguousarray(bodies[idx[0]].mesh.vertices.T))
+                               for idx in groups.values()]
+
+        # State.
+        # orientation rows as written; its columns are the body's axes
+        self.R = np.array([c.orientation for c in scene.bodies], dtype=np.float64)
+        origin = np.array([c.position for c in scene.bodies], dtype=np.float64)
+        self.x = origin + np.einsum("bij,bj->bi", self.R, self.center)
+        self.v = np.array([c.velocity for c in scene.bodies], dtype=np.float64)
+        self.w = np.array([c.angular_velocity for c in scene.bodies], dtype=np.float64)
+        if self.rotation == "off":
+            self.w[:] = 0.0                       # DEVIATION D7: rotation off, no turning
+        self.t = 0.0
+        self.steps = 0
+        if not (np.isfinite(self.x).all() and np.isfinite(self.v).all()
+                and np.isfinite(self.w).all()):
+            raise StateError("initial state has a non-finite value")
+
+        self._f = translational_rhs(world.gravity, world.drag, self.inv_mass,
+                                    world.drag_model)
+        self.lo = np.empty((B, 3))
+        self.hi = np.empty((B, 3))
+        self.events: list[Event] = []
+        self._touching: set[tuple[str, str]] = set()
+        self.stages = tuple(s for s in STAGES if self._needs(s))
+        self.stage_seconds = dict.fromkeys(self.stages, 0.0)
+        self._frames: list[tuple] = []
+        # the largest principal moment of each body: 1/2 lambda_max |w|^2 bounds
+        # the rotational energy without a rotation of the inertia tensor
+        self._lambda_max = np.linalg.eigvalsh(self.I_body)[:, -1]
+        self._energy_limit = DIVERGENCE_FACTOR * (self._energy_bound().sum()
+                                                  + self._energy_scale())
+
+    # -- what the scene needs ----------------------------------------------------------
+
+    def _needs(self, stage: str) -> bool:
+        if stage == "rotation":
+            return self.rotation != "off"
+        if stage in ("broad-phase", "body-response"):
+            return self.body_body
+        if stage == "narrow-phase":
+            return self.body_body and self.level != "aabb"
+        return True
+
+    # -- the reported state ------------------------------------------------------------
+
+    @property
+    def position(self) -> np.ndarray:
+        """(B, 3) reference points (mesh origins): ``x - R c``."""
+        if self._centred:
+            return self.x.copy()
+        return self.x - np.einsum("bij,bj->bi", self.R, self.center)
+
+    @property
+    def velocity(self) -> np.ndarray:
+        return self.v
+
+    @property
+    def angular_velocity(self) -> np.ndarray:
+        return self.w
+
+    @property
+    def orientation(self) -> np.ndarray:
+        return self.R
+
+    def pose(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """Body i's pose ``(R, origin)``, for the collision and box functions."""
+        return self.R[i], self.x[i] - self.R[i] @ self.center[i]
+
+    def world_vertices(self, i: int) -> np.ndarray:
+        return transform_vertices(self.bodies[i].mesh.vertices, self.pose(i))
+
+    def energy(self) -> np.ndarray:
+        """(B,) mechanical energy: ``m |v|^2 / 2 + w . I w / 2 + m g (y + H)``
+        (potential measured from the floor; rotational with the body's inertia)."""
+        world = self.scene.world
+        kinetic = 0.5 * self.mass * np.einsum("bi,bi->b", self.v, self.v)
+        Iw = np.einsum("bij,bj->bi", world_inertia(self.R, self.I_body), self.w)
+        rotational = 0.5 * np.einsum("bi,bi->b", self.w, Iw)
+        potential = self.mass * world.gravity * (self.x[:, 1] + world.half_size)
+        return kinetic + rotational + potential
+
+    def _energy_bound(self) -> np.ndarray:
+        """(B,) the energy with the rotational part bounded by
+        ``lambda_max |w|^2 / 2``: a cheap upper bound of :meth:`energy` for
+        the divergence check (O(B) without (B, 3, 3) products)."""
+        world = self.scene.world
+        kinetic = 0.5 * (self.mass * np.einsum("bi,bi->b", self.v, self.v)
+                         + self._lambda_max * np.einsum("bi,bi->b", self.w, self.w))
+        return kinetic + self.mass * world.gravity * (self.x[:, 1] + world.half_size)
+
+    def _energy_scale(self) -> float:
+        world = self.scene.world
+        span = 2.0 * world.half_size
+        return float((self.mass * (world.gravity * span + 0.5 * span * span)).sum())
+
+    # -- the step ---------------------------------------------------------------------
+
+    def step(self) -> None:
+        """One step of size h for all bodies (the outline in the module docstring).
+
+        Raises
+        ------
+        DivergenceError
+            The state became non-finite or its energy grew without bound; the
+            frames recorded so far are in ``error.partial``.
+        """
+        clock = time.perf_counter
+        seconds = self.stage_seconds
+        t0 = clock()
+        self._integrate()
+        t1 = clock()
+        seconds["integrate"] += t1 - t0
+        if self.rotation != "off":
+            self._rotate()
+            t0, t1 = t1, clock()
+            seconds["rotation"] += t1 - t0
+        self._bounds()
+        t0, t1 = t1, clock()
+        seconds["bounds"] += t1 - t0
+        touching = set()
+        # AMBIGUITY (A9): walls before bodies, the order of the seed's text
+        self._walls(touching)
+        t0, t1 = t1, clock()
+        seconds["walls"] += t1 - t0
+        if self.body_body:
+            pairs = self._broad_phase()
+            t0, t1 = t1, clock()
+            seconds["broad-phase"] += t1 - t0
+            if self.level != "aabb":
+                pairs = self._narrow_phase(pairs)
+                t0, t1 = t1, clock()
+                seconds["narrow-phase"] += t1 - t0
+            self._body_response(pairs, touching)
+            t0, t1 = t1, clock()
+            seconds["body-response"] += t1 - t0
+        self.t = (self.steps + 1) * self.h
+        self.steps += 1
+        self._note_events(touching)
+        self._check()
+        seconds["check"] += clock() - t1
+
+    def run(self, n_steps: int, every: int = 1) -> None:
+        """Take ``n_steps`` steps, recording a frame after every ``every``-th
+        step (counted from the start of the simulation)."""
+        for _ in range(n_steps):
+            self.step()
+            if self.steps % every == 0:
+                self.record()
+
+    # 1. forces and the solver, all bodies at once (S5, S6)
+    def _integrate(self) -> None:
+        B = len(self.bodies)
+        y = np.concatenate([self.x.reshape(-1), self.v.reshape(-1)])
+        y = self.method.step(self._f, self.t, y, self.h)
+        Y = y.reshape(2, B, 3)
+        self.x[...] = Y[0]
+        self.v[...] = Y[1]
+
+    # 2. orientation (S9, or the corrected exact rotation)
+    def _rotate(self) -> None:
+        if self.rotation == "seed":
+            self.R[...] = orientation_step_seed_compiled(self.R, self.w, self.h)
+        else:
+            self.R[...], self.w[...] = orientation_step_exact(
+                self.R, self.w, self.h, self.I_body, self.I_body_inv)
+
+    # 3. boxes (S2)
+    def _bounds(self) -> None:
+        origin = self.position
+        for idx, vertices_t in self._linear_groups:
+            # the linear scan's r_k(v) = (R_k0 x + R_k1 y) + R_k2 z, batched
+            self.lo[idx], self.hi[idx] = boxes_compiled(vertices_t, self.R[idx], origin[idx])
+        for i in self._tracked:
+            tracker = self.bodies[i].tracker
+            # The loop's poses are finite and orthonormal by construction (the
+            # check stage), so the tracker's per-call validation is skipped.
+            self.lo[i], self.hi[i] = tracker.update_unchecked(self.R[i], origin[i])
+
+    # 4. walls (S3, S7, S9 or corrected)
+    def _walls(self, touching: set) -> None:
+        H = self.scene.world.half_size
+        beyond = np.flatnonzero(((self.lo < -H) | (self.hi > H)).any(axis=1))
+        for i in beyond:
+            correction = world_cube_test(self.lo[i], self.hi[i], H).correction
+            if self.rotation == "impulse":
+                self._wall_impulse(i, correction)
+            else:
+                if self.rotation == "seed":
+                    self._wall_spin_seed(i, correction)
+                world = self.scene.world
+                self.x[i], self.v[i] = wall_response_seed(
+                    self.x[i], self.v[i], correction, world.restitution, world.friction,
+                    world.gravity, self.wall_speed)
+            self.lo[i] += correction
+            self.hi[i] += correction
+            for k in np.flatnonzero(correction):
+                touching.add((self.names[i], wall_name(k, correction[k])))
+
+    def _wall_spin_seed(self, i: int, correction: np.ndarray) -> None:
+        """S9 at each crossed wall: the contact vertex, then w += Pi x I."""
+        world = self.scene.world
+        W = self.world_vertices(i)
+        for k in np.flatnonzero(correction):
+            low = correction[k] > 0.0
+            N = np.zeros(3)
+            N[k] = 1.0 if low else -1.0                     # into the body
+            Pi = W[contact_vertex_seed(W, k, low)] - self.x[i]   # R (p_i - c)
+            self.w[i] = contact_spin_seed(self.w[i], self.v[i], Pi, N,
+                                          world.restitution, world.friction).w
+
+    def _wall_impulse(self, i: int, correction: np.ndarray) -> None:
+        """Corrected wall contact: push back, speed at the wall, impulses at
+        every vertex past the wall."""
+        world = self.scene.world
+        H = world.half_size
+        I_inv = world_inertia(self.R[i:i + 1], self.I_body_inv[i:i + 1])[0]
+        for k in np.flatnonzero(correction):
+            low = correction[k] > 0.0
+            W = self.world_vertices(i)
+            r_a = W[wall_contacts(W, k, -H if low else H, low)] - self.x[i]
+            self.x[i, k] += correction[k]                   # no interpenetration persists
+            # DEVIATION (D6): the speed at the wall (energy of the push-back, as in S7), but
+            # only for a real bounce: in resting contact this torque-free change
+            # at the centroid would cancel gravity by itself and leave the
+            # contact impulses (and with them friction and the torque that
+            # topples a body balanced on an edge) with nothing to do.
+            if self.v[i, k] * correction[k] < -impulse.RESTITUTION_THRESHOLD * abs(
+                    correction[k]):
+                self.v[i, k] = wall_speed(self.v[i, k],
+                                          -world.gravity if k == 1 else 0.0, correction[k])
+            if not len(r_a):
+                continue
+            n = np.zeros(3)
+            n[k] = 1.0 if low else -1.0
+            P = np.empty((len(r_a), 4))
+            impulse.solve_contacts(
+                np.ascontiguousarray(r_a), np.zeros_like(r_a), n, self.inv_mass[i], I_inv,
+                self.v[i], self.w[i], 0.0, np.zeros((3, 3)), np.zeros(3), np.zeros(3),
+                world.restitution, world.friction, impulse.RESTITUTION_THRESHOLD,
+                impulse.ITERATIONS, P)
+
+    # 5. broad phase (S4 test 1)
+    def _broad_phase(self) -> np.ndarray:
+        if self.level == "sphere":
+            from refsim.collision.spheres import bounding_sphere
+
+            centres = np.empty((len(self.bodies), 3))
+            radii = np.empty(len(self.bodies))
+            for i, b in enumerate(self.bodies):
+                c, radii[i] = bounding_sphere(b.mesh)
+                R, origin = self.pose(i)
+                centres[i] = R @ c + origin
+            return overlapping_pairs_compiled(centres - radii[:, None],
+                                              centres + radii[:, None])
+        return overlapping_pairs_compiled(self.lo, self.hi)
+
+    # 6. narrow phase (S4 at the scene's level)
+    def _narrow_phase(self, pairs: np.ndarray) -> list:
+        from refsim.collision.bodies import bodies_collide
+
+        hits = []
+        for a, b in pairs:
+            if bodies_collide(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
+                              self.pose(b), level=self.level):
+                hits.append((a, b))
+        return hits
+
+    # 7. body-body response (S8, or corrected)
+    def _body_response(self, pairs, touching: set) -> None:
+        world = self.scene.world
+        for a, b in pairs:
+            a, b = int(a), int(b)
+            touching.add((self.names[a], self.names[b]))
+            if self.body_response == "seed":
+                self.v[a], self.v[b], _ = exchange_velocities_seed(
+                    self.x[a], self.x[b], self.v[a], self.v[b])
+                continue
+            geometry = contact_geometry(self.world_vertices(a), self.world_vertices(b),
+                                        self.x[a], self.x[b], self.R[a], self.R[b])
+            if geometry.depth < 0.0:
+                continue                  # a separating axis: coarse-level false contact
+            if self.rotation == "off":
+                I_inv_a = I_inv_b = np.zeros((3, 3))
+            else:
+                I_inv_a, I_inv_b = world_inertia(self.R[[a, b]], self.I_body_inv[[a, b]])
+            P = np.empty((1, 4))
+            impulse.solve_contacts(
+                (geometry.point - self.x[a])[None, :], (geometry.point - self.x[b])[None, :],
+                geometry.n, self.inv_mass[a], I_inv_a, self.v[a], self.w[a],
+                self.inv_mass[b], I_inv_b, self.v[b], self.w[b], world.restitution,
+                world.friction, impulse.RESTITUTION_THRESHOLD, impulse.ITERATIONS, P)
+            dx_a, dx_b = separate_bodies(geometry, self.inv_mass[a], self.inv_mass[b])
+            self.x[a] += dx_a
+            self.x[b] += dx_b
+
+    # 8. divergence
+    def _check(self) -> None:
+        # One O(B) sum answers both questions: a non-finite x, v or w makes
+        # the energy NaN or inf, and "not (E <= limit)" is then true (R stays
+        # finite while w is: it is built from w by finite operations).
+        energy = self._energy_bound()
+        total = energy.sum()
+        if total <= self._energy_limit:
+            return
+        bad = ~(np.isfinite(self.x).all(axis=1) & np.isfinite(self.v).all(axis=1)
+                & np.isfinite(self.w).all(axis=1) & np.isfinite(self.R).all(axis=(1, 2)))
+        if bad.any():
+            self._diverged("state is not finite", int(np.flatnonzero(bad)[0]))
+        # finite state whose energy is beyond the limit (or overflows)
+        self._diverged(f"energy {total:.6g} exceeds {DIVERGENCE_FACTOR:.0e} times its "
+                       f"initial value plus scale ({self._energy_limit:.6g})",
+                       int(np.argmax(energy)))
+
+    def _diverged(self, message: str, i: int):
+        raise DivergenceError(message, step=self.steps, time=self.t, body=self.names[i],
+                              partial=self.trajectory())
+
+    def _note_events(self, touching: set) -> None:
+        for body, other in sorted(touching - self._touching):
+            kind = "wall" if other[:1] in "xyz" and other[1:] in ("-", "+") \
+                and other not in self.names else "body"
+            self.events.append(Event(kind=kind, step=self.steps, time=self.t, body=body,
+                                     other=other))
+        self._touching = touching
+
+    # -- frames ---------------------------------------------------------------------------
+
+    def record(self) -> None:
+        """Append the current state as a frame."""
+        self._frames.append((self.t, self.position.copy(), self.v.copy(), self.w.copy(),
+                             self.R.copy()))
+
+    def trajectory(self, settings: dict | None = None) -> Trajectory:
+        """The frames recorded so far as a :class:`Trajectory`."""
+        B = len(self.bodies)
+        if self._frames:
+            t, x, v, w, R = (np.array(a) for a in zip(*self._frames, strict=True))
+        else:
+            t = np.empty(0)
+            x, v, w = (np.empty((0, B, 3)) for _ in range(3))
+            R = np.empty((0, B, 3, 3))
+        ran = tuple(s for s in self.stages)
+        return Trajectory(t=t, position=x, velocity=v, angular_velocity=w, orientation=R,
+                          names=self.names, events=list(self.events), stages=ran,
+                          stage_seconds=dict(self.stage_seconds),
+                          settings=dict(settings or self._settings()))
+
+    def _settings(self) -> dict:
+        s = self.scene
+        return {"solver": s.integration.solver, "step": self.h,
+                "rotation": self.rotation, "body_response": self.body_response,
+                "collision_level": self.level, "aabb": s.collision.aabb,
+                "wall_speed": self.wall_speed, "boxes": self.boxes, "steps": self.steps}
+
+
+def default_every(n_steps: int) -> int:
+    """The frame stride that keeps at most about ``MAX_FRAMES`` frames."""
+    return max(1, math.ceil(n_steps / MAX_FRAMES))
+
+
+def simulate(scene, *, every: int | None = None, duration: float | None = None,
+             wall_speed: str = "wall", boxes: str = "auto") -> Trajectory:
+    """Run ``scene`` and return its trajectory.
+
+    Parameters
+    ----------
+    scene : refsim.Scene
+    every : int, optional
+        Record a frame every ``every`` steps (and the initial state); default
+        :func:`default_every` (at most about 1000 frames).
+    duration : float, optional
+        Override ``integration.duration`` (seconds).
+    wall_speed, boxes : str
+        See :class:`Simulation`.
+
+    Raises
+    ------
+    DivergenceError
+        With the frames so far in ``partial``.
+    """
+    if duration is not None:
+        scene = replace(scene, integration=replace(scene.integration, duration=duration))
+    n_steps = scene.integration.n_steps
+    if every is None:
+        every = default_every(n_steps)
+    if every < 1:
+        raise StateError(f"every must be >= 1, got {every}")
+    sim = Simulation(scene, wall_speed=wall_speed, boxes=boxes)
+    sim.record()
+    sim.run(n_steps, every=every)
+    if sim.steps % every:
+        sim.record()                                  # always end on the last state
+    traj = sim.trajectory()
+    traj.settings["every"] = every
+    return traj

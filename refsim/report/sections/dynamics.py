@@ -1,0 +1,428 @@
+"""Report section: rigid-body dynamics (S5, S7, S8, S9), claims C11 and C12.
+
+Every number comes from a ``measure_*`` function: the bounce studies of
+:mod:`refsim.dynamics.bounce` (refsim against the analytic answers of
+:mod:`refsim.dynamics.analytic` and the pybullet oracle), and the C11/C12
+measurements of :mod:`refsim.dynamics.measure`. This module only arranges
+them (STYLE.md, rule 9).
+
+``ctx.quick`` runs fewer restitutions, step sizes and solvers, shorter C11
+and C12 runs and fewer timed steps; the captions say what the quick run
+leaves out. Without pybullet the section still measures refsim against the
+analytic answers and says that the oracle's columns are missing. Everything
+is deterministic but the wall times (keys ``seconds_per_second``,
+``*_seconds``, ``ratio`` of the step cost; the step-cost table is marked
+``timing``); no verdict sentence quotes a time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict
+
+import numpy as np
+
+from refsim.report.charts import Series, line_chart
+from refsim.report.section import Figure, Section, Table, Verdict
+
+CHART_SIZE = (7.0, 4.0)
+CMD_BOUNCE = "python -m refsim.dynamics.bounce"
+CMD_MEASURE = "python -m refsim.dynamics.measure"
+#: Errors below this are rounding (RK4 integrates the parabola of free
+#: flight exactly; refsim's wall response is then exact too): the cost chart
+#: draws them at this floor so that a log axis can show them.
+ERROR_FLOOR = 1e-16
+
+STYLES = {"euler": "o-", "averaged-euler": "s--", "backwards-euler": "^-", "midpoint": "x:",
+          "rk4": "D-", "rk4, seed wall speed": "D--", "pybullet": "*-"}
+
+
+def _pybullet_available() -> tuple[bool, str]:
+    from oracles import OracleUnavailable
+
+    try:
+        from oracles.pybullet_adapter import PybulletOracle
+
+        PybulletOracle().close()
+    except OracleUnavailable as exc:
+        return False, str(exc)
+    return True, ""
+
+
+def _f(x, digits: int = 5) -> str:
+    if x is None or (isinstance(x, float) and not math.isfinite(x)):
+        return "n/a"
+    return f"{x:.{digits}g}"
+
+
+def _pct(x) -> str:
+    return "n/a" if not math.isfinite(x) else f"{100 * x:.3g}%"
+
+
+def _jsonable(obj):
+    """Dataclasses with numpy arrays as plain data for results.json."""
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if hasattr(obj, "__dataclass_fields__"):
+        return _jsonable(asdict(obj))
+    return obj
+
+
+def build(ctx) -> Section:
+    from refsim.dynamics import bounce
+    from refsim.dynamics import measure as dyn_measure
+    from refsim.dynamics.choices import choices
+
+    quick = ctx.quick
+    say = ctx.progress.announce
+    pb, missing = _pybullet_available()
+
+    # -- measurements ------------------------------------------------------------------
+    say("dynamics: apex ratios")
+    if quick:
+        apex_rows = bounce.measure_apexes(models=(bounce.SPHERE,), with_pybullet=pb)
+        apex_rows.append(bounce.measure_apex_row(bounce.CUBE, 0.8, rotation="seed",
+                                                 with_pybullet=pb))
+    else:
+        apex_rows = bounce.measure_apexes(with_pybullet=pb)
+    say("dynamics: oblique bounces")
+    oblique_rows = bounce.measure_oblique(with_pybullet=pb)
+    say("dynamics: time to rest")
+    rest_rows = bounce.measure_rest(restitutions=(0.5,) if quick else (0.5, 0.8),
+                                    with_pybullet=pb)
+    say("dynamics: energy over time")
+    series = bounce.measure_energy(with_pybullet=pb)
+    say("dynamics: error against cost")
+    cost = bounce.measure_cost(bounce.COST_STEPS_QUICK if quick else bounce.COST_STEPS,
+                               bounce.COST_SOLVERS_QUICK if quick else bounce.COST_SOLVERS,
+                               with_pybullet=pb)
+    settings_rows = []
+    if pb and not quick:
+        say("dynamics: pybullet's settings")
+        settings_rows = bounce.measure_pybullet_settings()
+    say("dynamics: step cost against pybullet")
+    step_rows = bounce.measure_step_cost(steps=50 if quick else 200, warmup=10 if quick else 20,
+                                         repeats=3 if quick else 5, with_pybullet=pb)
+    if not quick:
+        step_rows += bounce.measure_step_cost(counts=(bounce.BENCH_COUNTS[-1],),
+                                              warmup=bounce.LATE_WARMUP, repeats=3,
+                                              with_pybullet=pb)
+    say("dynamics: C12 spin")
+    # C12 runs its full 6 s in the quick report too: a shorter run stops
+    # before the corrected model comes to rest and would change the verdict.
+    if pb:
+        from oracles.pybullet_adapter import PybulletOracle
+        from refsim.dynamics.simulation import default_every
+
+        spin_scene = dyn_measure._scene("spinning-cube.toml")
+        with PybulletOracle() as oracle:
+            external = oracle.simulate(
+                spin_scene, every=default_every(spin_scene.integration.n_steps))
+        spin_rows = dyn_measure.measure_spin(spin_scene, external=external)
+    else:
+        spin_rows = dyn_measure.measure_spin()
+    say("dynamics: C11 interpenetration")
+    c11_rows = dyn_measure.measure_interpenetration(duration=1.0 if quick else 2.0)
+
+    # -- figures and tables --------------------------------------------------------------
+    figures, tables = [], []
+    pb_note = "" if pb else f" pybullet is missing ({missing}): its columns are n/a."
+
+    def stride(values, n=5):
+        return list(values)[::n]
+
+    figures.append(Figure(
+        id="dynamics-bounce-heights", title="Bounce heights over time",
+        svg=line_chart([
+            Series("analytic", stride(series.t), stride(series.analytic_height), "-"),
+            Series("refsim (seed wall response, RK4)", stride(series.t),
+                   stride(series.refsim_height), "--"),
+            Series("pybullet", stride(series.t), stride(series.pybullet_height), ":"),
+        ], xlabel="time (s)", ylabel="height of the lowest point above the floor (m)",
+            size=CHART_SIZE),
+        caption=f"{series.body}, e = {series.e}, dropped from {bounce.DROP_HEIGHT} m, "
+                f"h = {bounce.STEP} s, rotation off. refsim's curve lies on the analytic "
+                f"one; pybullet's drifts by milliseconds per bounce.{pb_note} "
+                f"Reproduce: {CMD_BOUNCE}"))
+    figures.append(Figure(
+        id="dynamics-energy", title="Mechanical energy over time",
+        svg=line_chart([
+            Series("analytic (e^(2k) after bounce k)", stride(series.t),
+                   stride(series.analytic_energy), "-"),
+            Series("refsim", stride(series.t), stride(series.refsim_energy), "--"),
+            Series("pybullet", stride(series.t), stride(series.pybullet_energy), ":"),
+        ], xlabel="time (s)", ylabel="energy / (m g) (m)", size=CHART_SIZE),
+        caption="Potential energy above the touching height plus kinetic, per unit weight. "
+                "Between bounces it is constant (RK4 is exact for free flight; Bullet's "
+                "symplectic Euler nearly so); each bounce multiplies it by e^2. "
+                f"Reproduce: {CMD_BOUNCE}"))
+
+    apex_table_rows = tuple(
+        (r.body, r.rotation, r.e, _f(r.analytic_ratio), _f(r.refsim_ratio),
+         _pct(r.refsim_error), _f(r.seed_speed_ratio), _pct(r.seed_speed_error),
+         _f(r.pybullet_ratio), _pct(r.pybullet_error), _f(r.refsim_max_spin, 3),
+         _f(r.pybullet_max_spin, 3))
+        for r in apex_rows)
+    tables.append(Table(
+        id="dynamics-apex-ratios", title="Apex ratios against e^2",
+        columns=("body", "rotation", "e", "e^2", "refsim", "error", "refsim, seed's literal "
+                 "wall speed", "error", "pybullet", "error", "refsim max |w| (rad/s)",
+                 "pybullet max |w| (rad/s)"),
+        rows=apex_table_rows,
+        caption=f"Geometric mean of the first {bounce.BOUNCES} apex ratios, h = {bounce.STEP} "
+                f"s, RK4, drop height {bounce.DROP_HEIGHT} m. refsim's default wall response "
+                "flips the speed the body had at the wall (DEVIATION D1) and matches e^2 to "
+                "rounding; the seed's literal flip keeps the deeper, faster speed and gains "
+                "about delta/h0 per bounce (0.2% at this step), still inside the issue's "
+                "0.5% target. pybullet detects a contact only once the hull overlaps the "
+                "wall and restitutes that velocity (split impulse removes the overlap "
+                "without energy). The cube's face-down bounce is exact for refsim's box "
+                "test with rotation off; the seed's rotation model picks one of the four "
+                "tied bottom vertices (AMBIGUITY A4), spins the cube after the first "
+                "bounce and adds energy (w += Pi x I takes nothing from the linear "
+                "motion), so later apexes are too high. pybullet's cube meets the floor at "
+                "four points solved one after another; on some bounces that breaks the "
+                "symmetry and the cube tips and spins (max |w|)."
+                + (" Quick run: the cube only at e = 0.8 with the seed's rotation." if quick
+                   else "")
+                + pb_note + f" Reproduce: {CMD_BOUNCE}"))
+
+    tables.append(Table(
+        id="dynamics-oblique", title="Lateral velocity after an oblique bounce",
+        columns=("body", "rotation", "v_t (m/s)", "v_n at impact (m/s)",
+                 "seed: (1 - friction) v_t", "Coulomb, point mass", "Coulomb, ball",
+                 "ball slides", "refsim", "pybullet", "pybullet |w| after (rad/s)"),
+        rows=tuple((r.body, r.rotation, r.v_t, _f(r.v_n, 4), _f(r.seed_analytic),
+                    _f(r.coulomb_point), _f(r.coulomb_ball), "yes" if r.ball_slides else "no",
+                    _f(r.refsim), _f(r.pybullet), _f(r.pybullet_spin, 3))
+                   for r in oblique_rows),
+        caption=f"friction = {bounce.OBLIQUE_FRICTION} (the seed's fraction; pybullet's "
+                f"Coulomb mu), e = {bounce.OBLIQUE_E}, released 5 cm above the floor. The "
+                "seed keeps (1 - friction) v_t whatever the normal speed; Coulomb friction "
+                "removes mu (1 + e) |v_n| while sliding, and a ball that would stop its "
+                "contact point leaves rolling at 5/7 v_t, which pybullet reproduces. "
+                "pybullet's cube tips on the friction at its leading edge, so its centre "
+                "keeps less. refsim's cube with the seed's rotation hits the floor again "
+                "as it turns (its box grows), and each hit damps v_t by another 0.7."
+                + pb_note + f" Reproduce: {CMD_BOUNCE}"))
+
+    tables.append(Table(
+        id="dynamics-rest", title="Time to rest",
+        columns=("body", "e", "Zeno time (s)", "analytic settle (s)", "bounce",
+                 "refsim settle (s)", "bounce", "pybullet settle (s)", "bounce"),
+        rows=tuple((r.body, r.e, _f(r.zeno), _f(r.analytic_settle), r.analytic_bounces,
+                    _f(r.refsim_settle), r.refsim_bounces, _f(r.pybullet_settle),
+                    r.pybullet_bounces) for r in rest_rows),
+        caption=f"The analytic bounces accumulate at the Zeno time t0 (1 + 2e/(1 - e)). "
+                f"Measured: the time of the bounce after which every apex stays below "
+                f"{bounce.REST_FRACTION} of the drop height. refsim settles on the analytic "
+                "bounce, up to a step per bounce; pybullet a bounce later, its low bounces "
+                "returning slightly more than e^2 (the overlap restitution above)."
+                + (" Quick run: e = 0.5 only." if quick else "") + pb_note
+                + f" Reproduce: {CMD_BOUNCE}"))
+
+    cost_series = []
+    for solver in dict.fromkeys(p.solver for p in cost.points):
+        pts = [p for p in cost.points if p.solver == solver and math.isfinite(p.error)]
+        cost_series.append(Series(solver, [p.seconds_per_second for p in pts],
+                                  [max(p.error, ERROR_FLOOR) for p in pts],
+                                  STYLES.get(solver, "o-")))
+    figures.append(Figure(
+        id="dynamics-error-cost", title="Apex-ratio error against cost, over step sizes",
+        svg=line_chart(cost_series, xlabel="wall time per simulated second (s)",
+                       ylabel="|apex ratio - e^2| / e^2", logx=True, logy=True,
+                       size=CHART_SIZE),
+        caption=f"{cost.body}, e = {cost.e}, {cost.bounces} bounces; each point one step "
+                f"size from 1/30 to 1/4000 s, in the manner of Erez, Tassa and Todorov "
+                f"(ICRA 2015). RK4 integrates free flight exactly and the wall-speed "
+                f"response is exact, so its error is rounding (drawn at {ERROR_FLOOR:g}); "
+                "with the seed's literal wall speed RK4's error is first order in h, as "
+                "are Euler's (energy gain) and the seed's \"backwards Euler\" (energy "
+                "loss). refsim's time is the whole simulate call; pybullet's the "
+                "stepSimulation calls alone. Timings vary from run to run."
+                + (" Quick run: 3 step sizes (1/30, 1/125, 1/500 s), 3 solvers." if quick
+                   else "") + pb_note
+                + f" Reproduce: {CMD_BOUNCE}"))
+
+    if settings_rows:
+        tables.append(Table(
+            id="dynamics-pybullet-settings", title="pybullet's settings, one at a time",
+            columns=("changed from the oracle's settings", "apex ratio", "error against e^2",
+                     "settles after bounce", "bounces in 9 s"),
+            rows=tuple((r.change, _f(r.ratio), f"{100 * r.error:+.3g}%",
+                        r.settle_bounce or "not within the run", r.bounces)
+                       for r in settings_rows),
+            caption=f"{bounce.SPHERE}, e = {bounce.OBLIQUE_E}, h = {bounce.STEP} s; the "
+                    "analytic series settles after bounce "
+                    f"{settings_rows[0].analytic_settle_bounce}. Each row changes one setting of "
+                    "oracles/pybullet_adapter.py back to (or near) pybullet's default; the "
+                    "module docstring says why each is set as it is. The restitution "
+                    "threshold changes only the micro-bounces after settling (fewer "
+                    f"bounces in all). Reproduce: {CMD_BOUNCE}"))
+    tables.append(Table(
+        id="dynamics-step-cost", title="Time per step against pybullet", timing=True,
+        columns=("cubes", "rotation", "timed after step", "refsim (us/step)",
+                 "pybullet (us/step)", "refsim / pybullet", "refsim by stage (us/step)"),
+        rows=tuple((r.bodies, r.rotation, r.warmup, _f(1e6 * r.refsim_seconds, 4),
+                    _f(1e6 * r.pybullet_seconds, 4), _f(r.ratio, 3),
+                    ", ".join(f"{k} {1e6 * v:.3g}" for k, v in r.refsim_stage_seconds.items()))
+                   for r in step_rows),
+        caption="Unit cubes on a grid with seeded random velocities, collision level "
+                "\"aabb\", the seed's body response; the fastest of "
+                f"{3 if quick else 5} runs of {50 if quick else 200} steps after a warm-up of "
+                f"{10 if quick else 20}. The issue's target is "
+                "refsim at most 2x pybullet at 40 bodies; this run measured "
+                + ", ".join(f"{r.ratio:.2g}x (rotation {r.rotation}, after step {r.warmup})"
+                            for r in step_rows
+                            if r.bodies == max(x.bodies for x in step_rows))
+                + ". Each of refsim's stages is a handful of numpy calls over all bodies, "
+                "each costing microseconds of interpreter and dispatch overhead on arrays "
+                "of a few dozen rows (RK4's four evaluations, the box scan, the seed's "
+                "orientation step, the energy check): the per-stage column shows the time "
+                "spread over the stages rather than one hot spot, and a fixed cost of about "
+                "50 us per step that pybullet's compiled loop does not pay, so the ratio "
+                "falls as bodies are added. Once the cubes have settled on the floor "
+                f"(timed after step {bounce.LATE_WARMUP}, full run only) Bullet has many "
+                "contacts to solve while refsim's box test stays as cheap. Timings vary "
+                "from run to run. Reproduce: "
+                "make bench (tests/benchmarks/test_bench_dynamics.py) or " + CMD_BOUNCE))
+
+    by_model = {s.model: s for s in spin_rows}
+    spin_series = [Series(s.model, s.t, s.spin, "-") for s in spin_rows]
+    energy_series = [Series(s.model, s.t, s.rotational_energy, "-") for s in spin_rows]
+    figures.append(Figure(
+        id="dynamics-c12-spin", title="C12: angular velocity over time",
+        svg=line_chart(spin_series, xlabel="time (s)", ylabel="|w| (rad/s)", size=CHART_SIZE),
+        caption="scenes/spinning-cube.toml: a cube dropped with spin (2, 5, 1) rad/s, "
+                "e = 0.5, friction 0.3. \"seed\": the seed's rotation model (S9); "
+                "\"impulse\": the corrected model (impulses with the real inertia and "
+                "Coulomb friction at every contact vertex); pybullet: the same scene."
+                + f" Reproduce: {CMD_MEASURE}"))
+    figures.append(Figure(
+        id="dynamics-c12-energy", title="C12: rotational energy over time",
+        svg=line_chart(energy_series, xlabel="time (s)", ylabel="w . I w / 2 (J)",
+                       size=CHART_SIZE),
+        caption="Rotational energy with each body's inertia tensor, for the same runs. "
+                f"Reproduce: {CMD_MEASURE}"))
+    tables.append(Table(
+        id="dynamics-c12", title="C12: spin at the end of the run",
+        columns=("model", "mean |w| over the last second (rad/s)",
+                 "mean |v| over the last second (m/s)", "at rest"),
+        rows=tuple((s.model, _f(s.final_spin, 4), _f(s.final_speed, 4),
+                    "yes" if s.at_rest else "no") for s in spin_rows),
+        caption=f"At rest: |w| < {dyn_measure.REST_SPIN} rad/s and |v| < "
+                f"{dyn_measure.REST_SPEED} m/s. Reproduce: {CMD_MEASURE}"))
+    tables.append(Table(
+        id="dynamics-c11", title="C11: interpenetrating frames",
+        columns=("case", "body response", "frames", "interpenetrating", "longest run",
+                 "contacts"),
+        rows=tuple((r.case, r.response, r.frames, r.interpenetrating, r.longest_run,
+                    r.contacts) for r in c11_rows),
+        caption="Frames (one per step) in which the exact triangle test finds the two "
+                "bodies intersecting. chase: same direction, 2 and 0.5 m/s; slow: head-on "
+                "at 0.05 m/s; stack: a body dropped onto another; glancing: an offset "
+                "pass. \"seed\": the seed's velocity exchange along the centroid line "
+                "(S8); \"impulse\": the corrected response with positional separation."
+                + (" Quick run: 1 s per case." if quick else "")
+                + f" Reproduce: {CMD_MEASURE}"))
+    choice_rows = tuple((tag, "AMBIGUITY" if tag.startswith("A") else "DEVIATION", text)
+                        for tag, text in choices())
+    tables.append(Table(
+        id="dynamics-choices", title="Choices where the seed is silent or wrong",
+        columns=("tag", "kind", "choice"), rows=choice_rows,
+        caption="From refsim/dynamics/choices.py; each tag marks the code that makes "
+                "the choice."))
+
+    # -- verdicts ---------------------------------------------------------------------------
+    seed_spin = by_model.get("seed")
+    corrected = by_model.get("impulse")
+    theirs = by_model.get("pybullet")
+    c12_measured = (
+        f"With the seed's rotation model the dropped cube still turns at "
+        f"{seed_spin.final_spin:.3g} rad/s (mean |w| over the last second; at rest: "
+        f"{'yes' if seed_spin.at_rest else 'no'}), its spin about the vertical at "
+        f"{seed_spin.spin_normal[-1]:.3g} rad/s against {seed_spin.spin_normal[0]:.3g} "
+        f"at the start: the seed's impulse I lies along the floor's normal, so the torque "
+        f"Pi x I has no vertical component and no floor contact can slow that spin, and "
+        f"nothing in S9 damps w between contacts; the corrected model ends at "
+        f"{corrected.final_spin:.3g} rad/s (at rest: {'yes' if corrected.at_rest else 'no'})"
+        + (f" and pybullet at {theirs.final_spin:.3g} rad/s" if theirs else "") + ".")
+    if not seed_spin.at_rest and corrected.at_rest:
+        c12 = "confirmed"
+    elif not seed_spin.at_rest:
+        c12 = "partly"
+    else:
+        c12 = "refuted"
+    # C11: a frame of overlap is what any discrete detection sees first (the
+    # contact is found after the step that made it); the claim is about
+    # overlap that persists, so a case counts when its longest run of
+    # interpenetrating frames exceeds one step.
+    seed_c11 = {r.case: r for r in c11_rows if r.response == "seed"}
+    imp_c11 = {r.case: r for r in c11_rows if r.response == "impulse"}
+    persistent = [c for c, r in seed_c11.items() if r.longest_run > 1]
+    c11_measured = ("With the seed's velocity exchange, interpenetrating frames "
+                    "(longest run): "
+                    + ", ".join(f"{c} {r.interpenetrating} of {r.frames} ({r.longest_run})"
+                                for c, r in seed_c11.items())
+                    + "; with the corrected response: "
+                    + ", ".join(f"{c} {r.interpenetrating}" for c, r in imp_c11.items())
+                    + ". The same-direction chase and the slow head-on approach overlap "
+                      "only in the one frame in which the contact is detected; overlap "
+                      "persists for more than a frame in: "
+                    + (", ".join(persistent) if persistent else "no case")
+                    + " (stack: a slow contact pressed together by gravity, which the "
+                      "exchange of velocities cannot undo; glancing: an offset pass, where "
+                      "the centroid line is not the contact's normal, choices D4).")
+    if persistent and len(persistent) == len(seed_c11):
+        c11 = "confirmed"
+    elif persistent:
+        c11 = "partly"
+    else:
+        c11 = "refuted"
+    verdicts = [
+        Verdict("C11", measured=c11_measured, verdict=c11, evidence="dynamics-c11",
+                command=CMD_MEASURE),
+        Verdict("C12", measured=c12_measured, verdict=c12, evidence="dynamics-c12-spin",
+                command=CMD_MEASURE),
+    ]
+
+    # -- results -------------------------------------------------------------------------------
+    spin_results = [{"model": s.model, "final_spin": s.final_spin,
+                     "final_speed": s.final_speed, "at_rest": s.at_rest, "t": s.t,
+                     "spin": s.spin, "rotational_energy": s.rotational_energy}
+                    for s in spin_rows]
+    results = _jsonable({
+        "pybullet": pb,
+        "apex_ratios": apex_rows,
+        "oblique": oblique_rows,
+        "rest": rest_rows,
+        "energy": series,
+        "cost": cost,
+        "step_cost": step_rows,
+        "pybullet_settings": settings_rows,
+        "c12": spin_results,
+        "c11": c11_rows,
+        "choices": [list(c) for c in choices()],
+        "settings": {"step": bounce.STEP, "solver": bounce.SOLVER,
+                     "drop_height": bounce.DROP_HEIGHT, "bounces": bounce.BOUNCES,
+                     "apex_ratio_target": bounce.APEX_RATIO_TARGET},
+    })
+    intro = ("A body dropped onto the floor of the world cube is the seed's wall response "
+             "(S7) in its simplest form: Newton's restitution law says each apex is e^2 "
+             "of the one before, the bounces end at a finite (Zeno) time, and friction "
+             "acts on the lateral velocity. refsim runs the seed's response, pybullet runs "
+             "the same scene with the settings that bring its bounce closest to the ideal "
+             "(oracles/pybullet_adapter.py lists each), and the analytic answers "
+             "(refsim/dynamics/analytic.py) say what both should give. Then the seed's two "
+             "admitted bugs: the angular velocity that does not damp (C12) and bodies that "
+             "interpenetrate (C11), each against the corrected model.")
+    return Section(key="dynamics", title="Rigid-body dynamics", intro=intro, figures=figures,
+                   tables=tables, verdicts=verdicts, results=results)
