@@ -2,7 +2,7 @@
 
     refsim info MODEL                  facts about a model file
     refsim run SCENE [-o OUT.npz] [--every K]
-                                       simulate a particle scene, write its frames
+                                       simulate a scene (bodies or particles), write frames
     refsim report [--quick] [-o DIR]   write the HTML accuracy report
 
 A user's mistake (a missing or malformed file, a bad scene) prints one line
@@ -18,28 +18,16 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import sys
-import tempfile
 import warnings
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from pathlib import Path
 
 from refsim.errors import DivergenceError, RefsimError, SceneError
+from refsim.io import write_npz_atomic
 
 EXIT_USER_ERROR = 2
 EXIT_DIVERGED = 3
-
-#: ``refsim run`` stores about this many frames unless ``--every`` says
-#: otherwise: enough to replay smoothly, and 200 frames of 10 000 particles
-#: are 96 MB of float64.
-DEFAULT_FRAMES = 200
-
-#: ``refsim run`` refuses to store more frame data than this (positions and
-#: velocities, 48 bytes a particle a frame) and asks for a larger ``--every``:
-#: the frames are held in memory until the file is written.
-MAX_FRAME_BYTES = 4 * 10**9
-
 
 def _info(args) -> int:
     from refsim.models.facts import describe, format_facts
@@ -50,106 +38,6 @@ def _info(args) -> int:
             print()
         print(format_facts(describe(load_model(path), name=str(path))))
     return 0
-
-
-@dataclass(frozen=True)
-class ParticleFrames:
-    """Stored frames of a particle run.
-
-    Attributes
-    ----------
-    step : numpy.ndarray
-        (frames,) int64 step index of each frame (0 is the initial state).
-    t : numpy.ndarray
-        (frames,) times, ``step * h``.
-    position, velocity : numpy.ndarray
-        (frames, N, 3) float64.
-    """
-
-    step: object
-    t: object
-    position: object
-    velocity: object
-
-
-def run_particles(config, n_steps: int, every: int) -> ParticleFrames:
-    """Run a :class:`~refsim.particles.system.ParticleSystem` from
-    ``config.initial_state()`` for ``n_steps`` steps, keeping every
-    ``every``-th state and the last one.
-
-    Raises
-    ------
-    DivergenceError
-        The state became non-finite. ``step`` and ``time`` are those of the
-        first non-finite step (the system checks once per stored frame; the
-        frame interval that failed is replayed step by step from its start,
-        which reproduces the same arithmetic bit for bit). ``partial`` holds
-        the frames stored before it.
-    """
-    import numpy as np
-
-    from refsim.particles.system import ParticleSystem
-
-    h = config.step
-    system = ParticleSystem(config)
-    steps = [0]
-    xs, vs = [system.positions.copy()], [system.velocities.copy()]
-
-    def frames():
-        step = np.array(steps, dtype=np.int64)
-        return ParticleFrames(step, step * h, np.stack(xs), np.stack(vs))
-
-    while system.steps < n_steps:
-        block = min(every, n_steps - system.steps)
-        try:
-            # Overflow on the way to divergence is expected and detected below,
-            # so numpy's warnings would only repeat it.
-            with np.errstate(over="ignore", invalid="ignore"):
-                system.run(block)
-        except DivergenceError:
-            first = _first_non_finite_step(config, xs[-1], vs[-1], block)
-            step = steps[-1] + first
-            raise DivergenceError("particle state is not finite", step=step, time=step * h,
-                                  partial=frames()) from None
-        steps.append(system.steps)
-        xs.append(system.positions.copy())
-        vs.append(system.velocities.copy())
-    return frames()
-
-
-def _first_non_finite_step(config, x, v, block: int) -> int:
-    """Steps from the state ``(x, v)`` until it is first non-finite (at most ``block``)."""
-    import numpy as np
-
-    from refsim.particles.system import ParticleSystem
-
-    system = ParticleSystem(config, positions=x, velocities=v)
-    for i in range(1, block + 1):
-        with np.errstate(over="ignore", invalid="ignore"):
-            system.step()
-        if not np.isfinite(system.state).all():
-            return i
-    return block
-
-
-def write_npz_atomic(path: Path, arrays: dict) -> None:
-    """``numpy.savez`` to ``path`` through a temporary file in the same
-    directory and ``os.replace``: readers see the old file or the whole new
-    one, and an error or Ctrl-C leaves no partial file."""
-    import numpy as np
-
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            np.savez(handle, **arrays)
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)        # mkstemp makes 0600; give what open() would
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _settings(scene, every: int) -> dict:
@@ -167,57 +55,82 @@ def _settings(scene, every: int) -> dict:
 
 
 def _run(args) -> int:
-    import numpy as np
-
     from refsim.scenes.loader import load_scene
-    from refsim.solvers.integrate import STEP_COUNT_RTOL  # duration / step tolerance
 
     scene = load_scene(args.scene)
-    if scene.bodies:
-        raise RefsimError(f"{args.scene}: rigid-body simulation is not implemented yet "
-                          "(issue 6)")
-    config = scene.particles
-    integration = scene.integration
-    ratio = integration.duration / integration.step
-    n_steps = round(ratio)
-    if abs(ratio - n_steps) > STEP_COUNT_RTOL * max(n_steps, 1):
-        raise SceneError(f"duration / step = {ratio:.9g} is not a whole number of steps",
-                         scene.path, "integration.duration")
-    if args.every is None:
-        every = max(1, math.ceil(n_steps / (DEFAULT_FRAMES - 1)))
-    elif args.every < 1:
+    if scene.bodies and scene.particles is not None:
+        raise SceneError("refsim run simulates either rigid bodies or particles; this scene "
+                         "has both (split it in two)", scene.path, "particles")
+    if args.every is not None and args.every < 1:
         raise RefsimError(f"--every must be at least 1, got {args.every}")
-    else:
-        every = args.every
+    out = Path(args.output) if args.output else Path(Path(args.scene).stem + ".npz")
+    if not out.parent.is_dir():
+        raise RefsimError(f"{out}: cannot write: no directory {out.parent}")
+    if scene.bodies:
+        return _run_bodies(scene, out, args.every)
+    return _run_particles(scene, out, args.every)
+
+
+def _write(out: Path, save) -> None:
+    try:
+        save(out)
+    except OSError as exc:
+        raise RefsimError(f"{out}: cannot write: {exc.strerror or exc}") from exc
+
+
+def _run_bodies(scene, out: Path, every: int | None) -> int:
+    """Rigid bodies: ``refsim.simulate``, written as a Trajectory (.npz)."""
+    from refsim.dynamics.simulation import simulate
+
+    try:
+        trajectory = simulate(scene, every=every)
+    except DivergenceError as exc:
+        partial = exc.partial
+        _write(out, partial.save)
+        raise DivergenceError(
+            f"{exc.args[0].split(', ', 2)[-1]}; wrote the {partial.n_frames} frames before it "
+            f"(t = 0 to {partial.t[-1]:.6g}) to {out}", step=exc.step, time=exc.time,
+            body=exc.body) from None
+    _write(out, trajectory.save)
+    ran = ", ".join(trajectory.stages)
+    bodies = len(trajectory.names)
+    print(f"wrote {out}: {trajectory.n_frames} frames of {bodies} "
+          f"{'body' if bodies == 1 else 'bodies'}, "
+          f"t = 0 to {trajectory.t[-1]:.6g} ({scene.integration.solver}, "
+          f"h = {scene.integration.step:g}); stages: {ran}")
+    return 0
+
+
+def _run_particles(scene, out: Path, every: int | None) -> int:
+    """Particles: :func:`refsim.particles.run.run_particles`, frames as .npz."""
+    import numpy as np
+
+    from refsim.particles.run import MAX_FRAME_BYTES, frame_stride, run_particles
+
+    config = scene.particles
+    n_steps, every = frame_stride(scene, every)
     n_frames = math.ceil(n_steps / every) + 1
     if n_frames * config.count * 48 > MAX_FRAME_BYTES:
         raise RefsimError(f"{n_frames} frames of {config.count} particles would take "
                           f"{n_frames * config.count * 48 / 1e9:.1f} GB; store fewer with "
                           f"--every (at most {MAX_FRAME_BYTES / 1e9:g} GB)")
-    out = Path(args.output) if args.output else Path(Path(args.scene).stem + ".npz")
-    if not out.parent.is_dir():
-        raise RefsimError(f"{out}: cannot write: no directory {out.parent}")
 
-    def write(frames: ParticleFrames, status: str) -> None:
+    def save(frames, status: str):
         arrays = {"t": frames.t, "step": frames.step, "position": frames.position,
                   "velocity": frames.velocity,
                   "scene": np.array(json.dumps(_settings(scene, every), sort_keys=True)),
                   "status": np.array(status)}
-        try:
-            write_npz_atomic(out, arrays)
-        except OSError as exc:
-            raise RefsimError(f"{out}: cannot write: {exc.strerror or exc}") from exc
+        _write(out, lambda path: write_npz_atomic(path, arrays))
 
     try:
         frames = run_particles(config, n_steps, every)
     except DivergenceError as exc:
         partial = exc.partial
-        status = f"diverged at step {exc.step}, t = {exc.time:.6g}"
-        write(partial, status)
+        save(partial, f"diverged at step {exc.step}, t = {exc.time:.6g}")
         raise DivergenceError(
             f"particle state is not finite; wrote the {len(partial.t)} frames before it "
             f"(t = 0 to {partial.t[-1]:.6g}) to {out}", step=exc.step, time=exc.time) from None
-    write(frames, "complete")
+    save(frames, "complete")
     print(f"wrote {out}: {len(frames.t)} frames of {config.count} particles, "
           f"t = 0 to {frames.t[-1]:.6g} ({config.solver}, h = {config.step:g}, "
           f"every {every} steps)")
@@ -251,17 +164,20 @@ def build_parser() -> argparse.ArgumentParser:
     info.set_defaults(run=_info)
 
     run = commands.add_parser(
-        "run", help="simulate a particle scene and write its frames (.npz)",
-        description="Simulate the particle system of SCENE for its [integration] "
-                    "duration and write an .npz with t (frames,), step (frames,), "
-                    "position and velocity (frames, N, 3), the scene's settings as JSON "
-                    "(scene) and status. Rigid bodies are not simulated yet.")
-    run.add_argument("scene", metavar="SCENE", help="a scene file (TOML) with [particles]")
+        "run", help="simulate a scene and write its frames (.npz)",
+        description="Simulate SCENE for its [integration] duration and write an .npz. "
+                    "Rigid bodies: t (frames,), position, velocity, angular_velocity "
+                    "(frames, bodies, 3), orientation (frames, bodies, 3, 3), names, events, "
+                    "stages, stage_seconds, settings (see refsim.Trajectory.load). "
+                    "Particles: t, step (frames,), position and velocity (frames, N, 3), "
+                    "the scene's settings as JSON (scene) and status.")
+    run.add_argument("scene", metavar="SCENE",
+                     help="a scene file (TOML) with [[body]] tables or a [particles] table")
     run.add_argument("-o", "--output", metavar="OUT.npz",
                      help="output file (default: the scene's name with .npz, here)")
     run.add_argument("--every", type=int, metavar="K",
-                     help=f"store every K-th step (default: about {DEFAULT_FRAMES} frames); "
-                          "the last step is always stored")
+                     help="store every K-th step (default: at most about 1000 frames for "
+                          "bodies, 200 for particles); the last step is always stored")
     run.set_defaults(run=_run)
 
     report = commands.add_parser("report", help="write the HTML accuracy report")

@@ -1,5 +1,5 @@
-"""``refsim run``: a particle scene's frames in an .npz; one line for a mistake,
-a diverging run or a rigid-body scene; never a partial file."""
+"""``refsim run``: a scene's frames in an .npz (particles or rigid bodies); one
+line for a mistake or a diverging run; never a partial file."""
 
 from __future__ import annotations
 
@@ -136,13 +136,80 @@ def test_a_bad_scene_is_one_line_and_no_file(tmp_path, capsys):
     assert files(tmp_path) == ["scene.toml"]
 
 
-def test_a_rigid_body_scene_is_not_run_yet(tmp_path, capsys):
+RIGID = """
+[world]
+half_size = 2.0
+restitution = 0.8
+
+[integration]
+solver = "rk4"
+step = 0.002
+duration = 0.6
+
+[collision]
+level = "exact"
+
+[dynamics]
+rotation = "seed"
+body_response = "seed"
+
+[[body]]
+name = "a"
+model = "icosahedron.ac"
+position = [-1.0, 0.0, 0.0]
+velocity = [2.0, 1.0, 0.0]
+angular_velocity = [0.0, 0.0, 3.0]
+
+[[body]]
+name = "b"
+model = "cube.ac"
+position = [1.0, 0.5, 0.0]
+velocity = [-2.0, 0.0, 0.5]
+"""
+
+
+def test_a_rigid_body_scene_writes_its_trajectory(tmp_path, capsys):
+    from refsim.dynamics.trajectory import Trajectory
+
+    scene = write(tmp_path, RIGID)
     out = tmp_path / "out.npz"
-    assert main(["run", str(SCENES_DIR / "bounce.toml"), "-o", str(out)]) == EXIT_USER_ERROR
+    assert main(["run", str(scene), "-o", str(out), "--every", "10"]) == 0
+    assert capsys.readouterr().out.startswith(f"wrote {out}: 31 frames of 2 bodies")
+    trajectory = Trajectory.load(out)
+    assert trajectory.names == ("a", "b")
+    assert trajectory.position.shape == (31, 2, 3)
+    assert trajectory.orientation.shape == (31, 2, 3, 3)
+    np.testing.assert_allclose(trajectory.t, np.arange(31) * 0.02, atol=1e-12)
+    np.testing.assert_array_equal(trajectory.position[0], [[-1.0, 0.0, 0.0], [1.0, 0.5, 0.0]])
+    assert np.all(np.abs(trajectory.position) < 2.0)          # inside the world cube
+    # two bodies, rotation on, level "exact": every stage runs
+    assert trajectory.stages == ("integrate", "rotation", "bounds", "walls", "broad-phase",
+                                 "narrow-phase", "body-response", "check")
+    assert any(e.kind == "body" for e in trajectory.events)   # they do meet
+    assert files(tmp_path) == ["out.npz", "scene.toml"]
+
+
+def test_a_diverging_rigid_run_keeps_its_frames(tmp_path, capsys, monkeypatch):
+    import refsim.dynamics.simulation as simulation
+    from refsim.dynamics.trajectory import Trajectory
+    from refsim.errors import DivergenceError
+
+    real = simulation.simulate
+
+    def diverging(scene, every=None):
+        partial = real(scene, every=every, duration=0.1)
+        raise DivergenceError("energy grew without bound", step=51, time=0.102, body="b",
+                              partial=partial)
+
+    monkeypatch.setattr(simulation, "simulate", diverging)
+    scene = write(tmp_path, RIGID)
+    out = tmp_path / "out.npz"
+    assert main(["run", str(scene), "-o", str(out), "--every", "10"]) == EXIT_DIVERGED
     err = capsys.readouterr().err
-    assert err.count("\n") == 1
-    assert "rigid-body simulation is not implemented yet (issue 6)" in err
-    assert files(tmp_path) == []
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert "diverged at step 51" in err and "'b'" in err and "energy grew" in err
+    assert "wrote the 6 frames" in err and str(out) in err
+    assert Trajectory.load(out).n_frames == 6
 
 
 def test_a_duration_that_is_not_whole_steps_names_the_key(tmp_path, capsys):
@@ -216,11 +283,11 @@ def test_console_script_run(tmp_path):
     assert result.stdout.startswith("wrote ")
 
 
-def test_a_scene_with_bodies_and_particles_is_not_run_yet(tmp_path, capsys):
+def test_a_scene_with_bodies_and_particles_is_refused(tmp_path, capsys):
     scene = write(tmp_path, TINY + '\n[[body]]\nmodel = "cube.ac"\n')
     assert main(["run", str(scene), "-o", str(tmp_path / "out.npz")]) == EXIT_USER_ERROR
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "not implemented yet (issue 6)" in err
+    assert err.count("\n") == 1 and "both" in err and "particles" in err
     assert files(tmp_path) == ["scene.toml"]
 
 

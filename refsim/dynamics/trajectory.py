@@ -21,12 +21,12 @@ the loop that ran; ``stage_seconds`` the wall time spent in each.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from refsim.io import write_npz_atomic
 
 
 @dataclass(frozen=True)
@@ -60,27 +60,14 @@ class Trajectory:
 
     def save(self, path) -> Path:
         """Write the trajectory as .npz, atomically (never half a file)."""
-        path = Path(path)
         events = json.dumps([e.__dict__ for e in self.events])
-        fd, tmp = tempfile.mkstemp(dir=path.parent or ".", prefix=f".{path.name}.",
-                                   suffix=".npz")
-        os.close(fd)
-        try:
-            np.savez_compressed(
-                tmp, t=self.t, position=self.position, velocity=self.velocity,
-                angular_velocity=self.angular_velocity, orientation=self.orientation,
-                names=np.array(self.names), events=np.array(events),
-                stages=np.array(self.stages),
-                stage_seconds=np.array(json.dumps(self.stage_seconds)),
-                settings=np.array(json.dumps(self.settings, default=str)))
-            mask = os.umask(0)
-            os.umask(mask)
-            os.chmod(tmp, 0o666 & ~mask)
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-        return path
+        return write_npz_atomic(path, dict(
+            t=self.t, position=self.position, velocity=self.velocity,
+            angular_velocity=self.angular_velocity, orientation=self.orientation,
+            names=np.array(self.names), events=np.array(events),
+            stages=np.array(self.stages),
+            stage_seconds=np.array(json.dumps(self.stage_seconds)),
+            settings=np.array(json.dumps(self.settings, default=str))), compressed=True)
 
     @classmethod
     def load(cls, path) -> Trajectory:

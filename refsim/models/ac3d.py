@@ -89,9 +89,7 @@ from __future__ import annotations
 
 import bisect
 import math
-import os
 import re
-import tempfile
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -99,6 +97,7 @@ from pathlib import Path
 import numpy as np
 
 from refsim.errors import ModelError, ModelWarning
+from refsim.io import write_text_atomic
 from refsim.models.mesh import Material, Mesh
 from refsim.models.triangulate import ear_clip
 
@@ -663,33 +662,12 @@ def format_ac3d(mesh: Mesh) -> str:
 def write_ac3d(mesh: Mesh, path) -> None:
     """Write ``mesh`` to ``path`` as AC3D, atomically.
 
-    The text goes to a temporary file in the same directory, which then
-    replaces ``path`` in one step (``os.replace``): a reader sees the old file
-    or the new one, never half of one, and a failure leaves no partial file.
+    The text is formatted first (a mesh AC3D cannot hold raises before any
+    file is touched), then written by :func:`refsim.io.write_text_atomic`: a
+    reader sees the old file or the new one, never half of one.
     """
-    data = format_ac3d(mesh).encode("utf-8")
-    path = Path(path)
+    text = format_ac3d(mesh)
     try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+        write_text_atomic(path, text)
     except OSError as exc:
         raise ModelError(f"cannot write the file: {exc.strerror or exc}", path=path) from None
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            try:
-                mode = path.stat().st_mode & 0o777  # keep an existing file's permissions
-            except OSError:
-                mode = 0o644  # mkstemp's 0o600 would hide a new model from other users
-            os.fchmod(handle.fileno(), mode)
-            handle.write(data)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-    except BaseException as exc:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        if isinstance(exc, OSError):
-            raise ModelError(f"cannot write the file: {exc.strerror or exc}",
-                             path=path) from None
-        raise

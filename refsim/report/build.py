@@ -6,9 +6,8 @@ fetched, no network. Each area contributes a section from
 yet is shown as a plain "not measured yet" section. The claims table collects
 the verdicts the sections return; a claim without one says so.
 
-Both files are rendered in memory first and then written atomically (a
-temporary file in the output directory, then ``os.replace``), so a failed run
-never leaves a half-written page.
+Both files are rendered in memory first and then written atomically
+(:mod:`refsim.io`), so a failed run never leaves a half-written page.
 """
 
 from __future__ import annotations
@@ -19,11 +18,11 @@ import json
 import os
 import platform
 import subprocess
-import tempfile
 from dataclasses import asdict, dataclass
 from importlib import metadata
 from pathlib import Path
 
+from refsim.io import write_text_atomic
 from refsim.paths import REPO_ROOT, TEMPLATES_DIR
 from refsim.report.claims import CLAIMS, TERMINOLOGY
 from refsim.report.progress import Progress
@@ -85,8 +84,8 @@ def build_report(out_dir: Path, *, quick: bool = False, stream=None) -> Path:
             "sections": {s.key: section_json(s) for s in sections},
         }
         payload = json.dumps(results, indent=2, sort_keys=True, default=_json_default)
-        write_atomic(out_dir / "results.json", payload + "\n")
-        write_atomic(out_dir / "index.html", html)
+        write_text_atomic(out_dir / "results.json", payload + "\n")
+        write_text_atomic(out_dir / "index.html", html)
         progress.step("written")
     return out_dir / "index.html"
 
@@ -178,26 +177,6 @@ def render(sections: list[Section], environment: dict, *, quick: bool) -> str:
                            agreements=agreement_rows(sections),
                            terminology=TERMINOLOGY, environment=environment,
                            quick=quick, css=css)
-
-
-def write_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` so that readers see the old or the new file,
-    never a part of one."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-        os.chmod(tmp, 0o666 & ~_umask())   # mkstemp makes 0600; give what open() would
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
 
 
 def _json_default(value):

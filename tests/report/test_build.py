@@ -8,6 +8,7 @@ import re
 
 import pytest
 
+from refsim.io import write_text_atomic
 from refsim.paths import bundled_models
 from refsim.report import build as report_build
 from refsim.report.build import AREAS, build_report
@@ -92,7 +93,7 @@ def test_a_failed_build_leaves_no_file(tmp_path, monkeypatch):
 def test_write_atomic_replaces_whole_file(tmp_path):
     target = tmp_path / "page.html"
     target.write_text("old")
-    report_build.write_atomic(target, "new")
+    write_text_atomic(target, "new")
     assert target.read_text() == "new"
     assert [p.name for p in tmp_path.iterdir()] == ["page.html"]
     assert target.stat().st_mode & 0o044 == 0o044   # readable by others, as open() makes it
