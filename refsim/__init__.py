@@ -10,6 +10,7 @@ stay quick and an area's heavy imports are paid only by those who use it.
 from __future__ import annotations
 
 import importlib
+import importlib.util
 
 __version__ = "0.1.0"
 
@@ -55,6 +56,9 @@ __all__ = sorted(_EXPORTS)
 def __getattr__(name: str):
     module = _EXPORTS.get(name)
     if module is None:
+        # a subpackage or module (refsim.types, refsim.collision, ...) on first use
+        if not name.startswith("_") and importlib.util.find_spec(f"refsim.{name}"):
+            return importlib.import_module(f"refsim.{name}")
         raise AttributeError(f"module 'refsim' has no attribute {name!r}")
     value = getattr(importlib.import_module(module), name)
     globals()[name] = value
