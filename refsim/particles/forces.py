@@ -32,7 +32,10 @@ def acceleration(v: np.ndarray, gravity: float, drag: float, mass: float,
     if drag_model == "linear":
         a = v * (-r)
     elif drag_model == "quadratic":
-        speed = np.sqrt(np.einsum("ij,ij->i", v, v))
+        # |v| summed in a fixed order, (vx vx + vy vy) + vz vz, which every
+        # path (acceleration_into, the compiled Euler step) repeats exactly;
+        # numpy's einsum would pick its own order.
+        speed = np.sqrt((v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1]) + v[:, 2] * v[:, 2])
         a = v * (speed * (-r))[:, np.newaxis]
     else:
         raise ValueError(f"unknown drag model {drag_model!r}")
@@ -48,7 +51,14 @@ def acceleration_into(v: np.ndarray, gravity: float, drag: float, mass: float,
     if drag_model == "linear":
         np.multiply(v, -r, out=out)
     elif drag_model == "quadratic":
-        np.einsum("ij,ij->i", v, v, out=speed)
+        # |v|^2 = (vx vx + vy vy) + vz vz, as in acceleration(); out[:, 0]
+        # serves as scratch before it receives its own value below.
+        tmp = out[:, 0]
+        np.multiply(v[:, 0], v[:, 0], out=speed)
+        np.multiply(v[:, 1], v[:, 1], out=tmp)
+        np.add(speed, tmp, out=speed)
+        np.multiply(v[:, 2], v[:, 2], out=tmp)
+        np.add(speed, tmp, out=speed)
         np.sqrt(speed, out=speed)
         np.multiply(speed, -r, out=speed)
         # Column by column: broadcasting speed[:, None] against (N, 3) makes

@@ -85,9 +85,11 @@ class ParticleSystem:
         (particle, wall) bounces handled.
     """
 
-    def __init__(self, config: ParticleConfig, positions=None, velocities=None):
+    def __init__(self, config: ParticleConfig, positions=None, velocities=None, *,
+                 kernel: str | None = None):
         self.config = config
         self.method = resolve_method(config.solver)
+        self.kernel = _choose_kernel(kernel, self.method)
         if positions is None and velocities is None:
             positions, velocities = config.initial_state()
         elif positions is None or velocities is None:
@@ -157,6 +159,9 @@ class ParticleSystem:
             Y_next = Y + (h b_1) k_1 + ... + (h b_s) k_s
         """
         h = self.config.step
+        if self.kernel == "fused":
+            self._step_fused(h)
+            return
         A, b = self.method.A_, self.method.b_
         Y, K, scratch = self.state, self._K, self._product
         for i in range(self.method.stages):
@@ -185,6 +190,20 @@ class ParticleSystem:
         self.steps += 1
         self.nfev += self.method.stages
 
+    def _step_fused(self, h: float) -> None:
+        """The Euler step as one compiled loop (``kernel="fused"``): the same
+        bits as the generic step above, in one pass over the state."""
+        from refsim.particles._numba_kernels import euler_step_fused
+
+        c = self.config
+        self.bounces += euler_step_fused(
+            self.state[0], self.state[1], h, c.gravity, c.drag / c.mass,
+            c.drag_model == "quadratic", c.walls, c.half_size, c.restitution,
+            1.0 - c.friction)
+        self.t += h
+        self.steps += 1
+        self.nfev += 1
+
     def run(self, steps: int) -> None:
         """Take ``steps`` steps, then check the state is finite.
 
@@ -209,3 +228,26 @@ class ParticleSystem:
     def potential_energy(self) -> float:
         """Gravitational, relative to ``y = 0``."""
         return self.config.mass * self.config.gravity * float(self.positions[:, 1].sum())
+
+
+KERNELS = ("numpy", "fused")
+
+
+def _choose_kernel(kernel: str | None, method) -> str:
+    """"numpy": the generic step over the tableau (any solver). "fused": the
+    Euler step compiled into one loop (solver "euler" only, needs numba).
+    Default: "fused" for Euler when numba is installed, else "numpy"."""
+    if kernel is not None and kernel not in KERNELS:
+        raise StateError(f"kernel must be one of {KERNELS}, got {kernel!r}")
+    euler = method.name == "euler"
+    if kernel == "fused" and not euler:
+        raise StateError(f"kernel 'fused' is the Euler step only, not {method.name!r}")
+    if kernel is None:
+        if not euler:
+            return "numpy"
+        try:
+            import refsim.particles._numba_kernels  # noqa: F401
+        except ImportError:
+            return "numpy"
+        return "fused"
+    return kernel
