@@ -51,6 +51,28 @@ AREAS: tuple[tuple[str, str, str], ...] = (
      "against the corrected one (C12), body-body interpenetration (C11)."),
 )
 
+# The page's cross-cutting parts: figures and tables (by id prefix) that are
+# shown together there rather than in their area's section (issue 7: speed
+# against accuracy as charts; stability, predicted and measured).
+PARTS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
+    ("speed-accuracy", "Speed against accuracy",
+     "What each method buys for its cost, measured on this machine: error or false "
+     "positives against time or work. Timings are medians of repeated runs on a shared "
+     "two-core machine; read ratios, not absolute values.",
+     ("solvers-wp-", "collision-levels-tradeoff", "collision-speed", "bounds-cost-",
+      "dynamics-error-cost", "dynamics-step-cost")),
+    ("stability", "Stability: where each method fails",
+     "Predicted limits (from the amplification factor R(z) of each solver, from exact "
+     "predicates for the triangle test) next to what the simulations and the oracles "
+     "measure.",
+     ("solvers-stability", "solvers-energy", "solvers-jitter", "collision-c4")),
+)
+
+#: Verdicts that make a claim an entry of the divergence catalogue; the seed's
+#: own "Existing Problems" (C11, C12) are listed when confirmed.
+DIVERGENT_VERDICTS = ("refuted", "partly")
+SEED_ISSUES = ("C11", "C12")
+
 PACKAGES = ("numpy", "scipy", "trimesh", "python-fcl", "pybullet", "matplotlib", "jinja2",
             "numba", "hypothesis")
 
@@ -81,6 +103,7 @@ def build_report(out_dir: Path, *, quick: bool = False, stream=None) -> Path:
             "environment": environment,
             "claims": claim_rows(sections),
             "agreements": agreement_rows(sections),
+            "divergences": divergence_rows(sections),
             "sections": {s.key: section_json(s) for s in sections},
         }
         payload = json.dumps(results, indent=2, sort_keys=True, default=_json_default)
@@ -115,6 +138,31 @@ def claim_rows(sections: list[Section]) -> list[dict]:
     return rows
 
 
+def part_of(item_id: str) -> str:
+    """The cross-cutting part an item is shown in, or "" for its own section."""
+    for key, _, _, prefixes in PARTS:
+        if any(item_id.startswith(prefix) for prefix in prefixes):
+            return key
+    return ""
+
+
+def divergence_rows(sections: list[Section]) -> list[dict]:
+    """The divergence catalogue: the seed's claims that refsim does not
+    confirm, the seed's own listed issues, and every class of oracle
+    disagreement the sections measured."""
+    rows = []
+    for claim in claim_rows(sections):
+        seed_issue = claim["claim"] in SEED_ISSUES and claim["verdict"] == "confirmed"
+        if claim["verdict"] in DIVERGENT_VERDICTS or seed_issue:
+            rows.append({"section": claim["area"], "title": f"{claim['claim']}: {claim['text']}",
+                         "kind": ("seed issue (the seed's own list), confirmed" if seed_issue
+                                  else f"seed claim {claim['verdict']}"),
+                         "finding": claim["measured"], "evidence": claim["evidence"]})
+    for s in sections:
+        rows += [{"section": s.key, **asdict(d)} for d in s.divergences]
+    return rows
+
+
 def agreement_rows(sections: list[Section]) -> list[dict]:
     """The summary at the top of the page: every section's oracle agreements."""
     return [{"section": s.key, **asdict(a)} for s in sections for a in s.agreements]
@@ -128,9 +176,10 @@ def section_json(section: Section) -> dict:
         "results": section.results,
         "tables": [{"id": t.id, "title": t.title, "columns": list(t.columns),
                     "rows": [[str(cell) for cell in row] for row in t.rows],
-                    "timing": t.timing}
+                    "timing": t.timing, "part": part_of(t.id)}
                    for t in section.tables],
-        "figures": [{"id": f.id, "title": f.title} for f in section.figures],
+        "figures": [{"id": f.id, "title": f.title, "part": part_of(f.id)}
+                    for f in section.figures],
     }
 
 
@@ -173,8 +222,14 @@ def render(sections: list[Section], environment: dict, *, quick: bool) -> str:
                              keep_trailing_newline=True)
     template = env.get_template("index.html.j2")
     css = (TEMPLATES_DIR / "style.css").read_text()
+    parts = [{"key": key, "title": title, "intro": intro,
+              "groups": [(s, [t for t in s.tables if part_of(t.id) == key],
+                          [f for f in s.figures if part_of(f.id) == key]) for s in sections]}
+             for key, title, intro, _ in PARTS]
     return template.render(sections=sections, claims=claim_rows(sections),
-                           agreements=agreement_rows(sections),
+                           agreements=agreement_rows(sections), parts=parts,
+                           divergences=divergence_rows(sections), part_of=part_of,
+                           part_titles={key: title for key, title, _, _ in PARTS},
                            terminology=TERMINOLOGY, environment=environment,
                            quick=quick, css=css)
 

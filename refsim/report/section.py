@@ -65,6 +65,18 @@ class Agreement:
     command: str        # the one command that reproduces it
 
 
+@dataclass(frozen=True)
+class Divergence:
+    """One entry of the page's divergence catalogue: where refsim and an
+    oracle (or the seed's words) part, what kind of difference it is, and the
+    figure or table that shows it."""
+
+    title: str          # "FCL misses contacts refsim finds near degenerate pairs"
+    kind: str           # e.g. "oracle: tolerance", "oracle: containment", "seed issue"
+    finding: str        # a sentence with the figures
+    evidence: str       # id of a figure or table of this section
+
+
 @dataclass
 class Section:
     key: str
@@ -76,4 +88,5 @@ class Section:
     tables: list[Table] = field(default_factory=list)
     verdicts: list[Verdict] = field(default_factory=list)
     agreements: list[Agreement] = field(default_factory=list)
+    divergences: list[Divergence] = field(default_factory=list)
     results: dict[str, Any] = field(default_factory=dict)

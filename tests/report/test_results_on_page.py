@@ -65,3 +65,34 @@ def test_every_agreement_is_on_the_page_with_its_command(quick_report):
     for row in results["agreements"]:
         for key in ("oracle", "check", "result", "command"):
             assert escape(row[key]) in summary, (row["oracle"], key)
+
+
+def _section_html(html: str, section_id: str) -> str:
+    return html.split(f'<section id="{section_id}">', 1)[1].split("</section>", 1)[0]
+
+
+def test_every_divergence_is_catalogued_with_its_evidence(quick_report):
+    _, html, results = quick_report
+    catalogue = _section_html(html, "divergences")
+    assert results["divergences"]
+    ids = {x["id"] for s in results["sections"].values() for x in s["tables"] + s["figures"]}
+    for row in results["divergences"]:
+        assert escape(row["finding"]) in catalogue and escape(row["kind"]) in catalogue
+        assert row["evidence"] in ids, row["title"]
+    # every claim that refsim does not confirm is in the catalogue
+    for claim in results["claims"]:
+        if claim["verdict"] in ("refuted", "partly"):
+            assert any(r["title"].startswith(claim["claim"] + ":")
+                       for r in results["divergences"]), claim["claim"]
+
+
+def test_cross_cutting_parts_hold_their_items_once(quick_report):
+    _, html, results = quick_report
+    items = [x for s in results["sections"].values() for x in s["tables"] + s["figures"]]
+    parts = {x["part"] for x in items if x["part"]}
+    assert parts == {"speed-accuracy", "stability"}
+    for item in items:
+        anchor = f'id="{item["id"]}"'
+        assert html.count(anchor) == 1, item["id"]
+        if item["part"]:
+            assert anchor in _section_html(html, item["part"]), item["id"]

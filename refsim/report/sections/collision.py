@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import asdict
 
 from refsim.report.charts import Series, line_chart
-from refsim.report.section import Agreement, Figure, Section, Table, Verdict
+from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Verdict
 
 LEVELS_COMMAND = "python -m refsim.collision.measure_levels"
 C4_COMMAND = "python -m refsim.collision.measure"
@@ -300,6 +300,7 @@ def build(ctx) -> Section:
         "c4": asdict(c4),
         "c4_sweep": asdict(sweep),
     }
+    divergences = _divergences(triangle_rows, agreement)
     return Section(
         key="collision", title="Body-body collision",
         intro=("The seed detects body-body collisions at rising accuracy: bounding spheres, "
@@ -311,7 +312,47 @@ def build(ctx) -> Section:
                "disagreement classified, how the hierarchy's speed compares with FCL's, and "
                "the near-parallel triangles of claim C4."),
         figures=figures, tables=tables, verdicts=verdicts, agreements=agreements,
-        results=results)
+        divergences=divergences, results=results)
+
+
+#: What each class of disagreement means, for the divergence catalogue.
+KIND_MEANING = {
+    "coplanar": "all six vertices lie in one plane, exactly; the oracle's float test "
+                "decides the in-plane overlap differently",
+    "touching": "the contact rests on an exact zero (shared vertex, edge or face); refsim's "
+                "exact predicates count it, the oracle's floats may not",
+    "tolerance": "a decision within rounding of the boundary: the oracle's float answer "
+                 "differs from the exact one on the same coordinates",
+    "containment": "one body inside a convex one: trimesh tests solids (fcl.Convex), "
+                   "refsim tests surfaces",
+    "float32 transform": "trimesh rounds the pose to float32 in add_object; refsim on the "
+                         "rounded pose agrees",
+    "bug": "no explanation found: a defect to fix",
+}
+
+
+def _divergences(triangle_rows, agreement) -> list[Divergence]:
+    """One catalogue entry per class of oracle disagreement that occurred."""
+    from refsim.collision import measure, measure_levels
+
+    entries = []
+    for kind in measure.DISAGREEMENT_KINDS:
+        found = [(label, r.n, r.counts[kind]) for label, r in triangle_rows if r.counts[kind]]
+        found += [(f"posed meshes ({p.source})", p.queries, p.counts[kind])
+                  for p in agreement.pairs if p.counts[kind]]
+        if found:
+            entries.append(Divergence(
+                f"python-fcl's triangle answers: {kind}", f"oracle disagreement: {kind}",
+                "; ".join(f"{count} of {n} {label}" for label, n, count in found)
+                + f" ({KIND_MEANING[kind]})", "collision-fcl-pairs"))
+    for kind in measure_levels.BODY_DISAGREEMENT_KINDS:
+        found = [b for b in agreement.bodies if b.counts[kind]]
+        if found:
+            entries.append(Divergence(
+                f"body-level answers: {kind}", f"oracle disagreement: {kind}",
+                "; ".join(f"{b.oracle} ({b.source}): {b.counts[kind]} of {b.n}" for b in found)
+                + f" ({KIND_MEANING[kind]})", "collision-body-oracles"))
+    return entries
 
 
 def _theta(value) -> str:
