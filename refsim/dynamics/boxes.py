@@ -23,6 +23,8 @@ import functools
 
 import numpy as np
 
+from refsim.jit import compiled_or_none
+
 
 def boxes_numpy(vertices_t: np.ndarray, R: np.ndarray, origin: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray]:
@@ -54,11 +56,7 @@ def boxes_loops(vertices_t: np.ndarray, R: np.ndarray, origin: np.ndarray, lo: n
 
 @functools.cache
 def _compiled():
-    try:
-        import numba
-    except Exception:  # not installed, or built against another numpy
-        return None
-    return numba.njit(cache=True)(boxes_loops)
+    return compiled_or_none(boxes_loops)
 
 
 def boxes_compiled(vertices_t, R, origin) -> tuple[np.ndarray, np.ndarray]:

@@ -27,6 +27,8 @@ import functools
 
 import numpy as np
 
+from refsim.jit import compiled_or_none
+
 
 def overlapping_pairs(lo: np.ndarray, hi: np.ndarray, axis: int = 0) -> np.ndarray:
     """Pairs ``(i, j)``, ``i < j``, of overlapping closed boxes; (k, 2) int64,
@@ -79,11 +81,7 @@ def overlapping_pairs_loops(lo: np.ndarray, hi: np.ndarray, axis: int = 0) -> np
 
 @functools.cache
 def _compiled_sweep():
-    try:
-        import numba
-    except Exception:  # not installed, or built against another numpy
-        return None
-    return numba.njit(cache=True)(overlapping_pairs_loops)
+    return compiled_or_none(overlapping_pairs_loops)
 
 
 def overlapping_pairs_compiled(lo: np.ndarray, hi: np.ndarray, axis: int = 0) -> np.ndarray:

@@ -68,6 +68,8 @@ import math
 
 import numpy as np
 
+from refsim.jit import compiled_or_none
+
 #: Sweeps of phase 1. Gauss-Seidel over the four corners of a face landing
 #: flat converges linearly: the cube's bounce speed is off by 2e-3 (relative)
 #: after 8 sweeps, 6e-6 after 16 and 1e-11 after 32 (measured in
@@ -279,9 +281,4 @@ def compiled_kernel():
 
 
 def _compile_kernel():
-    try:
-        import numba
-    except Exception:  # not installed, or built against another numpy
-        return None
-    # module-level function and helpers: numba's disk cache applies
-    return numba.njit(cache=True)(solve_contacts_python)
+    return compiled_or_none(solve_contacts_python)

@@ -77,6 +77,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from refsim.jit import compiled_or_none
+
 
 def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``a x b`` for (B, 3) arrays, by components (np.cross costs 10x more
@@ -163,11 +165,7 @@ def orientation_step_seed_loops(R: np.ndarray, w: np.ndarray, h: float,
 
 @functools.cache
 def _compiled_step():
-    try:
-        import numba
-    except Exception:  # not installed, or built against another numpy
-        return None
-    return numba.njit(cache=True)(orientation_step_seed_loops)
+    return compiled_or_none(orientation_step_seed_loops)
 
 
 def orientation_step_seed_compiled(R: np.ndarray, w: np.ndarray, h: float) -> np.ndarray:
