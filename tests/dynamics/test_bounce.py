@@ -126,6 +126,14 @@ def simulate():
     return refsim.simulate
 
 
+#: refsim's default wall response flips the speed the body had at the wall
+#: (DEVIATION D1) and RK4 integrates free fall (a quadratic in t) exactly, so
+#: the apex ratio equals e^2 up to rounding: a few ulps per step over a few
+#: thousand steps is far below 1e-9 relative. The report says "to rounding";
+#: this is that claim, not only the issue's 0.5% target.
+ROUNDING_LEVEL = 1e-9
+
+
 @pytest.mark.parametrize("e", [0.5, 0.8, 0.9])
 def test_refsim_apex_ratio_meets_the_target(simulate, e):
     """The issue's target: with RK4 at h = 1e-3, the mean apex ratio over the
@@ -134,6 +142,7 @@ def test_refsim_apex_ratio_meets_the_target(simulate, e):
     print(f"refsim e={e}: apex ratio {row.refsim_ratio:.6f} (e^2 {e * e:.6f}), "
           f"relative error {row.refsim_error:.2e}; heights {row.refsim_heights}")
     assert row.refsim_error <= APEX_RATIO_TARGET
+    assert row.refsim_error <= ROUNDING_LEVEL
     assert row.refsim_max_spin == 0.0                   # rotation "off"
 
 

@@ -134,5 +134,11 @@ def test_divergence_is_reported():
 
 
 def test_seed_literal_solver_runs_in_the_particle_system():
-    config = replace(ParticleConfig(count=3), solver="rk4-seed-literal")
-    ParticleSystem(config).run(2)
+    config = replace(ParticleConfig(count=3, walls=False), solver="rk4-seed-literal")
+    system = ParticleSystem(config)
+    x, v = system.positions.copy(), system.velocities.copy()
+    system.run(2)
+    for _ in range(2):
+        x, v = plain_step(config, x, v)
+    assert system.steps == 2 and system.nfev == 8          # four stages a step
+    assert np.array_equal(system.positions, x) and np.array_equal(system.velocities, v)

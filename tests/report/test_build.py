@@ -97,3 +97,27 @@ def test_write_atomic_replaces_whole_file(tmp_path):
     assert target.read_text() == "new"
     assert [p.name for p in tmp_path.iterdir()] == ["page.html"]
     assert target.stat().st_mode & 0o044 == 0o044   # readable by others, as open() makes it
+
+
+def test_divergence_catalogue_rules():
+    """Refuted and partly confirmed claims, the seed's own confirmed issues
+    (C11, C12), and each section's declared oracle disagreements are listed;
+    a confirmed ordinary claim is not."""
+    from refsim.report.build import divergence_rows
+    from refsim.report.section import Divergence, Section, Verdict
+
+    a = Section("bounds", "A", verdicts=[Verdict("C1", "m1", "confirmed", "fig-a"),
+                                         Verdict("C2", "m2", "partly", "fig-b")],
+                divergences=[Divergence("oracle differs", "oracle disagreement: tolerance",
+                                        "3 of 9", "tab-a")])
+    b = Section("dynamics", "B", verdicts=[Verdict("C12", "m12", "confirmed", "fig-c"),
+                                           Verdict("C11", "m11", "refuted", "fig-d")])
+    rows = divergence_rows([a, b])
+    titles = [r["title"].split(":")[0] for r in rows]
+    assert titles == ["C2", "C11", "C12", "oracle differs"]
+    kinds = {r["title"].split(":")[0]: r["kind"] for r in rows}
+    assert kinds["C2"] == "seed claim partly" and kinds["C11"] == "seed claim refuted"
+    assert kinds["C12"].startswith("seed issue")
+    assert rows[-1] == {"section": "bounds", "title": "oracle differs",
+                        "kind": "oracle disagreement: tolerance", "finding": "3 of 9",
+                        "evidence": "tab-a"}

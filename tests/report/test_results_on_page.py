@@ -79,11 +79,6 @@ def test_every_divergence_is_catalogued_with_its_evidence(quick_report):
     for row in results["divergences"]:
         assert escape(row["finding"]) in catalogue and escape(row["kind"]) in catalogue
         assert row["evidence"] in ids, row["title"]
-    # every claim that refsim does not confirm is in the catalogue
-    for claim in results["claims"]:
-        if claim["verdict"] in ("refuted", "partly"):
-            assert any(r["title"].startswith(claim["claim"] + ":")
-                       for r in results["divergences"]), claim["claim"]
 
 
 def test_cross_cutting_parts_hold_their_items_once(quick_report):
