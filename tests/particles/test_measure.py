@@ -28,13 +28,23 @@ from refsim.solvers.methods import SOLVERS
 JITTER_ESTIMATE_RTOL = 0.25
 
 
+#: The hop in units of g h^2 at two steps a factor 3 apart: equal to within
+#: the window's sampling of the bounce cycle (a frame is one step: the apex
+#: is caught to within one step's rise, ~1/17 of g h^2 out of 17).
+HOP_SCALING_RTOL = 0.02
+
+
 @pytest.mark.parametrize("h", [1 / 30, 1 / 100])
 def test_euler_hops_on_the_floor_as_the_energy_balance_predicts(h):
     j = measure_resting_jitter("euler", h)
     print(j)
     assert j.max_height == pytest.approx(euler_jitter_estimate(h, 0.8), rel=JITTER_ESTIMATE_RTOL)
-    # In units of g h^2 the hop does not depend on h: a discretization effect.
-    assert j.max_height_gh2 == pytest.approx(17.0, rel=0.02)
+
+
+def test_euler_hop_scales_as_h_squared():
+    # A discretization effect: in units of g h^2 the hop does not depend on h.
+    coarse, fine = (measure_resting_jitter("euler", h) for h in (1 / 30, 1 / 100))
+    assert coarse.max_height_gh2 == pytest.approx(fine.max_height_gh2, rel=HOP_SCALING_RTOL)
 
 
 #: The distance from the two-step cycle shrinks by e per cycle: after the
@@ -77,7 +87,8 @@ def test_drag_damps_euler_jitter():
 
 # -- C5: drag models -----------------------------------------------------------
 
-def test_quadratic_and_linear_drag_differ_visibly_and_cost_more():
+def test_quadratic_and_linear_drag_differ_visibly():
+    # (their cost ratio is a timing: measured and reported, never asserted)
     c = measure_drag_models(count=20_000, repeats=3)
     print(c)
     assert c.k_linear == pytest.approx(0.981) and c.k_quadratic == pytest.approx(0.0981)
@@ -112,20 +123,30 @@ def test_free_particle_orders(free_points):
         assert orders[method] == pytest.approx(order, abs=ORDER_TOL)
 
 
+#: Observed order with walls: 1 plus the fit's wander over the step range,
+#: where each wall contact adds an O(h) error whose coefficient depends on
+#: where in its step the contact falls (measured 0.99-1.12).
+WALL_ORDER_TOL = 0.3
+
+#: rk4 and midpoint with walls: the O(h) contact error dominates both, so
+#: their errors agree to the few percent that their free-flight errors add.
+WALL_ERROR_RTOL = 0.05
+
+
 def test_walls_make_every_method_first_order(wall_points):
     # A bounce is handled at the end of the step it happens in: an O(h)
     # position error per bounce, whatever the solver's order.
     orders = observed_orders(wall_points)
     print(orders)
-    for method in ("euler", "averaged-euler", "midpoint", "rk4"):
-        assert orders[method] == pytest.approx(1.0, abs=0.3)
+    for method in ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4"):
+        assert orders[method] == pytest.approx(1.0, abs=WALL_ORDER_TOL), method
 
 
 def test_rk4_equals_second_order_methods_with_walls(wall_points):
     rk4 = {p.parameter: p.error for p in wall_points if p.method == "rk4"}
     mid = {p.parameter: p.error for p in wall_points if p.method == "midpoint"}
     for h in rk4:
-        assert rk4[h] == pytest.approx(mid[h], rel=0.05)
+        assert rk4[h] == pytest.approx(mid[h], rel=WALL_ERROR_RTOL)
 
 
 def test_rk4_loses_at_equal_evaluations_with_walls(wall_points):
