@@ -39,6 +39,7 @@ from refsim.collision.predicates import (
     orient3d,
     orient3d_filtered,
 )
+from refsim.collision.sat_exact import triangles_intersect_sat
 from refsim.collision.triangle import (
     normal_signs,
     triangles_intersect,
@@ -229,6 +230,12 @@ def decision_margin(t1, t2) -> float:
 def classify_disagreement(a, b) -> str:
     """Why an engine's answer may differ from refsim's exact one on (a, b).
 
+    First, refsim's answer is checked against an independent exact ground
+    truth, the separating-axis test in rational arithmetic
+    (:mod:`refsim.collision.sat_exact`): if they differ, refsim is wrong and
+    the class is ``"bug"`` whatever the margins say. Otherwise refsim is right
+    and the oracle's answer is explained by the first that applies:
+
     - ``"coplanar"``: all six vertices lie on one plane, exactly.
     - ``"touching"``: refsim finds a common point, but no edge crosses the
       other triangle's open interior with all signs strict: the contact
@@ -239,10 +246,15 @@ def classify_disagreement(a, b) -> str:
       within reach of a float engine's rounding and epsilons.
     - ``"bug"``: anything else: a well-conditioned pair answered differently.
 
-    Call it only for pairs where the answers differ; it does not look at them.
+    (For a degenerate triangle the ground truth does not apply; such pairs go
+    straight to the classes above.) Call it only for pairs where the answers
+    differ; it does not look at them.
     """
     t1 = tuple(map(tuple, np.asarray(a, np.float64).tolist()))
     t2 = tuple(map(tuple, np.asarray(b, np.float64).tolist()))
+    truth = triangles_intersect_sat(t1, t2)
+    if truth is not None and truth != triangles_intersect(t1, t2):
+        return "bug"
     if _points_coplanar(t1 + t2):
         return "coplanar"
     if triangles_intersect(t1, t2) and not _strict_crossing(t1, t2):

@@ -1,0 +1,61 @@
+"""refsim's edge-triangle test against an independent exact algorithm: the
+separating axis theorem in rational arithmetic (refsim.collision.sat_exact)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from refsim.collision.measure import classify_disagreement, near_degenerate_pairs
+from refsim.collision.sat_exact import triangles_intersect_sat
+from refsim.collision.triangle import triangles_intersect
+
+from .test_triangle import CASES, T
+
+
+def _pairs():
+    rng = np.random.default_rng(31)
+    A, B = rng.uniform(-1.0, 1.0, (2, 600, 3, 3))
+    yield from zip(A, B)
+    # small integers: exact touching, coplanar and shared-edge cases by the hundred
+    A, B = rng.integers(-2, 3, (2, 1500, 3, 3)).astype(float)
+    yield from zip(A, B)
+    A, B, _ = near_degenerate_pairs(600, seed=32)
+    yield from zip(A, B)
+
+
+def test_two_exact_algorithms_agree():
+    compared = intersecting = 0
+    for a, b in _pairs():
+        truth = triangles_intersect_sat(a, b)
+        if truth is None:                    # a degenerate triangle: no ground truth
+            continue
+        assert triangles_intersect(a, b) == truth, (a.tolist(), b.tolist())
+        compared += 1
+        intersecting += truth
+    assert compared > 2500 and 500 < intersecting < compared - 500   # both answers tested
+
+
+@pytest.mark.parametrize("name", sorted(CASES))
+def test_constructed_cases(name):
+    other, expected = CASES[name][:2]
+    truth = triangles_intersect_sat(np.asarray(T, float), np.asarray(other, float))
+    assert truth in (expected, None)
+
+
+def test_degenerate_triangles_have_no_ground_truth():
+    segment = [[0, 0, 0], [1, 0, 0], [2, 0, 0]]
+    assert triangles_intersect_sat(segment, T) is None
+
+
+def test_a_wrong_refsim_answer_is_classified_as_a_bug(monkeypatch):
+    # A clean crossing pair (no exact zero, well conditioned): if refsim
+    # answered it wrongly, the ground truth must expose it as "bug" even
+    # though no margin heuristic would.
+    import refsim.collision.measure as measure
+
+    a = [[0.0, 0.0, -1.0], [1.0, 0.1, 1.0], [0.2, 1.0, 1.0]]
+    b = [[-1.0, 0.3, 0.0], [2.0, 0.4, 0.1], [0.5, 2.0, -0.1]]
+    assert triangles_intersect_sat(a, b) is True
+    monkeypatch.setattr(measure, "triangles_intersect", lambda t1, t2: False)
+    assert classify_disagreement(a, b) == "bug"
