@@ -67,6 +67,9 @@ BOUNCES = 3
 STEP = 1e-3
 SOLVER = "rk4"
 APEX_RATIO_TARGET = 0.005
+#: Relative apex-ratio errors below this are rounding (a few ulps per step
+#: over a few thousand steps): :func:`fit_error_orders` leaves them out.
+ROUNDING_ERROR = 1e-9
 #: Steps of the speed-vs-accuracy study, seconds.
 COST_STEPS = (1 / 30, 1 / 60, 1 / 125, 1 / 250, 1 / 500, 1 / 1000, 1 / 2000, 1 / 4000)
 COST_STEPS_QUICK = (1 / 30, 1 / 125, 1 / 500)
@@ -543,6 +546,21 @@ def measure_cost(steps=COST_STEPS, solvers=COST_SOLVERS, *, model: str = SPHERE,
     return CostStudy(e=e, body=model, bounces=bounces, points=points)
 
 
+def fit_error_orders(study: CostStudy, floor: float = ROUNDING_ERROR) -> dict[str, float]:
+    """Per solver of ``study``: the least-squares slope of log(error) against
+    log(step) over its points with a finite error above ``floor`` (the
+    observed order in h); solvers with fewer than two such points are left out."""
+    orders = {}
+    for solver in dict.fromkeys(p.solver for p in study.points):
+        pts = [p for p in study.points
+               if p.solver == solver and math.isfinite(p.error) and p.error > floor]
+        if len(pts) >= 2:
+            x = np.log([p.step for p in pts])
+            y = np.log([p.error for p in pts])
+            orders[solver] = float(np.polyfit(x, y, 1)[0])
+    return orders
+
+
 # -- pybullet's settings, one at a time ---------------------------------------------------
 
 
@@ -647,6 +665,8 @@ class StepCost:
     pybullet_seconds: float
     ratio: float
     refsim_stage_seconds: dict          # per step, by stage of refsim's loop
+    steps: int = 0                      # timed steps per repeat
+    repeats: int = 0                    # repeats (the fastest kept)
 
 
 def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: int = 200,
@@ -692,7 +712,8 @@ def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: 
                 rows.append(StepCost(bodies=count, rotation=rotation, warmup=warmup,
                                      refsim_seconds=ours,
                                      pybullet_seconds=theirs, ratio=ours / theirs,
-                                     refsim_stage_seconds=stages))
+                                     refsim_stage_seconds=stages, steps=steps,
+                                     repeats=repeats))
     finally:
         if oracle is not None:
             oracle.close()

@@ -159,7 +159,8 @@ def divergence_rows(sections: list[Section]) -> list[dict]:
             rows.append({"section": claim["area"], "title": f"{claim['claim']}: {claim['text']}",
                          "kind": ("seed issue (the seed's own list), confirmed" if seed_issue
                                   else f"seed claim {claim['verdict']}"),
-                         "finding": claim["measured"], "evidence": claim["evidence"]})
+                         "finding": claim["measured"], "evidence": claim["evidence"],
+                         "timing": claim["timing"]})
     for s in sections:
         rows += [{"section": s.key, **asdict(d)} for d in s.divergences]
     return rows

@@ -16,12 +16,12 @@ from .test_triangle import CASES, T
 def _pairs():
     rng = np.random.default_rng(31)
     A, B = rng.uniform(-1.0, 1.0, (2, 600, 3, 3))
-    yield from zip(A, B)
+    yield from zip(A, B, strict=True)
     # small integers: exact touching, coplanar and shared-edge cases by the hundred
     A, B = rng.integers(-2, 3, (2, 1500, 3, 3)).astype(float)
-    yield from zip(A, B)
+    yield from zip(A, B, strict=True)
     A, B, _ = near_degenerate_pairs(600, seed=32)
-    yield from zip(A, B)
+    yield from zip(A, B, strict=True)
 
 
 def test_two_exact_algorithms_agree():

@@ -8,6 +8,7 @@ Nothing is computed here beyond picking and formatting those numbers.
 
 from __future__ import annotations
 
+import sys
 from dataclasses import asdict
 
 from refsim.report.charts import Series, line_chart
@@ -191,11 +192,7 @@ def build(ctx) -> Section:
                  "The second body is turned by "
                  f"{measure_levels.FIXED_ANGLE} rad about {measure_levels.FIXED_AXIS}. "
                  + "; ".join(f"{c.model} {c.kind}: {c.description}" for c in speed.cases)
-                 + ". Below 1: refsim faster. Where the bodies are apart but their boxes "
-                 "overlap, refsim is several times slower than FCL: a fixed per-query cost "
-                 "(checking poses, transforming all vertices, refitting every node box) that "
-                 "FCL avoids by transforming boxes lazily; the hierarchy pays off only when "
-                 "there are many pairs to report. "
+                 + ". Below 1: refsim faster. " + _speed_findings(speed)
                  + (f"Numba compile cost from a fresh interpreter: triangle kernel "
                     f"{speed.compile.triangle_kernel_cold_seconds:.1f} s; all hierarchy kernels "
                     f"{speed.compile.hierarchy_cold_seconds:.1f} s with an empty cache, "
@@ -235,32 +232,7 @@ def build(ctx) -> Section:
                  f"the same coordinates. Reproduce: {C4_COMMAND}")))
 
     # -- verdicts --------------------------------------------------------------------
-    summary = {s.level: s for s in levels.summary}
-    fp = {lv: summary[lv].false_positive_rate for lv in LEVELS}
-    nested = fp["aabb"] >= fp["triangle-aabb"] >= fp["exact"]
-    queries = summary["exact"].negatives
-    touching_exact = [c for c in levels.configurations if c.kind == "touching"]
-    c3_verdict = ("refuted" if levels.false_negatives else
-                  "confirmed" if nested else "partly")
-    verdicts.append(Verdict(
-        claim="C3",
-        measured=(f"No level ever missed a contact ({levels.false_negatives} false negatives "
-                  f"over {len(levels.configurations)} constructed configurations and "
-                  f"{sum(r.n for r in levels.random)} random poses). False positives among "
-                  f"the {queries} non-colliding queries: "
-                  + ", ".join(f"{lv} {100 * fp[lv]:.0f}%" for lv in LEVELS)
-                  + ". Median time per boolean query: "
-                  + ", ".join(f"{lv} {summary[lv].median_seconds * 1e6:.0f} us"
-                              for lv in LEVELS)
-                  + ". The trade is real but small above the sphere level on 2000-triangle "
-                  "meshes (every box level transforms all vertices), and the exact level is "
-                  "slowest where bodies touch exactly ("
-                  + ", ".join(f"{c.name} {c.seconds['exact'] * 1e6:.0f} us"
-                              for c in touching_exact)
-                  + ": exact arithmetic decides those pairs). The sphere level is "
-                  "conservative but not nested with the box levels."),
-        verdict=c3_verdict, evidence="collision-levels-tradeoff", command=LEVELS_COMMAND,
-        timing=True))
+    verdicts.append(_c3_verdict(levels))
     verdicts.append(_c4_verdict(c4, sweep))
 
     agreements = []
@@ -315,6 +287,101 @@ def build(ctx) -> Section:
         divergences=divergences, results=results)
 
 
+def _c3_verdict(levels) -> Verdict:
+    """C3 from the measured levels. Its two halves: accuracy (no level misses
+    a contact, and false positives do not fall from a finer to a coarser
+    level) and speed (median times do not fall from a coarser to a finer
+    level: coarser is faster). Confirmed when both hold, partly when one
+    does, refuted when neither."""
+    from refsim.collision.bodies import LEVELS
+
+    summary = {s.level: s for s in levels.summary}
+    fp = {lv: summary[lv].false_positive_rate for lv in LEVELS}
+    median = {lv: summary[lv].median_seconds for lv in LEVELS}
+    queries = summary["exact"].negatives
+    n_random = sum(r.n for r in levels.random)
+    fp_ordered = all(fp[a] >= fp[b] for a, b in zip(LEVELS, LEVELS[1:], strict=False))
+    speed_ordered = all(median[a] <= median[b] for a, b in zip(LEVELS, LEVELS[1:], strict=False))
+    conservative = levels.false_negatives == 0
+    accuracy_half = conservative and fp_ordered
+    halves = accuracy_half + speed_ordered
+    verdict = "confirmed" if halves == 2 else "partly" if halves == 1 else "refuted"
+
+    if conservative:
+        text = (f"No level missed a contact (0 false negatives over "
+                f"{len(levels.configurations)} constructed configurations and {n_random} "
+                "random poses).")
+    else:
+        where = [f"{c.name} ({lv})" for c in levels.configurations for lv in LEVELS
+                 if c.false_negative(lv)]
+        where += [f"{r.model_a} / {r.model_b} random poses ({lv}: {k})"
+                  for r in levels.random for lv, k in r.false_negatives.items() if k]
+        text = (f"{levels.false_negatives} false negatives (a level said 'apart' where the "
+                f"surfaces meet) over {len(levels.configurations)} constructed configurations "
+                f"and {n_random} random poses: " + "; ".join(where) + ".")
+    text += (f" False positives among the {queries} non-colliding queries: "
+             + ", ".join(f"{lv} {100 * fp[lv]:.0f}%" for lv in LEVELS)
+             + (" (no more at each finer level)." if fp_ordered else
+                " (more at some finer level than at the coarser one)."))
+    text += (" Median time per boolean query: "
+             + ", ".join(f"{lv} {median[lv] * 1e6:.0f} us" for lv in LEVELS)
+             + (": each coarser level is no slower" if speed_ordered else
+                ": some coarser level is slower than a finer one")
+             + f"; exact costs {median['exact'] / median[LEVELS[1]]:.2g}x the "
+             f"{LEVELS[1]} level and {median['exact'] / median[LEVELS[0]]:.2g}x the "
+             f"{LEVELS[0]} level.")
+    slowest = sorted(levels.configurations, key=lambda c: c.seconds["exact"], reverse=True)[:2]
+    text += (" The exact level's slowest configurations: "
+             + ", ".join(f"{c.name} ({c.kind}) {c.seconds['exact'] * 1e6:.0f} us"
+                         for c in slowest)
+             + (" (bodies touching exactly: exact arithmetic decides those pairs)."
+                if all(c.kind == "touching" for c in slowest) else "."))
+    coarse, box = LEVELS[0], LEVELS[1]
+    sphere_only = [c.name for c in levels.configurations
+                   if c.answers[coarse] and not c.answers[box]]
+    box_only = [c.name for c in levels.configurations
+                if c.answers[box] and not c.answers[coarse]]
+    if box_only:
+        text += (f" The {coarse} level is not nested with the box levels: it says 'apart' "
+                 f"where the {box} level says 'collide' in " + ", ".join(box_only)
+                 + (f" (and the reverse in {', '.join(sphere_only)})" if sphere_only else "")
+                 + ".")
+    else:
+        text += (f" On the constructed configurations the {coarse} level says 'collide' "
+                 f"wherever the {box} level does.")
+    return Verdict(claim="C3", measured=text, verdict=verdict,
+                   evidence="collision-levels-tradeoff", command=LEVELS_COMMAND, timing=True)
+
+
+def _speed_findings(speed) -> str:
+    """The speed table's findings: refsim over FCL where the bodies are apart
+    but their boxes overlap, and where they meet."""
+    apart = [c for c in speed.cases if c.kind == "separated-boxes-overlap"
+             and c.pairs_ratio is not None]
+    if not apart:
+        return ""
+    others = [c for c in speed.cases if c.kind != "separated-boxes-overlap"
+              and c.pairs_ratio is not None]
+    text = ("Where the bodies are apart but their boxes overlap, refsim's time over FCL's: "
+            + "; ".join(f"{c.model} {c.pairs_ratio:.2g}x all pairs, "
+                        f"{_ratio_x(c.boolean_ratio)} boolean" for c in apart) + ".")
+    if all(c.pairs_ratio > 1 for c in apart):
+        text += (" There refsim pays a fixed per-query cost (checking poses, transforming "
+                 "all vertices, refitting every node box) that FCL avoids by transforming "
+                 "boxes lazily.")
+    if others:
+        text += (" Where they meet: "
+                 + "; ".join(f"{c.model} {c.kind} {c.pairs_ratio:.2g}x" for c in others)
+                 + " (all pairs).")
+        if max(c.pairs_ratio for c in others) < min(c.pairs_ratio for c in apart):
+            text += " The hierarchy compares best when there are pairs to report."
+    return text + " "
+
+
+def _ratio_x(value) -> str:
+    return "n/a" if value is None else f"{value:.2g}x"
+
+
 #: What each class of disagreement means, for the divergence catalogue.
 KIND_MEANING = {
     "coplanar": "all six vertices lie in one plane, exactly; the oracle's float test "
@@ -359,6 +426,11 @@ def _theta(value) -> str:
     return "never" if value is None else f"{value:g}"
 
 
+#: A tilt within this many double-precision epsilons is at the rounding of
+#: the coordinates (C4: "as large as the tilt").
+ROUNDING_TILT = 1e3
+
+
 def _c4_verdict(c4, sweep) -> Verdict:
     """C4 from the measured flips: the largest angle at which the plain-float
     test (the seed's arithmetic) differs from the exact answer, per kind of
@@ -389,10 +461,25 @@ def _c4_verdict(c4, sweep) -> Verdict:
         + ", ".join(f"{c} wrong from {_theta(t)} rad" if t else f"{c} never wrong"
                     for c, t in touching.items())
         + (". With axis-aligned coordinates (exact input) no float answer is wrong at any "
-           "angle." if aligned_ok else ".")
-        + " Near-parallel planes alone are harmless down to the angles where the rounding "
-          "of the coordinates is as large as the tilt; exact contacts can go wrong at any "
-          "angle.")
+           "angle." if aligned_ok else "."))
+    eps = sys.float_info.epsilon
+    if not worst:
+        measured += " Near-parallel planes alone never made the float test wrong."
+    elif max(worst) <= ROUNDING_TILT * eps:
+        measured += (f" Near-parallel planes alone are harmless down to {max(worst):g} rad, "
+                     f"{max(worst) / eps:.3g} times the double-precision epsilon: where the "
+                     "rounding of the coordinates is as large as the tilt.")
+    else:
+        measured += (f" Near-parallel planes alone already go wrong at {max(worst):g} rad, "
+                     f"{max(worst) / eps:.3g} times the double-precision epsilon.")
+    wrong_touch = [t for t in touching.values() if t is not None]
+    if wrong_touch and max(wrong_touch) >= max(sweep.thetas):
+        measured += (f" Exact contacts go wrong already at the largest angle measured "
+                     f"({max(sweep.thetas):g} rad).")
+    elif wrong_touch:
+        measured += f" Exact contacts go wrong from {max(wrong_touch):g} rad."
+    else:
+        measured += " Exact contacts never went wrong."
     verdict = "partly" if worst or any(touching.values()) else "confirmed"
     return Verdict(claim="C4", measured=measured, verdict=verdict,
                    evidence="collision-c4-sweep", command=C4_COMMAND)

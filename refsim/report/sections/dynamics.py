@@ -149,9 +149,8 @@ def build(ctx) -> Section:
         ], xlabel="time (s)", ylabel="height of the lowest point above the floor (m)",
             size=CHART_SIZE),
         caption=f"{series.body}, e = {series.e}, dropped from {bounce.DROP_HEIGHT} m, "
-                f"h = {bounce.STEP} s, rotation off. refsim's curve lies on the analytic "
-                f"one; pybullet's drifts by milliseconds per bounce.{pb_note} "
-                f"Reproduce: {CMD_BOUNCE}"))
+                f"h = {bounce.STEP} s, rotation off. {_height_gaps(series, apex_rows)}"
+                f"{pb_note} Reproduce: {CMD_BOUNCE}"))
     figures.append(Figure(
         id="dynamics-energy", title="Mechanical energy over time",
         svg=line_chart([
@@ -178,19 +177,11 @@ def build(ctx) -> Section:
                  "pybullet max |w| (rad/s)"),
         rows=apex_table_rows,
         caption=f"Geometric mean of the first {bounce.BOUNCES} apex ratios, h = {bounce.STEP} "
-                f"s, RK4, drop height {bounce.DROP_HEIGHT} m. refsim's default wall response "
-                "flips the speed the body had at the wall (DEVIATION D1) and matches e^2 to "
-                "rounding; the seed's literal flip keeps the deeper, faster speed and gains "
-                "about delta/h0 per bounce (0.2% at this step), still inside the issue's "
-                "0.5% target. pybullet detects a contact only once the hull overlaps the "
-                "wall and restitutes that velocity (split impulse removes the overlap "
-                "without energy). The cube's face-down bounce is exact for refsim's box "
-                "test with rotation off; the seed's rotation model picks one of the four "
-                "tied bottom vertices (AMBIGUITY A4), spins the cube after the first "
-                "bounce and adds energy (w += Pi x I takes nothing from the linear "
-                "motion), so later apexes are too high. pybullet's cube meets the floor at "
-                "four points solved one after another; on some bounces that breaks the "
-                "symmetry and the cube tips and spins (max |w|)."
+                f"s, RK4, drop height {bounce.DROP_HEIGHT} m. "
+                + _apex_findings(apex_rows, bounce.APEX_RATIO_TARGET, bounce.ROUNDING_ERROR)
+                + " pybullet detects a contact only once the hull overlaps the wall and "
+                "restitutes that velocity (split impulse removes the overlap without "
+                "energy)."
                 + (" Quick run: the cube only at e = 0.8 with the seed's rotation." if quick
                    else "")
                 + pb_note + f" Reproduce: {CMD_BOUNCE}"))
@@ -223,12 +214,13 @@ def build(ctx) -> Section:
                     r.pybullet_bounces) for r in rest_rows),
         caption=f"The analytic bounces accumulate at the Zeno time t0 (1 + 2e/(1 - e)). "
                 f"Measured: the time of the bounce after which every apex stays below "
-                f"{bounce.REST_FRACTION} of the drop height. refsim settles on the analytic "
-                "bounce, up to a step per bounce; pybullet a bounce later, its low bounces "
-                "returning slightly more than e^2 (the overlap restitution above)."
+                f"{bounce.REST_FRACTION} of the drop height. " + _rest_findings(rest_rows)
                 + (" Quick run: e = 0.5 only." if quick else "") + pb_note
                 + f" Reproduce: {CMD_BOUNCE}"))
 
+    cost_steps = sorted(dict.fromkeys(p.step for p in cost.points), reverse=True)
+    cost_solvers = [x for x in dict.fromkeys(p.solver for p in cost.points)
+                    if x not in ("pybullet", bounce.SEED_SPEED_SERIES)]
     cost_series = []
     for solver in dict.fromkeys(p.solver for p in cost.points):
         pts = [p for p in cost.points if p.solver == solver and math.isfinite(p.error)]
@@ -241,15 +233,15 @@ def build(ctx) -> Section:
                        ylabel="|apex ratio - e^2| / e^2", logx=True, logy=True,
                        size=CHART_SIZE),
         caption=f"{cost.body}, e = {cost.e}, {cost.bounces} bounces; each point one step "
-                f"size from 1/30 to 1/4000 s, in the manner of Erez, Tassa and Todorov "
-                f"(ICRA 2015). RK4 integrates free flight exactly and the wall-speed "
-                f"response is exact, so its error is rounding (drawn at {ERROR_FLOOR:g}); "
-                "with the seed's literal wall speed RK4's error is first order in h, as "
-                "are Euler's (energy gain) and the seed's \"backwards Euler\" (energy "
-                "loss). refsim's time is the whole simulate call; pybullet's the "
+                f"size from 1/{1 / max(cost_steps):.0f} to 1/{1 / min(cost_steps):.0f} s, in "
+                f"the manner of Erez, Tassa and Todorov "
+                f"(ICRA 2015). " + _order_findings(cost, bounce.fit_error_orders(cost),
+                                                   bounce.ROUNDING_ERROR)
+                + " refsim's time is the whole simulate call; pybullet's the "
                 "stepSimulation calls alone. Timings vary from run to run."
-                + (" Quick run: 3 step sizes (1/30, 1/125, 1/500 s), 3 solvers." if quick
-                   else "") + pb_note
+                + (f" Quick run: {len(cost_steps)} step sizes ("
+                   + ", ".join(f"1/{1 / h:.0f}" for h in cost_steps) + f" s), "
+                   f"{len(cost_solvers)} solvers." if quick else "") + pb_note
                 + f" Reproduce: {CMD_BOUNCE}"))
 
     if settings_rows:
@@ -277,22 +269,11 @@ def build(ctx) -> Section:
                    for r in step_rows),
         caption="Unit cubes on a grid with seeded random velocities, collision level "
                 "\"aabb\", the seed's body response; the fastest of "
-                f"{3 if quick else 5} runs of {50 if quick else 200} steps after a warm-up of "
-                f"{10 if quick else 20}. The issue's target is "
-                "refsim at most 2x pybullet at 40 bodies; this run measured "
-                + ", ".join(f"{r.ratio:.2g}x (rotation {r.rotation}, after step {r.warmup})"
-                            for r in step_rows
-                            if r.bodies == max(x.bodies for x in step_rows))
-                + ". Each of refsim's stages is a handful of numpy calls over all bodies, "
-                "each costing microseconds of interpreter and dispatch overhead on arrays "
-                "of a few dozen rows (RK4's four evaluations, the box scan, the seed's "
-                "orientation step, the energy check): the per-stage column shows the time "
-                "spread over the stages rather than one hot spot, and a fixed cost of about "
-                "50 us per step that pybullet's compiled loop does not pay, so the ratio "
-                "falls as bodies are added. Once the cubes have settled on the floor "
-                f"(timed after step {bounce.LATE_WARMUP}, full run only) Bullet has many "
-                "contacts to solve while refsim's box test stays as cheap. Timings vary "
-                "from run to run. Reproduce: "
+                + "; ".join(f"{rep} runs of {n} steps after a warm-up of {w}"
+                            for w, n, rep in dict.fromkeys((r.warmup, r.steps, r.repeats)
+                                                           for r in step_rows))
+                + ". " + _step_cost_findings(step_rows) + " Timings vary from run to run. "
+                "Reproduce: "
                 "make bench (tests/benchmarks/test_bench_dynamics.py) or " + CMD_BOUNCE))
 
     by_model = {s.model: s for s in spin_rows}
@@ -361,32 +342,7 @@ def build(ctx) -> Section:
         c12 = "partly"
     else:
         c12 = "refuted"
-    # C11: a frame of overlap is what any discrete detection sees first (the
-    # contact is found after the step that made it); the claim is about
-    # overlap that persists, so a case counts when its longest run of
-    # interpenetrating frames exceeds one step.
-    seed_c11 = {r.case: r for r in c11_rows if r.response == "seed"}
-    imp_c11 = {r.case: r for r in c11_rows if r.response == "impulse"}
-    persistent = [c for c, r in seed_c11.items() if r.longest_run > 1]
-    c11_measured = ("With the seed's velocity exchange, interpenetrating frames "
-                    "(longest run): "
-                    + ", ".join(f"{c} {r.interpenetrating} of {r.frames} ({r.longest_run})"
-                                for c, r in seed_c11.items())
-                    + "; with the corrected response: "
-                    + ", ".join(f"{c} {r.interpenetrating}" for c, r in imp_c11.items())
-                    + ". The same-direction chase and the slow head-on approach overlap "
-                      "only in the one frame in which the contact is detected; overlap "
-                      "persists for more than a frame in: "
-                    + (", ".join(persistent) if persistent else "no case")
-                    + " (stack: a slow contact pressed together by gravity, which the "
-                      "exchange of velocities cannot undo; glancing: an offset pass, where "
-                      "the centroid line is not the contact's normal, choices D4).")
-    if persistent and len(persistent) == len(seed_c11):
-        c11 = "confirmed"
-    elif persistent:
-        c11 = "partly"
-    else:
-        c11 = "refuted"
+    c11_measured, c11 = _c11(c11_rows)
     verdicts = [
         Verdict("C11", measured=c11_measured, verdict=c11, evidence="dynamics-c11",
                 command=CMD_MEASURE),
@@ -428,6 +384,225 @@ def build(ctx) -> Section:
                    tables=tables, verdicts=verdicts, results=results,
                    divergences=_divergences(apex_rows, oblique_rows),
                    agreements=_agreements(apex_rows, oblique_rows))
+
+
+#: The issue's step-cost target: refsim at most this many times pybullet's
+#: time per step at the largest body count.
+STEP_COST_TARGET = 2.0
+#: The C11 cases where bodies meet slowly or moving the same way (the claim's
+#: "slow or same-direction"; refsim.dynamics.measure.c11_scene): the chase,
+#: the slow head-on approach and the body dropped onto another. "glancing"
+#: (an offset pass at 1 m/s) is neither.
+C11_CLAIM_CASES = ("chase", "slow", "stack")
+#: What each C11 case is, for the verdict sentence (the scene, not a finding).
+C11_CASE_NOTES = {
+    "chase": "same direction, 2 and 0.5 m/s",
+    "slow": "head-on at 0.05 m/s",
+    "stack": "a body dropped onto another, pressed together by gravity",
+    "glancing": "an offset pass, where the centroid line is not the contact's normal, "
+                "choices D4",
+}
+
+
+def _finite(values) -> list[float]:
+    return [float(v) for v in values if v is not None and math.isfinite(v)]
+
+
+def _max_gap(a, b) -> float:
+    """Largest |a - b| over the pairs where both are finite (nan if none)."""
+    gaps = _finite(abs(x - y) for x, y in zip(a, b, strict=False)
+                   if x is not None and y is not None)
+    return max(gaps) if gaps else math.nan
+
+
+def _height_gaps(series, apex_rows) -> str:
+    """The heights chart's finding: the largest gaps to the analytic curve."""
+    text = (f"Largest height difference from the analytic curve: refsim "
+            f"{_f(_max_gap(series.refsim_height, series.analytic_height), 3)} m, pybullet "
+            f"{_f(_max_gap(series.pybullet_height, series.analytic_height), 3)} m")
+    row = next((r for r in apex_rows if r.body == series.body and r.e == series.e
+                and r.rotation == "off"), None)
+    if row is not None:
+        ms = [1e3 * _max_gap(times, row.analytic_times)
+              for times in (row.refsim_times, row.pybullet_times)]
+        text += (f"; apex times over the first {len(row.analytic_times) - 1} bounces differ "
+                 f"from the analytic ones by up to {_f(ms[0], 3)} ms (refsim) and "
+                 f"{_f(ms[1], 3)} ms (pybullet)")
+    return text + "."
+
+
+def _apex_findings(apex_rows, target: float, rounding: float) -> str:
+    """The apex table's findings, from its rows."""
+    parts = []
+    off = [r for r in apex_rows if r.rotation == "off"]
+    if off:
+        worst = max(r.refsim_error for r in off)
+        literal = max(r.seed_speed_error for r in off)
+        parts.append(
+            "With rotation off, refsim's default wall response (it flips the speed the "
+            f"body had at the wall, DEVIATION D1) is at most {_pct(worst)} from e^2 ("
+            + ("rounding" if worst <= rounding else
+               ("inside" if worst <= target else "outside") + f" the issue's {_pct(target)} "
+               "target")
+            + f"); the seed's literal flip (the deeper, faster speed one step past the wall) "
+            f"is at most {_pct(literal)} off, "
+            + ("inside" if literal <= target else "outside")
+            + f" the issue's {_pct(target)} target.")
+    cubes_off = [r for r in off if r.body == "cube.ac"]
+    if cubes_off:
+        worst = max(r.refsim_error for r in cubes_off)
+        parts.append(f"The cube's face-down bounce with rotation off: at most {_pct(worst)} "
+                     "from e^2.")
+    seeded = [r for r in apex_rows if r.body == "cube.ac" and r.rotation == "seed"]
+    if seeded:
+        high = [r for r in seeded if r.refsim_ratio > r.analytic_ratio]
+        spin = max(r.refsim_max_spin for r in seeded)
+        text = (f"With the seed's rotation model (which picks one of the four tied bottom "
+                f"vertices, AMBIGUITY A4) the cube turns at up to {_f(spin, 3)} rad/s and "
+                f"its apex ratio is off by up to {_pct(max(r.refsim_error for r in seeded))}")
+        if high:
+            text += (f", above e^2 in {len(high)} of {len(seeded)} drops (w += Pi x I "
+                     "takes nothing from the linear motion, so the spin is added energy)")
+        parts.append(text + ".")
+    cubes_pb = _finite(r.pybullet_max_spin for r in apex_rows if r.body == "cube.ac")
+    if cubes_pb:
+        spin = max(cubes_pb)
+        parts.append(
+            f"pybullet's cube reaches max |w| {_f(spin, 3)} rad/s"
+            + (": it meets the floor at four points solved one after another, which can "
+               "break the symmetry and tip it." if spin > NOTICEABLE_SPIN else
+               f", below {NOTICEABLE_SPIN} rad/s: it does not tip."))
+    return " ".join(parts)
+
+
+def _rest_findings(rest_rows) -> str:
+    """The time-to-rest table's finding: the settling bounce of each engine."""
+    parts = []
+    for r in rest_rows:
+        text = (f"e = {r.e}: the analytic series settles after bounce {r.analytic_bounces}, "
+                f"refsim after bounce {r.refsim_bounces} "
+                f"({_f(1e3 * (r.refsim_settle - r.analytic_settle), 3)} ms from the analytic "
+                "time)")
+        if r.pybullet_bounces:
+            diff = r.pybullet_bounces - r.analytic_bounces
+            text += (f", pybullet after bounce {r.pybullet_bounces} ("
+                     + ("the same bounce" if diff == 0 else
+                        f"{abs(diff)} bounce{'s' if abs(diff) > 1 else ''} "
+                        + ("later" if diff > 0 else "earlier"))
+                     + ")")
+        parts.append(text)
+    return ("; ".join(parts) + ".") if parts else ""
+
+
+def _order_findings(cost, orders: dict, rounding: float) -> str:
+    """The cost chart's finding: which series stay at rounding, and the
+    fitted order in h of the others."""
+    at_rounding = [solver for solver in dict.fromkeys(p.solver for p in cost.points)
+                   if all(p.error <= rounding for p in cost.points
+                          if p.solver == solver and math.isfinite(p.error))]
+    parts = []
+    if at_rounding:
+        parts.append(f"Errors at every step size below {rounding:g} (rounding, drawn at "
+                     f"{ERROR_FLOOR:g} when smaller): " + ", ".join(at_rounding) + ".")
+    if orders:
+        parts.append("Fitted slope of log error against log h (the observed order): "
+                     + ", ".join(f"{solver} {order:.2g}" for solver, order in orders.items())
+                     + ".")
+    return " ".join(parts)
+
+
+def _step_cost_findings(step_rows) -> str:
+    """The step-cost table's findings: refsim's 1-body time and the ratios."""
+    early = [r for r in step_rows if r.warmup == min(x.warmup for x in step_rows)]
+    parts = []
+    single = [r for r in early if r.bodies == min(x.bodies for x in early)]
+    if single:
+        parts.append(f"refsim's step with {single[0].bodies} body: "
+                     + ", ".join(f"{_f(1e6 * r.refsim_seconds, 3)} us (rotation {r.rotation})"
+                                 for r in single)
+                     + ", against pybullet's "
+                     + ", ".join(f"{_f(1e6 * r.pybullet_seconds, 3)} us" for r in single)
+                     + ".")
+        for r in single:
+            stages = r.refsim_stage_seconds
+            if stages:
+                top = max(stages, key=stages.get)
+                parts.append(f"Its largest stage (rotation {r.rotation}): {top}, "
+                             f"{_pct(stages[top] / r.refsim_seconds)} of the step.")
+                break
+    counts = sorted(dict.fromkeys(r.bodies for r in early))
+    ratios = {c: [r.ratio for r in early if r.bodies == c] for c in counts}
+    parts.append("refsim / pybullet by body count: "
+                 + "; ".join(f"{c}: " + ", ".join(f"{x:.2g}x" for x in ratios[c])
+                             for c in counts) + ".")
+    means = [float(np.mean(ratios[c])) for c in counts]
+    if len(means) > 1 and all(math.isfinite(m) for m in means):
+        falling = all(b < a for a, b in zip(means, means[1:], strict=False))
+        parts.append("The ratio falls as bodies are added: refsim's time per step grows far "
+                     "less with the body count than pybullet's." if falling else
+                     "The ratio does not fall steadily as bodies are added.")
+    biggest = max(r.bodies for r in step_rows)
+    at_max = [r for r in step_rows if r.bodies == biggest]
+    parts.append(f"The issue's target is refsim at most {STEP_COST_TARGET:g}x pybullet at "
+                 f"{biggest} bodies; this run measured "
+                 + ", ".join(f"{r.ratio:.2g}x (rotation {r.rotation}, after step {r.warmup}"
+                             f"{', within' if r.ratio <= STEP_COST_TARGET else ', above'} it)"
+                             for r in at_max) + ".")
+    late = [r for r in step_rows if r.warmup > min(x.warmup for x in step_rows)]
+    if late:
+        parts.append(f"Once the cubes have settled on the floor (timed after step "
+                     f"{late[0].warmup}): refsim "
+                     + ", ".join(f"{_f(1e6 * r.refsim_seconds, 3)} us" for r in late)
+                     + ", pybullet "
+                     + ", ".join(f"{_f(1e6 * r.pybullet_seconds, 3)} us" for r in late)
+                     + " per step.")
+    return " ".join(parts)
+
+
+def _c11(c11_rows) -> tuple[str, str]:
+    """C11's sentence and verdict from the measured frames.
+
+    A frame of overlap is what any discrete detection sees first (the contact
+    is found after the step that made it); the claim is about overlap that
+    persists, so a case counts when its longest run of interpenetrating
+    frames exceeds one step. Confirmed when the seed's response lets every
+    slow or same-direction case (C11_CLAIM_CASES) persist, partly when some,
+    refuted when none."""
+    seed_c11 = {r.case: r for r in c11_rows if r.response == "seed"}
+    imp_c11 = {r.case: r for r in c11_rows if r.response == "impulse"}
+    persistent = [c for c, r in seed_c11.items() if r.longest_run > 1]
+    single = [c for c, r in seed_c11.items() if r.longest_run == 1]
+    never = [c for c, r in seed_c11.items() if r.longest_run == 0]
+    imp_persistent = [c for c, r in imp_c11.items() if r.longest_run > 1]
+
+    def named(cases):
+        return ", ".join(f"{c} ({C11_CASE_NOTES[c]})" if c in C11_CASE_NOTES else c
+                         for c in cases)
+
+    text = ("With the seed's velocity exchange, interpenetrating frames (longest run): "
+            + ", ".join(f"{c} {r.interpenetrating} of {r.frames} ({r.longest_run})"
+                        for c, r in seed_c11.items())
+            + "; with the corrected response: "
+            + ", ".join(f"{c} {r.interpenetrating} ({r.longest_run})"
+                        for c, r in imp_c11.items()) + ".")
+    text += (" With the seed's response, overlap persists for more than a frame in: "
+             + (named(persistent) if persistent else "no case") + ".")
+    if single:
+        text += (" Overlap in single frames only (the frame in which the contact is "
+                 "detected) in: " + named(single) + ".")
+    if never:
+        text += " No overlap at all in: " + named(never) + "."
+    text += (" The corrected response lets overlap persist in: "
+             + (", ".join(imp_persistent) if imp_persistent else "no case") + ".")
+    claim_cases = [c for c in C11_CLAIM_CASES if c in seed_c11]
+    hit = [c for c in claim_cases if c in persistent]
+    if claim_cases and len(hit) == len(claim_cases):
+        verdict = "confirmed"
+    elif hit:
+        verdict = "partly"
+    else:
+        verdict = "refuted"
+    return text, verdict
 
 
 def _agreements(apex_rows, oblique_rows) -> list[Agreement]:

@@ -16,8 +16,9 @@ full run's where its captions say so.
 The measurement functions seed their own random states (the particle
 systems' ``seed``); none depends on ``ctx.seed``, so their figures are the
 same bytes on every run. Only wall times vary, and they sit under keys that
-name them (``wall_time``, ``cost_ratio``, ``..._time``); verdict sentences
-quote no timing.
+name them (``wall_time``, ``cost_ratio``, ``..._time``); the one verdict that
+quotes a timing (C5, the cost ratio of quadratic drag) is marked
+``timing=True``.
 """
 
 from __future__ import annotations
@@ -80,6 +81,47 @@ FORMULA_AGREE_RTOL = 1e-6
 #: C8/C9 budget and target, the defaults of measure_solver_choice.
 TARGET_FREE = 1e-4
 BUDGET_WALLS = 512
+
+#: C6: the hop "scales as h^2" when hop / (g h^2) of every method that hops
+#: varies by less than this, relative, over the steps measured. A hop
+#: proportional to h instead would change hop / (g h^2) by the ratio of the
+#: steps (3.3 from 1/30 to 1/100 s), so a tenth tells h^2 from h with a wide
+#: margin while allowing the estimate's own slack at coarse steps.
+HOP_SCALING_RTOL = 0.1
+
+#: C7: two solvers behave alike in a measured stability limit or resting hop
+#: when the values differ by less than this, relative (in order: when every
+#: observed order differs by at most ORDER_MATCH_TOL, i.e. the same integer
+#: order). A tenth is far above the measurements' own spread (limits bisected
+#: to 1e-9, hops reproduced to FORMULA_AGREE_RTOL) and well below a factor 2,
+#: one halving of the step, the smallest change a user would make to stay
+#: stable or to halve a hop.
+ALIKE_RTOL = 0.1
+
+#: C8/C9: two costs (evaluations to reach TARGET_FREE) or two errors at
+#: BUDGET_WALLS evaluations are tied when they differ by less than this,
+#: relative. Both are interpolated log-log between runs whose steps halve; a
+#: difference of a tenth is small against that factor 2 and is not one a
+#: choice of solver would turn on. "Better" means better by more than this.
+COST_TIE_RTOL = 0.1
+
+#: C8: a position difference at the frame step is visible when it exceeds
+#: this fraction of the cube's edge: one pixel when the cube fills a
+#: 1000-pixel view (4 mm for the 4 m cube).
+VISIBLE_FRACTION = 1e-3
+
+#: C5: the quadratic-drag path differs significantly from the linear-drag one
+#: when their largest distance exceeds this fraction of the distance
+#: travelled: 1% of the path is a centimetre per metre thrown, as much as a
+#: body's own size in most scenes and more than a viewer forgives in a
+#: trajectory they can compare (a reticle, a goal).
+DRAG_SIGNIFICANT_FRACTION = 0.01
+
+#: C5: quadratic drag has an extra cost when its step takes more than this
+#: times as long as a linear-drag step. Best-of-several wall times still
+#: vary by up to ~10% from run to run, so a ratio below 1.2 cannot be told
+#: from noise; 20% more time per step is a cost worth weighing.
+DRAG_EXTRA_COST_RATIO = 1.2
 
 PROBLEM_TITLES = {
     "exponential-decay": "exponential decay y' = -y",
@@ -367,7 +409,8 @@ def _stability(m):
                  "negative real axis (z = -h k/m), an undamped oscillation on the imaginary "
                  "axis (z = i h omega). Euler, averaged-euler and midpoint only touch the "
                  "imaginary axis at 0, so they amplify every oscillation; rk4 and the "
-                 "seed's backwards-euler (R = 1 + z + z^2) contain a piece of it."))
+                 "seed's backwards-euler (R = 1 + z + z^2) contain a piece of it. "
+                 f"Reproduce: {CMD_SOLVERS} stability"))
 
     rows = []
     for s in m["stability"]:
@@ -531,6 +574,7 @@ def _drag(m):
 def _c8_c9(m):
     choice = {c.method: c for c in m["choice"]}
     ff, fw = m["frame_free"], m["frame_walls"]
+    first_order, walls_clause = _wall_orders_clause(m)
     rows = []
     for method in METHODS:
         c = choice[method]
@@ -550,10 +594,11 @@ def _c8_c9(m):
                  f"work-precision runs ({m['particle_count']} particles); evaluations and "
                  f"errors at a budget from {m['choice_count']} particles, interpolated "
                  "log-log between runs ('never': not reached with up to "
-                 f"{m['choice_max_steps']} steps). With "
-                 "walls every method is first order: a contact between steps is caught up "
-                 "to a step late. Reproduce: "
-                 f"{CMD_PARTICLES} choice; {CMD_PARTICLES} frame"))
+                 f"{m['choice_max_steps']} steps). "
+                 + walls_clause[0].upper() + walls_clause[1:]
+                 + (": a contact between steps is caught up to a step late" if first_order
+                    else "")
+                 + f". Reproduce: {CMD_PARTICLES} choice; {CMD_PARTICLES} frame"))
     rows = []
     for method in METHODS:
         c = choice[method]
@@ -581,8 +626,58 @@ def _c8_c9(m):
 # -- verdicts ----------------------------------------------------------------------
 
 
+def _tied(a: float, b: float, rtol: float) -> bool:
+    """Two measured values within ``rtol`` of each other, relative; inf ties
+    only with inf, nan with nothing."""
+    if math.isnan(a) or math.isnan(b):
+        return False
+    if math.isinf(a) or math.isinf(b):
+        return a == b
+    return _relative_difference(a, b) <= rtol
+
+
+def _lower(a: float, b: float, rtol: float) -> bool:
+    """``a`` below ``b`` by more than a tie (nan is never lower)."""
+    return a < b and not _tied(a, b, rtol)
+
+
+def _rank(value: float, others: dict, rtol: float) -> str:
+    """Where ``value`` stands among ``others`` (method -> value): "the lowest",
+    "the highest", "tied lowest with ...", "tied highest with ..." or "between
+    the others"."""
+    ties = [k for k, v in others.items() if _tied(value, v, rtol)]
+    rest = [v for k, v in others.items() if k not in ties]
+    lowest = all(_lower(value, v, rtol) for v in rest)
+    highest = all(_lower(v, value, rtol) for v in rest)
+    if ties and len(ties) == len(others):
+        return "the same as all the others"
+    tied = f"tied with {', '.join(ties)} for " if ties else ""
+    if lowest:
+        return f"{tied}the lowest"
+    if highest:
+        return f"{tied}the highest"
+    return "between the others"
+
+
+def _listing(values: dict, fmt) -> str:
+    return ", ".join(f"{k} {fmt(v)}" for k, v in values.items())
+
+
+def _wall_orders_clause(m) -> tuple[bool, str]:
+    """Whether every observed order with walls is first order (within
+    ORDER_MATCH_TOL of 1), and a clause saying so with the orders."""
+    orders = {k: m["wall_orders"][k] for k in METHODS}
+    first = all(abs(o - 1) <= ORDER_MATCH_TOL for o in orders.values())
+    listed = _listing(orders, lambda o: f"{o:.2f}")
+    if first:
+        return True, f"with walls every method is first order (observed {listed})"
+    return False, (f"with walls the observed orders are {listed}, not all within "
+                   f"{ORDER_MATCH_TOL} of 1")
+
+
 def _verdicts(m, summary, quoted, choice):
     from refsim.solvers.methods import SOLVERS
+    from refsim.solvers.stability import stability_polynomial
 
     verdicts = []
     by = {s["method"]: s for s in summary}
@@ -592,6 +687,19 @@ def _verdicts(m, summary, quoted, choice):
         lo, hi = min(values), max(values)
         return f"{lo:.2f}" if f"{lo:.2f}" == f"{hi:.2f}" else f"{lo:.2f}-{hi:.2f}"
 
+    def why(method):
+        """The order conditions (up to the stated order) the tableau fails."""
+        solver = SOLVERS[method]
+        if solver.row_sums() != solver.c:
+            return "c_i != sum_j a_ij"
+        failing = [f"{name.split(' = ')[0]} = {value}, not {want}"
+                   for p, name, value, want in solver.order_conditions()
+                   if p <= solver.seed_order and value != want]
+        if failing:
+            return "; ".join(failing)
+        return (f"it meets every condition of order {solver.seed_order}; the fitted slopes "
+                "miss it")
+
     wrong = [s["method"] for s in summary if not s["observed_matches_seed"]]
     right = [s["method"] for s in summary if s["observed_matches_seed"]]
     c10 = "confirmed" if not wrong else ("refuted" if not right else "partly")
@@ -600,9 +708,9 @@ def _verdicts(m, summary, quoted, choice):
         measured=("Observed orders on {n} problems: {orders}; {wrong}".format(
             n=len(next(iter(summary))["observed"]),
             orders=", ".join(f"{s['method']} {span(s['method'])}" for s in summary),
-            wrong=("; ".join(f"{w} is order {SOLVERS[w].order} (its tableau fails "
-                             f"sum b_i c_i = 1/2), not {SOLVERS[w].seed_order} as stated"
-                             for w in wrong) + "; the others match.") if wrong
+            wrong=("; ".join(f"{w} is order {SOLVERS[w].order} by its tableau ({why(w)}), "
+                             f"not {SOLVERS[w].seed_order} as stated" for w in wrong)
+                   + ("; the others match." if right else ".")) if wrong
             else "all as stated.")),
         verdict=c10, evidence="solvers-orders", command=f"{CMD_SOLVERS} orders"))
 
@@ -610,93 +718,206 @@ def _verdicts(m, summary, quoted, choice):
     ej, ed = quoted["euler"]
     others = {k: v[0].max_height_gh2 for k, v in quoted.items() if k != "euler"}
     c6 = "confirmed" if ej.max_height_gh2 > JITTER_FACTOR * max(others.values()) else "refuted"
+    hops_by_h: dict[str, dict[float, float]] = {}
+    for j in m["jitter"]:
+        hops_by_h.setdefault(j.method, {})[j.h] = j.max_height_gh2
+    steps = sorted({j.h for j in m["jitter"]}, reverse=True)
+    hopping = {k: v for k, v in hops_by_h.items() if all(x > 0 for x in v.values())}
+    if len(steps) > 1 and hopping:
+        scales = all(_tied(min(v.values()), max(v.values()), HOP_SCALING_RTOL)
+                     for v in hopping.values())
+        spread = ("Euler's hop / (g h^2) is "
+                  + ", ".join(f"{hops_by_h['euler'][s]:.3g} at h = 1/{round(1 / s)}"
+                              for s in steps))
+        scaling = (f" {spread}: the jitter is bounded (for every method that hops, a hop "
+                   f"that scales as h^2 to within {HOP_SCALING_RTOL:.0%}), not a growing "
+                   "instability." if scales else
+                   f" {spread}: the hop does not scale as h^2 (to within "
+                   f"{HOP_SCALING_RTOL:.0%}) for every method that hops.")
+    else:
+        scaling = ""
     verdicts.append(Verdict(
         claim="C6",
         measured=(f"A particle at rest on the floor (e = 0.8, h = 1/{round(1 / h)} s) hops "
                   f"{ej.max_height:.3g} m = {ej.max_height_gh2:.3g} g h^2 with Euler "
                   f"(still {ed.max_height_gh2:.3g} g h^2 with drag k/m = "
                   f"{JITTER_DAMPED_DRAG:g}/s) against "
-                  f"{others['rk4']:.3g} g h^2 for averaged-euler, midpoint and rk4 and "
-                  f"{others['backwards-euler']:.3g} for backwards-euler: Euler gains "
-                  "g^2 h^2/2 of energy a step in flight. The jitter is bounded (a hop that "
-                  "scales as h^2), not a growing instability."),
+                  + ", ".join(f"{v:.3g} g h^2 for {k}" for k, v in others.items())
+                  + " (Euler gains g^2 h^2/2 of energy a step in flight)." + scaling),
         verdict=c6, evidence="solvers-jitter", command=f"{CMD_PARTICLES} jitter"))
 
     limits = {s.method: s for s in m["stability"]}
     four = ("averaged-euler", "backwards-euler", "midpoint", "rk4")
+    hop4 = {k: quoted[k][0].max_height_gh2 for k in four}
+    pairs = [(a, b) for i, a in enumerate(four) for b in four[i + 1:]]
+
+    def order_alike(a, b):
+        oa, ob = by[a]["observed"], by[b]["observed"]
+        return all(abs(oa[p] - ob[p]) <= ORDER_MATCH_TOL for p in oa)
+
+    def stability_alike(a, b):
+        la, lb = limits[a], limits[b]
+        return (_tied(la.drag_measured, lb.drag_measured, ALIKE_RTOL)
+                and _tied(la.oscillator_measured, lb.oscillator_measured, ALIKE_RTOL))
+
+    def hop_alike(a, b):
+        return _tied(hop4[a], hop4[b], ALIKE_RTOL)
+
+    agree = {"order": all(order_alike(a, b) for a, b in pairs),
+             "stability": all(stability_alike(a, b) for a, b in pairs),
+             "resting hop": all(hop_alike(a, b) for a, b in pairs)}
+    alike = [(a, b) for a, b in pairs
+             if order_alike(a, b) and stability_alike(a, b) and hop_alike(a, b)]
+    if all(agree.values()):
+        c7 = "confirmed"
+    elif not agree["order"] and not agree["stability"]:
+        c7 = "refuted"
+    else:
+        c7 = "partly"
+    same_r = {pair: stability_polynomial(SOLVERS[pair[0]]) == stability_polynomial(
+        SOLVERS[pair[1]]) for pair in alike}
+    pairs_text = ("; ".join(f"{a} and {b}" + (" (the same R(z))" if same_r[(a, b)] else "")
+                            for a, b in alike) if alike else "none")
     verdicts.append(Verdict(
         claim="C7",
-        measured=("The four differ: orders {orders}; stable drag step h k/m up to {drag}; "
+        measured=("Observed orders {orders}; stable drag step h k/m up to {drag}; "
                   "undamped oscillation stable for h omega up to {osc} (0: amplified at "
-                  "every step); resting hop {hop} g h^2.".format(
-                      orders=", ".join(f"{k} {SOLVERS[k].order}" for k in four),
+                  "every step); resting hop {hop} g h^2. The four {o} in order, {s} in "
+                  "stability and {r} in resting hop (alike: orders within {otol}, limits "
+                  "and hops within {rtol:.0%}). Pairs alike in all of these: {pairs}.").format(
+                      orders=", ".join(f"{k} {span(k)}" for k in four),
                       drag=", ".join(f"{k} {limits[k].drag_measured:.3g}" for k in four),
                       osc=", ".join(f"{k} {limits[k].oscillator_measured:.3g}" for k in four),
-                      hop=", ".join(f"{k} {quoted[k][0].max_height_gh2:.3g}" for k in four))
-                  + " Only averaged-euler and midpoint behave alike (the same R(z))."),
-        verdict="refuted", evidence="solvers-stability", command=f"{CMD_SOLVERS} stability"))
+                      hop=", ".join(f"{k} {hop4[k]:.3g}" for k in four),
+                      o="agree" if agree["order"] else "differ",
+                      s="agree" if agree["stability"] else "differ",
+                      r="agree" if agree["resting hop"] else "differ",
+                      otol=ORDER_MATCH_TOL, rtol=ALIKE_RTOL, pairs=pairs_text),
+        verdict=c7, evidence="solvers-stability", command=f"{CMD_SOLVERS} stability"))
 
+    # C8: is rk4 better than the best of the others at equal cost?
+    nfev_free = {k: c.nfev_free for k, c in choice.items()}
     wall_errors = {k: c.error_walls_at_budget for k, c in choice.items()}
-    second = ("averaged-euler", "midpoint")
-    ff = m["frame_free"]
+    rest = [k for k in METHODS if k != "rk4"]
+
+    def best_of(values):
+        finite = [k for k in rest if not math.isnan(values[k])]
+        return min(finite, key=lambda k: values[k]) if finite else None
+
+    best_free, best_walls = best_of(nfev_free), best_of(wall_errors)
+    rk4_free = best_free is not None and _lower(nfev_free["rk4"], nfev_free[best_free],
+                                                COST_TIE_RTOL)
+    rk4_walls = best_walls is not None and _lower(wall_errors["rk4"], wall_errors[best_walls],
+                                                  COST_TIE_RTOL)
+    c8 = ("refuted" if rk4_free and rk4_walls
+          else "confirmed" if not (rk4_free or rk4_walls) else "partly")
+    _, walls_clause = _wall_orders_clause(m)
+    second = [k for k in METHODS if choice[k].order == 2]
+    ff, fw = m["frame_free"], m["frame_walls"]
+    edge = 2 * ff.half_size
+    visible = VISIBLE_FRACTION * edge
+
+    def seen(frame):
+        return ("above" if any(frame.difference[k] > visible for k in second)
+                else "below")
+
     verdicts.append(Verdict(
         claim="C8",
         measured=(f"Without walls rk4 reaches {TARGET_FREE:g} m with "
-                  f"{_evaluations(choice['rk4'].nfev_free)} force evaluations against "
-                  + ", ".join(f"{_evaluations(choice[k].nfev_free)} for {k}"
-                              for k in ("averaged-euler", "midpoint", "euler",
-                                        "backwards-euler"))
-                  + f" (never: not within {m['choice_max_steps']} steps); with walls every "
-                    "method is first "
-                    "order (observed "
-                  + ", ".join(f"{k} {m['wall_orders'][k]:.2f}" for k in METHODS)
-                  + f") and at {BUDGET_WALLS} evaluations rk4's error is "
+                  f"{_evaluations(nfev_free['rk4'])} force evaluations against "
+                  + ", ".join(f"{_evaluations(nfev_free[k])} for {k}" for k in rest)
+                  + f" (never: not within {m['choice_max_steps']} steps): "
+                  + ("fewer than" if rk4_free else "not fewer than")
+                  + f" the best of the others ({best_free}). "
+                  + walls_clause[0].upper() + walls_clause[1:]
+                  + f", and at {BUDGET_WALLS} evaluations rk4's error is "
                   f"{wall_errors['rk4']:.3g} m against "
-                  + ", ".join(f"{wall_errors[k]:.3g}" for k in METHODS if k != "rk4")
-                  + " m for the others. At a 1/60 s frame step rk4 and the second-order "
-                    "methods end up "
+                  + ", ".join(f"{_g(wall_errors[k])} m for {k}" for k in rest)
+                  + (": lower than" if rk4_walls else ": not lower than")
+                  + f" the best of the others ({best_walls}). At a 1/60 s frame step rk4 "
+                    "and the second-order methods ("
+                  + ", ".join(second) + ") end up "
                   + ", ".join(f"{ff.difference[k]:.2g}" for k in second)
-                  + " m apart without walls, which no viewer would notice ("
-                  + ", ".join(f"{m['frame_walls'].difference[k]:.2g}" for k in second)
-                  + " m with walls, in a cube of 4 m). Worth it without walls, not with "
-                    "them."),
-        verdict="partly", evidence="solvers-c8", command=f"{CMD_PARTICLES} choice"))
+                  + f" m apart without walls, {seen(ff)} the {visible:.2g} m a viewer "
+                    f"could see (one pixel of a 1000-pixel view of the {edge:g} m cube), and "
+                  + ", ".join(f"{fw.difference[k]:.2g}" for k in second)
+                  + f" m with walls, {seen(fw)} it. Better than every other method at equal "
+                    f"cost (by more than {COST_TIE_RTOL:.0%}): "
+                  + ("yes" if rk4_free else "no") + " without walls, "
+                  + ("yes" if rk4_walls else "no") + " with walls."),
+        verdict=c8, evidence="solvers-c8", command=f"{CMD_PARTICLES} choice"))
 
     def _reaches(nfev: float) -> str:
         if math.isinf(nfev):
             return f"never reaches {TARGET_FREE:g} m within {m['choice_max_steps']} steps"
         return f"reaches {TARGET_FREE:g} m after {nfev:.3g} evaluations"
 
-    be = choice["backwards-euler"]
+    name = "backwards-euler"
+    be = choice[name]
+    peers = [k for k in METHODS if k != name and choice[k].stages == be.stages]
+    others9 = [k for k in METHODS if k != name]
+    peer_orders = ", ".join(f"{k} {choice[k].order}" for k in peers)
+    relation = ("lower than" if all(be.order < choice[k].order for k in peers)
+                else "higher than" if all(be.order > choice[k].order for k in peers)
+                else "equal to" if all(be.order == choice[k].order for k in peers)
+                else "against")
+    drag9 = {k: choice[k].drag_limit for k in others9}
+    osc_stable = [k for k in others9 if choice[k].oscillator_limit > 0]
+    hop9 = {k: choice[k].hop_height_gh2 for k in others9}
+    free_best = all(not _lower(nfev_free[k], be.nfev_free, COST_TIE_RTOL) for k in others9)
+    walls_best = all(not _lower(wall_errors[k], be.error_walls_at_budget, COST_TIE_RTOL)
+                     for k in others9) and not math.isnan(be.error_walls_at_budget)
+    free_best = free_best and not math.isnan(be.nfev_free)
+    walls9 = {k: wall_errors[k] for k in others9}
+    drag_rank = _rank(be.drag_limit, drag9, ALIKE_RTOL)
+    hop_rank = _rank(be.hop_height_gh2, hop9, ALIKE_RTOL)
+    walls_rank = _rank(be.error_walls_at_budget, walls9, COST_TIE_RTOL)
+    c9 = ("confirmed" if free_best and walls_best
+          else "refuted" if not (free_best or walls_best) else "partly")
+    osc_text = (f"it is stable for oscillation up to h omega = {be.oscillator_limit:.3g}"
+                if be.oscillator_limit > 0 else "it amplifies every oscillation")
+    osc_text += ("; of the others only " + ", ".join(
+        f"{k} ({choice[k].oscillator_limit:.3g})" for k in osc_stable) + " is"
+        if osc_stable else "; none of the others is")
     verdicts.append(Verdict(
         claim="C9",
-        measured=(f"Backwards-euler costs {be.stages} evaluations a step like averaged-euler "
-                  f"and midpoint but is order {be.order}, its stable drag step is "
-                  f"h k/m <= {be.drag_limit:.3g} against {choice['midpoint'].drag_limit:.3g}, "
-                  f"and without walls it {_reaches(be.nfev_free)} (midpoint "
-                  f"{_reaches(choice['midpoint'].nfev_free)}); but it "
-                  f"is the only one of them stable for oscillation (h omega <= "
-                  f"{be.oscillator_limit:.3g}), it does not hop at rest "
-                  f"({be.hop_height_gh2:.3g} g h^2 against "
-                  f"{choice['midpoint'].hop_height_gh2:.3g}), and with walls its error at "
-                  f"{BUDGET_WALLS} evaluations is {be.error_walls_at_budget:.3g} m against "
-                  + ", ".join(f"{wall_errors[k]:.3g}" for k in METHODS
-                              if k != "backwards-euler")
-                  + " m. Not justified on accuracy; defensible for bouncing and resting "
-                    "scenes."),
-        verdict="partly", evidence="solvers-c9", command=f"{CMD_PARTICLES} choice"))
+        measured=(f"Backwards-euler costs {be.stages} evaluations a step like "
+                  + " and ".join(peers)
+                  + f" and is order {be.order}, {relation} theirs ({peer_orders}); its stable "
+                  f"drag step h k/m <= {be.drag_limit:.3g} is {drag_rank} "
+                  f"(others {_listing(drag9, lambda v: f'{v:.3g}')}); {osc_text}; its resting "
+                  f"hop {be.hop_height_gh2:.3g} g h^2 is {hop_rank} "
+                  f"(others {_listing(hop9, lambda v: f'{v:.3g}')}). Without walls it "
+                  f"{_reaches(be.nfev_free)} ("
+                  + ", ".join(f"{k} {_evaluations(nfev_free[k])}" for k in others9)
+                  + f" evaluations); with walls its error at {BUDGET_WALLS} evaluations is "
+                  f"{_g(be.error_walls_at_budget)} m, "
+                  f"{walls_rank} (others {_listing(walls9, _g)} m). Best or "
+                  f"tied-best (within {COST_TIE_RTOL:.0%}) on accuracy per cost: "
+                  + ("yes" if free_best else "no") + " without walls, "
+                  + ("yes" if walls_best else "no") + " with walls."),
+        verdict=c9, evidence="solvers-c9", command=f"{CMD_PARTICLES} choice"))
 
     d = m["drag"]
+    significant = d.same_terminal_difference > DRAG_SIGNIFICANT_FRACTION * d.same_terminal_distance
+    extra = d.cost_ratio > DRAG_EXTRA_COST_RATIO
+    c5 = ("confirmed" if not significant and extra
+          else "refuted" if significant and not extra else "partly")
     verdicts.append(Verdict(
         claim="C5",
         measured=(f"With the same terminal speed ({d.terminal_speed:g} m/s) a projectile "
                   f"under quadratic drag ends up to {d.same_terminal_difference:.3g} m from "
                   f"the linear-drag path over {d.same_terminal_distance:.3g} m travelled "
-                  f"({d.same_k_difference:.3g} m with the same k): a visible difference, not "
-                  "an insignificant one. The extra cost is real (a quadratic-drag step takes "
-                  "longer; this run's ratio is under the table) but whether it is worth paying "
-                  "depends on whether the path matters."),
-        verdict="partly", evidence="solvers-drag", command=f"{CMD_PARTICLES} drag"))
+                  f"({d.same_k_difference:.3g} m with the same k): "
+                  + ("more" if significant else "not more")
+                  + f" than {DRAG_SIGNIFICANT_FRACTION:.0%} of the distance, "
+                  + ("a significant" if significant else "an insignificant")
+                  + f" difference. A quadratic-drag step took {d.cost_ratio:.2g} times as "
+                    "long as a linear one in this run: "
+                  + ("more" if extra else "not more")
+                  + f" than {DRAG_EXTRA_COST_RATIO:g} times, "
+                  + ("an extra cost." if extra else "no extra cost.")),
+        verdict=c5, evidence="solvers-drag", command=f"{CMD_PARTICLES} drag", timing=True))
     return verdicts
 
 
