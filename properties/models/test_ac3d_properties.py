@@ -22,6 +22,7 @@ from properties.strategies import meshes
 from refsim.errors import ModelError, ModelWarning
 from refsim.models.ac3d import format_ac3d, parse_ac3d, read_ac3d
 from refsim.models.mesh import Mesh
+from tests.helpers import assert_meshes_identical
 
 #: Tokens a mutation may put in place of another: keywords in the wrong place,
 #: bad numbers, stray quotes, huge counts.
@@ -35,16 +36,6 @@ TOKENS = ["OBJECT", "poly", "world", "kids", "numvert", "numsurf", "SURF", "mat"
 def folder():
     with tempfile.TemporaryDirectory() as name:
         yield Path(name)
-
-
-def _assert_identical(a: Mesh, b: Mesh):
-    assert a.vertices.tobytes() == b.vertices.tobytes()
-    assert a.faces.tolist() == b.faces.tolist()
-    assert a.face_material.tolist() == b.face_material.tolist()
-    assert a.face_flags.tolist() == b.face_flags.tolist()
-    assert a.face_object.tolist() == b.face_object.tolist()
-    assert a.materials == b.materials
-    assert a.objects == b.objects
 
 
 def _parses_or_model_error(read):
@@ -66,7 +57,7 @@ def _parses_or_model_error(read):
 
 @given(meshes())
 def test_write_then_read_is_identity(mesh):
-    _assert_identical(mesh, parse_ac3d(format_ac3d(mesh)))
+    assert_meshes_identical(mesh, parse_ac3d(format_ac3d(mesh)))
 
 
 @given(meshes())
@@ -130,4 +121,4 @@ def test_a_valid_data_block_anywhere_in_an_object_changes_nothing(mesh, data):
     if blob.endswith("\r") or not blob.endswith("\n"):
         blob += "\n"
     patched = "\n".join(lines[:k]) + f"\ndata {n}\n{blob}" + "\n".join(lines[k:])
-    _assert_identical(mesh, parse_ac3d(patched))
+    assert_meshes_identical(mesh, parse_ac3d(patched))

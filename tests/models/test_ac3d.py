@@ -11,6 +11,7 @@ import pytest
 from refsim.errors import ModelError, ModelWarning
 from refsim.models.ac3d import format_ac3d, parse_ac3d, read_ac3d, write_ac3d
 from refsim.models.mesh import Material, Mesh
+from tests.helpers import assert_meshes_identical
 
 REST = "amb 0.2 0.2 0.2  emis 0 0 0  spec 0.5 0.5 0.5  shi 10  trans 0"
 
@@ -408,22 +409,12 @@ def _two_object_mesh():
                 objects=["first part", "second"])
 
 
-def _assert_identical(a: Mesh, b: Mesh):
-    assert a.vertices.tobytes() == b.vertices.tobytes()  # bit for bit, -0.0 included
-    assert a.faces.tolist() == b.faces.tolist()
-    assert a.face_material.tolist() == b.face_material.tolist()
-    assert a.face_flags.tolist() == b.face_flags.tolist()
-    assert a.face_object.tolist() == b.face_object.tolist()
-    assert a.materials == b.materials
-    assert a.objects == b.objects
-
-
 def test_write_read_round_trip_is_exact(tmp_path):
     mesh = _two_object_mesh()
     path = tmp_path / "out.ac"
     write_ac3d(mesh, path)
     back = _read_quiet(path)
-    _assert_identical(mesh, back)
+    assert_meshes_identical(mesh, back)
     assert path.read_text() == format_ac3d(mesh)
     # and again: the written file is a fixed point
     assert format_ac3d(back) == format_ac3d(mesh)
@@ -449,14 +440,14 @@ def test_vertex_order_survives_when_a_later_object_uses_an_earlier_vertex():
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], float)
     f = np.array([[1, 2, 3], [0, 1, 2]])
     mesh = Mesh(v, f, face_object=[0, 1], objects=["a", "b"])
-    _assert_identical(mesh, parse_ac3d(format_ac3d(mesh)))
+    assert_meshes_identical(mesh, parse_ac3d(format_ac3d(mesh)))
 
 
 def test_empty_objects_and_duplicate_names_round_trip():
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
     mesh = Mesh(v, [[0, 1, 2]], face_object=[1], objects=["same", "same", "empty"])
     back = parse_ac3d(format_ac3d(mesh))
-    _assert_identical(mesh, back)
+    assert_meshes_identical(mesh, back)
 
 
 def test_unsorted_face_objects_are_regrouped_with_a_warning():

@@ -12,6 +12,7 @@ import trimesh
 from refsim.models.ac3d import format_ac3d, parse_ac3d
 from refsim.models.loading import load_model
 from refsim.paths import bundled_models, models_dir
+from tests.helpers import assert_meshes_identical
 
 MODELS = bundled_models()
 CONVEX = {"tetrahedron.ac", "cube.ac", "icosahedron.ac", "sphere-2k.ac", "sphere-5k.ac",
@@ -44,13 +45,7 @@ def test_generator_reproduces_the_bundled_files(tmp_path):
 @pytest.mark.parametrize("path", MODELS, ids=lambda p: p.name)
 def test_round_trip_is_exact(path):
     mesh = load_model(path)
-    again = parse_ac3d(format_ac3d(mesh))
-    assert np.array_equal(again.vertices, mesh.vertices)
-    assert np.array_equal(again.faces, mesh.faces)
-    assert np.array_equal(again.face_material, mesh.face_material)
-    assert np.array_equal(again.face_flags, mesh.face_flags)
-    assert np.array_equal(again.face_object, mesh.face_object)
-    assert again.objects == mesh.objects and again.materials == mesh.materials
+    assert_meshes_identical(parse_ac3d(format_ac3d(mesh)), mesh)
 
 
 @pytest.mark.parametrize("path", MODELS, ids=lambda p: p.name)

@@ -10,6 +10,7 @@ from refsim.errors import ModelError, SceneError
 from refsim.paths import SCENES_DIR, models_dir
 from refsim.scenes.loader import load_scene
 from refsim.scenes.schema import SOLVER_NAMES, IntegrationConfig, WorldConfig
+from tests.helpers import assert_scene_error
 
 MINIMAL = '[[body]]\nmodel = "cube.ac"\n'
 
@@ -86,13 +87,7 @@ BAD = [
 
 @pytest.mark.parametrize("text, key, phrase", BAD, ids=[b[1] + ":" + b[2] for b in BAD])
 def test_schema_violations_name_file_and_key(tmp_path, text, key, phrase):
-    path = write(tmp_path, text)
-    with pytest.raises(SceneError) as info:
-        load_scene(path)
-    err = info.value
-    assert err.key == key
-    assert phrase in err.message
-    assert str(path) in str(err) and key in str(err)
+    assert_scene_error(tmp_path, text, key, phrase)
 
 
 def test_invalid_toml_names_the_line(tmp_path):

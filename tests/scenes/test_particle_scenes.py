@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.errors import SceneError
 from refsim.particles.config import ParticleConfig
 from refsim.paths import SCENES_DIR
 from refsim.scenes.loader import load_scene
 from refsim.scenes.schema import PARTICLE_FIELDS_FROM, PARTICLE_KEYS
+from tests.helpers import assert_scene_error
 
 PARTICLES = "[particles]\ncount = 10\nseed = 4\n"
 
@@ -101,10 +101,4 @@ BAD = [
 
 @pytest.mark.parametrize("text, key, phrase", BAD, ids=[b[1] + ":" + b[2] for b in BAD])
 def test_bad_particle_keys_name_file_and_key(tmp_path, text, key, phrase):
-    path = write(tmp_path, text)
-    with pytest.raises(SceneError) as info:
-        load_scene(path)
-    err = info.value
-    assert err.key == key
-    assert phrase in err.message
-    assert str(path) in str(err) and key in str(err)
+    assert_scene_error(tmp_path, text, key, phrase)
