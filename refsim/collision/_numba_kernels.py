@@ -31,10 +31,19 @@ from refsim.collision.predicates import (
 )
 
 # -- the certified triangle-pair filter (triangle_numba's steps 1-4) -------------------
+#
+# Points are 3-tuples and triangles 3-tuples of points. Tuples are passed by
+# value; an array passed to a compiled helper, or a row sliced from one
+# (``t[0]``), is a reference-counted object, and doing that a dozen times per
+# pair made the first version of this filter ~3x slower: ``certified`` on
+# 1e5 random pairs took 150-210 ns a pair with (3, 3) arrays and row views,
+# 50-75 ns with tuples (tests/benchmarks/test_triangle_kernels.py times the
+# public function on 2000 pairs).
 
 
 @numba.njit(cache=True)
 def o3d(a, b, c, d):
+    """(sign, certain) of orient3d(a, b, c, d) under Shewchuk's static filter."""
     adx, ady, adz = a[0] - d[0], a[1] - d[1], a[2] - d[2]
     bdx, bdy, bdz = b[0] - d[0], b[1] - d[1], b[2] - d[2]
     cdx, cdy, cdz = c[0] - d[0], c[1] - d[1], c[2] - d[2]
@@ -60,25 +69,36 @@ def o2d_certain(a0, a1, b0, b1, c0, c1):
     return abs(det) > O2D_ERRBOUND_A * (abs(detleft) + abs(detright))
 
 @numba.njit(cache=True)
-def in_range(t):
+def filter_applies(t):
+    """Step 1 for one triangle: coordinates in the filter's range and the
+    triangle certainly non-degenerate."""
     for v in range(3):
         for k in range(3):
-            m = abs(t[v, k])
+            m = abs(t[v][k])
             if m != 0.0 and not (FILTER_MIN_ABS <= m <= FILTER_MAX_ABS):
                 return False
-    return True
-
-@numba.njit(cache=True)
-def nondegenerate(t):
-    p, q, r = t[0], t[1], t[2]
+    p, q, r = t
     for i, j in ((1, 2), (2, 0), (0, 1)):
         if o2d_certain(p[i], p[j], q[i], q[j], r[i], r[j]):
             return True
     return False
 
 @numba.njit(cache=True)
+def sides(plane, t):
+    """(signs, certain) of t's vertices against the plane of triangle ``plane``."""
+    s0, c0 = o3d(plane[0], plane[1], plane[2], t[0])
+    s1, c1 = o3d(plane[0], plane[1], plane[2], t[1])
+    s2, c2 = o3d(plane[0], plane[1], plane[2], t[2])
+    return (s0, s1, s2), (c0, c1, c2)
+
+@numba.njit(cache=True)
+def certainly_one_side(s, c):
+    return c[0] and c[1] and c[2] and s[0] == s[1] and s[1] == s[2]
+
+@numba.njit(cache=True)
 def edges_vs_triangle(e, t, s, c):
-    """(any certain hit, all three edges certainly miss)."""
+    """(any certain hit, all three edges certainly miss) for the edges of e
+    against triangle t; s, c are the sides of e's vertices to t's plane."""
     all_miss = True
     for i in range(3):
         j = (i + 1) % 3
@@ -98,24 +118,14 @@ def edges_vs_triangle(e, t, s, c):
     return False, all_miss
 
 @numba.njit(cache=True)
-def certify_pair(a, b):
-    """(answer, certain) for one pair of (3, 3) triangles."""
-    # step 1
-    if not (in_range(a) and in_range(b) and nondegenerate(a) and nondegenerate(b)):
-        return False, False
-    # step 2
-    sa = np.empty(3, dtype=np.int64)
-    ca = np.empty(3, dtype=np.bool_)
-    sb = np.empty(3, dtype=np.int64)
-    cb = np.empty(3, dtype=np.bool_)
-    for v in range(3):
-        sa[v], ca[v] = o3d(b[0], b[1], b[2], a[v])
-        sb[v], cb[v] = o3d(a[0], a[1], a[2], b[v])
-    one_side_a = ca[0] and ca[1] and ca[2] and sa[0] == sa[1] and sa[1] == sa[2]
-    one_side_b = cb[0] and cb[1] and cb[2] and sb[0] == sb[1] and sb[1] == sb[2]
-    if one_side_a or one_side_b:
+def certify_filtered(a, b):
+    """Steps 2-4 for triangles that passed step 1: (answer, certain)."""
+    sa, ca = sides(b, a)
+    if certainly_one_side(sa, ca):
+        return False, True                  # (the numpy kernel computes both sides first)
+    sb, cb = sides(a, b)
+    if certainly_one_side(sb, cb):
         return False, True
-    # steps 3 and 4
     hit, miss_a = edges_vs_triangle(a, b, sa, ca)
     if hit:
         return True, True
@@ -125,12 +135,24 @@ def certify_pair(a, b):
     return False, miss_a and miss_b
 
 @numba.njit(cache=True)
+def certify_pair(a, b):
+    """(answer, certain) for one pair of triangles (tuples of three points)."""
+    if not (filter_applies(a) and filter_applies(b)):
+        return False, False
+    return certify_filtered(a, b)
+
+@numba.njit(cache=True)
 def certified(A, B):
+    """``certify_pair`` for every pair of two (k, 3, 3) arrays."""
     k = A.shape[0]
     answer = np.zeros(k, dtype=np.bool_)
     certain = np.zeros(k, dtype=np.bool_)
     for n in range(k):
-        answer[n], certain[n] = certify_pair(A[n], B[n])
+        a = ((A[n, 0, 0], A[n, 0, 1], A[n, 0, 2]), (A[n, 1, 0], A[n, 1, 1], A[n, 1, 2]),
+             (A[n, 2, 0], A[n, 2, 1], A[n, 2, 2]))
+        b = ((B[n, 0, 0], B[n, 0, 1], B[n, 0, 2]), (B[n, 1, 0], B[n, 1, 1], B[n, 1, 2]),
+             (B[n, 2, 0], B[n, 2, 1], B[n, 2, 2]))
+        answer[n], certain[n] = certify_pair(a, b)
     return answer, certain
 
 @numba.njit(cache=True)
@@ -139,14 +161,16 @@ def certified_indexed(world_a, faces_a, world_b, faces_b, pairs):
     k = pairs.shape[0]
     answer = np.zeros(k, dtype=np.bool_)
     certain = np.zeros(k, dtype=np.bool_)
-    ta = np.empty((3, 3))
-    tb = np.empty((3, 3))
     for n in range(k):
-        for v in range(3):
-            for c in range(3):
-                ta[v, c] = world_a[faces_a[pairs[n, 0], v], c]
-                tb[v, c] = world_b[faces_b[pairs[n, 1], v], c]
-        answer[n], certain[n] = certify_pair(ta, tb)
+        p, q, r = faces_a[pairs[n, 0], 0], faces_a[pairs[n, 0], 1], faces_a[pairs[n, 0], 2]
+        a = ((world_a[p, 0], world_a[p, 1], world_a[p, 2]),
+             (world_a[q, 0], world_a[q, 1], world_a[q, 2]),
+             (world_a[r, 0], world_a[r, 1], world_a[r, 2]))
+        p, q, r = faces_b[pairs[n, 1], 0], faces_b[pairs[n, 1], 1], faces_b[pairs[n, 1], 2]
+        b = ((world_b[p, 0], world_b[p, 1], world_b[p, 2]),
+             (world_b[q, 0], world_b[q, 1], world_b[q, 2]),
+             (world_b[r, 0], world_b[r, 1], world_b[r, 2]))
+        answer[n], certain[n] = certify_pair(a, b)
     return answer, certain
 
 
@@ -193,42 +217,25 @@ def prepare(vertices, faces, rotation, translation, left, right, start, count, o
     return world, lo, hi, tri_lo, tri_hi
 
 @numba.njit(cache=True)
-def apart(lo1, hi1, i, lo2, hi2, j):
-    for k in range(3):
-        if lo1[i, k] > hi2[j, k] or lo2[j, k] > hi1[i, k]:
-            return True
-    return False
-
-@numba.njit(cache=True)
-def push(stack, top, a, b):
-    if top == stack.shape[0]:
-        bigger = np.empty((2 * top, 2), dtype=np.int64)
-        bigger[:top] = stack[:top]
-        stack = bigger
-    stack[top, 0] = a
-    stack[top, 1] = b
-    return stack, top + 1
-
-@numba.njit(cache=True)
 def traverse(left_a, right_a, start_a, count_a, order_a, lo_a, hi_a, tlo_a, thi_a,
-             world_a, faces_a,
              left_b, right_b, start_b, count_b, order_b, lo_b, hi_b, tlo_b, thi_b,
-             world_b, faces_b, mode):
-    """Returns (pairs, hit): the triangle-box pairs found (modes 0, 1), or
-    the pairs the exact filter could not certify (mode 2), and whether
-    mode 2 found a certified intersecting pair."""
+             first_only):
+    """The triangle-box pairs (i, j) whose world boxes overlap (seed test 2),
+    by simultaneous descent of the refit trees; at most one with ``first_only``."""
     out = np.empty((64, 2), dtype=np.int64)
     found = 0
     stack = np.empty((64, 2), dtype=np.int64)
-    stack, top = push(stack, 0, 0, 0)
-    ta = np.empty((3, 3))
-    tb = np.empty((3, 3))
+    stack[0, 0] = 0
+    stack[0, 1] = 0
+    top = 1
     while top > 0:
         top -= 1
         a = stack[top, 0]
         b = stack[top, 1]
-        if apart(lo_a, hi_a, a, lo_b, hi_b, b):
-            continue
+        if (lo_a[a, 0] > hi_b[b, 0] or lo_b[b, 0] > hi_a[a, 0]
+                or lo_a[a, 1] > hi_b[b, 1] or lo_b[b, 1] > hi_a[a, 1]
+                or lo_a[a, 2] > hi_b[b, 2] or lo_b[b, 2] > hi_a[a, 2]):
+            continue                                        # node boxes apart
         leaf_a = left_a[a] < 0
         leaf_b = left_b[b] < 0
         if leaf_a and leaf_b:
@@ -236,36 +243,303 @@ def traverse(left_a, right_a, start_a, count_a, order_a, lo_a, hi_a, tlo_a, thi_
                 i = order_a[s]
                 for r in range(start_b[b], start_b[b] + count_b[b]):
                     j = order_b[r]
-                    if apart(tlo_a, thi_a, i, tlo_b, thi_b, j):
-                        continue
-                    if mode == 2:
-                        for v in range(3):
-                            for k in range(3):
-                                ta[v, k] = world_a[faces_a[i, v], k]
-                                tb[v, k] = world_b[faces_b[j, v], k]
-                        answer, certain = certify_pair(ta, tb)
-                        if certain:
-                            if answer:
-                                return out[:found], True
-                            continue
+                    if (tlo_a[i, 0] > thi_b[j, 0] or tlo_b[j, 0] > thi_a[i, 0]
+                            or tlo_a[i, 1] > thi_b[j, 1] or tlo_b[j, 1] > thi_a[i, 1]
+                            or tlo_a[i, 2] > thi_b[j, 2] or tlo_b[j, 2] > thi_a[i, 2]):
+                        continue                            # triangle boxes apart
                     if found == out.shape[0]:
-                        grown = np.empty((2 * found, 2), dtype=np.int64)
-                        grown[:found] = out
-                        out = grown
+                        out = grow(out, found)
                     out[found, 0] = i
                     out[found, 1] = j
                     found += 1
-                    if mode == 1:
-                        return out[:found], False
+                    if first_only:
+                        return out[:found]
             continue
+        if top + 2 > stack.shape[0]:
+            stack = grow(stack, top)
         size_a = (hi_a[a, 0] - lo_a[a, 0]) + (hi_a[a, 1] - lo_a[a, 1]) \
             + (hi_a[a, 2] - lo_a[a, 2])
         size_b = (hi_b[b, 0] - lo_b[b, 0]) + (hi_b[b, 1] - lo_b[b, 1]) \
             + (hi_b[b, 2] - lo_b[b, 2])
         if leaf_b or (not leaf_a and size_a >= size_b):     # open the bigger node
-            stack, top = push(stack, top, right_a[a], b)
-            stack, top = push(stack, top, left_a[a], b)
+            stack[top, 0], stack[top, 1] = right_a[a], b
+            stack[top + 1, 0], stack[top + 1, 1] = left_a[a], b
         else:
-            stack, top = push(stack, top, a, right_b[b])
-            stack, top = push(stack, top, a, left_b[b])
-    return out[:found], False
+            stack[top, 0], stack[top, 1] = a, right_b[b]
+            stack[top + 1, 0], stack[top + 1, 1] = a, left_b[b]
+        top += 2
+    return out[:found]
+
+@numba.njit(cache=True)
+def grow(rows, used):
+    """``rows`` (k, 2) copied into an array twice as long (amortized O(1) appends)."""
+    bigger = np.empty((2 * rows.shape[0], 2), dtype=np.int64)
+    bigger[:used] = rows[:used]
+    return bigger
+
+
+# -- the exact level in the first body's frame (bvh_exact) ---------------------------
+#
+# The same steps as bvh_exact's readable traversal. The separating-axis node
+# test, the preparation of a leaf (once for body a, once for body b) and the
+# loops over a leaf pair are written out in the main loop: a helper taking a
+# dozen arrays cost ~40 ns per call here, which made the whole query ~20%
+# slower on the separated benchmarks (see the note above the triangle filter).
+
+#: Query modes of ``exact_query``.
+ALL_HITS, FIRST_HIT, CANDIDATES = 0, 1, 2
+
+#: Columns of a hierarchy's ``links`` (bvh_exact.FrameTree); its ``boxes``
+#: hold a node's centre in columns 0-2 and half-extents in 3-5.
+LEFT, RIGHT, START, COUNT = 0, 1, 2, 3
+
+
+@numba.njit(cache=True)
+def pose_deviation(rotation, translation, tol):
+    """max |R^T R - I| of a valid pose, or -1.0 if the pose is not valid (a
+    non-finite value, an entry of R above 1 + tol, or R^T R further than tol
+    from I: the conditions of refsim.types.as_pose)."""
+    for k in range(3):
+        if not abs(translation[k]) < np.inf:
+            return -1.0
+        for j in range(3):
+            if not abs(rotation[k, j]) <= 1.0 + tol:
+                return -1.0
+    deviation = 0.0
+    for i in range(3):
+        for j in range(3):
+            gram = (rotation[0, i] * rotation[0, j] + rotation[1, i] * rotation[1, j]
+                    + rotation[2, i] * rotation[2, j])
+            deviation = max(deviation, abs(gram - (1.0 if i == j else 0.0)))
+    return deviation if deviation <= tol else -1.0
+
+@numba.njit(cache=True)
+def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotation_a,
+                translation_a,
+                vertices_b, faces_b, links_b, order_b, boxes_b, reach_b, rotation_b,
+                translation_b,
+                mode, tol, margin_rounding, margin_per_deviation):
+    """Returns ``(status, found, uncertain)``.
+
+    status: 0, or 1 / 2 when pose a / b is not valid (nothing else computed).
+    found: the pairs certified to intersect (ALL_HITS; at most one for
+    FIRST_HIT), or every candidate pair (CANDIDATES: node boxes not separated,
+    triangle boxes overlap; nothing certified).
+    uncertain: the candidate pairs the float filter could not decide.
+    """
+    none = np.empty((0, 2), dtype=np.int64)
+    deviation_a = pose_deviation(rotation_a, translation_a, tol)
+    if deviation_a < 0.0:
+        return 1, none, none
+    deviation_b = pose_deviation(rotation_b, translation_b, tol)
+    if deviation_b < 0.0:
+        return 2, none, none
+
+    # Body b in a's frame: x_a = M x_b + u, M = Ra^T Rb, u = Ra^T (tb - ta).
+    M = np.empty((3, 3))
+    absM = np.empty((3, 3))
+    u = np.empty(3)
+    for i in range(3):
+        for j in range(3):
+            M[i, j] = (rotation_a[0, i] * rotation_b[0, j] + rotation_a[1, i] * rotation_b[1, j]
+                       + rotation_a[2, i] * rotation_b[2, j])
+            absM[i, j] = abs(M[i, j])
+        u[i] = (rotation_a[0, i] * (translation_b[0] - translation_a[0])
+                + rotation_a[1, i] * (translation_b[1] - translation_a[1])
+                + rotation_a[2, i] * (translation_b[2] - translation_a[2]))
+    scale = reach_a + reach_b
+    for k in range(3):
+        scale = max(scale, reach_a + reach_b + abs(translation_a[k]) + abs(translation_b[k]))
+    margin = (margin_rounding + margin_per_deviation * max(deviation_a, deviation_b)) * scale
+
+    # Per-query state, filled lazily, leaf by leaf.
+    world_a = np.empty((vertices_a.shape[0], 3))
+    world_b = np.empty((vertices_b.shape[0], 3))
+    vertex_done_a = np.zeros(vertices_a.shape[0], dtype=np.bool_)
+    vertex_done_b = np.zeros(vertices_b.shape[0], dtype=np.bool_)
+    tri_box_a = np.empty((faces_a.shape[0], 6))
+    tri_box_b = np.empty((faces_b.shape[0], 6))
+    tri_ok_a = np.empty(faces_a.shape[0], dtype=np.bool_)
+    tri_ok_b = np.empty(faces_b.shape[0], dtype=np.bool_)
+    leaf_box_a = np.empty((links_a.shape[0], 6))
+    leaf_box_b = np.empty((links_b.shape[0], 6))
+    leaf_done_a = np.zeros(links_a.shape[0], dtype=np.bool_)
+    leaf_done_b = np.zeros(links_b.shape[0], dtype=np.bool_)
+
+    found = np.empty((64, 2), dtype=np.int64)
+    n_found = 0
+    uncertain = np.empty((64, 2), dtype=np.int64)
+    n_uncertain = 0
+    T = np.empty(3)
+    stack = np.empty((256, 2), dtype=np.int64)
+    stack[0, 0] = 0
+    stack[0, 1] = 0
+    top = 1
+    while top > 0:
+        top -= 1
+        a = stack[top, 0]
+        b = stack[top, 1]
+
+        # Separating-axis test of node a's box and node b's box, in a's frame
+        # (bvh_exact.boxes_apart): T is b's centre minus a's centre.
+        for i in range(3):
+            T[i] = (M[i, 0] * boxes_b[b, 0] + M[i, 1] * boxes_b[b, 1]
+                    + M[i, 2] * boxes_b[b, 2] + u[i] - boxes_a[a, i])
+        a0, a1, a2 = boxes_a[a, 3], boxes_a[a, 4], boxes_a[a, 5]
+        b0, b1, b2 = boxes_b[b, 3], boxes_b[b, 4], boxes_b[b, 5]
+        apart = False
+        for i in range(3):                                  # a's face normals
+            radius = boxes_a[a, 3 + i] + b0 * absM[i, 0] + b1 * absM[i, 1] + b2 * absM[i, 2]
+            if abs(T[i]) > radius + margin:
+                apart = True
+                break
+        if apart:
+            continue
+        for j in range(3):                                  # b's face normals
+            projection = T[0] * M[0, j] + T[1] * M[1, j] + T[2] * M[2, j]
+            radius = a0 * absM[0, j] + a1 * absM[1, j] + a2 * absM[2, j] + boxes_b[b, 3 + j]
+            if abs(projection) > radius + margin:
+                apart = True
+                break
+        if apart:
+            continue
+        for i in range(3):                                  # the nine edge-edge axes
+            i1 = (i + 1) % 3
+            i2 = (i + 2) % 3
+            for j in range(3):
+                j1 = (j + 1) % 3
+                j2 = (j + 2) % 3
+                projection = T[i2] * M[i1, j] - T[i1] * M[i2, j]
+                radius = (boxes_a[a, 3 + i1] * absM[i2, j] + boxes_a[a, 3 + i2] * absM[i1, j]
+                          + boxes_b[b, 3 + j1] * absM[i, j2] + boxes_b[b, 3 + j2] * absM[i, j1])
+                if abs(projection) > radius + margin:
+                    apart = True
+                    break
+            if apart:
+                break
+        if apart:
+            continue
+
+        leaf_a = links_a[a, LEFT] < 0
+        leaf_b = links_b[b, LEFT] < 0
+        if leaf_a and leaf_b:
+            # A pair of leaves: world boxes, then the triangle pairs.
+            if not leaf_done_a[a]:
+                # prepare leaf a: world vertices (each once per query, with
+                # refsim's one transform arithmetic), triangle boxes (lo xyz,
+                # hi xyz), step 1 of the filter per triangle, the leaf's box
+                for k in range(3):
+                    leaf_box_a[a, k] = np.inf
+                    leaf_box_a[a, 3 + k] = -np.inf
+                for s in range(links_a[a, START], links_a[a, START] + links_a[a, COUNT]):
+                    f = order_a[s]
+                    for c in range(3):
+                        v = faces_a[f, c]
+                        if not vertex_done_a[v]:
+                            x, y, z = vertices_a[v, 0], vertices_a[v, 1], vertices_a[v, 2]
+                            for k in range(3):
+                                world_a[v, k] = ((rotation_a[k, 0] * x + rotation_a[k, 1] * y)
+                                                + rotation_a[k, 2] * z) + translation_a[k]
+                            vertex_done_a[v] = True
+                    p, q, r = faces_a[f, 0], faces_a[f, 1], faces_a[f, 2]
+                    for k in range(3):
+                        lo = min(world_a[p, k], min(world_a[q, k], world_a[r, k]))
+                        hi = max(world_a[p, k], max(world_a[q, k], world_a[r, k]))
+                        tri_box_a[f, k] = lo
+                        tri_box_a[f, 3 + k] = hi
+                        leaf_box_a[a, k] = min(leaf_box_a[a, k], lo)
+                        leaf_box_a[a, 3 + k] = max(leaf_box_a[a, 3 + k], hi)
+                    tri_ok_a[f] = filter_applies(
+                        ((world_a[p, 0], world_a[p, 1], world_a[p, 2]),
+                         (world_a[q, 0], world_a[q, 1], world_a[q, 2]),
+                         (world_a[r, 0], world_a[r, 1], world_a[r, 2])))
+                leaf_done_a[a] = True
+            if not leaf_done_b[b]:
+                # prepare leaf b: world vertices (each once per query, with
+                # refsim's one transform arithmetic), triangle boxes (lo xyz,
+                # hi xyz), step 1 of the filter per triangle, the leaf's box
+                for k in range(3):
+                    leaf_box_b[b, k] = np.inf
+                    leaf_box_b[b, 3 + k] = -np.inf
+                for s in range(links_b[b, START], links_b[b, START] + links_b[b, COUNT]):
+                    f = order_b[s]
+                    for c in range(3):
+                        v = faces_b[f, c]
+                        if not vertex_done_b[v]:
+                            x, y, z = vertices_b[v, 0], vertices_b[v, 1], vertices_b[v, 2]
+                            for k in range(3):
+                                world_b[v, k] = ((rotation_b[k, 0] * x + rotation_b[k, 1] * y)
+                                                + rotation_b[k, 2] * z) + translation_b[k]
+                            vertex_done_b[v] = True
+                    p, q, r = faces_b[f, 0], faces_b[f, 1], faces_b[f, 2]
+                    for k in range(3):
+                        lo = min(world_b[p, k], min(world_b[q, k], world_b[r, k]))
+                        hi = max(world_b[p, k], max(world_b[q, k], world_b[r, k]))
+                        tri_box_b[f, k] = lo
+                        tri_box_b[f, 3 + k] = hi
+                        leaf_box_b[b, k] = min(leaf_box_b[b, k], lo)
+                        leaf_box_b[b, 3 + k] = max(leaf_box_b[b, 3 + k], hi)
+                    tri_ok_b[f] = filter_applies(
+                        ((world_b[p, 0], world_b[p, 1], world_b[p, 2]),
+                         (world_b[q, 0], world_b[q, 1], world_b[q, 2]),
+                         (world_b[r, 0], world_b[r, 1], world_b[r, 2])))
+                leaf_done_b[b] = True
+            if (leaf_box_a[a, 0] > leaf_box_b[b, 3] or leaf_box_b[b, 0] > leaf_box_a[a, 3]
+                    or leaf_box_a[a, 1] > leaf_box_b[b, 4] or leaf_box_b[b, 1] > leaf_box_a[a, 4]
+                    or leaf_box_a[a, 2] > leaf_box_b[b, 5] or leaf_box_b[b, 2] > leaf_box_a[a, 5]):
+                continue
+            for s in range(links_a[a, START], links_a[a, START] + links_a[a, COUNT]):
+                i = order_a[s]
+                for r in range(links_b[b, START], links_b[b, START] + links_b[b, COUNT]):
+                    j = order_b[r]
+                    if (tri_box_a[i, 0] > tri_box_b[j, 3]
+                            or tri_box_b[j, 0] > tri_box_a[i, 3]
+                            or tri_box_a[i, 1] > tri_box_b[j, 4]
+                            or tri_box_b[j, 1] > tri_box_a[i, 4]
+                            or tri_box_a[i, 2] > tri_box_b[j, 5]
+                            or tri_box_b[j, 2] > tri_box_a[i, 5]):
+                        continue                            # triangle boxes apart
+                    if mode == CANDIDATES:
+                        answer, certain = True, True
+                    elif tri_ok_a[i] and tri_ok_b[j]:
+                        p0, p1, p2 = faces_a[i, 0], faces_a[i, 1], faces_a[i, 2]
+                        q0, q1, q2 = faces_b[j, 0], faces_b[j, 1], faces_b[j, 2]
+                        answer, certain = certify_filtered(
+                            ((world_a[p0, 0], world_a[p0, 1], world_a[p0, 2]),
+                             (world_a[p1, 0], world_a[p1, 1], world_a[p1, 2]),
+                             (world_a[p2, 0], world_a[p2, 1], world_a[p2, 2])),
+                            ((world_b[q0, 0], world_b[q0, 1], world_b[q0, 2]),
+                             (world_b[q1, 0], world_b[q1, 1], world_b[q1, 2]),
+                             (world_b[q2, 0], world_b[q2, 1], world_b[q2, 2])))
+                    else:
+                        answer, certain = False, False
+                    if certain:
+                        if answer:
+                            if n_found == found.shape[0]:
+                                found = grow(found, n_found)
+                            found[n_found, 0] = i
+                            found[n_found, 1] = j
+                            n_found += 1
+                            if mode == FIRST_HIT:
+                                return 0, found[:n_found], uncertain[:n_uncertain]
+                    else:
+                        if n_uncertain == uncertain.shape[0]:
+                            uncertain = grow(uncertain, n_uncertain)
+                        uncertain[n_uncertain, 0] = i
+                        uncertain[n_uncertain, 1] = j
+                        n_uncertain += 1
+            continue
+        if top + 2 > stack.shape[0]:
+            stack = grow(stack, top)
+        if leaf_b or (not leaf_a and a0 + a1 + a2 >= b0 + b1 + b2):
+            stack[top, 0] = links_a[a, RIGHT]               # open the bigger node
+            stack[top, 1] = b
+            stack[top + 1, 0] = links_a[a, LEFT]
+            stack[top + 1, 1] = b
+        else:
+            stack[top, 0] = a
+            stack[top, 1] = links_b[b, RIGHT]
+            stack[top + 1, 0] = a
+            stack[top + 1, 1] = links_b[b, LEFT]
+        top += 2
+    return 0, found[:n_found], uncertain[:n_uncertain]

@@ -17,10 +17,13 @@ Every level is conservative: it never says "apart" where the exact test says
 pairs, which exist only when the object boxes overlap); the sphere level is
 conservative too but does not nest with the box levels.
 
-``method`` picks how the triangle-box pairs are found, with identical
-answers: "seed" tests the triangle boxes pairwise as the seed does
+``method`` picks how the pairs are found, with identical answers: "seed"
+tests the triangle boxes pairwise as the seed does
 (:mod:`refsim.collision.seed_levels`); "bvh" (the default) descends a
-triangle hierarchy (:mod:`refsim.collision.bvh`).
+triangle hierarchy: at level "triangle-aabb" one refit in world space, which
+finds test 2's pairs themselves (:mod:`refsim.collision.bvh`); at level
+"exact" one traversed in the first body's frame, which transforms only the
+leaves it reaches (:mod:`refsim.collision.bvh_exact`).
 """
 
 from __future__ import annotations
@@ -28,12 +31,8 @@ from __future__ import annotations
 import numpy as np
 
 from refsim.collision.boxes import boxes_overlap, world_vertices
-from refsim.collision.bvh import (
-    check_kernel,
-    prepare_body,
-    tree_box_pairs,
-    tree_first_exact_hit,
-)
+from refsim.collision.bvh import check_kernel, prepare_body, tree_box_pairs
+from refsim.collision.bvh_exact import collide_bvh, intersecting_pairs_bvh
 from refsim.collision.seed_levels import exact_pairs, triangle_box_pairs
 from refsim.collision.spheres import spheres_overlap
 from refsim.types import as_pose
@@ -75,17 +74,17 @@ def intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
     """
     _check(level, PAIR_LEVELS, method)
     kernel = check_kernel(kernel)
+    if level == "exact" and method == "bvh":
+        return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
     pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
     if method == "seed":
         world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
         pairs = triangle_box_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces)
-    else:
-        pa, pb = prepare_body(mesh_a, pose_a, kernel), prepare_body(mesh_b, pose_b, kernel)
-        world_a, world_b = pa.world, pb.world
-        pairs = tree_box_pairs(pa, pb, kernel)
-    if level == "exact":
-        pairs = exact_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces, pairs, kernel)
-    return pairs
+        if level == "exact":
+            pairs = exact_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces, pairs, kernel)
+        return pairs
+    pa, pb = prepare_body(mesh_a, pose_a, kernel), prepare_body(mesh_b, pose_b, kernel)
+    return tree_box_pairs(pa, pb, kernel)                               # triangle-aabb
 
 
 def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
@@ -93,6 +92,8 @@ def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
     """Whether two bodies collide at ``level`` (see the module's table)."""
     _check(level, LEVELS, method)
     kernel = check_kernel(kernel)
+    if level == "exact" and method == "bvh":
+        return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
     pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
     if level == "sphere":
         return spheres_overlap(mesh_a, pose_a, mesh_b, pose_b)
@@ -106,13 +107,7 @@ def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
             return len(candidates) > 0
         return _any_exact(world_a, mesh_a, world_b, mesh_b, candidates, kernel)
     pa, pb = prepare_body(mesh_a, pose_a, kernel), prepare_body(mesh_b, pose_b, kernel)
-    if level == "triangle-aabb":
-        return len(tree_box_pairs(pa, pb, kernel, first_only=True)) > 0
-    if kernel == "numba":
-        hit, uncertain = tree_first_exact_hit(pa, pb)
-        return hit or _any_exact(pa.world, mesh_a, pb.world, mesh_b, uncertain, kernel)
-    return _any_exact(pa.world, mesh_a, pb.world, mesh_b, tree_box_pairs(pa, pb, kernel),
-                      kernel)
+    return len(tree_box_pairs(pa, pb, kernel, first_only=True)) > 0     # triangle-aabb
 
 
 def _any_exact(world_a, mesh_a, world_b, mesh_b, candidates, kernel) -> bool:

@@ -753,8 +753,9 @@ class HierarchySpeed:
 
 
 #: The code timed by :func:`measure_hierarchy_compile_seconds`: every numba
-#: kernel of the hierarchy (prepare, traversal in all modes, the exact
-#: filter at the leaves and the indexed batch filter), on two cubes.
+#: kernel of the hierarchy (level triangle-aabb's refit and traversal, level
+#: exact's query in the first body's frame in both modes, with the exact
+#: filter it calls), on two cubes.
 _HIERARCHY_COMPILE_CODE = """
 import time
 import numpy as np

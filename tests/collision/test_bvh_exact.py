@@ -1,0 +1,196 @@
+"""The exact level's hierarchy query in the first body's frame
+(refsim.collision.bvh_exact): the compiled traversal hands the exact test the
+same candidates as the readable one, the candidates lie between the exact
+pairs and test 2's pairs, the node margin is both needed and enough, and bad
+poses are rejected as everywhere else."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from refsim.collision import bvh_exact
+from refsim.collision.bodies import bodies_collide, intersecting_pairs
+from refsim.collision.boxes import world_vertices
+from refsim.collision.seed_levels import exact_pairs, triangle_box_pairs
+from refsim.errors import StateError
+from refsim.models import shapes
+from refsim.models.loading import load_model
+from refsim.paths import models_dir
+from refsim.types import ORTHONORMAL_TOL, random_rotation
+
+numba = pytest.importorskip("numba", reason="numba (refsim[fast]) is not installed")
+
+SPHERE = load_model(models_dir() / "sphere-2k.ac")
+TORUS = load_model(models_dir() / "torus.ac")
+STAR = load_model(models_dir() / "star.ac")
+CUBE = load_model(models_dir() / "cube.ac")                 # the unit cube about the origin
+IDENTITY = (np.eye(3), np.zeros(3))
+
+#: (mesh a, mesh b, spread of b's random translation): overlapping, grazing
+#: and separated poses all occur.
+PAIRS = [(SPHERE, SPHERE, 1.5), (TORUS, TORUS, 1.5), (STAR, TORUS, 1.0),
+         (shapes.geodesic_sphere(1), STAR, 1.2)]
+
+
+def _poses(seed, n, spread):
+    rng = np.random.default_rng(seed)
+    return [((random_rotation(rng), rng.uniform(-spread, spread, 3)),
+             (random_rotation(rng), rng.uniform(-spread, spread, 3))) for _ in range(n)]
+
+
+def _seed_pairs(mesh_a, pose_a, mesh_b, pose_b):
+    """Test 2's pairs and the exact pairs, by the seed's pairwise path."""
+    world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
+    boxes = triangle_box_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces)
+    return boxes, exact_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces, boxes)
+
+
+def _as_set(pairs):
+    return set(map(tuple, np.asarray(pairs).tolist()))
+
+
+@pytest.mark.parametrize("mesh_a, mesh_b, spread", PAIRS, ids=lambda x: getattr(x, "name", x))
+def test_candidates_compiled_equal_readable_and_lie_between_exact_and_test2(
+        mesh_a, mesh_b, spread):
+    touching = 0
+    for pose_a, pose_b in _poses(7, 5, spread):
+        readable = bvh_exact.candidate_pairs(mesh_a, pose_a, mesh_b, pose_b)
+        compiled, uncertain = bvh_exact.query_compiled(mesh_a, pose_a, mesh_b, pose_b,
+                                                       bvh_exact.CANDIDATES)
+        assert len(uncertain) == 0
+        assert np.array_equal(bvh_exact._sorted(compiled), readable)
+        boxes, exact = _seed_pairs(mesh_a, pose_a, mesh_b, pose_b)
+        assert _as_set(exact) <= _as_set(readable) <= _as_set(boxes)
+        for kernel in ("numba", "python"):
+            assert np.array_equal(intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b,
+                                                     kernel=kernel), exact), kernel
+            assert bodies_collide(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel) == (
+                len(exact) > 0), kernel
+        touching += len(exact) > 0
+    assert touching >= 1          # the poses test contact, not only misses
+
+
+def test_the_node_test_drops_test2_pairs_of_rotated_bodies():
+    """With the second body rotated, the oriented node boxes drop pairs that
+    test 2's world boxes keep (the separated torus benchmark pose)."""
+    from refsim.collision.measure_levels import SPEED_CONFIGURATIONS
+
+    config = next(c for c in SPEED_CONFIGURATIONS
+                  if c.model == "torus" and c.kind == "separated-boxes-overlap")
+    (mesh_a, mesh_b), (pose_a, pose_b) = (config.as_configuration().meshes(),
+                                          config.as_configuration().poses())
+    boxes, exact = _seed_pairs(mesh_a, pose_a, mesh_b, pose_b)
+    candidates = bvh_exact.candidate_pairs(mesh_a, pose_a, mesh_b, pose_b)
+    assert len(exact) == 0 and len(candidates) < len(boxes)
+
+
+def _scaled_cubes():
+    """Cube a at the origin with rotation (1 + e) I, a pose as_pose accepts
+    (R^T R - I = 2e + e^2 < ORTHONORMAL_TOL); cube b unrotated at x = 1 + e/4.
+    World a reaches x = 0.5 + e/2 and b starts at 0.5 + e/4: they overlap by
+    e/4 (all exact in binary). In a's frame, taking Ra^T for Ra's inverse,
+    the node boxes look e * 3/4 apart along x."""
+    e = 2.0 ** -22
+    assert 2 * e + e * e < ORTHONORMAL_TOL
+    pose_a = ((1.0 + e) * np.eye(3), np.zeros(3))
+    pose_b = (np.eye(3), np.array([1.0 + e / 4, 0.0, 0.0]))
+    return pose_a, pose_b
+
+
+def test_margin_is_needed_for_rotations_off_orthonormal():
+    pose_a, pose_b = _scaled_cubes()
+    _, exact = _seed_pairs(CUBE, pose_a, CUBE, pose_b)
+    assert len(exact) > 0
+    zero = dict(margin_rounding=0.0, margin_per_deviation=0.0)
+    assert len(bvh_exact.candidate_pairs(CUBE, pose_a, CUBE, pose_b, **zero)) == 0
+    found, uncertain = bvh_exact.query_compiled(CUBE, pose_a, CUBE, pose_b,
+                                                bvh_exact.ALL_HITS, **zero)
+    assert len(found) == 0 and len(uncertain) == 0            # the pairs are lost ...
+    for kernel in ("numba", "python"):                       # ... and found with the margin
+        assert np.array_equal(intersecting_pairs(CUBE, pose_a, CUBE, pose_b, kernel=kernel),
+                              exact)
+
+
+def test_margin_is_enough_near_touching_with_rotations_at_the_tolerance():
+    """Two cubes face to face, each rotation a random rotation made
+    non-orthonormal by a random perturbation of up to 0.15 ORTHONORMAL_TOL per
+    entry, moved apart along the shared face normal by gaps and depths from
+    1e-4 down to 1e-12: the same pairs as the seed's path every time. (The
+    perturbation keeps R^T R - I below the tolerance, checked below.)"""
+    rng = np.random.default_rng(21)
+    checked = hits = 0
+    for _ in range(6):
+        rotation = random_rotation(rng)
+        rotation_a = rotation + rng.uniform(-0.15, 0.15, (3, 3)) * ORTHONORMAL_TOL
+        rotation_b = rotation + rng.uniform(-0.15, 0.15, (3, 3)) * ORTHONORMAL_TOL
+        for offset in (1e-4, 1e-8, 1e-12, -1e-12, -1e-8, -1e-4):
+            pose_a = (rotation_a, np.zeros(3))
+            pose_b = (rotation_b, (1.0 + offset) * rotation[:, 0])   # unit cubes
+            assert max(bvh_exact.deviation(rotation_a), bvh_exact.deviation(rotation_b)) > 1e-8
+            _, exact = _seed_pairs(CUBE, pose_a, CUBE, pose_b)
+            for kernel in ("numba", "python"):
+                got = intersecting_pairs(CUBE, pose_a, CUBE, pose_b, kernel=kernel)
+                assert np.array_equal(got, exact), (offset, kernel)
+            checked += 1
+            hits += len(exact) > 0
+    assert checked == 36 and hits >= 6
+
+
+def test_touching_pairs_go_through_the_readable_kernel():
+    """Cubes sharing a face: every float certificate fails, the pairs come
+    back uncertain and the readable exact kernel answers them."""
+    touching = (np.eye(3), np.array([1.0, 0.0, 0.0]))
+    found, uncertain = bvh_exact.query_compiled(CUBE, IDENTITY, CUBE, touching,
+                                                bvh_exact.ALL_HITS)
+    assert len(uncertain) > 0
+    _, exact = _seed_pairs(CUBE, IDENTITY, CUBE, touching)
+    assert len(exact) > 0
+    assert np.array_equal(intersecting_pairs(CUBE, IDENTITY, CUBE, touching), exact)
+    assert bodies_collide(CUBE, IDENTITY, CUBE, touching)
+
+
+def test_poses_in_other_forms_give_the_same_answer():
+    rng = np.random.default_rng(4)
+    rotation, translation = random_rotation(rng), np.array([0.3, 1.1, -0.4])
+    expected = intersecting_pairs(TORUS, IDENTITY, STAR, (rotation, translation))
+    assert len(expected) > 0
+    for pose in [(rotation.tolist(), translation.tolist()),
+                 [rotation, translation],
+                 (np.asfortranarray(rotation), translation),
+                 (rotation.astype(np.float32).astype(np.float64), translation)]:
+        got = intersecting_pairs(TORUS, IDENTITY, STAR, pose)
+        if pose[0] is not None and np.array_equal(np.asarray(pose[0]), rotation):
+            assert np.array_equal(got, expected)
+        else:
+            assert len(got) > 0
+
+
+@pytest.mark.parametrize("bad, message", [
+    ((np.eye(3), np.array([np.nan, 0.0, 0.0])), "pose_b: non-finite"),
+    ((np.full((3, 3), np.inf), np.zeros(3)), "pose_b: non-finite"),
+    ((2.0 * np.eye(3), np.zeros(3)), "pose_b: rotation is not orthonormal"),
+    ((np.eye(3) + 1e-5, np.zeros(3)), "pose_b: rotation is not orthonormal"),
+    ((np.eye(2), np.zeros(3)), "pose_b: expected shapes"),
+    ("not a pose", "pose_b"),
+])
+def test_bad_poses_raise(bad, message):
+    for call in (intersecting_pairs, bodies_collide):
+        for kernel in ("numba", "python"):
+            with pytest.raises(StateError, match=message):
+                call(STAR, IDENTITY, STAR, bad, kernel=kernel)
+    with pytest.raises(StateError, match=message.replace("pose_b", "pose_a")):
+        intersecting_pairs(STAR, bad, STAR, IDENTITY)
+
+
+def test_frame_tree_boxes_contain_their_triangles():
+    frame = bvh_exact.frame_tree_of(TORUS)
+    tree = frame.tree
+    for node in range(tree.n_nodes):
+        members = tree.order[tree.start[node]:tree.start[node] + tree.count[node]]
+        points = TORUS.vertices[TORUS.faces[members]].reshape(-1, 3)
+        # within a rounding of the box (the margin covers that; see FrameTree)
+        slack = 4 * np.finfo(float).eps * frame.reach
+        assert (np.abs(points - frame.centre[node]) <= frame.half[node] + slack).all()
+    assert frame.reach == np.abs(TORUS.vertices).max()
+    assert bvh_exact.frame_tree_of(TORUS) is frame                  # built once per mesh
