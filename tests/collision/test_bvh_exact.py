@@ -155,15 +155,15 @@ def test_poses_in_other_forms_give_the_same_answer():
     rotation, translation = random_rotation(rng), np.array([0.3, 1.1, -0.4])
     expected = intersecting_pairs(TORUS, IDENTITY, STAR, (rotation, translation))
     assert len(expected) > 0
-    for pose in [(rotation.tolist(), translation.tolist()),
+    for pose in [(rotation.tolist(), translation.tolist()),          # through as_pose
                  [rotation, translation],
-                 (np.asfortranarray(rotation), translation),
-                 (rotation.astype(np.float32).astype(np.float64), translation)]:
-        got = intersecting_pairs(TORUS, IDENTITY, STAR, pose)
-        if pose[0] is not None and np.array_equal(np.asarray(pose[0]), rotation):
-            assert np.array_equal(got, expected)
-        else:
-            assert len(got) > 0
+                 (np.asfortranarray(rotation), translation)]:
+        assert np.array_equal(intersecting_pairs(TORUS, IDENTITY, STAR, pose), expected)
+    # float32 arrays are converted, not read as float64 bit patterns
+    single = (rotation.astype(np.float32), translation.astype(np.float32))
+    widened = (single[0].astype(np.float64), single[1].astype(np.float64))
+    assert np.array_equal(intersecting_pairs(TORUS, IDENTITY, STAR, single),
+                          intersecting_pairs(TORUS, IDENTITY, STAR, widened, method="seed"))
 
 
 @pytest.mark.parametrize("bad, message", [
