@@ -290,7 +290,7 @@ def grow(rows, used):
 ALL_HITS, FIRST_HIT, CANDIDATES = 0, 1, 2
 
 #: Columns of a hierarchy's ``links`` (bvh_exact.FrameTree); its ``boxes``
-#: hold a node's centre in columns 0-2 and half-extents in 3-5.
+#: hold a node's centre in columns 0-2, half-extents in 3-5 and axes in 6-14.
 LEFT, RIGHT, START, COUNT = 0, 1, 2, 3
 
 
@@ -318,8 +318,10 @@ def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotatio
                 translation_a,
                 vertices_b, faces_b, links_b, order_b, boxes_b, reach_b, rotation_b,
                 translation_b,
-                mode, tol, margin_rounding, margin_per_deviation):
+                axes_deviation, mode, tol, margin_rounding, margin_per_deviation):
     """Returns ``(status, found, uncertain)``.
+
+    axes_deviation: the larger ``FrameTree.axes_deviation`` of the two meshes.
 
     status: 0, or 1 / 2 when pose a / b is not valid (nothing else computed).
     found: the pairs certified to intersect (ALL_HITS; at most one for
@@ -337,20 +339,19 @@ def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotatio
 
     # Body b in a's frame: x_a = M x_b + u, M = Ra^T Rb, u = Ra^T (tb - ta).
     M = np.empty((3, 3))
-    absM = np.empty((3, 3))
     u = np.empty(3)
     for i in range(3):
         for j in range(3):
             M[i, j] = (rotation_a[0, i] * rotation_b[0, j] + rotation_a[1, i] * rotation_b[1, j]
                        + rotation_a[2, i] * rotation_b[2, j])
-            absM[i, j] = abs(M[i, j])
         u[i] = (rotation_a[0, i] * (translation_b[0] - translation_a[0])
                 + rotation_a[1, i] * (translation_b[1] - translation_a[1])
                 + rotation_a[2, i] * (translation_b[2] - translation_a[2]))
     scale = reach_a + reach_b
     for k in range(3):
         scale = max(scale, reach_a + reach_b + abs(translation_a[k]) + abs(translation_b[k]))
-    margin = (margin_rounding + margin_per_deviation * max(deviation_a, deviation_b)) * scale
+    deviation = max(max(deviation_a, deviation_b), axes_deviation)
+    margin = (margin_rounding + margin_per_deviation * deviation) * scale
 
     # Per-query state, filled lazily, leaf by leaf.
     world_a = np.empty((vertices_a.shape[0], 3))
@@ -371,6 +372,10 @@ def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotatio
     uncertain = np.empty((64, 2), dtype=np.int64)
     n_uncertain = 0
     T = np.empty(3)
+    R = np.empty((3, 3))
+    absR = np.empty((3, 3))
+    d = np.empty(3)
+    MB = np.empty((3, 3))
     stack = np.empty((256, 2), dtype=np.int64)
     stack[0, 0] = 0
     stack[0, 1] = 0
@@ -380,24 +385,36 @@ def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotatio
         a = stack[top, 0]
         b = stack[top, 1]
 
-        # Separating-axis test of node a's box and node b's box, in a's frame
-        # (bvh_exact.boxes_apart): T is b's centre minus a's centre.
+        # Node b's box in the frame of node a's box (bvh_exact.node_pair_frame):
+        # R = Aa^T M Ab, T = Aa^T (M cb + u - ca); a node's axes are the
+        # columns of the 3x3 matrix in boxes[node, 6:15], row by row.
         for i in range(3):
-            T[i] = (M[i, 0] * boxes_b[b, 0] + M[i, 1] * boxes_b[b, 1]
+            d[i] = (M[i, 0] * boxes_b[b, 0] + M[i, 1] * boxes_b[b, 1]
                     + M[i, 2] * boxes_b[b, 2] + u[i] - boxes_a[a, i])
+            for j in range(3):
+                MB[i, j] = (M[i, 0] * boxes_b[b, 6 + j] + M[i, 1] * boxes_b[b, 9 + j]
+                            + M[i, 2] * boxes_b[b, 12 + j])
+        for i in range(3):
+            T[i] = boxes_a[a, 6 + i] * d[0] + boxes_a[a, 9 + i] * d[1] + boxes_a[a, 12 + i] * d[2]
+            for j in range(3):
+                R[i, j] = (boxes_a[a, 6 + i] * MB[0, j] + boxes_a[a, 9 + i] * MB[1, j]
+                           + boxes_a[a, 12 + i] * MB[2, j])
+                absR[i, j] = abs(R[i, j])
+
+        # Separating-axis test of the two boxes (bvh_exact.boxes_apart).
         a0, a1, a2 = boxes_a[a, 3], boxes_a[a, 4], boxes_a[a, 5]
         b0, b1, b2 = boxes_b[b, 3], boxes_b[b, 4], boxes_b[b, 5]
         apart = False
         for i in range(3):                                  # a's face normals
-            radius = boxes_a[a, 3 + i] + b0 * absM[i, 0] + b1 * absM[i, 1] + b2 * absM[i, 2]
+            radius = boxes_a[a, 3 + i] + b0 * absR[i, 0] + b1 * absR[i, 1] + b2 * absR[i, 2]
             if abs(T[i]) > radius + margin:
                 apart = True
                 break
         if apart:
             continue
         for j in range(3):                                  # b's face normals
-            projection = T[0] * M[0, j] + T[1] * M[1, j] + T[2] * M[2, j]
-            radius = a0 * absM[0, j] + a1 * absM[1, j] + a2 * absM[2, j] + boxes_b[b, 3 + j]
+            projection = T[0] * R[0, j] + T[1] * R[1, j] + T[2] * R[2, j]
+            radius = a0 * absR[0, j] + a1 * absR[1, j] + a2 * absR[2, j] + boxes_b[b, 3 + j]
             if abs(projection) > radius + margin:
                 apart = True
                 break
@@ -409,9 +426,9 @@ def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotatio
             for j in range(3):
                 j1 = (j + 1) % 3
                 j2 = (j + 2) % 3
-                projection = T[i2] * M[i1, j] - T[i1] * M[i2, j]
-                radius = (boxes_a[a, 3 + i1] * absM[i2, j] + boxes_a[a, 3 + i2] * absM[i1, j]
-                          + boxes_b[b, 3 + j1] * absM[i, j2] + boxes_b[b, 3 + j2] * absM[i, j1])
+                projection = T[i2] * R[i1, j] - T[i1] * R[i2, j]
+                radius = (boxes_a[a, 3 + i1] * absR[i2, j] + boxes_a[a, 3 + i2] * absR[i1, j]
+                          + boxes_b[b, 3 + j1] * absR[i, j2] + boxes_b[b, 3 + j2] * absR[i, j1])
                 if abs(projection) > radius + margin:
                     apart = True
                     break

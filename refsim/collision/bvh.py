@@ -9,10 +9,14 @@ Complex Deformable Models using AABB Trees", JGT 1997, which also argues for
 refitting). Of the three axes, the split takes the one whose two halves have
 the least total box surface area (the cost measure of J. D. MacDonald and
 K. S. Booth, "Heuristics for ray tracing using space subdivision", 1990).
-Against splitting the longest axis of the centroids, on the separated
-2k-triangle benchmark poses, the exact query visited 9% fewer node pairs for
-the torus (505 against 557) and 9% more for the sphere (751 against 691),
-and took 18.5 against 20.7 us and 19.1 against 18.7 us (medians, one run).
+The choice was measured with the exact query's earlier axis-aligned node
+boxes on the separated 2k-triangle benchmark poses (commit 762e5f1): against
+splitting the longest axis of the centroids it visited 9% fewer node pairs
+for the torus (505 against 557) and 9% more for the sphere (751 against 691).
+With the oriented node boxes of :mod:`refsim.collision.bvh_exact` a one-off
+trial gave the same picture (the longest-axis split visited fewer pairs on
+the sphere, more on the torus), and a split across each node's principal
+axis (as in OBBTree) visited more on five of the six benchmark poses.
 Nodes are numbered in pre-order, so every child has a larger index than its
 parent.
 

@@ -189,6 +189,9 @@ def build(ctx) -> Section:
                     _ratio(c.boolean_ratio)) for c in speed.cases),
         caption=("Medians of " f"{speed.repeats} runs in the same process (kernel "
                  f"{speed.kernel}); FCL's models and refsim's trees built before timing. "
+                 "refsim's bvh at the exact level: a box per node along the principal axes "
+                 "of its vertices, built once per mesh, tested as oriented boxes in the "
+                 "first body's frame (refsim.collision.bvh_exact). "
                  "The second body is turned by "
                  f"{measure_levels.FIXED_ANGLE} rad about {measure_levels.FIXED_AXIS}. "
                  + "; ".join(f"{c.model} {c.kind}: {c.description}" for c in speed.cases)
