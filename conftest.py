@@ -1,0 +1,42 @@
+"""Suite-wide pytest hooks.
+
+In CI a skipped test is a check that silently did not run (a missing
+optional engine, numba or Chromium), so there every skip fails instead:
+``.ci/run`` sets ``REFSIM_NO_SKIPS=1``, as does ``CI=true``. Locally a skip
+stays a skip, with its reason in the summary (``pytest -rs``).
+"""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+#: pytester runs a small suite in a temporary directory (tests/test_no_skips_in_ci.py).
+pytest_plugins = ["pytester"]
+
+
+def _skips_fail() -> bool:
+    return (os.environ.get("REFSIM_NO_SKIPS") == "1"
+            or os.environ.get("CI", "").lower() == "true")
+
+
+def _fail_skip(report) -> None:
+    if report.skipped and not hasattr(report, "wasxfail") and _skips_fail():
+        reason = report.longrepr[2] if isinstance(report.longrepr, tuple) else report.longrepr
+        report.outcome = "failed"
+        report.longrepr = f"skipped where every check must run (REFSIM_NO_SKIPS / CI): {reason}"
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """A test skipped in setup or in its body (``pytest.skip``, ``skipif``)."""
+    outcome = yield
+    _fail_skip(outcome.get_result())
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_make_collect_report(collector):
+    """A module skipped as it is collected (``pytest.importorskip`` at the top)."""
+    outcome = yield
+    _fail_skip(outcome.get_result())
