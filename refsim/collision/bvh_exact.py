@@ -12,7 +12,7 @@ Interference Detection", SIGGRAPH 1996):
 1. Node volumes are oriented boxes in body space, computed once per mesh
    (:class:`FrameTree`: the topology of :func:`refsim.collision.bvh.tree_of`;
    each node's box along the principal axes of its vertices,
-   :func:`oriented_box`). On a curved surface such a box is about as thin
+   :func:`oriented_box`, :func:`principal_axes`). On a curved surface such a box is about as thin
    as the patch is bent, where the axis-aligned box of a tilted patch is as
    thick as the patch is wide: on the separated sphere benchmark the query
    visits 117 node pairs against 751 with axis-aligned node boxes, 2185
@@ -154,29 +154,39 @@ class FrameTree:
         return self.boxes[:, 6:].reshape(-1, 3, 3)
 
 
-def oriented_box(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(centre, half, axes)`` of a box about ``points`` (k, 3), oriented
-    along the principal axes of their covariance (Gottschalk et al. 1996
-    take the covariance of the triangles' hull; of the vertices is simpler
-    and, on the benchmark meshes, visits about as many node pairs). The axes
-    are the eigenvectors from ``numpy.linalg.eigh``: orthonormal up to a few
-    roundoffs, whatever the points (a flat or a one-point set gives a box of
-    zero thickness)."""
+def principal_axes(points: np.ndarray) -> np.ndarray:
+    """(3, 3), columns the principal axes of the points' covariance
+    (Gottschalk et al. 1996 take the covariance of the triangles' hull; of
+    the vertices is simpler and, on the benchmark meshes, visits about as
+    many node pairs): the eigenvectors from ``numpy.linalg.eigh``,
+    orthonormal up to a few roundoffs whatever the points."""
     covariance = np.cov(points.T) if len(points) > 1 else np.zeros((3, 3))
-    _, axes = np.linalg.eigh(covariance)
+    return np.linalg.eigh(covariance)[1]
+
+
+def oriented_box(points: np.ndarray, axes: np.ndarray | None = None):
+    """``(centre, half, axes)`` of the box about ``points`` (k, 3) along
+    ``axes`` (columns; by default :func:`principal_axes`). The box is the set
+    ``|axes[:, i] . (p - centre)| <= half[i]``, and ``half`` is computed with
+    that expression, so it holds the points for any axes (a flat or a
+    one-point set gives a box of zero thickness)."""
+    axes = principal_axes(points) if axes is None else axes
     projected = points @ axes
     centre = axes @ ((projected.min(axis=0) + projected.max(axis=0)) / 2)
     half = np.abs((points - centre) @ axes).max(axis=0)
     return centre, half, axes
 
 
-def build_frame_tree(mesh) -> FrameTree:
+def build_frame_tree(mesh, choose_axes=principal_axes) -> FrameTree:
+    """The mesh's :class:`FrameTree`, each node's box along
+    ``choose_axes(points)`` (the tests pass axes off orthonormal)."""
     tree = tree_of(mesh)
     boxes = np.empty((tree.n_nodes, 15))
     axes_deviation = 0.0
     for node in range(tree.n_nodes):
         members = tree.order[tree.start[node]:tree.start[node] + tree.count[node]]
-        centre, half, axes = oriented_box(mesh.vertices[np.unique(mesh.faces[members])])
+        points = mesh.vertices[np.unique(mesh.faces[members])]
+        centre, half, axes = oriented_box(points, choose_axes(points))
         boxes[node] = np.concatenate([centre, half, axes.ravel()])
         axes_deviation = max(axes_deviation, deviation(axes))
     links = np.column_stack([tree.left, tree.right, tree.start, tree.count]).astype(np.int64)

@@ -137,6 +137,39 @@ def test_margin_is_enough_near_touching_with_rotations_at_the_tolerance():
     assert checked == 36 and hits >= 6
 
 
+def test_margin_is_enough_with_node_axes_off_orthonormal():
+    """Node boxes along axes perturbed by up to 0.15 ORTHONORMAL_TOL per entry
+    (the margin counts the axes' deviation like a rotation's): cubes face to
+    face at gaps and depths from 1e-4 to 1e-12, and random torus poses, give
+    the seed's pairs. Without the deviation term, some case loses a pair."""
+    rng = np.random.default_rng(5)
+
+    def perturbed(points):
+        return (bvh_exact.principal_axes(points)
+                + rng.uniform(-0.15, 0.15, (3, 3)) * ORTHONORMAL_TOL)
+
+    cube = load_model(models_dir() / "cube.ac")               # fresh meshes: own caches
+    torus = load_model(models_dir() / "torus.ac")
+    for mesh in (cube, torus):
+        frame = mesh.derived("frame_tree", lambda m: bvh_exact.build_frame_tree(m, perturbed))
+        assert bvh_exact.frame_tree_of(mesh) is frame and frame.axes_deviation > 1e-8
+    hits = lost_without = 0
+    cases = [(cube, cube, (rotation, np.zeros(3)), (rotation, (1.0 + offset) * rotation[:, 0]))
+             for rotation in (random_rotation(rng) for _ in range(3))
+             for offset in (1e-4, 1e-8, 1e-12, -1e-12, -1e-8, -1e-4)]
+    cases += [(torus, torus, pa, pb) for pa, pb in _poses(9, 6, 1.5)]
+    for mesh_a, mesh_b, pose_a, pose_b in cases:
+        _, exact = _seed_pairs(mesh_a, pose_a, mesh_b, pose_b)
+        for kernel in ("numba", "python"):
+            got = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel)
+            assert np.array_equal(got, exact), kernel
+        hits += len(exact) > 0
+        found, uncertain = bvh_exact.query_compiled(mesh_a, pose_a, mesh_b, pose_b,
+                                                    bvh_exact.ALL_HITS, margin_per_deviation=0.0)
+        lost_without += not _as_set(exact) <= _as_set(found) | _as_set(uncertain)
+    assert hits >= 12 and lost_without >= 1
+
+
 def test_touching_pairs_go_through_the_readable_kernel():
     """Cubes sharing a face: every float certificate fails, the pairs come
     back uncertain and the readable exact kernel answers them."""
