@@ -37,14 +37,15 @@ pair it keeps is decided by the exact test.
 
 Why the margin, and how big. The node test decides in floating point, about
 transformed boxes, and the answer has to hold for the rounded world
-triangles. Let ``S = reach_a + reach_b + |ta|_inf + |tb|_inf``, where
+triangles. Let ``S = reach_a + reach_b + max_k (|ta_k| + |tb_k|)``, where
 ``reach`` is the largest absolute body coordinate of a mesh (a node box's
 centre then lies within 3 reach of the origin and its half-extents are at
 most sqrt(3) reach), u = 2^-53, and g the largest ``max|Q^T Q - I|`` of the
 two rotations and of all node axes Q (``refsim.types.ORTHONORMAL_TOL``
-allows 1e-6 for a rotation; the axes, computed eigenvectors, are within a
-few u); in the 2-norm ``|Q^T Q - I| <= 3g``. Along a separating axis of
-length 1 + O(g), the test can be wrong by (crude bounds):
+allows 1e-6 for a rotation; the axes, computed eigenvectors, are within
+about 15u on the bundled meshes); in the 2-norm ``|Q^T Q - I| <= 3g``. Along
+a separating axis of length 1 + O(g), the test can be wrong by (crude
+bounds):
 
 - rounding. A world vertex is off by <= 4u(3 reach + |t|) a coordinate,
   about 21u S in length (Ra^T and Aa^T do not lengthen it). R and T come
@@ -59,17 +60,19 @@ length 1 + O(g), the test can be wrong by (crude bounds):
   normals and the edge axes assume R orthonormal, where
   ``|R^T R - I| <= 12g``: off by <= 36g reach_b and <= 104g reach_b. (Node
   a's extents and the projections of T are right for any R; node a's box is
-  exact in its own frame, since T is the very expression it is defined by.)
-  Under 120 g S in all.
+  exact in its own frame, since T is the very expression it is defined by.
+  Axes with determinant -1, which eigh returns for about 40% of the nodes,
+  change nothing: the extents take absolute values and the boxes are
+  symmetric.) Under 120 g S in all.
 
 The margin is ``(MARGIN_ROUNDING + MARGIN_PER_DEVIATION * g) S`` with 2^-40
-(about 8800 u) and 1024, each about nine times its bound: a node pair closer
-than the margin is simply visited, which costs a few node tests and changes
-no answer (for rotations built in double precision g is a few u, and the
-second term is a tenth of the first). The tests check that the margin is
-needed (with it set to zero, pairs that intersect by less than it are lost)
-and sufficient (random and near-touching poses, rotations off orthonormal by
-up to the tolerance).
+(8192 u) and 1024, each about eight times its bound: a node pair closer than
+the margin is simply visited, which costs a few node tests and changes no
+answer (with g ~ 15u from the node axes, the second term is about twice the
+first: a margin near 3e-12 S). The tests check that the margin is needed
+(with it set to zero, pairs that intersect by less than it are lost) and
+sufficient (random and near-touching poses, rotations and node axes off
+orthonormal by up to the tolerance).
 
 Two kernels take the same steps: :func:`candidate_pairs` (readable loops)
 and a numba-compiled copy (``refsim[fast]``,
@@ -77,7 +80,11 @@ and a numba-compiled copy (``refsim[fast]``,
 pairs with the float filter as it finds them and can stop at the first hit.
 The compiled copy checks the poses itself (the checks of
 :func:`refsim.types.as_pose`), which keeps a query's fixed cost to a few
-microseconds.
+microseconds. The two evaluate the same formulas but not always to the same
+bits (numpy's matmul may sum in another order, or fuse): both errors are
+within the margin's bound, so both are right; their candidate lists differ
+only if a node pair lies within a few ulps of the margin, which the tests'
+poses do not produce.
 
 Cost: O(m log m) once per mesh for the boxes (a 3x3 eigenproblem per node;
 about 0.06 s for 2000 triangles here); per query about O(k log m) node
@@ -101,8 +108,8 @@ from refsim.errors import StateError
 from refsim.types import ORTHONORMAL_TOL, as_pose
 
 #: The node test's margin, relative to the scene's size S (see the module
-#: docstring): about 8800 unit roundoffs against the < 1000 the arithmetic
-#: can lose...
+#: docstring): 8192 unit roundoffs against the < 1000 the arithmetic can
+#: lose...
 MARGIN_ROUNDING = 2.0 ** -40
 #: ... plus this many times the rotations' and node axes' departure from
 #: orthonormality (< 120 needed).
@@ -188,7 +195,10 @@ def build_frame_tree(mesh, choose_axes=principal_axes) -> FrameTree:
         points = mesh.vertices[np.unique(mesh.faces[members])]
         centre, half, axes = oriented_box(points, choose_axes(points))
         boxes[node] = np.concatenate([centre, half, axes.ravel()])
-        axes_deviation = max(axes_deviation, deviation(axes))
+        # (a non-finite deviation, from coordinates near 1e154, makes the
+        # margin infinite: nothing is dropped, every answer still exact)
+        off = deviation(axes)
+        axes_deviation = max(axes_deviation, off if np.isfinite(off) else np.inf)
     links = np.column_stack([tree.left, tree.right, tree.start, tree.count]).astype(np.int64)
     return FrameTree(tree, np.ascontiguousarray(links), boxes,
                      float(np.abs(mesh.vertices).max()), axes_deviation)
