@@ -13,10 +13,13 @@ The choice was measured with the exact query's earlier axis-aligned node
 boxes on the separated 2k-triangle benchmark poses (commit 762e5f1): against
 splitting the longest axis of the centroids it visited 9% fewer node pairs
 for the torus (505 against 557) and 9% more for the sphere (751 against 691).
-With the oriented node boxes of :mod:`refsim.collision.bvh_exact` a one-off
-trial gave the same picture (the longest-axis split visited fewer pairs on
-the sphere, more on the torus), and a split across each node's principal
-axis (as in OBBTree) visited more on five of the six benchmark poses.
+With the oriented node boxes of :mod:`refsim.collision.bvh_exact`, a one-off
+trial (not kept in the repository) on the six benchmark poses: the
+longest-axis split visited fewer node pairs on the separated and grazing
+sphere (77 and 527 against 117 and 571) and more on the other four (sphere
+deep 2241 against 2185; torus 209, 427, 3169 against 197, 423, 3097); a
+median split across each node's principal axis (as in OBBTree) visited more
+on five of the six.
 Nodes are numbered in pre-order, so every child has a larger index than its
 parent.
 
