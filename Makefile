@@ -15,7 +15,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 test: $(STAMP)
-	$(BIN)/python -m pytest tests properties --benchmark-disable
+	$(BIN)/python -m pytest tests properties --benchmark-disable -n auto
 
 report: $(STAMP)
 	$(BIN)/refsim report

@@ -30,8 +30,7 @@ traversal, output-sensitive in the number of intersecting pairs.
 from __future__ import annotations
 
 import numpy as np
-
-from oracles import import_engine
+from refsim.oracles import import_engine
 
 #: Upper bound on contacts requested from FCL when listing all intersecting
 #: face pairs. FCL stops collecting at this count; it only needs to exceed

@@ -24,7 +24,7 @@ Conventions converted here and nowhere else
 - Mass properties: pybullet's mesh shapes get the inertia of their bounding
   box (padded by the margin) unless told otherwise. Each body's principal
   moments (uniform solid of the body's mass, from trimesh's integrals, see
-  :mod:`oracles.trimesh_adapter`) are passed with ``changeDynamics(mass=...,
+  :mod:`refsim.oracles.trimesh_adapter`) are passed with ``changeDynamics(mass=...,
   localInertiaDiagonal=...)``, and its centre of mass and principal axes as
   ``baseInertialFramePosition/Orientation`` of ``createMultiBody``.
   :func:`mass_properties` computes them (scale applied).
@@ -127,8 +127,7 @@ import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
-
-from oracles import import_engine
+from refsim.oracles import import_engine
 
 
 @dataclass(frozen=True)
@@ -207,7 +206,7 @@ class PybulletOracle:
     """pybullet behind the wall-bounce queries (own DIRECT client, lazy import).
 
     Use as a context manager or call :meth:`close`. Raises
-    :class:`oracles.OracleUnavailable` when pybullet is not installed.
+    :class:`refsim.oracles.OracleUnavailable` when pybullet is not installed.
     """
 
     def __init__(self, settings: PybulletSettings | None = None):

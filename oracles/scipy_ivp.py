@@ -12,7 +12,7 @@ Two queries, both on ``y' = f(t, y)`` with ``f(t, y) -> (d,)``:
 
 Conventions: scipy wants ``f(t, y)`` and returns ``y`` as (d, n_times); the
 adapter returns (n_times, d) like :func:`refsim.integrate`. scipy is a core
-dependency of refsim, so no :class:`oracles.OracleUnavailable` is raised.
+dependency of refsim, so no :class:`refsim.oracles.OracleUnavailable` is raised.
 """
 
 from __future__ import annotations

@@ -32,8 +32,7 @@ from __future__ import annotations
 from typing import Protocol
 
 import numpy as np
-
-from oracles import import_engine
+from refsim.oracles import import_engine
 
 #: trimesh's identity shortcut: ``apply_transform`` returns early when every
 #: entry of the 4x4 is within this of the identity's (trimesh.base, 4.x).
@@ -98,7 +97,7 @@ def bounds_tolerance(vertices, pose) -> np.ndarray:
 class TrimeshOracle:
     """trimesh behind refsim's bounds and mesh-facts interfaces (lazy import).
 
-    Raises :class:`oracles.OracleUnavailable` when trimesh is not installed.
+    Raises :class:`refsim.oracles.OracleUnavailable` when trimesh is not installed.
     """
 
     def __init__(self):

@@ -12,7 +12,7 @@ different question from refsim's in two documented ways:
    triangle surface. So for trimesh a small body entirely inside a convex one
    collides (two Convex solids: GJK; a BVHModel's triangles inside a Convex
    solid: each triangle against the solid), while for refsim (and FCL on two
-   BVHModels, :mod:`oracles.fcl_adapter`) two surfaces that do not meet do
+   BVHModels, :mod:`refsim.oracles.fcl_adapter`) two surfaces that do not meet do
    not collide. A body inside a *non-convex* one (a cube in the torus's hole,
    or inside a non-convex solid) is not found by trimesh either: the
    non-convex mesh is only a surface. GJK also stops at a tolerance (FCL's
@@ -43,9 +43,8 @@ convexity test runs once.
 from __future__ import annotations
 
 import numpy as np
-
-from oracles import OracleUnavailable, import_engine
-from oracles.trimesh_adapter import pose_matrix
+from refsim.oracles import OracleUnavailable, import_engine
+from refsim.oracles.trimesh_adapter import pose_matrix
 
 
 def float32_pose(pose):
@@ -58,7 +57,7 @@ def float32_pose(pose):
 class TrimeshCollisionOracle:
     """``trimesh.collision.CollisionManager`` behind a boolean body query.
 
-    Raises :class:`oracles.OracleUnavailable` when trimesh or python-fcl is
+    Raises :class:`refsim.oracles.OracleUnavailable` when trimesh or python-fcl is
     not installed.
     """
 

@@ -417,32 +417,48 @@ def wall_hit_scenes(draw):
 
     The body (cube, tetrahedron or icosahedron; mass and rotation random) sits
     with its lowest vertex above the floor of a 4 m cube by at most 40 % of
-    what one step covers, and moves down at 0.5 to 8 m/s, with any spin and
-    lateral velocity; the rotation model is "impulse", gravity on or off,
+    what one step covers, and moves down at 0.5 to 8 m/s, with lateral
+    velocity and a spin; the rotation model is "impulse", gravity on or off,
     restitution and friction random.
+
+    Why the floor is crossed: in one step h the lowest vertex moves down by
+    at least ``|v_y| h`` (gravity only adds to it) less what the spin can lift
+    it, at most ``|w| r h`` for a vertex at distance ``r`` from the centre of
+    mass (a chord is no longer than its arc). The spin is scaled to
+    ``|w| r_max <= |v_y| / 2``, so the vertex ends at least ``|v_y| h / 2 - gap
+    >= 0.1 |v_y| h`` below the floor.
     """
     model = draw(_st.sampled_from(["cube.ac", "tetrahedron.ac", "icosahedron.ac"]))
     R = draw(rotations(kinds=("random", "identity", "signed-permutation")))
     import refsim
-    from refsim.paths import models_dir
+    from refsim.bundled import models_dir
+    from refsim.types import transform_points
 
-    vertices = refsim.load_model(models_dir() / model).vertices
-    lowest = float((vertices @ R.T)[:, 1].min())
+    mesh = refsim.load_model(models_dir() / model)
+    vertices = mesh.vertices
+    lowest = float(transform_points(vertices, (R, _np.zeros(3)))[:, 1].min())
+    offsets = vertices - mesh.centroid_volume
+    r_max = float(_np.sqrt((offsets * offsets).sum(axis=1)).max())
     half = 4.0
+    h = 1e-3
     v = draw(_DYN_VEC)
     v[1] = -draw(_st.floats(min_value=0.5, max_value=8.0))
-    # at most 40 % of the way one step (1 ms) covers: the floor is crossed
-    gap = draw(_st.floats(min_value=0.0, max_value=0.4)) * 1e-3 * -v[1]
+    w = draw(_DYN_VEC)
+    w_norm = float(_np.sqrt((w * w).sum()))
+    w_limit = 0.5 * -v[1] / r_max
+    if w_norm > w_limit:
+        w = w * (w_limit / w_norm)
+    gap = draw(_st.floats(min_value=0.0, max_value=0.4)) * h * -v[1]
     return {
         "world": {"half_size": half, "gravity": draw(_st.sampled_from([0.0, 9.81])),
                   "restitution": draw(_st.floats(min_value=0.0, max_value=1.0)),
                   "friction": draw(_st.floats(min_value=0.0, max_value=1.0))},
-        "integration": {"solver": "rk4", "step": 1e-3, "duration": 1e-3},
+        "integration": {"solver": "rk4", "step": h, "duration": h},
         "collision": {"level": "none"},
         "dynamics": {"rotation": "impulse", "body_response": "off"},
         "body": [{"name": "body", "model": model, "orientation": R.tolist(),
                   "position": [0.0, -half - lowest + gap, 0.0], "velocity": v.tolist(),
-                  "angular_velocity": draw(_DYN_VEC).tolist(),
+                  "angular_velocity": w.tolist(),
                   "mass": draw(_st.floats(min_value=0.1, max_value=10.0))}],
     }
 

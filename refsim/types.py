@@ -58,27 +58,61 @@ def as_pose(pose, *, what: str = "pose") -> Pose:
 
 
 def transform_points(points: np.ndarray, pose: Pose) -> np.ndarray:
-    """World coordinates of body-space ``points`` (n, 3) under ``pose``."""
+    """World coordinates (n, 3) of body-space ``points`` (n, 3) under ``pose``.
+
+    Coordinate ``k`` of each point is ``((R[k, 0] x + R[k, 1] y) + R[k, 2] z) + t[k]``,
+    each product and sum rounded once, in that order: the one transform
+    arithmetic of every box and kernel in refsim
+    (:mod:`refsim.bounds.aabb_linear`). ``points @ R.T`` is not used: BLAS
+    picks its kernel, and with it fused multiply-adds and a summation order,
+    per processor, so its last bit depends on the machine.
+    """
     rotation, translation = pose
-    return points @ rotation.T + translation
+    p = np.asarray(points, dtype=np.float64)
+    x, y, z = p[:, 0:1], p[:, 1:2], p[:, 2:3]
+    return ((rotation[:, 0] * x + rotation[:, 1] * y) + rotation[:, 2] * z) + translation
 
 
 def rotation_about_axis(axis, angle: float) -> np.ndarray:
-    """The rotation by ``angle`` radians about ``axis`` (Rodrigues' formula)."""
+    """The rotation by ``angle`` radians about ``axis`` (Rodrigues' formula).
+
+    ``R = c I + s [k]x + (1 - c) k k^T`` for the unit axis ``k``, written out
+    entry by entry (no BLAS: the same bits on every machine).
+    """
     axis = np.asarray(axis, dtype=np.float64)
-    norm = np.linalg.norm(axis)
-    if norm == 0.0:
+    if axis.shape != (3,) or not np.isfinite(axis).all():
+        raise StateError("rotation axis must be 3 finite numbers")
+    scale = np.abs(axis).max()
+    if scale == 0.0:
         raise StateError("rotation axis has zero length")
-    x, y, z = axis / norm
+    a = axis / scale                                  # no overflow or underflow in |a|^2
+    norm = np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+    x, y, z = a / norm
     c, s = np.cos(angle), np.sin(angle)
-    k = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
+    C = 1.0 - c
+    return np.array([[c + C * x * x, C * x * y - s * z, C * x * z + s * y],
+                     [C * y * x + s * z, c + C * y * y, C * y * z - s * x],
+                     [C * z * x - s * y, C * z * y + s * x, c + C * z * z]])
+
+
+def quaternion_to_rotation(q) -> np.ndarray:
+    """The rotation (3, 3) of the unit quaternion ``q = (w, x, y, z)``, entry by entry."""
+    w, x, y, z = q
+    return np.array([
+        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
+        [2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)],
+        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)]])
 
 
 def random_rotation(rng: np.random.Generator) -> np.ndarray:
-    """A rotation drawn uniformly from SO(3) (QR of a Gaussian matrix)."""
-    q, r = np.linalg.qr(rng.standard_normal((3, 3)))
-    q = q * np.sign(np.diag(r))
-    if np.linalg.det(q) < 0.0:
-        q[:, 0] = -q[:, 0]
-    return q
+    """A rotation drawn uniformly from SO(3).
+
+    A normalized 4-vector of independent standard normals is a unit
+    quaternion uniform on the 3-sphere, and so a uniform rotation (K. Shoemake,
+    "Uniform random rotations", Graphics Gems III, 1992). Plain arithmetic
+    throughout, so a seed gives the same rotation on every machine (a QR
+    factorization would not: LAPACK's result depends on the processor).
+    """
+    g = rng.standard_normal(4)
+    norm = np.sqrt(((g[0] * g[0] + g[1] * g[1]) + g[2] * g[2]) + g[3] * g[3])
+    return quaternion_to_rotation(g / norm)

@@ -3,8 +3,7 @@
 from __future__ import annotations
 
 import pytest
-
-from oracles import OracleUnavailable
+from refsim.oracles import OracleUnavailable
 
 
 @pytest.fixture

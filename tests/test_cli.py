@@ -7,9 +7,9 @@ import sys
 
 import pytest
 
+from refsim.bundled import models_dir
 from refsim.cli import EXIT_USER_ERROR, main
 from refsim.errors import ModelError
-from refsim.paths import models_dir
 
 
 def test_info_prints_the_facts(capsys):

@@ -10,9 +10,9 @@ import sys
 import numpy as np
 import pytest
 
+from refsim.bundled import scenes_dir
 from refsim.cli import EXIT_DIVERGED, EXIT_USER_ERROR, main
 from refsim.particles.config import ParticleConfig
-from refsim.paths import SCENES_DIR
 
 TINY = """
 [world]
@@ -118,7 +118,7 @@ def test_frames_match_the_particle_system(tmp_path):
 
 def test_bundled_particle_scene_is_runnable(tmp_path):
     # The bundled scene, shortened to 20 steps: the same tables, the same checks.
-    text = (SCENES_DIR / "particles.toml").read_text().replace("duration = 4.0",
+    text = (scenes_dir() / "particles.toml").read_text().replace("duration = 4.0",
                                                                "duration = 0.04")
     out = tmp_path / "p.npz"
     assert main(["run", str(write(tmp_path, text)), "-o", str(out)]) == 0

@@ -16,13 +16,13 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
-
-from oracles import OracleUnavailable
-from oracles.trimesh_adapter import (
+from refsim.oracles import OracleUnavailable
+from refsim.oracles.trimesh_adapter import (
     TrimeshOracle,
     bounds_tolerance,
     trimesh_skips_transform,
 )
+
 from properties.strategies import convex_hull_meshes, pose_sequences, rotations
 from refsim.bounds.aabb_incremental import IncrementalAABB, numba_available
 from refsim.bounds.aabb_linear import (

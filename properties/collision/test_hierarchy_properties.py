@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from hypothesis import given
+from refsim.oracles import OracleUnavailable
 
-from oracles import OracleUnavailable
 from properties.strategies import posed_model_pairs
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
@@ -72,7 +72,7 @@ _FCL = []
 def fcl_oracle():
     if not _FCL:
         try:
-            from oracles.fcl_adapter import FCLOracle
+            from refsim.oracles.fcl_adapter import FCLOracle
             _FCL.append(FCLOracle())
         except OracleUnavailable as exc:
             pytest.skip(str(exc))

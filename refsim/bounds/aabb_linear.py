@@ -53,7 +53,7 @@ import numpy as np
 
 from refsim.errors import RefsimError
 from refsim.models.mesh import Mesh
-from refsim.types import Pose, as_pose
+from refsim.types import Pose, as_pose, transform_points
 
 LINEAR_KERNELS = ("numpy", "numba")
 
@@ -105,8 +105,7 @@ def transform_vertices(vertices: np.ndarray, pose: Pose) -> np.ndarray:
     Equal, bit for bit, to ``rotated_coordinate(R, v, k) + t[k]`` for every
     vertex; every vertex it returns lies inside :func:`aabb_linear`'s box.
     """
-    rotation, translation = pose
-    return rotated_coordinates(rotation, vertices.T).T + translation
+    return transform_points(vertices, pose)
 
 
 def aabb_linear_kernel(vertices_t: np.ndarray, rotation: np.ndarray,

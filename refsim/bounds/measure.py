@@ -379,7 +379,7 @@ class BoundsAgreement:
     bit for bit (convex meshes only, None otherwise; the poses are random
     jumps, the hardest case for the walk). ``trimesh_bitwise``: poses where
     trimesh's box equals the scan's bit for bit; ``trimesh_within``: poses
-    within the arithmetic bound ``oracles.trimesh_adapter.bounds_tolerance``;
+    within the arithmetic bound ``refsim.oracles.trimesh_adapter.bounds_tolerance``;
     ``max_difference_over_tolerance``: the largest difference seen as a
     fraction of that bound.
     """
@@ -395,8 +395,8 @@ class BoundsAgreement:
 
 def measure_bounds_agreement(meshes=None, *, poses: int = 200, seed: int = 0):
     """Agreement counts for the bundled-style meshes (list of BoundsAgreement)."""
-    from oracles.trimesh_adapter import TrimeshOracle, bounds_tolerance
     from refsim.bounds.aabb_linear import aabb_linear
+    from refsim.oracles.trimesh_adapter import TrimeshOracle, bounds_tolerance
 
     oracle = TrimeshOracle()
     meshes = meshes or [shapes.box(), shapes.icosahedron(), shapes.geodesic_sphere(10),

@@ -46,7 +46,7 @@ from refsim.collision.triangle import (
     triangles_intersect_float,
 )
 from refsim.collision.triangle_batch import certified_batch, triangles_intersect_batch
-from refsim.types import random_rotation, rotation_about_axis
+from refsim.types import random_rotation, rotation_about_axis, transform_points
 
 TriangleTest = Callable[[np.ndarray, np.ndarray], bool]
 
@@ -378,12 +378,12 @@ def c4_pair(config: str, theta: float, frame: str = "generic", seed: int = 0):
     hinge = np.array([0.0, y0, 0.0])
     tilt = rotation_about_axis([1.0, 0.0, 0.0], theta)
     A = np.array(C4_A)
-    B = (np.array(b_local) - hinge) @ tilt.T + hinge
+    B = transform_points(np.array(b_local) - hinge, (tilt, hinge))
     if frame == "generic":
         rotation = random_rotation(np.random.default_rng(seed))
         translation = np.array([0.3, -0.7, 1.1])
-        A = A @ rotation.T + translation
-        B = B @ rotation.T + translation
+        A = transform_points(A, (rotation, translation))
+        B = transform_points(B, (rotation, translation))
     elif frame != "axis-aligned":
         raise ValueError(f"unknown frame {frame!r}")
     return A, B
@@ -582,7 +582,7 @@ def main(argv=None) -> None:
     oracle = None
     if not args.no_oracle:
         try:
-            from oracles.fcl_adapter import FCLOracle
+            from refsim.oracles.fcl_adapter import FCLOracle
             oracle = FCLOracle().triangles_intersect
         except Exception as exc:  # the oracle is optional here
             print(f"oracle unavailable: {exc}")

@@ -73,9 +73,9 @@ def bundled_mesh(name: str, scale: float = 1.0):
     """A bundled model (``models/<name>.ac``), its vertices scaled by ``scale``
     about the origin (the scene files' ``scale`` key). Cached: the same mesh
     object, hence the same hierarchy and oracle models, for every query."""
+    from refsim.bundled import models_dir
     from refsim.models.loading import load_model
     from refsim.models.mesh import Mesh
-    from refsim.paths import models_dir
 
     mesh = load_model(models_dir() / f"{name}.ac")
     if scale == 1.0:
@@ -810,7 +810,7 @@ def measure_hierarchy_speed(fcl=None, repeats: int = 21, *,
     """The hierarchy against FCL on the benchmark configurations.
 
     ``fcl``: an object with ``intersecting_pairs(mesh_a, pose_a, mesh_b,
-    pose_b)`` and ``collide(...)`` (``oracles.fcl_adapter.FCLOracle``), or
+    pose_b)`` and ``collide(...)`` (``refsim.oracles.fcl_adapter.FCLOracle``), or
     None to time refsim alone. FCL's models are built once per mesh before
     timing, as refsim's trees are. The seed's path is timed with
     ``max(3, repeats // 4)`` repeats (it takes up to ~0.1 s a call).
@@ -860,11 +860,11 @@ def default_body_oracles() -> tuple[tuple[BodyOracle, ...], Callable | None, obj
     an engine that is missing is left out (and said so on stderr)."""
     import sys
 
-    from oracles import OracleUnavailable
+    from refsim.oracles import OracleUnavailable
 
     body, fcl_pairs, fcl = [], None, None
     try:
-        from oracles.fcl_adapter import FCLOracle
+        from refsim.oracles.fcl_adapter import FCLOracle
 
         fcl = FCLOracle()
         fcl_pairs = fcl.intersecting_pairs
@@ -872,7 +872,7 @@ def default_body_oracles() -> tuple[tuple[BodyOracle, ...], Callable | None, obj
     except OracleUnavailable as exc:
         print(f"python-fcl unavailable: {exc}", file=sys.stderr)
     try:
-        from oracles.trimesh_collision import TrimeshCollisionOracle
+        from refsim.oracles.trimesh_collision import TrimeshCollisionOracle
 
         tm = TrimeshCollisionOracle()
         body.append(BodyOracle("trimesh", tm.bodies_collide, pose_used=tm.pose_used,

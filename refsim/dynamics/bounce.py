@@ -1,7 +1,7 @@
 """Bounce studies: refsim's wall response against the analytic answer and pybullet.
 
 What: a body dropped onto the floor of the world cube (seed S5, S7), run by
-``refsim.simulate`` and by the pybullet oracle (:mod:`oracles.pybullet_adapter`)
+``refsim.simulate`` and by the pybullet oracle (:mod:`refsim.oracles.pybullet_adapter`)
 on the same scene, and compared with the closed forms of
 :mod:`refsim.dynamics.analytic`:
 
@@ -86,8 +86,8 @@ REST_FRACTION = 1e-3
 
 def _touch_depth(model: str, orientation=None, scale: float = 1.0) -> float:
     """How far the mesh reaches below its origin (rotated, scaled)."""
+    from refsim.bundled import models_dir
     from refsim.models.loading import load_model
-    from refsim.paths import models_dir
 
     mesh = load_model(models_dir() / model)
     r = np.eye(3) if orientation is None else np.asarray(orientation, dtype=np.float64)
@@ -145,7 +145,7 @@ def run_refsim(scene, wall_speed: str = "wall"):
 def run_pybullet(scene, oracle=None):
     """The pybullet oracle's trajectory of ``scene`` and its stepping time,
     seconds (``stepSimulation`` alone, not the reading of state)."""
-    from oracles.pybullet_adapter import PybulletOracle
+    from refsim.oracles.pybullet_adapter import PybulletOracle
 
     own = oracle is None
     oracle = oracle or PybulletOracle()
@@ -577,12 +577,12 @@ class SettingRow:
 
 
 def measure_pybullet_settings(e: float = 0.8, duration: float = 9.0) -> list[SettingRow]:
-    """Why each setting of :class:`oracles.pybullet_adapter.PybulletSettings`:
+    """Why each setting of :class:`refsim.oracles.pybullet_adapter.PybulletSettings`:
     the oracle's bounce, then the same with one setting back at (or near)
     pybullet's default."""
     from dataclasses import replace
 
-    from oracles.pybullet_adapter import PybulletOracle, PybulletSettings
+    from refsim.oracles.pybullet_adapter import PybulletOracle, PybulletSettings
 
     base = PybulletSettings()
     changes = (
@@ -685,7 +685,7 @@ def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: 
     rows = []
     oracle = None
     if with_pybullet:
-        from oracles.pybullet_adapter import PybulletOracle
+        from refsim.oracles.pybullet_adapter import PybulletOracle
 
         oracle = PybulletOracle()
     try:

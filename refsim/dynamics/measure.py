@@ -36,10 +36,10 @@ REST_SPIN = 1e-3           # rad/s
 
 
 def _scene(name: str):
-    from refsim.paths import SCENES_DIR
+    from refsim.bundled import scenes_dir
     from refsim.scenes.loader import load_scene
 
-    return load_scene(SCENES_DIR / name)
+    return load_scene(scenes_dir() / name)
 
 
 def _scene_from(data: dict):

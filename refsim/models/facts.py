@@ -108,8 +108,8 @@ class TrimeshAgreement:
 def measure_trimesh_agreement(paths) -> list[TrimeshAgreement]:
     """Compare convexity, closedness, volume and volume centroid with trimesh
     for each model file (``refsim info`` shows refsim's side)."""
-    from oracles.trimesh_adapter import TrimeshOracle
     from refsim.models.loading import load_model
+    from refsim.oracles.trimesh_adapter import TrimeshOracle
 
     oracle = TrimeshOracle()
     rows = []

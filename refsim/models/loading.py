@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from refsim.bundled import models_dir
 from refsim.errors import ModelError
 from refsim.models.ac3d import read_ac3d
 from refsim.models.mesh import Mesh
@@ -37,7 +38,9 @@ def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
     Parameters
     ----------
     path : str or PathLike
-        A ``.ac``, ``.obj``, ``.stl``, ``.ply`` or ``.off`` file (suffix in any case).
+        A ``.ac``, ``.obj``, ``.stl``, ``.ply`` or ``.off`` file (suffix in any
+        case). A bare file name that is not in the current directory names a
+        bundled model (``refsim.bundled.models_dir()``), e.g. ``"cube.ac"``.
     weld_tolerance : float
         Passed to :class:`Mesh`: 0 welds exactly equal vertices only.
 
@@ -52,11 +55,21 @@ def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
     if suffix not in SUFFIXES:
         raise ModelError(f"unknown model format {path.suffix or '(no suffix)'!r}; "
                          f"supported: {', '.join(SUFFIXES)}", path=path)
+    path = _bundled_if_bare(path)
     if not path.is_file():
         raise ModelError("no such file", path=path)
     if suffix == ".ac":
         return read_ac3d(path, weld_tolerance=weld_tolerance)
     return _load_with_trimesh(path, weld_tolerance)
+
+
+def _bundled_if_bare(path: Path) -> Path:
+    """``path`` itself, or the bundled model of that name when ``path`` is a
+    bare name that does not exist here."""
+    if path.exists() or path.name != str(path):
+        return path
+    bundled = models_dir() / path.name
+    return bundled if bundled.is_file() else path
 
 
 def _load_with_trimesh(path: Path, weld_tolerance: float) -> Mesh:

@@ -92,7 +92,9 @@ def geodesic_sphere(frequency: int, radius: float = 1.0) -> Mesh:
             for vi, w in key:
                 p = p + w * base_v[vi]
             points[key] = len(coords)
-            coords.append(p / np.linalg.norm(p))
+            # |p| written out in one order: np.linalg.norm goes through BLAS,
+            # whose summation order (and so the last bit) differs per processor.
+            coords.append(p / np.sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]))
         return points[key]
 
     faces = []

@@ -182,7 +182,7 @@ class DragComparison:
 
 
 def _trajectory(config: ParticleConfig, x0, v0, t_eval):
-    from oracles.scipy_ivp import reference_solution
+    from refsim.oracles.scipy_ivp import reference_solution
 
     y0 = np.concatenate([x0, v0])
     ref = reference_solution(particle_rhs(config, count=1), y0, 0.0, float(t_eval[-1]),
@@ -243,7 +243,7 @@ def wall_reference(config: ParticleConfig, x0: np.ndarray, v0: np.ndarray,
     """Positions and velocities at ``t1`` with each wall contact located exactly.
 
     Each particle is integrated by DOP853 (tolerance
-    :data:`oracles.scipy_ivp.REFERENCE_TOL`) until an event function
+    :data:`refsim.oracles.scipy_ivp.REFERENCE_TOL`) until an event function
     ``x_a -+ half_size`` crosses zero outward; there the seed's response is
     applied (normal component times ``-e``, lateral times ``1 - friction``)
     and integration restarts. Returns (2, N, 3).
@@ -256,7 +256,7 @@ def wall_reference(config: ParticleConfig, x0: np.ndarray, v0: np.ndarray,
     """
     from scipy.integrate import solve_ivp
 
-    from oracles.scipy_ivp import REFERENCE_TOL
+    from refsim.oracles.scipy_ivp import REFERENCE_TOL
 
     f = particle_rhs(config, count=1)
     L = config.half_size
@@ -310,7 +310,7 @@ def particle_test_config(count: int = 200, walls: bool = False, seed: int = 3) -
 def particle_reference(config: ParticleConfig, t1: float) -> np.ndarray:
     """(2, N, 3) state at ``t1`` from ``config.initial_state()``: DOP853 on the
     whole system without walls, :func:`wall_reference` with."""
-    from oracles.scipy_ivp import reference_solution
+    from refsim.oracles.scipy_ivp import reference_solution
 
     x0, v0 = config.initial_state()
     if config.walls:
@@ -337,7 +337,7 @@ def measure_particle_work_precision(config: ParticleConfig | None = None, t1: fl
     ``steps`` steps (the particle system's fast path), and for scipy RK45 /
     DOP853 on the same system (only without walls: scipy would step through
     the walls). Default system: :func:`particle_test_config`."""
-    from oracles.scipy_ivp import adaptive_run
+    from refsim.oracles.scipy_ivp import adaptive_run
 
     config = particle_test_config() if config is None else config
     Y_ref = particle_reference(config, t1)

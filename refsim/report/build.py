@@ -22,8 +22,8 @@ from dataclasses import asdict, dataclass
 from importlib import metadata
 from pathlib import Path
 
+from refsim.bundled import templates_dir
 from refsim.io import write_text_atomic
-from refsim.paths import REPO_ROOT, TEMPLATES_DIR
 from refsim.report.claims import CLAIMS, TERMINOLOGY
 from refsim.report.progress import Progress
 from refsim.report.section import Section
@@ -205,12 +205,19 @@ def collect_environment() -> dict:
     }
 
 
+#: The top of refsim's source tree when it runs from a git checkout (an
+#: editable install); an installed wheel has no ``.git`` beside its package.
+_SOURCE = Path(__file__).resolve().parents[2]
+
+
 def _git_commit() -> str:
+    if not (_SOURCE / ".git").exists():
+        return "unknown (an installed refsim, not a git checkout)"
     try:
-        commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPO_ROOT, text=True,
+        commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=_SOURCE, text=True,
                                 capture_output=True, check=True, timeout=10).stdout.strip()
         dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
-                               cwd=REPO_ROOT, text=True, capture_output=True,
+                               cwd=_SOURCE, text=True, capture_output=True,
                                timeout=10).stdout.strip()
     except (OSError, subprocess.SubprocessError):
         return "unknown (not a git checkout)"
@@ -220,11 +227,11 @@ def _git_commit() -> str:
 def render(sections: list[Section], environment: dict, *, quick: bool) -> str:
     import jinja2
 
-    env = jinja2.Environment(loader=jinja2.FileSystemLoader(TEMPLATES_DIR),
+    env = jinja2.Environment(loader=jinja2.FileSystemLoader(templates_dir()),
                              autoescape=True, undefined=jinja2.StrictUndefined,
                              keep_trailing_newline=True)
     template = env.get_template("index.html.j2")
-    css = (TEMPLATES_DIR / "style.css").read_text()
+    css = (templates_dir() / "style.css").read_text()
     parts = [{"key": key, "title": title, "intro": intro,
               "groups": [(s, [t for t in s.tables if part_of(t.id) == key],
                           [f for f in s.figures if part_of(f.id) == key]) for s in sections]}

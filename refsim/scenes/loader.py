@@ -20,8 +20,8 @@ import math
 import tomllib
 from pathlib import Path
 
+from refsim.bundled import models_dir, scenes_dir
 from refsim.errors import SceneError
-from refsim.paths import models_dir
 from refsim.scenes.schema import (
     BODY_FIELDS,
     MAX_STEPS,
@@ -36,8 +36,14 @@ from refsim.scenes.schema import (
 
 
 def load_scene(path) -> Scene:
-    """Read, validate and resolve the scene file at ``path``."""
+    """Read, validate and resolve the scene file at ``path``.
+
+    A bare file name that is not in the current directory names a bundled
+    scene (``refsim.bundled.scenes_dir()``), e.g. ``"bounce.toml"``.
+    """
     path = Path(path)
+    if not path.exists() and path.name == str(path) and (scenes_dir() / path.name).is_file():
+        path = scenes_dir() / path.name
     try:
         text = path.read_bytes().decode("utf-8")
     except FileNotFoundError:

@@ -170,7 +170,7 @@ def reference_at_t1(problem: Problem, reference: str = "dop853") -> np.ndarray:
         return problem.exact(problem.t1)
     if reference != "dop853":
         raise ValueError(f"reference must be 'dop853' or 'exact', got {reference!r}")
-    from oracles.scipy_ivp import reference_solution
+    from refsim.oracles.scipy_ivp import reference_solution
 
     return reference_solution(problem.f, problem.y0, problem.t0, problem.t1).y[-1]
 
@@ -475,7 +475,7 @@ def measure_work_precision(problem: Problem | None = None, methods=tuple(SOLVERS
     through STEP_RANGE, capped at 2^14 to bound the time), scipy RK45 and
     DOP853 at ``tolerances``.
     """
-    from oracles.scipy_ivp import adaptive_run
+    from refsim.oracles.scipy_ivp import adaptive_run
 
     problem = kepler_orbit() if problem is None else problem
     y_ref = reference_at_t1(problem)

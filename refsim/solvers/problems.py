@@ -5,7 +5,7 @@ What: exponential decay, the harmonic oscillator, a projectile with linear
 drag, the two-body Kepler orbit, and a small particle system with quadratic
 drag (the seed's S10 forces, no walls). The first four have exact solutions;
 the particle system is measured against scipy's DOP853
-(:mod:`oracles.scipy_ivp`).
+(:mod:`refsim.oracles.scipy_ivp`).
 
 Seed section: S6 (the solvers these problems measure) and S5/S10 (the
 forces of the projectile and particle problems).

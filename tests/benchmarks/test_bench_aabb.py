@@ -16,9 +16,9 @@ from __future__ import annotations
 import itertools
 
 import pytest
+from refsim.oracles import OracleUnavailable
+from refsim.oracles.trimesh_adapter import TrimeshOracle
 
-from oracles import OracleUnavailable
-from oracles.trimesh_adapter import TrimeshOracle
 from refsim.bounds.aabb_incremental import numba_available
 from refsim.bounds.measure import make_method, pose_sequence
 from refsim.models import shapes

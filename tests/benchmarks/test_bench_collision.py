@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from refsim.oracles.fcl_adapter import FCLOracle
 
-from oracles.fcl_adapter import FCLOracle
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 from refsim.collision.measure_levels import SPEED_CONFIGURATIONS
 

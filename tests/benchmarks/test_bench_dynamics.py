@@ -40,7 +40,7 @@ def test_refsim_step(benchmark, count, rotation):
 @pytest.mark.parametrize("rotation", BENCH_ROTATIONS)
 @pytest.mark.parametrize("count", BENCH_COUNTS)
 def test_pybullet_step(benchmark, oracle, count, rotation):
-    from oracles.pybullet_adapter import PybulletOracle
+    from refsim.oracles.pybullet_adapter import PybulletOracle
 
     benchmark.group = f"dynamics step: {count} cubes, rotation {rotation}"
     scene = cubes_scene(count, rotation)

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from refsim.oracles.fcl_adapter import FCLOracle
 
-from oracles.fcl_adapter import FCLOracle
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_batch import triangles_intersect_batch
 

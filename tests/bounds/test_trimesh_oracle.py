@@ -4,13 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
-from oracles.trimesh_adapter import (
+from refsim.oracles.trimesh_adapter import (
     TrimeshOracle,
     bounds_tolerance,
     pose_matrix,
     trimesh_skips_transform,
 )
+
 from refsim.bounds.aabb_incremental import IncrementalAABB
 from refsim.bounds.aabb_linear import aabb_linear
 from refsim.bounds.measure import perturbed_sphere

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from refsim.bundled import models_dir
 from refsim.collision import bvh
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 from refsim.collision.boxes import (
@@ -18,7 +19,6 @@ from refsim.collision.seed_levels import triangle_box_pairs
 from refsim.errors import StateError
 from refsim.models import shapes
 from refsim.models.loading import load_model
-from refsim.paths import models_dir
 from refsim.types import random_rotation, rotation_about_axis
 
 numba = pytest.importorskip("numba", reason="numba (refsim[fast]) is not installed")

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from refsim.oracles.fcl_adapter import FCLOracle
 
-from oracles.fcl_adapter import FCLOracle
 from refsim.collision.measure import (
     NEAR_DEGENERATE_MARGIN,
     classify_disagreement,
@@ -24,6 +24,7 @@ from refsim.collision.measure import (
 )
 from refsim.collision.triangle_batch import triangles_intersect_batch
 from refsim.models.mesh import Mesh
+from refsim.report.sections.collision import ROUNDING_TILT
 from refsim.types import random_rotation, transform_points
 
 from .test_triangle import CASES, T
@@ -144,17 +145,20 @@ def test_c4_near_parallel_planes(fcl):
     for config in ("overlap", "touch", "miss", "shared-edge"):
         s = result.get(config, "axis-aligned")
         assert s.flip_exact is None and s.flip_float is None and s.flip_oracle is None
-    # After a generic rigid motion the input itself is rounded: the exact
-    # answer for the rounded coordinates leaves the intended one (touching
-    # becomes a near miss at once; the miss becomes a hit at 1e-16), and the
-    # float test and FCL flip at the same angles.
-    touch = result.get("touch", "generic")
-    miss = result.get("miss", "generic")
-    assert touch.flip_exact == 1e-1
-    assert miss.flip_exact == 1e-16
-    for s in result.series:
-        assert s.float_wrong == 0 and s.oracle_wrong == 0
-        assert s.flip_float == s.flip_exact and s.flip_oracle == s.flip_exact
+    # After a generic rigid motion the input itself is rounded, so the exact
+    # answer for the rounded coordinates may leave the intended one, but for
+    # triangles that cross or miss transversally only where the tilt is as
+    # small as that rounding; and there the float test and FCL differ from
+    # the exact answer on the same coordinates, and nowhere above it. (Which
+    # way a touching pair rounds depends on the frame: no law to assert.)
+    rounding = ROUNDING_TILT * np.finfo(float).eps
+    for config in ("overlap", "miss"):
+        s = result.get(config, "generic")
+        assert s.flip_exact is None or s.flip_exact <= rounding
+        for answers in (s.plain_float, s.oracle):
+            wrong = [theta for theta, a, e in zip(s.thetas, answers, s.exact, strict=True)
+                     if a != e]
+            assert max(wrong, default=0.0) <= rounding, (config, wrong)
 
 
 def test_float_tests_are_wrong_only_near_degeneracy(fcl):

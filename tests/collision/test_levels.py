@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from refsim.oracles.fcl_adapter import FCLOracle
+from refsim.oracles.trimesh_collision import TrimeshCollisionOracle, float32_pose
 
-from oracles.fcl_adapter import FCLOracle
-from oracles.trimesh_collision import TrimeshCollisionOracle, float32_pose
 from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
 from refsim.collision.measure_levels import (
     CONFIGURATIONS,

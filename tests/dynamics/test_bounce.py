@@ -203,7 +203,7 @@ def test_pybullet_lateral_velocity_is_coulomb_s(simulate, oracle):
     friction loss), and pybullet solves friction alongside restitution
     iteratively; 2% of v_t covers both.
     """
-    from oracles.pybullet_adapter import PybulletOracle
+    from refsim.oracles.pybullet_adapter import PybulletOracle
 
     oracle(PybulletOracle).close()                     # skip when pybullet is missing
     rows = measure_oblique(models=(SPHERE,))

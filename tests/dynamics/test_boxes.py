@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 import refsim
+from refsim.bundled import models_dir
 from refsim.dynamics.boxes import boxes_compiled, boxes_numpy
-from refsim.paths import models_dir
 from refsim.types import random_rotation
 
 

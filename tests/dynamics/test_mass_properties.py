@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from refsim.oracles.trimesh_adapter import TrimeshOracle
 
 import refsim
-from oracles.trimesh_adapter import TrimeshOracle
+from refsim.bundled import models_dir
 from refsim.dynamics.mass_properties import mass_properties, point_mass_properties
 from refsim.errors import ModelError
-from refsim.paths import models_dir
 
 #: Sums of m signed terms of order 1: a few hundred ulps for the 2000-face meshes.
 RTOL = 1e-12

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from refsim.oracles.pybullet_adapter import PybulletOracle, mass_properties
 
-from oracles.pybullet_adapter import PybulletOracle, mass_properties
 from refsim.dynamics import analytic
 from refsim.dynamics.bounce import (
     DROP_HEIGHT,
@@ -102,8 +102,8 @@ def test_mass_and_inertia_passed_are_trimesh_s(pybullet, model, scale, mass):
 
 def test_mass_properties_of_a_unit_cube_are_exact():
     pytest.importorskip("trimesh")
+    from refsim.bundled import models_dir
     from refsim.models.loading import load_model
-    from refsim.paths import models_dir
 
     mesh = load_model(models_dir() / "cube.ac")
     props = mass_properties(mesh.vertices, mesh.faces, mass=6.0, scale=2.0)
@@ -204,9 +204,9 @@ def test_mass_properties_agree_with_refsim_s_own_integrals(model):
     tetrahedron sums (refsim.dynamics.mass_properties): two independent
     computations of the same uniform solid."""
     pytest.importorskip("trimesh")
+    from refsim.bundled import models_dir
     from refsim.dynamics.mass_properties import mass_properties as refsim_mass_properties
     from refsim.models.loading import load_model
-    from refsim.paths import models_dir
 
     mesh = load_model(models_dir() / model)
     theirs = mass_properties(mesh.vertices, mesh.faces, mass=2.0, scale=1.5)

@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 import refsim
+from refsim.bundled import scenes_dir
 from refsim.dynamics.measure import REST_SPEED, REST_SPIN
 from refsim.dynamics.simulation import MAX_FRAMES, Simulation, default_every, simulate
 from refsim.errors import DivergenceError, StateError
-from refsim.paths import SCENES_DIR
 from refsim.scenes.loader import scene_from_dict
 
 #: Exact rotations composed 10 000 times: rounding grows like sqrt(steps) ulps,
@@ -80,14 +80,14 @@ def test_wall_hit_in_the_loop_pushes_back_exactly_and_records_an_event():
 
 
 def test_equal_masses_exchange_velocities_in_the_loop():
-    scene = refsim.load_scene(SCENES_DIR / "head-on.toml")
+    scene = refsim.load_scene(scenes_dir() / "head-on.toml")
     traj = simulate(scene, duration=2.5)
     assert np.allclose(traj.velocity[-1], [[-1.0, 0, 0], [1.5, 0, 0]])
     assert [e.kind for e in traj.events] == ["body"]
 
 
 def test_spinning_cube_comes_to_rest_with_the_corrected_model():
-    scene = refsim.load_scene(SCENES_DIR / "spinning-cube.toml")
+    scene = refsim.load_scene(scenes_dir() / "spinning-cube.toml")
     scene = replace(scene, dynamics=replace(scene.dynamics, rotation="impulse"))
     traj = simulate(scene, duration=5.0, every=100)
     w = np.linalg.norm(traj.angular_velocity[-5:, 0], axis=1)
@@ -98,7 +98,7 @@ def test_spinning_cube_comes_to_rest_with_the_corrected_model():
 
 
 def test_seed_model_keeps_the_vertical_spin():
-    scene = refsim.load_scene(SCENES_DIR / "spinning-cube.toml")
+    scene = refsim.load_scene(scenes_dir() / "spinning-cube.toml")
     traj = simulate(scene, duration=5.0, every=100)
     # C12: the seed's contact torque is perpendicular to the floor's normal
     assert traj.angular_velocity[-1, 0, 1] == pytest.approx(5.0, rel=1e-12)
@@ -164,7 +164,7 @@ def test_particle_only_scene_is_refused_clearly():
         Simulation(scene)
 
 
-RIGID_SCENES = [p for p in sorted(SCENES_DIR.glob("*.toml")) if "[[body]]" in p.read_text()]
+RIGID_SCENES = [p for p in sorted(scenes_dir().glob("*.toml")) if "[[body]]" in p.read_text()]
 
 
 def test_the_bundled_rigid_scenes_are_found():

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 import trimesh
 
+from refsim.bundled import bundled_models, models_dir
 from refsim.models.ac3d import format_ac3d, parse_ac3d
 from refsim.models.loading import load_model
-from refsim.paths import bundled_models, models_dir
 from tests.helpers import assert_meshes_identical
 
 MODELS = bundled_models()

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import pytest
 
+from refsim.bundled import bundled_models, models_dir
 from refsim.models.facts import describe, format_facts, measure_trimesh_agreement
 from refsim.models.loading import load_model
-from refsim.paths import bundled_models, models_dir
 
 #: Volumes and centroids from two summation orders agree to a few ulps times
 #: the number of triangles; 1e-12 relative leaves room and still catches a

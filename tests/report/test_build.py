@@ -8,8 +8,8 @@ import re
 
 import pytest
 
+from refsim.bundled import bundled_models
 from refsim.io import write_text_atomic
-from refsim.paths import bundled_models
 from refsim.report import build as report_build
 from refsim.report.build import AREAS, build_report
 from refsim.report.claims import CLAIMS

@@ -6,8 +6,8 @@ import shutil
 
 import pytest
 
+from refsim.bundled import models_dir, scenes_dir
 from refsim.errors import ModelError, SceneError
-from refsim.paths import SCENES_DIR, models_dir
 from refsim.scenes.loader import load_scene
 from refsim.scenes.schema import SOLVER_NAMES, IntegrationConfig, WorldConfig
 from tests.helpers import assert_scene_error
@@ -21,7 +21,7 @@ def write(tmp_path, text, name="scene.toml"):
     return path
 
 
-@pytest.mark.parametrize("scene", sorted(SCENES_DIR.glob("*.toml")), ids=lambda p: p.name)
+@pytest.mark.parametrize("scene", sorted(scenes_dir().glob("*.toml")), ids=lambda p: p.name)
 def test_bundled_scenes_load(scene):
     loaded = load_scene(scene)
     assert loaded.bodies or loaded.particles is not None

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from refsim.bundled import scenes_dir
 from refsim.particles.config import ParticleConfig
-from refsim.paths import SCENES_DIR
 from refsim.scenes.loader import load_scene
 from refsim.scenes.schema import PARTICLE_FIELDS_FROM, PARTICLE_KEYS
 from tests.helpers import assert_scene_error
@@ -27,7 +27,7 @@ def test_every_particle_field_comes_from_exactly_one_table():
 
 
 def test_bundled_particle_scene():
-    scene = load_scene(SCENES_DIR / "particles.toml")
+    scene = load_scene(scenes_dir() / "particles.toml")
     assert scene.bodies == ()
     p = scene.particles
     assert p.count == 10_000 and p.seed == 1997 and p.walls is True

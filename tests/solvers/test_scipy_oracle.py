@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from refsim.oracles.scipy_ivp import adaptive_run, reference_solution
 
-from oracles.scipy_ivp import adaptive_run, reference_solution
 from refsim.solvers.problems import (
     exponential_decay,
     harmonic_oscillator,

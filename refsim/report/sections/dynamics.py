@@ -38,10 +38,10 @@ STYLES = {"euler": "o-", "averaged-euler": "s--", "backwards-euler": "^-", "midp
 
 
 def _pybullet_available() -> tuple[bool, str]:
-    from oracles import OracleUnavailable
+    from refsim.oracles import OracleUnavailable
 
     try:
-        from oracles.pybullet_adapter import PybulletOracle
+        from refsim.oracles.pybullet_adapter import PybulletOracle
 
         PybulletOracle().close()
     except OracleUnavailable as exc:
@@ -119,8 +119,8 @@ def build(ctx) -> Section:
     # C12 runs its full 6 s in the quick report too: a shorter run stops
     # before the corrected model comes to rest and would change the verdict.
     if pb:
-        from oracles.pybullet_adapter import PybulletOracle
         from refsim.dynamics.simulation import default_every
+        from refsim.oracles.pybullet_adapter import PybulletOracle
 
         spin_scene = dyn_measure._scene("spinning-cube.toml")
         with PybulletOracle() as oracle:

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from refsim.bundled import bundled_models
 from refsim.models.facts import describe, measure_trimesh_agreement
-from refsim.paths import bundled_models
 from refsim.report.charts import bar_chart
 from refsim.report.section import Agreement, Figure, Section, Table
 
@@ -12,7 +12,7 @@ from refsim.report.section import Agreement, Figure, Section, Table
 #: values are in results.json.
 SHOWN_AS_ZERO = 1e-12
 
-AGREEMENT_COMMAND = ("python -c \"from refsim.paths import bundled_models; "
+AGREEMENT_COMMAND = ("python -c \"from refsim.bundled import bundled_models; "
                      "from refsim.models.facts import measure_trimesh_agreement as m; "
                      "[print(r) for r in m(bundled_models())]\"")
 

@@ -1,0 +1,1 @@
+"""The report's templates, installed as package data ``refsim.bundled.templates``."""

@@ -1,0 +1,1 @@
+"""The bundled scene files (TOML), installed as package data ``refsim.bundled.scenes``."""
