@@ -58,6 +58,8 @@ def _run(args) -> int:
     from refsim.scenes.loader import load_scene
 
     scene = load_scene(args.scene)
+    if args.duration is not None:
+        scene = _with_duration(scene, args.duration)
     if scene.bodies and scene.particles is not None:
         raise SceneError("refsim run simulates either rigid bodies or particles; this scene "
                          "has both (split it in two)", scene.path, "particles")
@@ -69,6 +71,20 @@ def _run(args) -> int:
     if scene.bodies:
         return _run_bodies(scene, out, args.every)
     return _run_particles(scene, out, args.every)
+
+
+def _with_duration(scene, duration: float):
+    """``scene`` simulated for ``duration`` seconds instead of its own."""
+    from dataclasses import replace
+
+    from refsim.scenes.schema import MAX_STEPS
+
+    if not (math.isfinite(duration) and duration > 0):
+        raise RefsimError(f"--duration must be a finite number > 0, got {duration!r}")
+    if duration / scene.integration.step > MAX_STEPS:
+        raise RefsimError(f"--duration {duration:g} at step {scene.integration.step:g} "
+                          f"exceeds {MAX_STEPS:.0e} steps")
+    return replace(scene, integration=replace(scene.integration, duration=duration))
 
 
 def _write(out: Path, save) -> None:
@@ -178,6 +194,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--every", type=int, metavar="K",
                      help="store every K-th step (default: at most about 1000 frames for "
                           "bodies, 200 for particles); the last step is always stored")
+    run.add_argument("--duration", type=float, metavar="SECONDS",
+                     help="simulate this long instead of the scene's [integration] duration")
     run.set_defaults(run=_run)
 
     report = commands.add_parser("report", help="write the HTML accuracy report")

@@ -1,11 +1,24 @@
 """The exceptions refsim raises for bad input.
 
 Every error a user can cause (a malformed model or scene file, a degenerate
-mesh, a non-finite state, a diverging simulation) is a :class:`RefsimError`.
-Each names where the problem is: the file and line, the key path, the body
-and step. The command line prints ``str(error)`` as its one line and exits
-non-zero; anything that is not a ``RefsimError`` is a bug in refsim and keeps
-its traceback.
+mesh, a non-finite state, an unknown option, a diverging simulation) is a
+:class:`RefsimError`. Each names where the problem is: the file and line, the
+key path, the argument, the body and step. The command line prints
+``str(error)`` as its one line and exits non-zero; anything that is not a
+``RefsimError`` is a bug in refsim and keeps its traceback.
+
+The errors about a bad value are also :class:`ValueError`, and
+:class:`ArgumentTypeError` is also :class:`TypeError`, so that code written
+for Python's conventions (``except ValueError``) catches them too:
+
+    RefsimError
+    ├── ModelError          (ValueError)  a model file or mesh
+    ├── SceneError          (ValueError)  a scene file or scene key
+    ├── StateError          (ValueError)  a number, array or state
+    ├── OptionError         (ValueError)  an option not among its choices
+    ├── ArgumentTypeError   (TypeError)   an argument of the wrong type
+    ├── OutputError         (OSError)     an output file that cannot be written
+    └── DivergenceError                   a simulation that blew up
 """
 
 from __future__ import annotations
@@ -17,7 +30,7 @@ class RefsimError(Exception):
     """Base class of every error caused by the user's input."""
 
 
-class ModelError(RefsimError):
+class ModelError(RefsimError, ValueError):
     """A model file or mesh that cannot be used.
 
     Parameters
@@ -46,7 +59,7 @@ class ModelWarning(UserWarning):
     surfaces, which have no area and become no triangles)."""
 
 
-class SceneError(RefsimError):
+class SceneError(RefsimError, ValueError):
     """A scene file that does not follow the schema.
 
     ``key`` is the dotted path of the offending key, e.g. ``world.half_size``
@@ -64,8 +77,30 @@ class SceneError(RefsimError):
         super().__init__(f"{where}: {message}")
 
 
-class StateError(RefsimError):
+class StateError(RefsimError, ValueError):
     """A non-finite or otherwise invalid numeric input (coordinates, a state)."""
+
+
+class OptionError(RefsimError, ValueError):
+    """An option whose value is not one of its choices (see :func:`check_option`)."""
+
+
+class ArgumentTypeError(RefsimError, TypeError):
+    """An argument of the wrong type (``None`` where a mesh is expected, say)."""
+
+
+class OutputError(RefsimError, OSError):
+    """An output file that cannot be written (the message names it)."""
+
+
+def check_option(name: str, value, choices) -> str:
+    """``value`` when it is one of ``choices``; else :class:`OptionError`
+    naming the option, the value and the choices. The one check of every
+    string option in refsim's public functions."""
+    if isinstance(value, str) and value in choices:
+        return value
+    listed = ", ".join(repr(c) for c in choices)
+    raise OptionError(f"{name} must be one of {listed}, got {value!r}")
 
 
 class DivergenceError(RefsimError):
