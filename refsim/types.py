@@ -57,6 +57,24 @@ def as_pose(pose, *, what: str = "pose") -> Pose:
     return rotation, translation
 
 
+def unit_exponent(values) -> int:
+    """The exponent ``e`` with ``max |values| * 2**-e`` in ``[0.5, 1)`` (0 for all zeros).
+
+    Geometry is invariant under a uniform change of scale, and multiplying by
+    a power of two is exact in binary floating point (barring underflow of
+    values far below the largest). Computing volumes, cross products, convex
+    hulls and inertia on ``values * 2**-e`` and scaling the result back by the
+    matching power (``2**(3e)`` for a volume) therefore keeps every
+    intermediate far from overflow and underflow, for coordinates anywhere in
+    float64's range; a result that is itself beyond float64 becomes inf, as
+    IEEE arithmetic rounds it.
+    """
+    largest = float(np.abs(values).max(initial=0.0))
+    if largest == 0.0:
+        return 0
+    return int(np.frexp(largest)[1])
+
+
 def transform_points(points: np.ndarray, pose: Pose) -> np.ndarray:
     """World coordinates (n, 3) of body-space ``points`` (n, 3) under ``pose``.
 

@@ -53,6 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.boxes import triangle_boxes, world_vertices
+from refsim.types import unit_exponent
 
 #: Triangles per leaf. Small leaves prune more; each leaf-leaf visit costs
 #: LEAF_SIZE^2 box tests. 4 was fastest for 2k-triangle meshes here (the
@@ -90,7 +91,12 @@ def _surface_area(lo: np.ndarray, hi: np.ndarray) -> float:
 def build_tree(vertices: np.ndarray, faces: np.ndarray, leaf_size: int = LEAF_SIZE) -> TriangleTree:
     """Top-down median split of the triangles' centroids, on the axis whose
     halves have the least total box area."""
-    triangles = vertices[faces]
+    # The split is chosen on coordinates times 2**-e (every one below 1): the
+    # areas of boxes of a mesh with coordinates near 1e154 would overflow to
+    # inf (and inf - inf to nan), leaving no axis "best". The tree's
+    # topology is all that is built here, and scaling by a power of two
+    # changes no comparison.
+    triangles = np.ldexp(vertices, -unit_exponent(vertices))[faces]
     centroids = triangles.mean(axis=1)
     tri_lo, tri_hi = triangles.min(axis=1), triangles.max(axis=1)
     order = np.arange(len(faces), dtype=np.int64)

@@ -105,7 +105,7 @@ from refsim.collision.bvh import TriangleTree, tree_of
 from refsim.collision.seed_levels import exact_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.errors import StateError
-from refsim.types import ORTHONORMAL_TOL, as_pose
+from refsim.types import ORTHONORMAL_TOL, as_pose, unit_exponent
 
 #: The node test's margin, relative to the scene's size S (see the module
 #: docstring): 8192 unit roundoffs against the < 1000 the arithmetic can
@@ -166,7 +166,11 @@ def principal_axes(points: np.ndarray) -> np.ndarray:
     (Gottschalk et al. 1996 take the covariance of the triangles' hull; of
     the vertices is simpler and, on the benchmark meshes, visits about as
     many node pairs): the eigenvectors from ``numpy.linalg.eigh``,
-    orthonormal up to a few roundoffs whatever the points."""
+    orthonormal up to a few roundoffs whatever the points. The covariance is
+    taken of the points times ``2**-e`` (:func:`refsim.types.unit_exponent`):
+    the axes do not change with the scale, and squares of coordinates near
+    1e154 would overflow."""
+    points = np.ldexp(points, -unit_exponent(points))
     covariance = np.cov(points.T) if len(points) > 1 else np.zeros((3, 3))
     return np.linalg.eigh(covariance)[1]
 

@@ -27,6 +27,13 @@ Seed section: none; the seed sets the inertia tensor to the identity ("we
 have effectively factored out angular momentum and the inertia tensor", S9).
 The corrected model (``rotation = "impulse"``) needs the real one.
 
+Scale: the integrals are computed on the vertices times ``2**-e``
+(:func:`refsim.types.unit_exponent`, every coordinate below 1) and scaled
+back: the volume by ``2**(3e)``, the centre by ``2**e``, the inertia by
+``2**(2e)`` (it is mass times length squared). The products of five
+coordinates in the second moment would otherwise underflow to zero for a
+body of size 1e-65 and overflow for one of size 1e62.
+
 Cost: O(m) for m triangles, once per body.
 """
 
@@ -37,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.errors import ModelError
+from refsim.types import unit_exponent
 
 
 @dataclass(frozen=True)
@@ -67,13 +75,15 @@ def mass_properties(vertices: np.ndarray, faces: np.ndarray, mass: float) -> Mas
         When the enclosed volume is not positive (open, inside-out or flat mesh).
     """
     vertices = np.asarray(vertices, dtype=np.float64)
+    e = unit_exponent(vertices)
+    vertices = np.ldexp(vertices, -e)                    # unit coordinates (see Scale)
     c = vertices.mean(axis=0)                            # reference point
     p = vertices[np.asarray(faces)] - c                  # (m, 3, 3): p_1, p_2, p_3 (p_0 = 0)
     V = np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])) / 6.0
     volume = float(V.sum())
     if not volume > 0.0:
         raise ModelError(f"mass properties need a closed, outward-wound mesh "
-                         f"(enclosed volume {volume:.6g})")
+                         f"(enclosed volume {np.ldexp(volume, 3 * e):.6g})")
     s = p.sum(axis=1)                                    # p_0 = 0 adds nothing
     first = (V[:, None] * s).sum(axis=0) / 4.0           # int x dV about c
     second = (np.einsum("i,ikj,ikl->jl", V, p, p)
@@ -84,8 +94,8 @@ def mass_properties(vertices: np.ndarray, faces: np.ndarray, mass: float) -> Mas
     C = rho * (second - volume * np.outer(center, center))
     inertia = np.trace(C) * np.eye(3) - C
     inertia = 0.5 * (inertia + inertia.T)                # exact symmetry
-    return MassProperties(mass=float(mass), volume=volume, center=center + c,
-                          inertia=inertia)
+    return MassProperties(mass=float(mass), volume=float(np.ldexp(volume, 3 * e)),
+                          center=np.ldexp(center + c, e), inertia=np.ldexp(inertia, 2 * e))
 
 
 def point_mass_properties(vertices: np.ndarray, mass: float) -> MassProperties:
@@ -94,8 +104,11 @@ def point_mass_properties(vertices: np.ndarray, mass: float) -> MassProperties:
     masses for each vertex)"): centre the vertex average, inertia of the
     point masses. Used for open meshes, which bound no solid."""
     vertices = np.asarray(vertices, dtype=np.float64)
+    e = unit_exponent(vertices)
+    vertices = np.ldexp(vertices, -e)                    # unit coordinates (see Scale)
     center = vertices.mean(axis=0)
     d = vertices - center
     C = (mass / len(vertices)) * d.T @ d
     inertia = np.trace(C) * np.eye(3) - C
-    return MassProperties(mass=float(mass), volume=0.0, center=center, inertia=inertia)
+    return MassProperties(mass=float(mass), volume=0.0, center=np.ldexp(center, e),
+                          inertia=np.ldexp(inertia, 2 * e))

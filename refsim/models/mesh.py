@@ -37,6 +37,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
 from refsim.errors import ModelError
+from refsim.types import unit_exponent
 
 #: Relative tolerance of the convexity test. A vertex of a neighbouring face
 #: may stand this far above a face's plane, relative to the diagonal of the
@@ -217,20 +218,41 @@ class Mesh:
     # -- geometry ------------------------------------------------------------------
 
     @cached_property
+    def _exponent(self) -> int:
+        """``e`` with the largest coordinate times ``2**-e`` in [0.5, 1)
+        (:func:`refsim.types.unit_exponent`)."""
+        return unit_exponent(self.vertices)
+
+    @cached_property
+    def _unit_vertices(self) -> np.ndarray:
+        """The vertices times ``2**-e``: every coordinate below 1 in magnitude.
+
+        The volume, centroid, areas, convexity and hull are computed on these
+        and scaled back, so that no intermediate overflows or underflows
+        whatever the model's units (a cube of side 1e-300 or 1e300 is as
+        convex as one of side 1).
+        """
+        return np.ldexp(self.vertices, -self._exponent)
+
+    @cached_property
     def _face_cross(self) -> np.ndarray:
-        v = self.vertices[self.faces]
+        """Cross products of each face's edges, in unit coordinates (times ``2**-2e``)."""
+        v = self._unit_vertices[self.faces]
         return np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
 
     @cached_property
     def face_areas(self) -> np.ndarray:
-        return _readonly(0.5 * np.linalg.norm(self._face_cross, axis=1))
+        cross = self._face_cross
+        norm = np.sqrt((cross * cross).sum(axis=1))
+        return _readonly(np.ldexp(0.5 * norm, 2 * self._exponent))
 
     @cached_property
     def degenerate_faces(self) -> np.ndarray:
         """Indices of zero-area triangles (a segment or a point).
 
         Zero means exactly zero in floating point: the cross product of two
-        edge vectors vanishes (collinear corners or a repeated vertex).
+        edge vectors, in unit coordinates, vanishes (collinear corners or a
+        repeated vertex).
         """
         return _readonly(np.flatnonzero((self._face_cross == 0.0).all(axis=1)))
 
@@ -241,8 +263,9 @@ class Mesh:
 
     @cached_property
     def centroid_vertex_average(self) -> np.ndarray:
-        """The seed's centroid: the mean of the shared vertices (S9)."""
-        return _readonly(self.vertices.mean(axis=0))
+        """The seed's centroid: the mean of the shared vertices (S9), summed in
+        unit coordinates (so that it is finite whenever the vertices are)."""
+        return _readonly(np.ldexp(self._unit_vertices.mean(axis=0), self._exponent))
 
     @cached_property
     def volume(self) -> float | None:
@@ -250,7 +273,7 @@ class Mesh:
         wind outward), or None for an open mesh."""
         if not self.is_closed:
             return None
-        return float(self._tetra_volumes().sum())
+        return float(np.ldexp(self._tetra_volumes().sum(), 3 * self._exponent))
 
     @cached_property
     def centroid_volume(self) -> np.ndarray | None:
@@ -266,14 +289,18 @@ class Mesh:
         total = volumes.sum()
         if total == 0.0:
             return None
-        c = self.centroid_vertex_average
-        v = self.vertices[self.faces]
-        centroids = (c + v.sum(axis=1)) / 4.0
-        return _readonly((volumes[:, None] * centroids).sum(axis=0) / total)
+        u = self._unit_vertices
+        c = u.mean(axis=0)
+        centroids = (c + u[self.faces].sum(axis=1)) / 4.0
+        centre = (volumes[:, None] * centroids).sum(axis=0) / total
+        return _readonly(np.ldexp(centre, self._exponent))
 
     def _tetra_volumes(self) -> np.ndarray:
-        v = self.vertices[self.faces] - self.centroid_vertex_average
-        return np.einsum("ij,ij->i", v[:, 0], np.cross(v[:, 1], v[:, 2])) / 6.0
+        """Signed volumes of the tetrahedra (c, a, b, d) in unit coordinates."""
+        u = self._unit_vertices
+        v = u[self.faces] - u.mean(axis=0)
+        cross = np.cross(v[:, 1], v[:, 2])
+        return (v[:, 0] * cross).sum(axis=1) / 6.0
 
     @cached_property
     def is_convex(self) -> bool:
@@ -287,13 +314,16 @@ class Mesh:
         locally convex everywhere yet winds around more than once.
         """
         twins = self._half_edge_twins
-        if twins is None or not self.volume or self.volume <= 0.0:
+        if twins is None:
             return False
-        lo, hi = self.bounds
-        tol = CONVEX_RTOL * float(np.linalg.norm(hi - lo))
-        v, f = self.vertices, self.faces
+        volume = float(self._tetra_volumes().sum())        # in unit coordinates
+        if not volume > 0.0:
+            return False
+        v, f = self._unit_vertices, self.faces
+        span = v.max(axis=0) - v.min(axis=0)
+        tol = CONVEX_RTOL * float(np.sqrt((span * span).sum()))
         cross = self._face_cross
-        norm = np.linalg.norm(cross, axis=1)
+        norm = np.sqrt((cross * cross).sum(axis=1))
         usable = norm > 0.0
         unit = np.zeros_like(cross)
         unit[usable] = cross[usable] / norm[usable, None]
@@ -304,14 +334,14 @@ class Mesh:
             a, b = f[:, k], f[:, (k + 1) % 3]
             tf = f[g]
             third = np.where((tf != a[:, None]) & (tf != b[:, None]), tf, -1).max(axis=1)
-            height = np.einsum("ij,ij->i", v[third] - v[a], unit)
+            height = ((v[third] - v[a]) * unit).sum(axis=1)
             if (height[usable] > tol).any():
                 return False
         try:
             hull = ConvexHull(v)
         except QhullError:
             return False
-        return abs(hull.volume - self.volume) <= 1e-9 * hull.volume
+        return abs(hull.volume - volume) <= 1e-9 * hull.volume
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:
