@@ -77,13 +77,13 @@ def _with_duration(scene, duration: float):
     """``scene`` simulated for ``duration`` seconds instead of its own."""
     from dataclasses import replace
 
-    from refsim.scenes.schema import MAX_STEPS
+    from refsim.errors import StateError
+    from refsim.solvers.integrate import whole_steps
 
-    if not (math.isfinite(duration) and duration > 0):
-        raise RefsimError(f"--duration must be a finite number > 0, got {duration!r}")
-    if duration / scene.integration.step > MAX_STEPS:
-        raise RefsimError(f"--duration {duration:g} at step {scene.integration.step:g} "
-                          f"exceeds {MAX_STEPS:.0e} steps")
+    try:
+        whole_steps(duration, scene.integration.step)
+    except StateError as exc:
+        raise RefsimError(f"--duration {duration!r}: {exc}") from None
     return replace(scene, integration=replace(scene.integration, duration=duration))
 
 
@@ -165,8 +165,15 @@ def _report(args) -> int:
     return 0
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with its usage errors on one line (it prints the usage first)."""
+
+    def error(self, message: str):
+        self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="refsim",
         description="Reference implementation of a 1997 rigid-body N-body simulation, "
                     "checked against FCL, trimesh, scipy and pybullet.")

@@ -118,3 +118,19 @@ class DivergenceError(RefsimError):
         self.partial = partial
         who = f" body {body!r}," if body is not None else ""
         super().__init__(f"diverged at step {step}, t = {time:.6g},{who} {message}")
+
+
+def check_count(name: str, value, minimum: int = 0, maximum: int | None = None) -> int:
+    """``value`` as an int when it is a whole number in ``[minimum, maximum]``;
+    else :class:`ArgumentTypeError` (not an integer; ``True`` is not a count)
+    or :class:`StateError` (out of range), naming the argument."""
+    import numbers
+
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ArgumentTypeError(f"{name} must be an integer, got {type(value).__name__} "
+                                f"{value!r}")
+    value = int(value)
+    if value < minimum or (maximum is not None and value > maximum):
+        upper = "" if maximum is None else f" and at most {maximum}"
+        raise StateError(f"{name} must be at least {minimum}{upper}, got {value}")
+    return value

@@ -58,7 +58,9 @@ def as_pose(pose, *, what: str = "pose") -> Pose:
 
 
 def unit_exponent(values) -> int:
-    """The exponent ``e`` with ``max |values| * 2**-e`` in ``[0.5, 1)`` (0 for all zeros).
+    """The exponent ``e`` with ``max |values| * 2**-e`` in ``[0.5, 1)``; for
+    all zeros -1075, below the exponent of every nonzero float64, so that
+    the largest of several exponents is that of the largest nonzero value.
 
     Geometry is invariant under a uniform change of scale, and multiplying by
     a power of two is exact in binary floating point (barring underflow of
@@ -71,7 +73,7 @@ def unit_exponent(values) -> int:
     """
     largest = float(np.abs(values).max(initial=0.0))
     if largest == 0.0:
-        return 0
+        return -1075
     return int(np.frexp(largest)[1])
 
 

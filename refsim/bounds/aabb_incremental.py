@@ -85,8 +85,8 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from refsim.bounds.aabb_linear import _require_numba, numba_available, rotated_coordinates
-from refsim.errors import ModelError, RefsimError
-from refsim.models.mesh import Mesh
+from refsim.errors import ModelError, check_option
+from refsim.models.mesh import Mesh, require_mesh
 from refsim.types import Pose, as_pose
 
 INCREMENTAL_KERNELS = ("python", "numba")
@@ -191,11 +191,10 @@ class IncrementalAABB:
 
     def __init__(self, mesh: Mesh, *, kernel: str | None = None,
                  allow_nonconvex: bool = False):
+        require_mesh(mesh)
         if kernel is None:
             kernel = "numba" if numba_available() else "python"
-        if kernel not in INCREMENTAL_KERNELS:
-            raise RefsimError(f"IncrementalAABB: kernel must be one of "
-                              f"{INCREMENTAL_KERNELS}, got {kernel!r}")
+        check_option("IncrementalAABB: kernel", kernel, INCREMENTAL_KERNELS)
         if kernel == "numba":
             _require_numba("IncrementalAABB")
         if not allow_nonconvex and not mesh.is_convex:

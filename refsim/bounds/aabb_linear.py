@@ -51,8 +51,8 @@ import functools
 
 import numpy as np
 
-from refsim.errors import RefsimError
-from refsim.models.mesh import Mesh
+from refsim.errors import OptionError, check_option
+from refsim.models.mesh import Mesh, require_mesh
 from refsim.types import Pose, as_pose, transform_points
 
 LINEAR_KERNELS = ("numpy", "numba")
@@ -74,7 +74,8 @@ def numba_available() -> bool:
 
 def _require_numba(what: str) -> None:
     if not numba_available():
-        raise RefsimError(f"{what}: kernel 'numba' needs numba (pip install -e '.[fast]')")
+        raise OptionError(f"{what}: kernel 'numba' needs a working numba, which does not "
+                          "import here")
 
 
 def rotated_coordinate(rotation, vertex, k: int) -> float:
@@ -138,6 +139,7 @@ def aabb_linear(mesh: Mesh, pose: Pose, *, kernel: str = "numpy"
     lo, hi : ndarray, shape (3,)
         The box corners: ``lo[k] = min_v r_k(v) + t_k``, ``hi`` likewise.
     """
+    require_mesh(mesh)
     rotation, translation = as_pose(pose)
     if kernel == "numpy":
         return aabb_linear_kernel(mesh.vertices.T, rotation, translation)
@@ -147,7 +149,8 @@ def aabb_linear(mesh: Mesh, pose: Pose, *, kernel: str = "numpy"
 
         return nk.aabb_linear_numba(np.ascontiguousarray(mesh.vertices.T), rotation,
                                     translation)
-    raise RefsimError(f"aabb_linear: kernel must be one of {LINEAR_KERNELS}, got {kernel!r}")
+    check_option("aabb_linear: kernel", kernel, LINEAR_KERNELS)
+    raise AssertionError("unreachable")
 
 
 class LinearAABB:
@@ -160,9 +163,8 @@ class LinearAABB:
     method = "linear"
 
     def __init__(self, mesh: Mesh, *, kernel: str = "numpy"):
-        if kernel not in LINEAR_KERNELS:
-            raise RefsimError(f"LinearAABB: kernel must be one of {LINEAR_KERNELS}, "
-                              f"got {kernel!r}")
+        require_mesh(mesh)
+        check_option("LinearAABB: kernel", kernel, LINEAR_KERNELS)
         self.mesh = mesh
         self.kernel = kernel
         n = mesh.n_vertices

@@ -15,8 +15,8 @@ import numpy as np
 
 from refsim.bounds.aabb_incremental import IncrementalAABB
 from refsim.bounds.aabb_linear import LinearAABB
-from refsim.errors import RefsimError
-from refsim.models.mesh import Mesh
+from refsim.errors import check_option
+from refsim.models.mesh import Mesh, require_mesh
 from refsim.types import Pose
 
 AABB_MODES = ("linear", "incremental", "auto")
@@ -48,8 +48,8 @@ def make_aabb_tracker(mesh: Mesh, mode: str = "auto", *, kernel: str | None = No
         Passed on: "numpy"/"numba" for the scan, "python"/"numba" for the
         tracker; default the fastest available.
     """
-    if mode not in AABB_MODES:
-        raise RefsimError(f"aabb mode must be one of {AABB_MODES}, got {mode!r}")
+    check_option("aabb mode", mode, AABB_MODES)
+    require_mesh(mesh)
     if mode == "auto":
         mode = "incremental" if mesh.is_convex else "linear"
     if mode == "incremental":

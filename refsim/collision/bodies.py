@@ -35,6 +35,8 @@ from refsim.collision.bvh import check_kernel, prepare_body, tree_box_pairs
 from refsim.collision.bvh_exact import collide_bvh, intersecting_pairs_bvh
 from refsim.collision.seed_levels import exact_pairs, triangle_box_pairs
 from refsim.collision.spheres import spheres_overlap
+from refsim.errors import check_option
+from refsim.models.mesh import require_mesh
 from refsim.types import as_pose
 
 LEVELS = ("sphere", "aabb", "triangle-aabb", "exact")
@@ -47,11 +49,11 @@ METHODS = ("bvh", "seed")
 BOOLEAN_BATCH = 256
 
 
-def _check(level: str, allowed: tuple[str, ...], method: str) -> None:
-    if level not in allowed:
-        raise ValueError(f"level must be one of {allowed}, got {level!r}")
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+def _check(level: str, allowed: tuple[str, ...], method: str, mesh_a, mesh_b) -> None:
+    check_option("level", level, allowed)
+    check_option("method", method, METHODS)
+    require_mesh(mesh_a, "mesh_a")
+    require_mesh(mesh_b, "mesh_b")
 
 
 def intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
@@ -72,7 +74,7 @@ def intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
     -------
     (k, 2) int64 array, rows sorted.
     """
-    _check(level, PAIR_LEVELS, method)
+    _check(level, PAIR_LEVELS, method, mesh_a, mesh_b)
     kernel = check_kernel(kernel)
     if level == "exact" and method == "bvh":
         return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
@@ -90,7 +92,7 @@ def intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
 def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
                    method: str = "bvh", *, kernel: str | None = None) -> bool:
     """Whether two bodies collide at ``level`` (see the module's table)."""
-    _check(level, LEVELS, method)
+    _check(level, LEVELS, method, mesh_a, mesh_b)
     kernel = check_kernel(kernel)
     if level == "exact" and method == "bvh":
         return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)

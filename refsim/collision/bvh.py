@@ -53,6 +53,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.boxes import triangle_boxes, world_vertices
+from refsim.errors import OptionError, check_option
 from refsim.types import unit_exponent
 
 #: Triangles per leaf. Small leaves prune more; each leaf-leaf visit costs
@@ -255,10 +256,9 @@ def prepare_body(mesh, pose, kernel: str) -> PreparedBody:
 
 def check_kernel(kernel: str | None) -> str:
     kernel = kernel or default_kernel()
-    if kernel not in KERNELS:
-        raise ValueError(f"kernel must be one of {KERNELS}, got {kernel!r}")
+    check_option("kernel", kernel, KERNELS)
     if kernel == "numba" and _compiled() is None:
-        raise ImportError("kernel='numba' needs numba (pip install -e '.[fast]')")
+        raise OptionError("kernel 'numba' needs a working numba, which does not import here")
     return kernel
 
 

@@ -98,14 +98,17 @@ def drop_scene(model: str, e: float, *, step: float = STEP, solver: str = SOLVER
                duration: float = 3.0, rotation: str = "off", friction: float = 0.0,
                height: float = DROP_HEIGHT, velocity=(0.0, 0.0, 0.0)):
     """A scene with one body of ``model`` whose lowest point is ``height`` above
-    the floor, moving with ``velocity``."""
+    the floor, moving with ``velocity``; ``duration`` is rounded up to a whole
+    number of steps."""
     from refsim.scenes.loader import scene_from_dict
+    from refsim.solvers.integrate import covering_duration
 
     y = -HALF_SIZE + _touch_depth(model) + height
     return scene_from_dict({
         "world": {"half_size": HALF_SIZE, "gravity": GRAVITY, "drag": 0.0,
                   "restitution": e, "friction": friction},
-        "integration": {"solver": solver, "step": step, "duration": duration},
+        "integration": {"solver": solver, "step": step,
+                        "duration": covering_duration(duration, step)},
         "collision": {"level": "aabb"},
         "dynamics": {"rotation": rotation, "body_response": "off"},
         "body": [{"name": "body", "model": model, "position": [0.0, y, 0.0],

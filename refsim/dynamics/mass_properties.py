@@ -46,6 +46,13 @@ import numpy as np
 from refsim.errors import ModelError
 from refsim.types import unit_exponent
 
+#: A body's inertia tensor must be positive definite: its smallest principal
+#: moment above this fraction of its largest. The vertices of a segment or a
+#: single point leave one moment zero up to rounding (about 1e-16 of the
+#: largest); the flattest body a scene means to simulate, a thin plate or a
+#: needle, keeps a ratio many orders above 1e-12.
+INERTIA_RTOL = 1e-12
+
 
 @dataclass(frozen=True)
 class MassProperties:
@@ -94,8 +101,10 @@ def mass_properties(vertices: np.ndarray, faces: np.ndarray, mass: float) -> Mas
     C = rho * (second - volume * np.outer(center, center))
     inertia = np.trace(C) * np.eye(3) - C
     inertia = 0.5 * (inertia + inertia.T)                # exact symmetry
-    return MassProperties(mass=float(mass), volume=float(np.ldexp(volume, 3 * e)),
-                          center=np.ldexp(center + c, e), inertia=np.ldexp(inertia, 2 * e))
+    with np.errstate(over="ignore"):    # beyond float64: inf (inertia_problem reports it)
+        return MassProperties(mass=float(mass), volume=float(np.ldexp(volume, 3 * e)),
+                              center=np.ldexp(center + c, e),
+                              inertia=np.ldexp(inertia, 2 * e))
 
 
 def point_mass_properties(vertices: np.ndarray, mass: float) -> MassProperties:
@@ -112,3 +121,29 @@ def point_mass_properties(vertices: np.ndarray, mass: float) -> MassProperties:
     inertia = np.trace(C) * np.eye(3) - C
     return MassProperties(mass=float(mass), volume=0.0, center=np.ldexp(center, e),
                           inertia=np.ldexp(inertia, 2 * e))
+
+
+def body_mass_properties(mesh, mass: float) -> MassProperties:
+    """A simulated body's mass properties: those of the uniform solid when the
+    mesh is closed and encloses a positive volume, else the seed's point
+    masses at the vertices (:func:`point_mass_properties`: an open or flat
+    surface bounds no solid)."""
+    if mesh.is_closed and (mesh.volume or 0.0) > 0.0:
+        return mass_properties(mesh.vertices, mesh.faces, mass)
+    return point_mass_properties(mesh.vertices, mass)
+
+
+def inertia_problem(props: MassProperties) -> str | None:
+    """Why a body with these mass properties cannot be simulated, or None.
+
+    The loop inverts the inertia tensor and bounds the rotational energy by
+    its largest moment, so it needs finite moments, all positive
+    (``INERTIA_RTOL``).
+    """
+    if not (np.isfinite(props.inertia).all() and np.isfinite(props.center).all()):
+        return "its inertia is beyond float64's range (the body is too large or too heavy)"
+    moments = np.linalg.eigvalsh(props.inertia)
+    if not moments[0] > INERTIA_RTOL * moments[-1]:
+        return ("its inertia tensor is singular: the model's vertices lie on a line or "
+                "at one point; a body needs triangles that span a plane")
+    return None

@@ -7,17 +7,19 @@ One step (:meth:`Simulation.step`), as an outline:
                positions and velocities of all B bodies at once;
 2. rotation    the orientation step: the seed's Euler step of the axes (S9)
                or the exact rotation with angular momentum (corrected);
-3. bounds      each body's world box (S2: the linear scan, or the incremental
+3. check       divergence: a non-finite state, or energy beyond all bounds
+               (right after the motion, so that no later stage ever sees a
+               non-finite state: every stage after it maps finite to finite);
+4. bounds      each body's world box (S2: the linear scan, or the incremental
                tracker for convex bodies, ``collision.aabb``; small meshes
                batched, see ``boxes``);
-4. walls       the world-cube test (S3) and the response (S7, plus S9's
+5. walls       the world-cube test (S3) and the response (S7, plus S9's
                change of w at the contact vertex; or the corrected impulses);
-5. broad-phase sort and sweep over the B boxes (S4 test 1; compiled by numba);
-6. narrow-phase the scene's collision level on the pairs that pass (S4);
-7. body-response  the seed's velocity exchange (S8) or the corrected impulse;
-8. check       divergence: a non-finite state, or energy beyond all bounds.
+6. broad-phase sort and sweep over the B boxes (S4 test 1; compiled by numba);
+7. narrow-phase the scene's collision level on the pairs that pass (S4);
+8. body-response  the seed's velocity exchange (S8) or the corrected impulse.
 
-Stages 2, 5-7 run only when needed: no rotation work with ``rotation =
+Stages 2, 6-8 run only when needed: no rotation work with ``rotation =
 "off"``; no body-body work for one body, ``collision.level = "none"`` or
 ``body_response = "off"``; no narrow phase at level "aabb" (the boxes are
 the answer). ``Trajectory.stages`` lists the stages that ran and
@@ -66,7 +68,7 @@ from refsim.dynamics.body_response import (
 from refsim.dynamics.boxes import boxes_compiled
 from refsim.dynamics.broad_phase import overlapping_pairs_compiled
 from refsim.dynamics.forces import translational_rhs
-from refsim.dynamics.mass_properties import mass_properties, point_mass_properties
+from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
 from refsim.dynamics.rotation_impulse import (
     orientation_step_exact,
     wall_contacts,
@@ -79,8 +81,15 @@ from refsim.dynamics.rotation_seed import (
 )
 from refsim.dynamics.trajectory import Event, Trajectory
 from refsim.dynamics.walls import SPEEDS, wall_name, wall_response_seed, wall_speed
-from refsim.errors import DivergenceError, StateError
+from refsim.errors import (
+    ArgumentTypeError,
+    DivergenceError,
+    StateError,
+    check_count,
+    check_option,
+)
 from refsim.models.mesh import Mesh
+from refsim.scenes.schema import Scene
 from refsim.solvers.integrate import resolve_method
 
 #: At most about this many frames by default (``every`` is chosen so).
@@ -102,8 +111,8 @@ BATCH_VERTICES = 64
 
 BOXES = ("auto", "trackers", "batched")
 
-STAGES = ("integrate", "rotation", "bounds", "walls", "broad-phase", "narrow-phase",
-          "body-response", "check")
+STAGES = ("integrate", "rotation", "check", "bounds", "walls", "broad-phase", "narrow-phase",
+          "body-response")
 
 
 @dataclass(frozen=True)
@@ -117,14 +126,6 @@ class Body:
     mass: float
     center: np.ndarray          # body-space centroid the body rotates about
     inertia: np.ndarray         # (3, 3) body-space, about the solid's centre of mass
-
-
-def _scaled_mesh(mesh: Mesh, scale: float) -> Mesh:
-    if scale == 1.0:
-        return mesh
-    return mesh.derived(f"scaled:{scale!r}",
-                        lambda m: Mesh(m.vertices * scale, m.faces, name=m.name,
-                                       source=m.source))
 
 
 class Simulation:
@@ -162,10 +163,11 @@ class Simulation:
     """
 
     def __init__(self, scene, *, wall_speed: str = "wall", boxes: str = "auto"):
-        if wall_speed not in SPEEDS:
-            raise StateError(f"wall_speed must be one of {SPEEDS}, got {wall_speed!r}")
-        if boxes not in BOXES:
-            raise StateError(f"boxes must be one of {BOXES}, got {boxes!r}")
+        if not isinstance(scene, Scene):
+            raise ArgumentTypeError(f"scene must be a refsim.Scene (refsim.load_scene(path)), "
+                                    f"got {type(scene).__name__}")
+        check_option("wall_speed", wall_speed, SPEEDS)
+        check_option("boxes", boxes, BOXES)
         self.boxes = boxes
         self.scene = scene
         self.wall_speed = wall_speed
@@ -183,11 +185,11 @@ class Simulation:
 
         bodies = []
         for cfg in scene.bodies:
-            mesh = _scaled_mesh(scene.mesh(cfg), cfg.scale)
-            if mesh.is_closed and (mesh.volume or 0.0) > 0.0:
-                props = mass_properties(mesh.vertices, mesh.faces, cfg.mass)
-            else:
-                props = point_mass_properties(mesh.vertices, cfg.mass)
+            mesh = scene.mesh(cfg).scaled(cfg.scale)
+            props = body_mass_properties(mesh, cfg.mass)
+            problem = inertia_problem(props)      # (the loader checked a scene file's bodies)
+            if problem:
+                raise StateError(f"body {cfg.name!r}: {problem}")
             # AMBIGUITY (seed S9): the seed's centroid is the vertex average
             # ("assuming equal masses for each vertex"); the corrected model
             # rotates about the solid's centre of mass. Equal for every
@@ -336,6 +338,9 @@ class Simulation:
             self._rotate()
             t0, t1 = t1, clock()
             seconds["rotation"] += t1 - t0
+        self._check()
+        t0, t1 = t1, clock()
+        seconds["check"] += t1 - t0
         self._bounds()
         t0, t1 = t1, clock()
         seconds["bounds"] += t1 - t0
@@ -358,16 +363,22 @@ class Simulation:
         self.t = (self.steps + 1) * self.h
         self.steps += 1
         self._note_events(touching)
-        self._check()
-        seconds["check"] += clock() - t1
 
     def run(self, n_steps: int, every: int = 1) -> None:
         """Take ``n_steps`` steps, recording a frame after every ``every``-th
-        step (counted from the start of the simulation)."""
-        for _ in range(n_steps):
-            self.step()
-            if self.steps % every == 0:
-                self.record()
+        step (counted from the start of the simulation).
+
+        Overflow on the way to a non-finite state raises DivergenceError
+        from the check stage; numpy's own warnings of it are silenced here
+        (they would repeat the news once per operation, unattributed).
+        """
+        n_steps = check_count("n_steps", n_steps)
+        every = check_count("every", every, minimum=1)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            for _ in range(n_steps):
+                self.step()
+                if self.steps % every == 0:
+                    self.record()
 
     # 1. forces and the solver, all bodies at once (S5, S6)
     def _integrate(self) -> None:
@@ -386,7 +397,7 @@ class Simulation:
             self.R[...], self.w[...] = orientation_step_exact(
                 self.R, self.w, self.h, self.I_body, self.I_body_inv)
 
-    # 3. boxes (S2)
+    # 4. boxes (S2)
     def _bounds(self) -> None:
         origin = self.position
         for idx, vertices_t in self._linear_groups:
@@ -398,7 +409,7 @@ class Simulation:
             # check stage), so the tracker's per-call validation is skipped.
             self.lo[i], self.hi[i] = tracker.update_unchecked(self.R[i], origin[i])
 
-    # 4. walls (S3, S7, S9 or corrected)
+    # 5. walls (S3, S7, S9 or corrected)
     def _walls(self, touching: set) -> None:
         H = self.scene.world.half_size
         beyond = np.flatnonzero(((self.lo < -H) | (self.hi > H)).any(axis=1))
@@ -461,7 +472,7 @@ class Simulation:
                 world.restitution, world.friction, impulse.RESTITUTION_THRESHOLD,
                 impulse.ITERATIONS, P)
 
-    # 5. broad phase (S4 test 1)
+    # 6. broad phase (S4 test 1)
     def _broad_phase(self) -> np.ndarray:
         if self.level == "sphere":
             from refsim.collision.spheres import bounding_sphere
@@ -476,7 +487,7 @@ class Simulation:
                                               centres + radii[:, None])
         return overlapping_pairs_compiled(self.lo, self.hi)
 
-    # 6. narrow phase (S4 at the scene's level)
+    # 7. narrow phase (S4 at the scene's level)
     def _narrow_phase(self, pairs: np.ndarray) -> list:
         from refsim.collision.bodies import bodies_collide
 
@@ -487,7 +498,7 @@ class Simulation:
                 hits.append((a, b))
         return hits
 
-    # 7. body-body response (S8, or corrected)
+    # 8. body-body response (S8, or corrected)
     def _body_response(self, pairs, touching: set) -> None:
         world = self.scene.world
         for a, b in pairs:
@@ -515,7 +526,7 @@ class Simulation:
             self.x[a] += dx_a
             self.x[b] += dx_b
 
-    # 8. divergence
+    # 3. divergence
     def _check(self) -> None:
         # One O(B) sum answers both questions: a non-finite x, v or w makes
         # the energy NaN or inf, and "not (E <= limit)" is then true (R stays
@@ -534,8 +545,9 @@ class Simulation:
                        int(np.argmax(energy)))
 
     def _diverged(self, message: str, i: int):
-        raise DivergenceError(message, step=self.steps, time=self.t, body=self.names[i],
-                              partial=self.trajectory())
+        # raised within the step being taken: step self.steps + 1
+        raise DivergenceError(message, step=self.steps + 1, time=(self.steps + 1) * self.h,
+                              body=self.names[i], partial=self.trajectory())
 
     def _note_events(self, touching: set) -> None:
         for body, other in sorted(touching - self._touching):

@@ -97,6 +97,7 @@ from pathlib import Path
 import numpy as np
 
 from refsim.errors import ModelError, ModelWarning
+from refsim.files import read_regular_file
 from refsim.io import write_text_atomic
 from refsim.models.mesh import Material, Mesh
 from refsim.models.triangulate import ear_clip
@@ -566,11 +567,15 @@ def _parse(text: str, path, weld_tolerance: float, count_encoding: str) -> Mesh:
 
 
 def read_ac3d(path, *, weld_tolerance: float = 0.0) -> Mesh:
-    """Read an AC3D file. UTF-8 text, or Latin-1 when it is not valid UTF-8."""
-    try:
-        raw = Path(path).read_bytes()
-    except OSError as exc:
-        raise ModelError(f"cannot read the file: {exc.strerror or exc}", path=path) from None
+    """Read an AC3D file. UTF-8 text, or Latin-1 when it is not valid UTF-8.
+
+    Raises
+    ------
+    ModelError
+        Naming the file and, for a malformed file, the line; a directory,
+        FIFO or device is refused without being opened.
+    """
+    raw = read_regular_file(path, ModelError)
     try:
         return _parse(raw.decode("utf-8"), path, weld_tolerance, "utf-8")
     except UnicodeDecodeError:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -63,8 +64,12 @@ def centroid_offset(mesh: Mesh) -> float | None:
     if mesh.centroid_volume is None:
         return None
     lo, hi = mesh.bounds
-    gap = np.linalg.norm(mesh.centroid_vertex_average - mesh.centroid_volume)
-    return float(gap / np.linalg.norm(hi - lo))
+    # Lengths by math.hypot, which scales internally: no overflow for any
+    # finite coordinates (np.linalg.norm squares them). The differences of
+    # coordinates near 1e308 are taken in half scale for the same reason.
+    gap = math.hypot(*(0.5 * mesh.centroid_vertex_average - 0.5 * mesh.centroid_volume))
+    diagonal = math.hypot(*(0.5 * hi - 0.5 * lo))
+    return gap / diagonal
 
 
 def format_facts(facts: ModelFacts) -> str:
@@ -85,7 +90,9 @@ def format_facts(facts: ModelFacts) -> str:
         ("bounds max", vec(facts.bounds_hi)),
         ("centroid (vertex average, seed)", vec(facts.centroid_vertex_average)),
         ("centroid (volume)", vec(facts.centroid_volume)),
-        ("volume", "n/a (open mesh)" if facts.volume is None else f"{facts.volume:.6g}"),
+        ("volume", "n/a (open mesh)" if facts.volume is None else
+         f"{facts.volume:.6g}" if math.isfinite(facts.volume) else
+         f"{facts.volume:.6g} (beyond float64's range)"),
         ("centroid offset / diagonal", "n/a (open mesh)" if facts.centroid_offset is None
          else f"{facts.centroid_offset:.3g}"),
         ("most neighbours of a vertex", facts.max_neighbors),

@@ -18,12 +18,14 @@ Cost: that of the reader, O(file size), plus the O(n log n) weld.
 
 from __future__ import annotations
 
+import io
 from pathlib import Path
 
 import numpy as np
 
 from refsim.bundled import models_dir
 from refsim.errors import ModelError
+from refsim.files import as_path, read_regular_file
 from refsim.models.ac3d import read_ac3d
 from refsim.models.mesh import Mesh
 
@@ -50,17 +52,15 @@ def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
         When the file is missing, its suffix is not supported, or it cannot
         be read as a triangle mesh.
     """
-    path = Path(path)
+    path = as_path(path)
     suffix = path.suffix.lower()
     if suffix not in SUFFIXES:
         raise ModelError(f"unknown model format {path.suffix or '(no suffix)'!r}; "
                          f"supported: {', '.join(SUFFIXES)}", path=path)
     path = _bundled_if_bare(path)
-    if not path.is_file():
-        raise ModelError("no such file", path=path)
     if suffix == ".ac":
         return read_ac3d(path, weld_tolerance=weld_tolerance)
-    return _load_with_trimesh(path, weld_tolerance)
+    return _load_with_trimesh(path, read_regular_file(path, ModelError), weld_tolerance)
 
 
 def _bundled_if_bare(path: Path) -> Path:
@@ -72,11 +72,28 @@ def _bundled_if_bare(path: Path) -> Path:
     return bundled if bundled.is_file() else path
 
 
-def _load_with_trimesh(path: Path, weld_tolerance: float) -> Mesh:
+#: The formats trimesh reads as text (the others, binary STL and PLY, as bytes).
+TEXT_SUFFIXES = (".obj", ".off")
+
+
+def _load_with_trimesh(path: Path, data: bytes, weld_tolerance: float) -> Mesh:
     import trimesh  # lazy: only these formats need it
 
+    suffix = path.suffix.lower()
+    if suffix in TEXT_SUFFIXES:
+        # Decoded here, UTF-8 or else Latin-1 (every byte is a Latin-1
+        # character), as the AC3D reader does: trimesh would otherwise guess
+        # the encoding of a file that is not UTF-8 with the optional package
+        # charset_normalizer, and fail without it.
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            text = data.decode("latin-1")
+        source = io.StringIO(text)
+    else:
+        source = io.BytesIO(data)
     try:
-        loaded = trimesh.load(path, force="mesh", process=False)
+        loaded = trimesh.load(source, file_type=suffix[1:], force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types for bad files
         raise ModelError(f"trimesh cannot read it: {_one_line(exc)}", path=path) from None
     faces = getattr(loaded, "faces", None)

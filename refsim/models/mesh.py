@@ -36,7 +36,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import ConvexHull, QhullError, cKDTree
 
-from refsim.errors import ModelError
+from refsim.errors import ArgumentTypeError, ModelError
 from refsim.types import unit_exponent
 
 #: Relative tolerance of the convexity test. A vertex of a neighbouring face
@@ -153,6 +153,16 @@ class Mesh:
             cache[key] = build(self)
         return cache[key]
 
+    def scaled(self, factor: float) -> Mesh:
+        """This mesh with every vertex times ``factor`` (> 0), kept with the
+        mesh (a scene's bodies of one model and one scale share it)."""
+        if factor == 1.0:
+            return self
+        return self.derived(f"scaled:{factor!r}", lambda m: Mesh(
+            m.vertices * factor, m.faces, face_material=m.face_material,
+            face_flags=m.face_flags, face_object=m.face_object, materials=m.materials,
+            objects=m.objects, name=m.name, source=m.source))
+
     def _error(self, message: str) -> ModelError:
         return ModelError(message, path=self.source or self.name)
 
@@ -244,7 +254,8 @@ class Mesh:
     def face_areas(self) -> np.ndarray:
         cross = self._face_cross
         norm = np.sqrt((cross * cross).sum(axis=1))
-        return _readonly(np.ldexp(0.5 * norm, 2 * self._exponent))
+        with np.errstate(over="ignore", under="ignore"):    # out of float64's range: inf, 0
+            return _readonly(np.ldexp(0.5 * norm, 2 * self._exponent))
 
     @cached_property
     def degenerate_faces(self) -> np.ndarray:
@@ -273,7 +284,8 @@ class Mesh:
         wind outward), or None for an open mesh."""
         if not self.is_closed:
             return None
-        return float(np.ldexp(self._tetra_volumes().sum(), 3 * self._exponent))
+        with np.errstate(over="ignore"):      # a volume beyond float64 is inf, as IEEE rounds it
+            return float(np.ldexp(self._tetra_volumes().sum(), 3 * self._exponent))
 
     @cached_property
     def centroid_volume(self) -> np.ndarray | None:
@@ -342,6 +354,16 @@ class Mesh:
         except QhullError:
             return False
         return abs(hull.volume - volume) <= 1e-9 * hull.volume
+
+
+def require_mesh(obj, what: str = "mesh") -> Mesh:
+    """``obj`` when it is a :class:`Mesh`; else :class:`ArgumentTypeError`
+    naming the argument (``refsim.Mesh(vertices, faces)`` builds one)."""
+    if not isinstance(obj, Mesh):
+        raise ArgumentTypeError(f"{what} must be a refsim.Mesh, got {type(obj).__name__} "
+                                "(build one with refsim.Mesh(vertices, faces) or "
+                                "refsim.load_model(path))")
+    return obj
 
 
 def _readonly(array: np.ndarray) -> np.ndarray:

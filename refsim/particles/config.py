@@ -21,6 +21,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from refsim.errors import SceneError
+from refsim.limits import MAX_MAGNITUDE, MAX_PARTICLES, MIN_POSITIVE
 
 DRAG_MODELS = ("linear", "quadratic")
 
@@ -93,6 +94,10 @@ class ParticleConfig:
                 bad(field, f"expected a number, got {value!r}")
             if not math.isfinite(value):
                 bad(field, f"must be finite, got {value!r}")
+            if abs(value) > MAX_MAGNITUDE:
+                bad(field, f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {value!r}")
+            if lo_open and lo == 0.0 and 0.0 < value < MIN_POSITIVE:
+                bad(field, f"must be at least {MIN_POSITIVE:g}, got {value!r}")
             if value < lo or (lo_open and value == lo) or value > hi:
                 low = "(" if lo_open else "["
                 bad(field, f"must be in {low}{lo}, {hi}], got {value!r}")
@@ -102,8 +107,9 @@ class ParticleConfig:
             value = getattr(self, field)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
                 bad(field, f"expected an integer, got {value!r}")
-        if self.count < 1:
-            bad("count", f"must be at least 1, got {self.count!r}")
+        if not 1 <= self.count <= MAX_PARTICLES:
+            bad("count", f"must be in [1, {MAX_PARTICLES}], got {self.count!r} (at most "
+                f"{MAX_PARTICLES:.0e} particles: refsim.limits.MAX_PARTICLES)")
         if self.seed < 0:
             bad("seed", f"must be non-negative, got {self.seed!r}")
         number("half_size", lo=0.0, lo_open=True)

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from refsim.errors import DivergenceError, StateError
+from refsim.errors import DivergenceError, StateError, check_count, check_option
 from refsim.particles.config import ParticleConfig
 from refsim.particles.forces import acceleration, acceleration_into
 from refsim.particles.walls import wall_response, wall_response_inplace
@@ -212,9 +212,15 @@ class ParticleSystem:
         DivergenceError
             The state became non-finite (checked once, after the steps, to
             keep the loop at one pass over memory per operation).
+        StateError, ArgumentTypeError
+            ``steps`` is negative or not an integer.
         """
-        for _ in range(steps):
-            self.step()
+        steps = check_count("steps", steps)
+        # Overflow on the way to inf is what the check below reports, once;
+        # numpy's warnings would print it again, per operation.
+        with np.errstate(over="ignore", invalid="ignore"):
+            for _ in range(steps):
+                self.step()
         # max and min propagate NaN and see +-inf, without the (2, N, 3) bool
         # temporary of np.isfinite(state).all().
         if not (np.isfinite(self.state.max()) and np.isfinite(self.state.min())):
@@ -237,8 +243,8 @@ def _choose_kernel(kernel: str | None, method) -> str:
     """"numpy": the generic step over the tableau (any solver). "fused": the
     Euler step compiled into one loop (solver "euler" only, needs numba).
     Default: "fused" for Euler when numba is installed, else "numpy"."""
-    if kernel is not None and kernel not in KERNELS:
-        raise StateError(f"kernel must be one of {KERNELS}, got {kernel!r}")
+    if kernel is not None:
+        check_option("kernel", kernel, KERNELS)
     euler = method.name == "euler"
     if kernel == "fused" and not euler:
         raise StateError(f"kernel 'fused' is the Euler step only, not {method.name!r}")

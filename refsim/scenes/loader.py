@@ -20,19 +20,27 @@ import math
 import tomllib
 from pathlib import Path
 
+import numpy as np
+
 from refsim.bundled import models_dir, scenes_dir
-from refsim.errors import SceneError
+from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
+from refsim.errors import ModelError, SceneError, StateError
+from refsim.files import as_path, decode_utf8, read_regular_file
+from refsim.limits import MAX_MAGNITUDE
+from refsim.models.loading import load_model
 from refsim.scenes.schema import (
     BODY_FIELDS,
-    MAX_STEPS,
     PARTICLE_FIELDS_FROM,
     PARTICLE_KEYS,
+    START_INSIDE_RTOL,
     TABLES,
     BodyConfig,
     Field,
     ParticleConfig,
     Scene,
 )
+from refsim.solvers.integrate import whole_steps
+from refsim.types import transform_points
 
 
 def load_scene(path) -> Scene:
@@ -40,20 +48,25 @@ def load_scene(path) -> Scene:
 
     A bare file name that is not in the current directory names a bundled
     scene (``refsim.bundled.scenes_dir()``), e.g. ``"bounce.toml"``.
+
+    Raises
+    ------
+    SceneError
+        Naming the file and the key (or line) of the first problem found.
+    ModelError
+        Never: a body's broken model is reported as a SceneError naming the
+        scene, the body's key and the model file's own line.
     """
-    path = Path(path)
+    path = as_path(path)
     if not path.exists() and path.name == str(path) and (scenes_dir() / path.name).is_file():
         path = scenes_dir() / path.name
-    try:
-        text = path.read_bytes().decode("utf-8")
-    except FileNotFoundError:
-        raise SceneError("no such file", path) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SceneError(f"cannot read: {exc}", path) from None
+    text = decode_utf8(read_regular_file(path, SceneError), path, SceneError)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"invalid TOML: {exc}", path) from None
+    except RecursionError:
+        raise SceneError("invalid TOML: values nested too deeply", path) from None
     return scene_from_dict(data, path)
 
 
@@ -73,9 +86,10 @@ def scene_from_dict(data: dict, path: Path | None = None) -> Scene:
         configs[table] = cls(**_read_fields(raw, fields, table, path))
 
     integration = configs["integration"]
-    if integration.duration / integration.step > MAX_STEPS:
-        raise SceneError(f"duration / step exceeds {MAX_STEPS:.0e} steps",
-                         path, "integration.step")
+    try:
+        whole_steps(integration.duration, integration.step)
+    except StateError as exc:
+        raise SceneError(str(exc), path, "integration.duration") from None
 
     raw_bodies = data.get("body", [])
     if not isinstance(raw_bodies, list):
@@ -100,7 +114,9 @@ def scene_from_dict(data: dict, path: Path | None = None) -> Scene:
         raise SceneError("a scene needs at least one [[body]] or a [particles] table",
                          path, "body")
 
-    meshes = _load_meshes(bodies)
+    meshes = _load_meshes(bodies, path)
+    for i, body in enumerate(bodies):
+        _check_body(body, meshes[body.model], configs["world"], path, f"body[{i}]")
     return Scene(path=path, bodies=tuple(bodies), meshes=meshes, particles=particles,
                  **configs)
 
@@ -165,9 +181,16 @@ def _number(value, path, key) -> float:
     # bool is an int in Python; "true" is never a number in a scene.
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise SceneError(f"must be a number, got {type(value).__name__} {value!r}", path, key)
-    value = float(value)
+    try:
+        value = float(value)
+    except OverflowError:                 # an integer beyond float64
+        raise SceneError(f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {value!r}",
+                         path, key) from None
     if not math.isfinite(value):
         raise SceneError(f"must be finite, got {value!r}", path, key)
+    if abs(value) > MAX_MAGNITUDE:
+        raise SceneError(f"must be at most {MAX_MAGNITUDE:g} in magnitude, got {value!r}",
+                         path, key)
     return value
 
 
@@ -203,11 +226,54 @@ def _resolve_model(name: str, scene_path: Path | None, key: str) -> Path:
     raise SceneError(f"model {name!r} not found (looked in {looked})", scene_path, key)
 
 
-def _load_meshes(bodies) -> dict:
-    from refsim.models.loading import load_model
-
+def _load_meshes(bodies, scene_path) -> dict:
+    """Each distinct model once; a model's error names the scene and the
+    first body that uses it, then the model file and its line."""
     meshes = {}
-    for body in bodies:
+    for i, body in enumerate(bodies):
         if body.model not in meshes:
-            meshes[body.model] = load_model(body.model)
+            try:
+                meshes[body.model] = load_model(body.model)
+            except ModelError as exc:           # the model's own error stays the cause
+                raise SceneError(str(exc), scene_path, f"body[{i}].model") from exc
     return meshes
+
+
+def _check_body(body: BodyConfig, mesh, world, path, where: str) -> None:
+    """A body the loop can simulate: a model wound outward, a starting box
+    inside the world cube, and a positive-definite inertia."""
+    name = body.model.name
+    if mesh.is_closed and mesh.volume is not None and mesh.volume < 0.0:
+        raise SceneError(f"model {name} is wound inside out (enclosed volume "
+                         f"{mesh.volume:.6g}); reverse its faces' corner order",
+                         path, f"{where}.model")
+    try:
+        scaled = mesh.scaled(body.scale)
+    except ModelError:
+        raise SceneError(f"model {name} at scale {body.scale:g} has coordinates beyond "
+                         "float64's range", path, f"{where}.scale") from None
+    H = world.half_size
+    rotation = np.array(body.orientation, dtype=np.float64)
+    with np.errstate(over="ignore"):          # a box beyond float64 is refused below
+        world_vertices = transform_points(scaled.vertices,
+                                          (rotation, np.array(body.position)))
+    lo, hi = world_vertices.min(axis=0), world_vertices.max(axis=0)
+    slack = START_INSIDE_RTOL * H
+    if ((hi - lo) > 2.0 * H + slack).any():
+        raise SceneError(f"model {name} at scale {body.scale:g} is larger than the world "
+                         f"cube: its box spans {_spans(hi - lo)}, the cube {2.0 * H:g}",
+                         path, f"{where}.scale" if body.scale != 1.0 else f"{where}.model")
+    for k in range(3):
+        if lo[k] < -H - slack or hi[k] > H + slack:
+            raise SceneError(
+                f"the body starts outside the world cube: its box spans {'xyz'[k]} = "
+                f"{lo[k]:.6g} to {hi[k]:.6g}, the cube -{H:g} to {H:g}", path,
+                f"{where}.position")
+
+    problem = inertia_problem(body_mass_properties(scaled, body.mass))
+    if problem:
+        raise SceneError(f"model {name} at scale {body.scale:g}: {problem}", path, where)
+
+
+def _spans(extent) -> str:
+    return " x ".join(f"{x:.6g}" for x in extent)

@@ -32,7 +32,9 @@ from typing import Any
 
 import numpy as np
 
+from refsim.limits import MIN_POSITIVE
 from refsim.particles.config import ParticleConfig
+from refsim.solvers.integrate import whole_steps
 
 SOLVER_NAMES = ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4")
 COLLISION_LEVELS = ("none", "sphere", "aabb", "triangle-aabb", "exact")
@@ -41,9 +43,10 @@ ROTATION_MODELS = ("off", "seed", "impulse")
 RESPONSE_MODELS = ("off", "seed", "impulse")
 DRAG_MODELS = ("linear", "quadratic")
 
-#: At most this many steps in one scene (duration / step): a guard against a
-#: typo such as ``step = 1e-9`` that would otherwise run for days.
-MAX_STEPS = 100_000_000
+#: A body's starting box may stick out of the world cube by this fraction of
+#: the cube's half size: the rounding of a position written as
+#: ``-half_size + half the body's height``, never a real overlap.
+START_INSIDE_RTOL = 1e-9
 
 
 # -- the configuration objects -------------------------------------------------
@@ -67,7 +70,8 @@ class IntegrationConfig:
 
     @property
     def n_steps(self) -> int:
-        return int(round(self.duration / self.step))
+        """The whole number of steps in ``duration`` (the loader checks it is one)."""
+        return whole_steps(self.duration, self.step)
 
 
 @dataclass(frozen=True)
@@ -141,7 +145,9 @@ class Field:
 
 
 def positive(value) -> str | None:
-    return None if value > 0 else "must be > 0"
+    if not value > 0:
+        return "must be > 0"
+    return None if value >= MIN_POSITIVE else f"must be at least {MIN_POSITIVE:g}"
 
 
 def non_negative(value) -> str | None:

@@ -28,7 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from refsim.errors import DivergenceError, StateError
+from refsim.errors import DivergenceError, OptionError, StateError, check_option
+from refsim.limits import MAX_RESULT_BYTES, MAX_STEPS
 from refsim.solvers.explicit_rk import ExplicitRungeKutta
 from refsim.solvers.methods import SEED_LITERAL_VARIANTS, SOLVERS
 
@@ -37,6 +38,34 @@ from refsim.solvers.methods import SEED_LITERAL_VARIANTS, SOLVERS
 #: (5000) misses the duration by a few ulps; 1e-9 admits that rounding and
 #: nothing a user would call a different step.
 STEP_COUNT_RTOL = 1e-9
+
+
+def whole_steps(duration: float, h: float) -> int:
+    """The number of steps of ``h`` in ``duration``, which must be a whole
+    number of them (to ``STEP_COUNT_RTOL``), at least one and at most
+    ``MAX_STEPS``.
+
+    Raises
+    ------
+    StateError
+        Naming ``duration / h``; the scene loader turns it into a
+        :class:`~refsim.errors.SceneError` naming the key.
+    """
+    if not (math.isfinite(duration) and math.isfinite(h) and duration > 0.0 and h > 0.0):
+        raise StateError(f"duration {duration!r} and step {h!r} must be finite and > 0")
+    ratio = duration / h
+    if ratio > MAX_STEPS:
+        raise StateError(f"duration / step = {duration:g} / {h:g} = {ratio:.3g} steps exceeds "
+                         f"the limit of {MAX_STEPS:.0e}")
+    n = round(ratio)
+    if n < 1:
+        raise StateError(f"duration {duration:g} is shorter than one step of {h:g}")
+    if abs(ratio - n) > STEP_COUNT_RTOL * n:
+        raise StateError(f"duration / step = {duration:g} / {h:g} = {ratio:.9g} is not a whole "
+                         f"number of steps "
+                         f"(try duration = {math.floor(ratio) * h:.9g} or "
+                         f"{math.ceil(ratio) * h:.9g})")
+    return n
 
 
 @dataclass(frozen=True)
@@ -72,7 +101,13 @@ def resolve_method(method) -> ExplicitRungeKutta:
     if method in SEED_LITERAL_VARIANTS:
         return SEED_LITERAL_VARIANTS[method]
     known = ", ".join(sorted(SOLVERS))
-    raise StateError(f"unknown solver {method!r}; expected one of {known}")
+    raise OptionError(f"unknown solver {method!r}; expected one of {known}")
+
+
+def covering_duration(duration: float, h: float) -> float:
+    """The shortest whole number of steps of ``h`` that covers ``duration``,
+    as a duration: for a study that needs "at least this long"."""
+    return max(1, math.ceil(duration / h * (1.0 - STEP_COUNT_RTOL))) * h
 
 
 def step_grid(t0: float, t1: float, h: float,
@@ -89,9 +124,11 @@ def step_grid(t0: float, t1: float, h: float,
         raise StateError(f"step h must be positive, got {h!r}")
     if t1 < t0:
         raise StateError(f"t1 = {t1!r} is before t0 = {t0!r}")
-    if last_step not in ("error", "short"):
-        raise StateError(f"last_step must be 'error' or 'short', got {last_step!r}")
+    check_option("last_step", last_step, ("error", "short"))
     ratio = (t1 - t0) / h
+    if ratio > MAX_STEPS:
+        raise StateError(f"(t1 - t0) / h = {ratio:.3g} steps exceeds the limit of "
+                         f"{MAX_STEPS:.0e}")
     n = round(ratio)
     if abs(ratio - n) <= STEP_COUNT_RTOL * max(n, 1):
         t = t0 + h * np.arange(n + 1, dtype=np.float64)
@@ -142,6 +179,11 @@ def solve_fixed_step(f, y0, t0: float, t1: float, h: float, method="rk4", *,
         raise StateError("y0 has a non-finite value")
     t, hs = step_grid(t0, t1, h, last_step)
     steps = len(hs)
+    size = (steps + 1) * y0.size * 8
+    if size > MAX_RESULT_BYTES:
+        raise StateError(f"the trajectory of {steps + 1} states of size {y0.size} would take "
+                         f"{size / 2**30:.3g} GiB (at most {MAX_RESULT_BYTES / 2**30:g} GiB); "
+                         "integrate a shorter interval or a larger step")
 
     nfev = 0
 

@@ -22,6 +22,7 @@ import pytest
 from refsim.oracles.fcl_adapter import FCLOracle
 from refsim.oracles.trimesh_collision import TrimeshCollisionOracle, float32_pose
 
+import refsim
 from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
 from refsim.collision.measure_levels import (
     CONFIGURATIONS,
@@ -300,3 +301,40 @@ def test_speed_configurations_are_what_they_say(fcl):
             assert 1 <= c.exact_pairs <= 50        # "a handful" (measured: 18, 20)
         else:
             assert c.exact_pairs >= 100            # "hundreds" (measured: 198, 264)
+
+
+# -- any finite scale ------------------------------------------------------------------
+
+#: Powers of two from near the smallest normal float to near the largest; at
+#: each, two bodies are scaled with their poses' translations (exact in binary
+#: floating point), so every answer must equal the one at scale 1.
+SCALE_EXPONENTS = [-1000, -600, -300, -100, 100, 300, 600, 900, 1010]
+
+
+@pytest.mark.parametrize("exponent", SCALE_EXPONENTS)
+def test_every_level_answers_the_same_at_any_scale(exponent):
+    cube, ico = refsim.load_model("cube.ac"), refsim.load_model("icosahedron.ac")
+    tilt = refsim.types.rotation_about_axis([1.0, 2.0, 3.0], 0.4)
+    cases = [(cube, cube, 0.9), (ico, cube, 1.2), (cube, ico, 3.0)]   # overlap, near, apart
+    s = 2.0 ** exponent
+    for a, b, gap in cases:
+        pa = (np.eye(3), np.array([-0.5 * gap, 0.0, 0.0]))
+        pb = (tilt, np.array([0.5 * gap, 0.1, 0.0]))
+        big_a, big_b = refsim.Mesh(a.vertices * s, a.faces), refsim.Mesh(b.vertices * s, b.faces)
+        big_pa, big_pb = (pa[0], pa[1] * s), (pb[0], pb[1] * s)
+        assert big_a.is_convex == a.is_convex
+        for level in ("sphere", "aabb", "triangle-aabb", "exact"):
+            assert (refsim.bodies_collide(big_a, big_pa, big_b, big_pb, level=level)
+                    == refsim.bodies_collide(a, pa, b, pb, level=level)), (level, gap)
+        assert np.array_equal(refsim.intersecting_pairs(big_a, big_pa, big_b, big_pb),
+                              refsim.intersecting_pairs(a, pa, b, pb))
+
+
+def test_the_sphere_level_is_conservative_near_float64s_largest_values():
+    # two cubes with corners at +-5e307 whose centres are 6e307 apart overlap
+    cube = refsim.load_model("cube.ac")
+    huge = refsim.Mesh(cube.vertices * 1e308, cube.faces)
+    a, b = (np.eye(3), np.zeros(3)), (np.eye(3), np.array([6e307, 0.0, 0.0]))
+    assert refsim.bodies_collide(huge, a, huge, b, level="exact")
+    for level in ("sphere", "aabb", "triangle-aabb"):
+        assert refsim.bodies_collide(huge, a, huge, b, level=level)

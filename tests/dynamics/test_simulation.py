@@ -43,7 +43,7 @@ def test_public_names():
 def test_one_body_has_no_body_body_stage_and_rotation_off_no_rotation_stage():
     sim = Simulation(_scene([CUBE], collision={"level": "exact"},
                             dynamics={"body_response": "seed"}))
-    assert sim.stages == ("integrate", "bounds", "walls", "check")
+    assert sim.stages == ("integrate", "check", "bounds", "walls")
     traj = simulate(_scene([CUBE]))
     assert "rotation" not in traj.stages and "broad-phase" not in traj.stages
     assert set(traj.stage_seconds) == set(traj.stages)
@@ -53,8 +53,8 @@ def test_two_bodies_at_level_aabb_have_broad_phase_but_no_narrow_phase():
     other = {**CUBE, "name": "other", "position": [2.0, 0.0, 0.0]}
     sim = Simulation(_scene([CUBE, other], collision={"level": "aabb"},
                             dynamics={"body_response": "seed", "rotation": "seed"}))
-    assert sim.stages == ("integrate", "rotation", "bounds", "walls", "broad-phase",
-                          "body-response", "check")
+    assert sim.stages == ("integrate", "rotation", "check", "bounds", "walls", "broad-phase",
+                          "body-response")
 
 
 def test_free_fall_is_exact_with_rk4():
@@ -210,3 +210,18 @@ def test_sphere_level_finds_the_contact_and_the_seed_exchanges():
     assert "narrow-phase" in traj.stages
     assert np.allclose(traj.velocity[-1], [[0.0, 0, 0], [1.0, 0, 0]])
     assert [(e.kind, e.body, e.other) for e in traj.events] == [("body", "left", "right")]
+
+
+def test_a_state_that_overflows_within_a_step_is_a_divergence_of_that_body():
+    # quadratic drag at 2.4e38 m/s: RK4's second stage overflows to inf; the
+    # check right after the motion names the body before any box is computed
+    fast = {"name": "fast", "model": "cube.ac", "velocity": [0.0, 0.0, 2.4e38]}
+    scene = _scene([fast, dict(CUBE, position=[2.0, 0.0, 0.0])],
+                   world={"half_size": 3.0, "drag": 1e3, "drag_model": "quadratic"},
+                   collision={"level": "aabb"}, dynamics={"body_response": "seed"})
+    sim = Simulation(scene)
+    with pytest.raises(DivergenceError) as info:
+        sim.run(5)
+    assert (info.value.step, info.value.body) == (1, "fast")
+    assert info.value.time == pytest.approx(scene.integration.step)
+    assert str(info.value).startswith("diverged at step 1, t = 0.001, body 'fast', ")

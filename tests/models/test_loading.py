@@ -6,6 +6,8 @@ trimesh, loaded back through :func:`refsim.load_model`, and compared.
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 import trimesh
@@ -142,3 +144,28 @@ def test_broken_ac_file_goes_through_our_reader(tmp_path):
     with pytest.raises(ModelError) as info:
         refsim.load_model(path)
     assert info.value.line == 3
+
+
+@pytest.mark.parametrize("suffix", [".ac", ".obj", ".stl"])
+@pytest.mark.parametrize("kind", ["directory", "FIFO"])
+def test_special_files_are_refused_without_opening_them(tmp_path, suffix, kind):
+    path = tmp_path / f"model{suffix}"
+    path.mkdir() if kind == "directory" else os.mkfifo(path)
+    with pytest.raises(ModelError) as info:
+        refsim.load_model(path)
+    assert str(info.value) == f"{path}: not a regular file (a {kind})"
+
+
+def test_an_obj_file_with_a_latin1_comment_loads(tmp_path):
+    path = tmp_path / "tetra.obj"
+    path.write_bytes(b"# caf\xe9\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                     b"f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n")
+    mesh = refsim.load_model(path)
+    assert mesh.n_faces == 4 and mesh.is_convex
+
+
+def test_a_bare_name_finds_a_bundled_model(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)                       # no cube.ac here
+    assert refsim.load_model("cube.ac").n_faces == 12
+    with pytest.raises(ModelError, match="no such file"):
+        refsim.load_model("no-such-model.ac")

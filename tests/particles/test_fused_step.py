@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.errors import StateError
+from refsim.errors import OptionError, StateError
 from refsim.particles.config import ParticleConfig
 from refsim.particles.system import ParticleSystem
 
@@ -38,5 +38,5 @@ def test_kernel_choice():
     assert ParticleSystem(ParticleConfig(count=10, solver="rk4")).kernel == "numpy"
     with pytest.raises(StateError, match="Euler step only"):
         ParticleSystem(ParticleConfig(count=10, solver="midpoint"), kernel="fused")
-    with pytest.raises(StateError, match="kernel must be"):
+    with pytest.raises(OptionError, match="kernel must be"):
         ParticleSystem(euler, kernel="cuda")

@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 
 import pytest
 
 from refsim.bundled import models_dir, scenes_dir
 from refsim.errors import ModelError, SceneError
+from refsim.models.ac3d import write_ac3d
+from refsim.models.loading import load_model
+from refsim.models.mesh import Mesh
 from refsim.scenes.loader import load_scene
 from refsim.scenes.schema import SOLVER_NAMES, IntegrationConfig, WorldConfig
 from tests.helpers import assert_scene_error
@@ -61,8 +65,26 @@ BAD = [
     ('[world]\ndrag_model = "cubic"\n' + MINIMAL, "world.drag_model", "one of"),
     ("[integration]\nstep = 0.0\n" + MINIMAL, "integration.step", "must be > 0"),
     ('[integration]\nsolver = "rk5"\n' + MINIMAL, "integration.solver", "one of"),
-    ("[integration]\nstep = 1e-9\nduration = 1000.0\n" + MINIMAL, "integration.step",
-     "steps"),
+    ("[integration]\nstep = 1e-9\nduration = 1000.0\n" + MINIMAL, "integration.duration",
+     "exceeds the limit"),
+    ("[integration]\nstep = 0.003\nduration = 1.0\n" + MINIMAL, "integration.duration",
+     "not a whole number of steps (try duration = 0.999 or 1.002)"),
+    ("[integration]\nstep = 0.01\nduration = 0.001\n" + MINIMAL, "integration.duration",
+     "shorter than one step"),
+    ("[world]\nhalf_size = 1e51\n" + MINIMAL, "world.half_size", "at most 1e+50"),
+    ("[world]\ngravity = 1e400\n" + MINIMAL, "world.gravity", "must be finite"),
+    ("[[body]]\nmodel = \"cube.ac\"\nmass = 1e-320\n", "body[0].mass", "at least 1e-50"),
+    ("[[body]]\nmodel = \"cube.ac\"\nmass = 5e-324\n", "body[0].mass", "at least 1e-50"),
+    ("[[body]]\nmodel = \"cube.ac\"\nvelocity = [0, 1e100, 0]\n", "body[0].velocity[1]",
+     "at most 1e+50"),
+    ("[[body]]\nmodel = \"cube.ac\"\nposition = [0, 99999999999999999999999999, 0]\n",
+     "body[0].position", "starts outside the world cube"),
+    ("[[body]]\nmodel = \"cube.ac\"\nposition = [0, -4.6, 0]\n", "body[0].position",
+     "y = -5.1 to -4.1, the cube -5 to 5"),
+    ("[[body]]\nmodel = \"cube.ac\"\nscale = 1e155\n", "body[0].scale", "at most 1e+50"),
+    ("[[body]]\nmodel = \"cube.ac\"\nscale = 20.0\n", "body[0].scale",
+     "larger than the world cube"),
+    ("[[body]]\nmodel = \"cube.ac\"\nscale = 1e-65\n", "body[0].scale", "at least 1e-50"),
     ('[collision]\nlevel = "obb"\n' + MINIMAL, "collision.level", "one of"),
     ('[collision]\naabb = "fast"\n' + MINIMAL, "collision.aabb", "one of"),
     ('[dynamics]\nrotation = "full"\n' + MINIMAL, "dynamics.rotation", "one of"),
@@ -110,11 +132,16 @@ def test_model_resolves_next_to_the_scene_first(tmp_path):
     assert scene.mesh(scene.bodies[0]).n_faces == 4
 
 
-def test_broken_model_reports_the_model_file_and_line(tmp_path):
+def test_broken_model_reports_the_scene_key_and_the_model_file_and_line(tmp_path):
     (tmp_path / "cube.ac").write_text("AC3Db\nOBJECT poly\nnumvert 2\n0 0 0\n")
-    with pytest.raises(ModelError) as info:
-        load_scene(write(tmp_path, MINIMAL))
-    assert info.value.path.endswith("cube.ac") and info.value.line is not None
+    scene = write(tmp_path, MINIMAL)
+    with pytest.raises(SceneError) as info:
+        load_scene(scene)
+    assert info.value.key == "body[0].model" and info.value.path == str(scene)
+    model = info.value.__cause__
+    assert isinstance(model, ModelError)
+    assert model.path.endswith("cube.ac") and model.line is not None
+    assert f"{model.path}:{model.line}:" in str(info.value)
 
 
 def test_models_are_loaded_once_per_file(tmp_path):
@@ -128,3 +155,59 @@ def test_solver_names_match_the_solvers():
     import refsim
 
     assert set(SOLVER_NAMES) == set(refsim.SOLVERS)
+
+
+# -- files that are not scenes, and bodies that cannot be simulated ---------------------
+
+
+@pytest.mark.parametrize("kind", ["directory", "fifo"])
+def test_special_files_are_refused_without_opening_them(tmp_path, kind):
+    path = tmp_path / "scene.toml"
+    if kind == "directory":
+        path.mkdir()
+    else:
+        os.mkfifo(path)                     # reading it would block forever
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    assert str(info.value) == f"{path}: not a regular file (a {kind.replace('fifo', 'FIFO')})"
+
+
+def test_bytes_that_are_not_utf8_are_reported_by_line_and_column(tmp_path):
+    path = tmp_path / "scene.toml"
+    path.write_bytes(b'[world]\ngravity = 9.81\n# caf\xe9\n' + MINIMAL.encode())
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    assert str(info.value) == f"{path}: line 3, column 6: not UTF-8 text (byte 0xe9)"
+
+
+@pytest.mark.parametrize("depth", [400, 500, 5000])
+def test_deep_nesting_is_one_scene_error(tmp_path, depth):
+    text = "x = " + "[" * depth + "]" * depth + "\n"
+    with pytest.raises(SceneError) as info:
+        load_scene(write(tmp_path, text))
+    assert info.value.path == str(tmp_path / "scene.toml")
+
+
+@pytest.mark.parametrize("model, why", [
+    ("AC3Db\nOBJECT poly\nnumvert 3\n0 0 0\n1 0 0\n2 0 0\nnumsurf 1\nSURF 0x0\nmat 0\n"
+     "refs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", "vertices lie on a line"),
+    ("AC3Db\nOBJECT poly\nnumvert 1\n0 0 0\nnumsurf 1\nSURF 0x0\nmat 0\n"
+     "refs 3\n0 0 0\n0 0 0\n0 0 0\nkids 0\n", "at one point"),
+])
+def test_a_body_whose_inertia_is_singular_is_refused(tmp_path, model, why):
+    (tmp_path / "flat.ac").write_text(model)
+    assert_scene_error(tmp_path, '[[body]]\nmodel = "flat.ac"\n', "body[0]", why)
+
+
+def test_a_model_wound_inside_out_is_refused(tmp_path):
+    cube = load_model(models_dir() / "cube.ac")
+    write_ac3d(Mesh(cube.vertices, cube.faces[:, ::-1]), tmp_path / "inverted.ac")
+    assert_scene_error(tmp_path, '[[body]]\nmodel = "inverted.ac"\n', "body[0].model",
+                       "wound inside out (enclosed volume -1)")
+
+
+def test_a_body_resting_on_the_floor_is_inside(tmp_path):
+    # position y = -H + 1/2 puts the unit cube's bottom exactly on the floor
+    scene = load_scene(write(tmp_path, MINIMAL.replace("\n", "\nposition = [0, -4.5, 0]\n",
+                                                        1)))
+    assert scene.bodies[0].position == (0.0, -4.5, 0.0)

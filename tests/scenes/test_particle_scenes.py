@@ -79,7 +79,11 @@ def test_a_scene_without_particles_has_none(tmp_path):
 
 BAD = [
     # (scene text, the key path the error must name, a phrase it must contain)
-    ("[particles]\ncount = 0\n", "particles.count", "at least 1"),
+    ("[particles]\ncount = 0\n", "particles.count", "must be in [1, 20000000]"),
+    ("[particles]\ncount = 1000000000\n", "particles.count", "at most 2e+07 particles"),
+    ("[particles]\ncount = 4611686018427387904\n", "particles.count", "must be in [1, "),
+    ("[particles]\nmass = 1e-320\n", "particles.mass", "at least 1e-50"),
+    ("[particles]\nspeed_max = 1e60\n", "particles.speed_max", "at most 1e+50"),
     ("[particles]\ncount = 2.5\n", "particles.count", "integer"),
     ("[particles]\ncount = true\n", "particles.count", "integer"),
     ("[particles]\nseed = -1\n", "particles.seed", "non-negative"),

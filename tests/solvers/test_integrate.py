@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import refsim
-from refsim.errors import DivergenceError, StateError
+from refsim.errors import DivergenceError, OptionError, StateError
 
 
 def decay(t, y):
@@ -74,7 +74,7 @@ def test_t1_before_t0():
 
 
 def test_unknown_method():
-    with pytest.raises(StateError, match="unknown solver"):
+    with pytest.raises(OptionError, match="unknown solver"):
         refsim.integrate(decay, [1.0], 0.0, 1.0, 0.1, method="rk5")
 
 

@@ -1,0 +1,34 @@
+"""The limits refsim sets on its inputs, in one place, each with its reason.
+
+Every input enters through a validation that refuses values beyond these with
+one error naming the file and key or the argument (DESIGN.md, Errors), so that
+no input can overflow the arithmetic, allocate without bound or run for days.
+"""
+
+from __future__ import annotations
+
+#: Every number in a scene has magnitude at most ``MAX_MAGNITUDE``, and every
+#: quantity that must be positive (a mass, a scale, a size, a step) at least
+#: ``MIN_POSITIVE``. The loop multiplies a handful of scene quantities at a
+#: time (an energy is a mass times a speed squared; an inertia a mass times a
+#: length squared, inverted), and in this range no such product comes near
+#: float64's overflow (1.8e308) or its smallest normal number (2.2e-308),
+#: while no scene in any unit system comes near the range's ends.
+MAX_MAGNITUDE = 1e50
+MIN_POSITIVE = 1e-50
+
+#: At most this many steps in one run (an interval over a step): a guard
+#: against a step such as 1e-12 or 5e-324 that would run for days or ask for
+#: terabytes.
+MAX_STEPS = 100_000_000
+
+#: The largest trajectory :func:`refsim.solvers.integrate.solve_fixed_step`
+#: allocates, in bytes: a longer run or a larger state is refused before any
+#: allocation.
+MAX_RESULT_BYTES = 4 * 2**30
+
+#: At most this many particles in one system. A step of RK4 holds about eight
+#: arrays of N x 3 floats (the state, four stage derivatives and scratch):
+#: 2e7 particles are about 4 GB, the most a 2-core machine of the kind refsim
+#: is tested on (24 GB) runs comfortably beside its output.
+MAX_PARTICLES = 20_000_000
