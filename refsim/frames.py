@@ -98,19 +98,26 @@ class _Layout:
         arrays = {name: np.asarray(value) for name, value in frame.items()}
         self.shapes = {name: a.shape for name, a in arrays.items()}
         self.dtypes = {name: a.dtype for name, a in arrays.items()}
+        self._entries = [(name, a.shape, a.dtype) for name, a in arrays.items()]
 
-    def check(self, frame: Mapping[str, object]) -> dict[str, np.ndarray]:
-        """``frame``'s values as C-contiguous arrays of the layout's dtypes."""
+    def check(self, frame: Mapping[str, object]) -> list[tuple[str, np.ndarray]]:
+        """``frame``'s ``(name, value)`` pairs in the layout's order, each a
+        C-contiguous array of the layout's shape and dtype. O(1) per entry
+        for an array that already fits (used as it is, no copy); this runs
+        once per stored frame, so it stays small next to a step."""
         if frame.keys() != self.shapes.keys():
             raise StateError(f"frame has entries {sorted(frame)}, expected "
                              f"{sorted(self.shapes)}")
-        out = {}
-        for name, value in frame.items():
-            a = _c_order(value, self.dtypes[name])
-            if a.shape != self.shapes[name]:
-                raise StateError(f"frame entry {name!r} has shape {a.shape}, expected "
-                                 f"{self.shapes[name]}")
-            out[name] = a
+        out = []
+        for name, shape, dtype in self._entries:
+            a = frame[name]
+            if not (type(a) is np.ndarray and a.dtype == dtype and a.shape == shape
+                    and a.flags.c_contiguous):
+                a = _c_order(a, dtype)
+                if a.shape != shape:
+                    raise StateError(f"frame entry {name!r} has shape {a.shape}, expected "
+                                     f"{shape}")
+            out.append((name, a))
         return out
 
 
@@ -144,7 +151,7 @@ class MemorySink:
                 grown = np.empty((self._capacity, *buffer.shape[1:]), dtype=buffer.dtype)
                 grown[:self.n_frames] = buffer
                 self._buffers[name] = grown
-        for name, value in values.items():
+        for name, value in values:
             self._buffers[name][self.n_frames] = value
         self.n_frames += 1
 
@@ -259,8 +266,8 @@ class SpillSink:
             self._open(frame)
         values = self._layout.check(frame)
         try:
-            for name, value in values.items():
-                self._files[name][0].write(value.reshape(-1).view(np.uint8))
+            for name, value in values:
+                self._files[name][0].write(value)     # its bytes, C order (buffer protocol)
         except OSError as exc:
             raise output_error(self.out, exc.strerror or str(exc)) from None
         self.n_frames += 1

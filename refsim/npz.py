@@ -33,8 +33,8 @@ import numpy as np
 from refsim.errors import RefsimError
 
 #: Bytes handed to the zip writer at a time: large enough that the Python
-#: loop costs nothing next to CRC-32 and the copy (under 1 % at 1 MiB), small
-#: enough to be a rounding error in the memory of any run.
+#: work per chunk is small next to CRC-32 and the copy of the chunk itself,
+#: small enough to be a rounding error in the memory of any run.
 CHUNK_BYTES = 1 << 20
 
 #: The date written into every zip entry (the zip format's epoch): a fixed
@@ -55,9 +55,9 @@ class NpzFileError(RefsimError, ValueError):
     shape. ``path`` is the file, ``entry`` the entry's name when one is at
     fault.
 
-    DEVIATION: the brief keeps the error hierarchy in ``refsim.errors``;
-    this class lives here because that module is not this change's to edit.
-    It belongs beside ``SceneError`` (a ValueError that names the file).
+    A ``ValueError``, like ``SceneError`` and ``ModelError`` for the other
+    files refsim reads (a missing file included, as theirs). Defined beside
+    the reader that raises it; ``refsim.errors`` lists the rest of the tree.
     """
 
     def __init__(self, message: str, path: str | PathLike, entry: str | None = None):

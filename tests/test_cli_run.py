@@ -420,3 +420,32 @@ def test_a_special_output_is_refused_before_running(tmp_path, capsys, monkeypatc
     assert err.count("\n") == 1 and "Traceback" not in err
     assert err.startswith(f"refsim: error: {out}: cannot write: it is a ")
     assert os.lstat(out).st_mode == before.st_mode and os.lstat(out).st_ino == before.st_ino
+
+
+#: A file-size limit for the child below. With 1000 particles the spill of
+#: position (101 frames, 2.4 MB) passes it part way through the run; with 250
+#: each spill file stays under it (606 kB) and the .npz (1.2 MB) passes it
+#: while it is assembled.
+FILE_SIZE_LIMIT = 10**6
+
+
+def _limit_file_size():
+    import resource
+    import signal
+
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)    # EFBIG instead of a kill
+    resource.setrlimit(resource.RLIMIT_FSIZE, (FILE_SIZE_LIMIT, FILE_SIZE_LIMIT))
+
+
+@pytest.mark.parametrize("count", [1000, 250], ids=["while-spilling", "while-assembling"])
+def test_a_full_disk_is_one_line_and_leaves_no_file(tmp_path, count):
+    # a real write failure (EFBIG past RLIMIT_FSIZE, as ENOSPC on a full disk)
+    scene = write(tmp_path, TINY.replace("count = 12", f"count = {count}"))
+    out = tmp_path / "out.npz"
+    out.write_bytes(b"old")
+    result = subprocess.run([sys.executable, "-m", "refsim.cli", "run", str(scene), "-o",
+                             str(out), "--every", "1"], capture_output=True, text=True,
+                            preexec_fn=_limit_file_size)
+    assert result.returncode == EXIT_USER_ERROR and result.stdout == ""
+    assert result.stderr == f"refsim: error: {out}: cannot write: File too large\n"
+    assert files(tmp_path) == ["out.npz", "scene.toml"] and out.read_bytes() == b"old"

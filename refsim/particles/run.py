@@ -50,7 +50,9 @@ def frame_stride(scene, every: int | None) -> tuple[int, int]:
 
 @dataclass(frozen=True)
 class ParticleFrames:
-    """Stored frames of a particle run.
+    """Stored frames of a particle run: numpy arrays, or, from a run with a
+    :class:`refsim.frames.SpillSink`, :class:`refsim.frames.SpilledArray`
+    views of its files (valid while it is open).
 
     Attributes
     ----------
