@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from refsim.errors import DivergenceError, SceneError
+from refsim.errors import DivergenceError
 
 #: ``refsim run`` stores about this many frames unless ``--every`` says
 #: otherwise: enough to replay smoothly, and 200 frames of 10 000 particles
@@ -33,16 +33,9 @@ FRAME_ENTRIES = ("t", "step", "position", "velocity")
 
 def frame_stride(scene, every: int | None) -> tuple[int, int]:
     """``(n_steps, every)`` for a particle scene: the whole number of steps
-    in ``integration.duration`` and the stride between stored frames
-    (``every``, or about ``DEFAULT_FRAMES`` frames)."""
-    from refsim.solvers.integrate import STEP_COUNT_RTOL  # duration / step tolerance
-
-    integration = scene.integration
-    ratio = integration.duration / integration.step
-    n_steps = round(ratio)
-    if abs(ratio - n_steps) > STEP_COUNT_RTOL * max(n_steps, 1):
-        raise SceneError(f"duration / step = {ratio:.9g} is not a whole number of steps",
-                         scene.path, "integration.duration")
+    in ``integration.duration`` (the loader checked it is one) and the stride
+    between stored frames (``every``, or about ``DEFAULT_FRAMES`` frames)."""
+    n_steps = scene.integration.n_steps
     if every is None:
         every = max(1, math.ceil(n_steps / (DEFAULT_FRAMES - 1)))
     return n_steps, every
