@@ -20,8 +20,12 @@ Conventions converted here and nowhere else:
   pair can yield several contacts (two points for one crossing). They are
   reduced to sorted unique ``(b1, b2)`` face-index pairs.
 
-BVH models are built once per mesh and cached in the adapter object, keyed
-by ``id(mesh)`` (the mesh is kept alive alongside, so the id stays valid).
+BVH models are built once per mesh and cached in the adapter object
+(:class:`refsim.engines.cache.MeshCache`: by identity for read-only arrays,
+such as a ``refsim.Mesh``'s, else by content).
+
+The adapter is an engine (:mod:`refsim.engines`) with the capabilities
+``triangles``, ``pairs`` and ``collide``: ``refsim.oracles.fcl_adapter:engine``.
 
 Cost: building a model is O(m log m) for m faces; a query is FCL's BVH
 traversal, output-sensitive in the number of intersecting pairs.
@@ -32,6 +36,8 @@ from __future__ import annotations
 import numpy as np
 from refsim.oracles import import_engine
 
+from refsim.engines.cache import MeshCache
+
 #: Upper bound on contacts requested from FCL when listing all intersecting
 #: face pairs. FCL stops collecting at this count; it only needs to exceed
 #: the pairs any test mesh pair produces (m_a * m_b * 2 for the largest
@@ -40,11 +46,13 @@ MAX_CONTACTS = 100_000_000
 
 
 class FCLOracle:
-    """python-fcl behind refsim's collision interfaces (lazy import)."""
+    """python-fcl behind the engine contract (lazy import)."""
+
+    name = "fcl"
 
     def __init__(self):
         self.fcl = import_engine("fcl", "python-fcl")
-        self._models: dict[int, tuple[object, object]] = {}
+        self._models = MeshCache(self._bvh)
 
     # -- models --------------------------------------------------------------
 
@@ -57,14 +65,6 @@ class FCLOracle:
         model.endModel()
         return model
 
-    def model_of(self, mesh):
-        """The cached BVHModel of a ``refsim.Mesh``."""
-        entry = self._models.get(id(mesh))
-        if entry is None or entry[0] is not mesh:
-            entry = (mesh, self._bvh(mesh.vertices, mesh.faces))
-            self._models[id(mesh)] = entry
-        return entry[1]
-
     def _object(self, model, pose=None):
         fcl = self.fcl
         if pose is None:
@@ -72,6 +72,10 @@ class FCLOracle:
         rotation, translation = pose
         return fcl.CollisionObject(model, fcl.Transform(
             np.asarray(rotation, dtype=np.float64), np.asarray(translation, dtype=np.float64)))
+
+    def _objects(self, vertices_a, faces_a, pose_a, vertices_b, faces_b, pose_b):
+        return (self._object(self._models.get(vertices_a, faces_a), pose_a),
+                self._object(self._models.get(vertices_b, faces_b), pose_b))
 
     # -- queries -------------------------------------------------------------
 
@@ -84,14 +88,14 @@ class FCLOracle:
         result = self.fcl.CollisionResult()
         return self.fcl.collide(o1, o2, request, result) > 0
 
-    def intersecting_pairs(self, mesh_a, pose_a, mesh_b, pose_b) -> np.ndarray:
+    def intersecting_pairs(self, vertices_a, faces_a, pose_a, vertices_b, faces_b,
+                           pose_b) -> np.ndarray:
         """All (face of a, face of b) pairs FCL finds intersecting.
 
         Returns a (k, 2) int64 array of sorted unique rows.
         """
         fcl = self.fcl
-        o1 = self._object(self.model_of(mesh_a), pose_a)
-        o2 = self._object(self.model_of(mesh_b), pose_b)
+        o1, o2 = self._objects(vertices_a, faces_a, pose_a, vertices_b, faces_b, pose_b)
         request = fcl.CollisionRequest(num_max_contacts=MAX_CONTACTS, enable_contact=True)
         result = fcl.CollisionResult()
         fcl.collide(o1, o2, request, result)
@@ -100,24 +104,14 @@ class FCLOracle:
             return np.zeros((0, 2), dtype=np.int64)
         return np.unique(pairs.reshape(-1, 2), axis=0)
 
-    def collide(self, mesh_a, pose_a, mesh_b, pose_b) -> bool:
+    def bodies_collide(self, vertices_a, faces_a, pose_a, vertices_b, faces_b,
+                       pose_b) -> bool:
         """FCL's boolean answer: do the two posed meshes touch or overlap?"""
         fcl = self.fcl
-        o1 = self._object(self.model_of(mesh_a), pose_a)
-        o2 = self._object(self.model_of(mesh_b), pose_b)
+        o1, o2 = self._objects(vertices_a, faces_a, pose_a, vertices_b, faces_b, pose_b)
         return fcl.collide(o1, o2, fcl.CollisionRequest(), fcl.CollisionResult()) > 0
 
 
-def fcl_triangles_intersect(a, b) -> bool:
-    """FCL's answer for one triangle pair (a fresh adapter; see FCLOracle)."""
-    return FCLOracle().triangles_intersect(a, b)
-
-
-def fcl_intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b) -> np.ndarray:
-    """(k, 2) int64 sorted unique face pairs FCL reports intersecting."""
-    return FCLOracle().intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b)
-
-
-def fcl_collide(mesh_a, pose_a, mesh_b, pose_b) -> bool:
-    """FCL's boolean collision query for two posed meshes."""
-    return FCLOracle().collide(mesh_a, pose_a, mesh_b, pose_b)
+def engine() -> FCLOracle:
+    """The engine factory (``refsim.oracles.fcl_adapter:engine``)."""
+    return FCLOracle()

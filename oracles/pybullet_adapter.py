@@ -209,6 +209,8 @@ class PybulletOracle:
     :class:`refsim.oracles.OracleUnavailable` when pybullet is not installed.
     """
 
+    name = "pybullet"
+
     def __init__(self, settings: PybulletSettings | None = None):
         self.p = import_engine("pybullet", "pybullet")
         self.settings = settings or PybulletSettings()
@@ -423,3 +425,9 @@ class PybulletOracle:
         return {"mass": info[0], "lateral_friction": info[1],
                 "inertia": np.asarray(info[2], dtype=np.float64), "restitution": info[5],
                 "collision_margin": info[11]}
+
+
+def engine(**settings) -> PybulletOracle:
+    """The engine factory (``refsim.oracles.pybullet_adapter:engine``);
+    keyword arguments set fields of :class:`PybulletSettings`."""
+    return PybulletOracle(PybulletSettings(**settings))

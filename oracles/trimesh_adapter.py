@@ -12,13 +12,16 @@ Conventions converted here and nowhere else:
   ``process=True`` merges duplicate vertices and drops degenerate faces,
   which would change the mesh being checked.
 - A pose ``(R, t)`` becomes the homogeneous 4x4 ``[[R, t], [0, 1]]``, applied
-  with ``Trimesh.apply_transform``; ``.bounds`` is the (2, 3) array
+  to the vertices with ``PointCloud.apply_transform`` (trimesh's
+  ``transform_points``, the code ``Trimesh.apply_transform`` uses too);
+  ``.bounds`` is the (2, 3) array
   ``[lo, hi]``. trimesh computes ``matrix @ [v, 1]`` with BLAS (fused
   multiply-adds, its own summation order), so its coordinates may differ
-  from refsim's in the last bits: ``BOUNDS_ARITHMETIC_ULPS`` below bounds by
-  how much.
-- trimesh skips a transform within 1e-8 of the identity (every entry; its
-  ``apply_transform`` returns early), so for such poses its box is the
+  from refsim's in the last bits, by at most the arithmetic bound of any
+  float64 evaluation of ``R v + t``
+  (:func:`refsim.studies.bounds.bounds_tolerance`).
+- trimesh skips a transform within 1e-8 of the identity (every entry;
+  ``transform_points`` returns early), so for such poses its box is the
   untransformed one. :func:`trimesh_skips_transform` tells when.
 - ``is_convex``, ``volume``, ``center_mass`` are trimesh's (the solid's
   centroid, not refsim's vertex average).
@@ -37,21 +40,6 @@ from refsim.oracles import import_engine
 #: trimesh's identity shortcut: ``apply_transform`` returns early when every
 #: entry of the 4x4 is within this of the identity's (trimesh.base, 4.x).
 TRIMESH_IDENTITY_ATOL = 1e-8
-
-#: How far trimesh's world coordinate may be from refsim's, in units of
-#: ``u * (sum_j |R_kj v_j| + |t_k|)`` (u = 2**-53). Each is the exact value
-#: rounded through at most four operations (refsim: three for ``r_k`` plus the
-#: translation; trimesh: a length-4 dot product), so each is within
-#: ``gamma_4 ~ 4u`` of exact and the two within 8u; 16 doubles that for a
-#: rotation orthonormal only to ``ORTHONORMAL_TOL``.
-BOUNDS_ARITHMETIC_ULPS = 16.0
-
-
-class BoundsOracle(Protocol):
-    """The query refsim's box updates are checked with."""
-
-    def transformed_bounds(self, vertices, faces, pose) -> tuple[np.ndarray, np.ndarray]: ...
-
 
 class MeshFactsOracle(Protocol):
     """The queries refsim's mesh facts are checked with."""
@@ -81,24 +69,14 @@ def trimesh_skips_transform(pose) -> bool:
     return bool(np.abs(pose_matrix(pose) - np.eye(4)).max() < TRIMESH_IDENTITY_ATOL)
 
 
-def bounds_tolerance(vertices, pose) -> np.ndarray:
-    """(3,) per-axis bound on |trimesh's box - refsim's box| from arithmetic alone.
-
-    ``BOUNDS_ARITHMETIC_ULPS * u * (max_v sum_j |R_kj v_j| + |t_k|)``; when
-    trimesh skips the transform (:func:`trimesh_skips_transform`) the
-    difference is instead that of the whole (tiny) transform, which this
-    does not cover.
-    """
-    rotation, translation = (np.asarray(a, dtype=np.float64) for a in pose)
-    size = (np.abs(np.asarray(vertices, dtype=np.float64)) @ np.abs(rotation).T).max(axis=0)
-    return BOUNDS_ARITHMETIC_ULPS * 2.0 ** -53 * (size + np.abs(translation))
-
-
 class TrimeshOracle:
-    """trimesh behind refsim's bounds and mesh-facts interfaces (lazy import).
+    """trimesh behind the engine contract's ``aabb`` and refsim's mesh-facts
+    interface (lazy import).
 
     Raises :class:`refsim.oracles.OracleUnavailable` when trimesh is not installed.
     """
+
+    name = "trimesh"
 
     def __init__(self):
         self.trimesh = import_engine("trimesh", "trimesh")
@@ -107,11 +85,12 @@ class TrimeshOracle:
         return self.trimesh.Trimesh(vertices=np.asarray(vertices, dtype=np.float64),
                                     faces=np.asarray(faces, dtype=np.int64), process=False)
 
-    def transformed_bounds(self, vertices, faces, pose) -> tuple[np.ndarray, np.ndarray]:
-        """World box ``(lo, hi)`` of the mesh under ``pose``, by trimesh."""
-        mesh = self._mesh(vertices, faces)
-        mesh.apply_transform(pose_matrix(pose))
-        bounds = np.asarray(mesh.bounds, dtype=np.float64)
+    def aabb(self, vertices, pose) -> tuple[np.ndarray, np.ndarray]:
+        """World box ``(lo, hi)`` of the points under ``pose``, by trimesh (a
+        ``PointCloud`` transformed by its own ``apply_transform``)."""
+        cloud = self.trimesh.PointCloud(np.array(vertices, dtype=np.float64))
+        cloud.apply_transform(pose_matrix(pose))
+        bounds = np.asarray(cloud.bounds, dtype=np.float64)
         return bounds[0].copy(), bounds[1].copy()
 
     def is_convex(self, vertices, faces) -> bool:
@@ -133,3 +112,8 @@ class TrimeshOracle:
         mesh = self._mesh(vertices, faces)
         mesh.density = mass / mesh.volume
         return np.asarray(mesh.moment_inertia, dtype=np.float64)
+
+
+def engine() -> TrimeshOracle:
+    """The engine factory (``refsim.oracles.trimesh_adapter:engine``)."""
+    return TrimeshOracle()

@@ -46,6 +46,8 @@ import numpy as np
 from refsim.oracles import OracleUnavailable, import_engine
 from refsim.oracles.trimesh_adapter import pose_matrix
 
+from refsim.engines.cache import MeshCache
+
 
 def float32_pose(pose):
     """The pose trimesh's ``add_object`` really applies: every entry of the
@@ -55,11 +57,18 @@ def float32_pose(pose):
 
 
 class TrimeshCollisionOracle:
-    """``trimesh.collision.CollisionManager`` behind a boolean body query.
+    """``trimesh.collision.CollisionManager`` behind the engine contract's
+    boolean query (capability ``collide``).
+
+    Besides ``bodies_collide`` it declares its conventions, which the levels
+    study uses to classify a disagreement: :meth:`pose_used` (the float32
+    pose it applies) and :meth:`is_solid` (a convex mesh is a solid to it).
 
     Raises :class:`refsim.oracles.OracleUnavailable` when trimesh or python-fcl is
     not installed.
     """
+
+    name = "trimesh"
 
     def __init__(self):
         self.trimesh = import_engine("trimesh", "trimesh")
@@ -67,30 +76,24 @@ class TrimeshCollisionOracle:
         self.collision = import_engine("trimesh.collision", "trimesh")
         if getattr(self.collision, "fcl", None) is None:
             raise OracleUnavailable("trimesh.collision could not import python-fcl")
-        self._meshes: dict[int, tuple[object, object]] = {}
+        self._meshes = MeshCache(lambda v, f: self.trimesh.Trimesh(
+            vertices=np.asarray(v, dtype=np.float64), faces=np.asarray(f, dtype=np.int64),
+            process=False))
 
-    def trimesh_of(self, mesh):
-        """The cached ``trimesh.Trimesh`` of a refsim ``Mesh`` (process=False)."""
-        entry = self._meshes.get(id(mesh))
-        if entry is None or entry[0] is not mesh:
-            tm = self.trimesh.Trimesh(vertices=np.asarray(mesh.vertices, dtype=np.float64),
-                                      faces=np.asarray(mesh.faces, dtype=np.int64),
-                                      process=False)
-            entry = (mesh, tm)
-            self._meshes[id(mesh)] = entry
-        return entry[1]
-
-    def uses_convex(self, mesh) -> bool:
+    def is_solid(self, vertices, faces) -> bool:
         """Whether trimesh treats the mesh as a solid ``fcl.Convex`` (else a
         surface ``fcl.BVHModel``)."""
-        return bool(self.trimesh_of(mesh).is_convex)
+        return bool(self._meshes.get(vertices, faces).is_convex)
 
-    def bodies_collide(self, mesh_a, pose_a, mesh_b, pose_b) -> bool:
+    def bodies_collide(self, vertices_a, faces_a, pose_a, vertices_b, faces_b,
+                       pose_b) -> bool:
         """trimesh's answer: both bodies added to a fresh CollisionManager
         (``add_object``, float32 transforms), then ``in_collision_internal``."""
         manager = self.collision.CollisionManager()
-        manager.add_object("a", self.trimesh_of(mesh_a), transform=pose_matrix(pose_a))
-        manager.add_object("b", self.trimesh_of(mesh_b), transform=pose_matrix(pose_b))
+        manager.add_object("a", self._meshes.get(vertices_a, faces_a),
+                           transform=pose_matrix(pose_a))
+        manager.add_object("b", self._meshes.get(vertices_b, faces_b),
+                           transform=pose_matrix(pose_b))
         return bool(manager.in_collision_internal())
 
     @staticmethod
@@ -99,8 +102,6 @@ class TrimeshCollisionOracle:
         return float32_pose(pose)
 
 
-def trimesh_bodies_collide(mesh_a, pose_a, mesh_b, pose_b) -> bool:
-    """trimesh's CollisionManager answer for two posed refsim meshes (a fresh
-    adapter; see :class:`TrimeshCollisionOracle` for how it differs from
-    refsim's surface intersection)."""
-    return TrimeshCollisionOracle().bodies_collide(mesh_a, pose_a, mesh_b, pose_b)
+def engine() -> TrimeshCollisionOracle:
+    """The engine factory (``refsim.oracles.trimesh_collision:engine``)."""
+    return TrimeshCollisionOracle()

@@ -85,7 +85,8 @@ def test_fcl_pairs_differ_only_where_floats_may(case):
     fcl = fcl_oracle()
     mesh_a, pose_a, mesh_b, pose_b, label = case
     ours = as_set(intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b))
-    theirs = as_set(fcl.intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b))
+    theirs = as_set(fcl.intersecting_pairs(mesh_a.vertices, mesh_a.faces, pose_a,
+                                           mesh_b.vertices, mesh_b.faces, pose_b))
     world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
     for i, j in ours ^ theirs:
         kind = classify_disagreement(world_a[mesh_a.faces[i]], world_b[mesh_b.faces[j]])

@@ -99,38 +99,3 @@ def format_facts(facts: ModelFacts) -> str:
     ]
     width = max(len(k) for k, _ in rows)
     return "\n".join(f"{k:<{width}}  {v}" for k, v in rows)
-
-
-@dataclass(frozen=True)
-class TrimeshAgreement:
-    """refsim's facts about one model against trimesh's (the mesh oracle)."""
-
-    name: str
-    convex_agrees: bool
-    closed_agrees: bool
-    volume_relative_difference: float
-    centroid_difference_over_diagonal: float
-
-
-def measure_trimesh_agreement(paths) -> list[TrimeshAgreement]:
-    """Compare convexity, closedness, volume and volume centroid with trimesh
-    for each model file (``refsim info`` shows refsim's side)."""
-    from refsim.models.loading import load_model
-    from refsim.oracles.trimesh_adapter import TrimeshOracle
-
-    oracle = TrimeshOracle()
-    rows = []
-    for path in paths:
-        mesh = load_model(path)
-        v, f = mesh.vertices, mesh.faces
-        lo, hi = mesh.bounds
-        diagonal = float(np.linalg.norm(hi - lo))
-        volume = oracle.volume(v, f)
-        rows.append(TrimeshAgreement(
-            name=path.name,
-            convex_agrees=mesh.is_convex == oracle.is_convex(v, f),
-            closed_agrees=mesh.is_closed == oracle.is_watertight(v, f),
-            volume_relative_difference=abs(mesh.volume - volume) / abs(volume),
-            centroid_difference_over_diagonal=float(
-                np.linalg.norm(mesh.centroid_volume - oracle.center_mass(v, f)) / diagonal)))
-    return rows

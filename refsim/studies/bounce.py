@@ -18,7 +18,7 @@ on the same scene, and compared with the closed forms of
   in the manner of the work-precision comparisons of T. Erez, Y. Tassa and
   E. Todorov, "Simulation tools for model-based robotics: comparison of
   Bullet, Havok, MuJoCo, ODE and PhysX", ICRA 2015;
-- :func:`measure_pybullet_settings`: the oracle's bounce with one pybullet
+- :func:`measure_engine_variants`: the oracle's bounce with one pybullet
   setting at a time put back to its default (why each setting);
 - :func:`measure_step_cost`: seconds per step of 1, 10 and 40 cubes
   (:func:`cubes_scene`), refsim's ``Simulation.step()`` against pybullet's
@@ -50,6 +50,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from refsim.dynamics import analytic
+from refsim.solvers.methods import SOLVERS
 
 #: The sphere-like body and the cube of the studies (bundled models).
 SPHERE = "sphere-2k.ac"
@@ -145,19 +146,16 @@ def run_refsim(scene, wall_speed: str = "wall"):
     return trajectory, time.perf_counter() - start
 
 
-def run_pybullet(scene, oracle=None):
-    """The pybullet oracle's trajectory of ``scene`` and its stepping time,
-    seconds (``stepSimulation`` alone, not the reading of state)."""
-    from refsim.oracles.pybullet_adapter import PybulletOracle
-
-    own = oracle is None
-    oracle = oracle or PybulletOracle()
-    try:
-        trajectory = oracle.simulate(scene)
-    finally:
-        if own:
-            oracle.close()
-    return trajectory, trajectory.stage_seconds["step"]
+def run_engine(scene, engine):
+    """A rigid-body engine's trajectory of ``scene`` (:mod:`refsim.engines`,
+    capability ``rigid``) and its stepping time, seconds: the engine's own
+    ``stage_seconds["step"]`` when it reports one (pybullet's
+    ``stepSimulation`` alone, not the reading of state), else the wall time
+    of ``simulate``."""
+    start = time.perf_counter()
+    trajectory = engine.simulate(scene)
+    seconds = time.perf_counter() - start
+    return trajectory, getattr(trajectory, "stage_seconds", {}).get("step", seconds)
 
 
 # -- reading a trajectory -----------------------------------------------------------
@@ -277,7 +275,7 @@ def _first(values, k) -> list[float]:
 
 def measure_apex_row(model: str, e: float, *, rotation: str = "off", step: float = STEP,
                      solver: str = SOLVER, bounces: int = BOUNCES,
-                     with_pybullet: bool = True) -> ApexRow:
+                     oracle=None) -> ApexRow:
     scene = drop_scene(model, e, step=step, solver=solver, rotation=rotation,
                        duration=duration_for(e, bounces))
     y_touch = touch_height(scene)
@@ -287,8 +285,8 @@ def measure_apex_row(model: str, e: float, *, rotation: str = "off", step: float
     literal, _ = run_refsim(scene, wall_speed="seed")
     s = read_bounces(literal.t, literal.position[:, 0, 1], literal.velocity[:, 0, 1], y_touch)
     s_ratio = apex_ratio(s.apex_heights, bounces)
-    if with_pybullet:
-        theirs, _ = run_pybullet(scene)
+    if oracle is not None:
+        theirs, _ = run_engine(scene, oracle)
         p = read_bounces(theirs.t, theirs.position[:, 0, 1], theirs.velocity[:, 0, 1], y_touch)
         p_heights, p_times = p.apex_heights, p.apex_times
         p_spin = float(np.abs(theirs.angular_velocity).max())
@@ -322,14 +320,14 @@ def _variants(models) -> list[tuple[str, str]]:
 
 
 def measure_apexes(models=(SPHERE, CUBE), restitutions=RESTITUTIONS, *, step: float = STEP,
-                   solver: str = SOLVER, with_pybullet: bool = True) -> list[ApexRow]:
+                   solver: str = SOLVER, oracle=None) -> list[ApexRow]:
     """Apex rows for each model and restitution: the sphere-like body with
     rotation "off"; the cube with rotation "off" and with the seed's model."""
     rows = []
     for model, rotation in _variants(models):
         for e in restitutions:
             rows.append(measure_apex_row(model, e, rotation=rotation, step=step,
-                                         solver=solver, with_pybullet=with_pybullet))
+                                         solver=solver, oracle=oracle))
     return rows
 
 
@@ -362,7 +360,7 @@ OBLIQUE_E = 0.8
 
 def measure_oblique(models=(SPHERE, CUBE), cases=OBLIQUE_CASES, *, friction=OBLIQUE_FRICTION,
                     e=OBLIQUE_E, step: float = STEP, solver: str = SOLVER,
-                    with_pybullet: bool = True) -> list[ObliqueRow]:
+                    oracle=None) -> list[ObliqueRow]:
     """Lateral velocity after the first bounce of a body released 5 cm above
     the floor moving at ``(v_t, -v_n, 0)``; read at the apex after it."""
     rows = []
@@ -377,8 +375,8 @@ def measure_oblique(models=(SPHERE, CUBE), cases=OBLIQUE_CASES, *, friction=OBLI
                                velocity=(v_t, -v_n, 0.0))
             ours, _ = run_refsim(scene)
             after_ours = float(ours.velocity[-1, 0, 0])
-            if with_pybullet:
-                theirs, _ = run_pybullet(scene)
+            if oracle is not None:
+                theirs, _ = run_engine(scene, oracle)
                 after_theirs = float(theirs.velocity[-1, 0, 0])
                 # The centre's velocity (the mesh origin's includes w x r).
                 spin = float(np.linalg.norm(theirs.angular_velocity[-1, 0]))
@@ -424,7 +422,7 @@ def settle_time(bounces: Bounces, h0: float, fraction: float = REST_FRACTION) ->
 
 
 def measure_rest(model: str = SPHERE, restitutions=(0.5, 0.8), *, step: float = STEP,
-                 solver: str = SOLVER, with_pybullet: bool = True) -> list[RestRow]:
+                 solver: str = SOLVER, oracle=None) -> list[RestRow]:
     rows = []
     for e in restitutions:
         h0 = DROP_HEIGHT
@@ -434,8 +432,8 @@ def measure_rest(model: str = SPHERE, restitutions=(0.5, 0.8), *, step: float = 
         ours, _ = run_refsim(scene)
         r_t, r_k = settle_time(read_bounces(ours.t, ours.position[:, 0, 1],
                                             ours.velocity[:, 0, 1], y_touch), h0)
-        if with_pybullet:
-            theirs, _ = run_pybullet(scene)
+        if oracle is not None:
+            theirs, _ = run_engine(scene, oracle)
             p_t, p_k = settle_time(read_bounces(theirs.t, theirs.position[:, 0, 1],
                                                 theirs.velocity[:, 0, 1], y_touch), h0)
         else:
@@ -466,7 +464,7 @@ class EnergySeries:
 
 def measure_energy(model: str = SPHERE, e: float = 0.8, *, duration: float = 6.0,
                    step: float = STEP, solver: str = SOLVER, stride: int = 10,
-                   with_pybullet: bool = True) -> EnergySeries:
+                   oracle=None) -> EnergySeries:
     """Height above the touching height and mechanical energy (per unit
     weight ``m g``: metres) over time."""
     scene = drop_scene(model, e, step=step, solver=solver, duration=duration)
@@ -476,8 +474,8 @@ def measure_energy(model: str = SPHERE, e: float = 0.8, *, duration: float = 6.0
     g = GRAVITY
     r_h = ours.position[::stride, 0, 1] - y_touch
     r_e = mechanical_energy(ours, y_touch, g)[::stride] / g
-    if with_pybullet:
-        theirs, _ = run_pybullet(scene)
+    if oracle is not None:
+        theirs, _ = run_engine(scene, oracle)
         p_h = theirs.position[::stride, 0, 1] - y_touch
         p_e = mechanical_energy(theirs, y_touch, g)[::stride] / g
     else:
@@ -516,28 +514,29 @@ class CostStudy:
 
 def measure_cost(steps=COST_STEPS, solvers=COST_SOLVERS, *, model: str = SPHERE,
                  e: float = 0.8, bounces: int = BOUNCES,
-                 with_pybullet: bool = True) -> CostStudy:
+                 oracle=None) -> CostStudy:
     """Apex-ratio error against wall time per simulated second, per step size.
 
     refsim runs each solver with its default wall response and, as the
-    series ``SEED_SPEED_SERIES``, RK4 with the seed's literal wall speed.
+    series ``SEED_SPEED_SERIES``, RK4 with the seed's literal wall speed;
+    ``oracle`` (a rigid-body engine, or None) runs each step size once.
     refsim's time is the whole ``refsim.simulate`` call (its loop, its wall
-    test and recording the frames); pybullet's is its ``stepSimulation``
-    calls alone (not the reading of state through the Python API, which
-    would otherwise dominate).
+    test and recording the frames); the oracle's is what :func:`run_engine`
+    reports (pybullet's ``stepSimulation`` calls alone, not the reading of
+    state through the Python API, which would otherwise dominate).
     """
     ideal = analytic.apex_ratio(e)
     duration = duration_for(e, bounces)
     points = []
     engines = ([("refsim", s) for s in solvers] + [("refsim", SEED_SPEED_SERIES)]
-               + ([("pybullet", "pybullet")] if with_pybullet else []))
+               + ([(oracle.name, oracle.name)] if oracle is not None else []))
     for engine, solver in engines:
         for h in steps:
-            method = SOLVER if solver in ("pybullet", SEED_SPEED_SERIES) else solver
+            method = solver if engine == "refsim" and solver in SOLVERS else SOLVER
             scene = drop_scene(model, e, step=h, solver=method, duration=duration)
             y_touch = touch_height(scene)
-            if engine == "pybullet":
-                traj, seconds = run_pybullet(scene)
+            if engine != "refsim":
+                traj, seconds = run_engine(scene, oracle)
             else:
                 traj, seconds = run_refsim(
                     scene, wall_speed="seed" if solver == SEED_SPEED_SERIES else "wall")
@@ -579,33 +578,19 @@ class SettingRow:
     analytic_settle_bounce: int     # the same for the analytic series
 
 
-def measure_pybullet_settings(e: float = 0.8, duration: float = 9.0) -> list[SettingRow]:
-    """Why each setting of :class:`refsim.oracles.pybullet_adapter.PybulletSettings`:
-    the oracle's bounce, then the same with one setting back at (or near)
-    pybullet's default."""
-    from dataclasses import replace
-
-    from refsim.oracles.pybullet_adapter import PybulletOracle, PybulletSettings
-
-    base = PybulletSettings()
-    changes = (
-        ("none (the oracle's settings)", base),
-        ("useMaximalCoordinates=False (multibody)", replace(base, use_maximal_coordinates=False)),
-        ("contactProcessingThreshold=1e30 (Bullet's default: all)",
-         replace(base, contact_processing_threshold=1e30)),
-        ("useSplitImpulse=0", replace(base, use_split_impulse=0)),
-        ("restitutionVelocityThreshold=0.2 (Bullet's default)",
-         replace(base, restitution_velocity_threshold=0.2)),
-        ("linear/angular damping 0.04 (pybullet's default)",
-         replace(base, linear_damping=0.04, angular_damping=0.04)),
-    )
+def measure_engine_variants(variants, e: float = 0.8, duration: float = 9.0
+                            ) -> list[SettingRow]:
+    """The sphere's bounce in each of ``variants``, ``(label, engine)`` pairs
+    of rigid-body engines (the report passes pybullet with its oracle
+    settings, then with one setting at a time back at, or near, pybullet's
+    default: why each setting of
+    :class:`refsim.oracles.pybullet_adapter.PybulletSettings`)."""
     scene = drop_scene(SPHERE, e, duration=duration)
     y_touch = touch_height(scene)
     ideal = analytic.apex_ratio(e)
     rows = []
-    for label, settings in changes:
-        with PybulletOracle(settings) as oracle:
-            traj = oracle.simulate(scene)
+    for label, engine in variants:
+        traj, _ = run_engine(scene, engine)
         b = read_bounces(traj.t, traj.position[:, 0, 1], traj.velocity[:, 0, 1], y_touch)
         ratio = apex_ratio(b.apex_heights, BOUNCES)
         _, k = settle_time(b, DROP_HEIGHT)
@@ -674,8 +659,9 @@ class StepCost:
 
 def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: int = 200,
                       warmup: int = 20, repeats: int = 5,
-                      with_pybullet: bool = True) -> list[StepCost]:
-    """Seconds per step of each cubes scene in refsim and pybullet.
+                      oracle=None) -> list[StepCost]:
+    """Seconds per step of each cubes scene in refsim and in ``oracle`` (a
+    rigid-body engine with ``step_time(scene, steps, warmup)``: pybullet's).
 
     Each engine runs the scene ``repeats`` times from its start: ``warmup``
     untimed steps (they also pay any first-call compilation), then ``steps``
@@ -686,40 +672,29 @@ def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: 
     from refsim.dynamics.simulation import Simulation
 
     rows = []
-    oracle = None
-    if with_pybullet:
-        from refsim.oracles.pybullet_adapter import PybulletOracle
-
-        oracle = PybulletOracle()
-    try:
-        for count in counts:
-            for rotation in rotations:
-                scene = cubes_scene(count, rotation)
-                ours, stages = math.inf, {}
-                for _ in range(repeats):
-                    sim = Simulation(scene)
-                    for _ in range(warmup):
-                        sim.step()
-                    before = dict(sim.stage_seconds)
-                    start = time.perf_counter()
-                    for _ in range(steps):
-                        sim.step()
-                    mean = (time.perf_counter() - start) / steps
-                    if mean < ours:
-                        ours = mean
-                        stages = {k: (sim.stage_seconds[k] - before[k]) / steps
-                                  for k in before}
-                theirs = math.nan
-                if oracle is not None:
-                    theirs = min(oracle.step_time(scene, steps, warmup) for _ in range(repeats))
-                rows.append(StepCost(bodies=count, rotation=rotation, warmup=warmup,
-                                     refsim_seconds=ours,
-                                     pybullet_seconds=theirs, ratio=ours / theirs,
-                                     refsim_stage_seconds=stages, steps=steps,
-                                     repeats=repeats))
-    finally:
-        if oracle is not None:
-            oracle.close()
+    for count in counts:
+        for rotation in rotations:
+            scene = cubes_scene(count, rotation)
+            ours, stages = math.inf, {}
+            for _ in range(repeats):
+                sim = Simulation(scene)
+                for _ in range(warmup):
+                    sim.step()
+                before = dict(sim.stage_seconds)
+                start = time.perf_counter()
+                for _ in range(steps):
+                    sim.step()
+                mean = (time.perf_counter() - start) / steps
+                if mean < ours:
+                    ours = mean
+                    stages = {k: (sim.stage_seconds[k] - before[k]) / steps for k in before}
+            theirs = math.nan
+            if oracle is not None:
+                theirs = min(oracle.step_time(scene, steps, warmup) for _ in range(repeats))
+            rows.append(StepCost(bodies=count, rotation=rotation, warmup=warmup,
+                                 refsim_seconds=ours, pybullet_seconds=theirs,
+                                 ratio=ours / theirs, refsim_stage_seconds=stages,
+                                 steps=steps, repeats=repeats))
     return rows
 
 
@@ -736,13 +711,15 @@ def main(argv=None) -> None:
     parser.add_argument("--quick", action="store_true", help="fewer step sizes and solvers")
     parser.add_argument("--no-pybullet", action="store_true", help="refsim and analytic only")
     args = parser.parse_args(argv)
-    pb = not args.no_pybullet
+    from refsim.oracles.pybullet_adapter import PybulletOracle
+
+    pb = None if args.no_pybullet else PybulletOracle()
 
     print(f"Apex ratios (geometric mean of the first {BOUNCES}; ideal e^2), "
           f"step {STEP}, solver {SOLVER}:")
     print(f"{'body':14} {'rot':5} {'e':>4} {'e^2':>8} {'refsim':>9} {'err':>8} "
           f"{'pybullet':>9} {'err':>8} {'refsim h1/h0':>12} {'pyb h1/h0':>10}")
-    for r in measure_apexes(with_pybullet=pb):
+    for r in measure_apexes(oracle=pb):
         print(f"{r.body:14} {r.rotation:5} {r.e:4} {r.analytic_ratio:8.5f} "
               f"{r.refsim_ratio:9.5f} {r.refsim_error:8.2%} {r.pybullet_ratio:9.5f} "
               f"{r.pybullet_error:8.2%} {r.refsim_first_ratio:12.5f} "
@@ -760,13 +737,13 @@ def main(argv=None) -> None:
               f"{_fmt(r.pybullet_max_spin)} rad/s")
     print(f"\nOblique bounce (friction {OBLIQUE_FRICTION}, e {OBLIQUE_E}): lateral "
           "velocity after the bounce, m/s")
-    for r in measure_oblique(with_pybullet=pb):
+    for r in measure_oblique(oracle=pb):
         print(f"  {r.body:14} v_t {r.v_t} v_n {r.v_n:.3f}: seed {r.seed_analytic:.4f} "
               f"coulomb(point) {r.coulomb_point:.4f} coulomb(ball) {r.coulomb_ball:.4f} "
               f"(ball slides: {r.ball_slides}) | refsim {r.refsim:.4f} "
               f"pybullet {r.pybullet:.4f} (|w| {r.pybullet_spin:.3f})")
     print(f"\nTime to rest (sphere; settled once apexes stay below {REST_FRACTION} h0), s")
-    for r in measure_rest(with_pybullet=pb):
+    for r in measure_rest(oracle=pb):
         print(f"  e {r.e}: Zeno {r.zeno:.4f}; settle analytic {r.analytic_settle:.4f} "
               f"(bounce {r.analytic_bounces}) refsim {_fmt(r.refsim_settle)} "
               f"(bounce {r.refsim_bounces}) pybullet {_fmt(r.pybullet_settle)} "
@@ -774,23 +751,25 @@ def main(argv=None) -> None:
     if pb:
         print(f"\npybullet settings, one at a time (sphere, e {OBLIQUE_E}; analytic settling "
               f"bounce {analytic.bounces_until(OBLIQUE_E, REST_FRACTION)}):")
-        for r in measure_pybullet_settings():
+        from refsim.report.sections.dynamics import _pybullet_variants
+
+        for r in measure_engine_variants(_pybullet_variants()):
             print(f"  {r.change:58} ratio {r.ratio:.5f} ({r.error:+.2%}) settles after "
                   f"bounce {r.settle_bounce}, {r.bounces} bounces")
     print("\nStep cost, cubes in the world cube (collision aabb), seconds per step:")
-    for r in measure_step_cost(with_pybullet=pb):
+    for r in measure_step_cost(oracle=pb):
         print(f"  {r.bodies:3d} bodies, rotation {r.rotation:4}: refsim {r.refsim_seconds:.3e} "
               f"pybullet {r.pybullet_seconds:.3e} ratio {r.ratio:.2f}")
         print("      refsim by stage (us): " + ", ".join(
             f"{k} {1e6 * v:.1f}" for k, v in r.refsim_stage_seconds.items()))
     print(f"  after {LATE_WARMUP} steps (the cubes settled on the floor, in contact):")
     for r in measure_step_cost(counts=(BENCH_COUNTS[-1],), warmup=LATE_WARMUP, repeats=3,
-                               with_pybullet=pb):
+                               oracle=pb):
         print(f"  {r.bodies:3d} bodies, rotation {r.rotation:4}: refsim {r.refsim_seconds:.3e} "
               f"pybullet {r.pybullet_seconds:.3e} ratio {r.ratio:.2f}")
     steps = COST_STEPS_QUICK if args.quick else COST_STEPS
     solvers = COST_SOLVERS_QUICK if args.quick else COST_SOLVERS
-    study = measure_cost(steps, solvers, with_pybullet=pb)
+    study = measure_cost(steps, solvers, oracle=pb)
     print(f"\nSpeed vs accuracy (sphere, e {study.e}, apex ratio over {study.bounces} bounces):")
     print(f"  {'engine':9} {'solver':16} {'step':>9} {'ratio':>9} {'error':>10} {'s/s':>10}")
     for pt in study.points:

@@ -33,10 +33,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from refsim.bounds.aabb_incremental import IncrementalAABB, numba_available
-from refsim.bounds.aabb_linear import LinearAABB
+from refsim.bounds.aabb_linear import LinearAABB, aabb_linear
 from refsim.models import shapes
 from refsim.models.mesh import Mesh
-from refsim.types import as_pose, random_rotation, rotation_about_axis
+from refsim.types import as_pose, random_rotation, rotation_about_axis, transform_points
 
 #: The sweep of C1: box (12 triangles), icosahedron (20) and geodesic spheres
 #: of 20 f^2 triangles, f = 2 .. 64 (80 .. 81920 triangles).
@@ -379,7 +379,7 @@ class BoundsAgreement:
     bit for bit (convex meshes only, None otherwise; the poses are random
     jumps, the hardest case for the walk). ``trimesh_bitwise``: poses where
     trimesh's box equals the scan's bit for bit; ``trimesh_within``: poses
-    within the arithmetic bound ``refsim.oracles.trimesh_adapter.bounds_tolerance``;
+    within the arithmetic bound :func:`bounds_tolerance`;
     ``max_difference_over_tolerance``: the largest difference seen as a
     fraction of that bound.
     """
@@ -393,12 +393,34 @@ class BoundsAgreement:
     max_difference_over_tolerance: float
 
 
-def measure_bounds_agreement(meshes=None, *, poses: int = 200, seed: int = 0):
-    """Agreement counts for the bundled-style meshes (list of BoundsAgreement)."""
-    from refsim.bounds.aabb_linear import aabb_linear
-    from refsim.oracles.trimesh_adapter import TrimeshOracle, bounds_tolerance
+#: How far two float64 evaluations of a world coordinate ``(R v + t)_k`` may
+#: differ, in units of ``u * (sum_j |R_kj v_j| + |t_k|)`` (u = 2**-53). Each
+#: is the exact value rounded through at most four operations (refsim: three
+#: for ``r_k`` plus the translation; an engine with a homogeneous 4x4: a
+#: length-4 dot product, fused or not), so each is within ``gamma_4 ~ 4u`` of
+#: exact and the two within 8u; 16 doubles that for a rotation orthonormal
+#: only to ``refsim.types.ORTHONORMAL_TOL``.
+BOUNDS_ARITHMETIC_ULPS = 16.0
 
-    oracle = TrimeshOracle()
+
+def bounds_tolerance(vertices, pose) -> np.ndarray:
+    """(3,) per-axis bound on the difference of two boxes computed in
+    float64 from the same vertices and pose by different arithmetic:
+    ``BOUNDS_ARITHMETIC_ULPS * u * (max_v sum_j |R_kj v_j| + |t_k|)``.
+
+    An engine that does not apply the pose as given (trimesh skips one within
+    1e-8 of the identity) is outside this bound.
+    """
+    rotation, translation = (np.asarray(a, dtype=np.float64) for a in pose)
+    vertices = np.abs(np.asarray(vertices, dtype=np.float64))
+    size = transform_points(vertices, (np.abs(rotation), np.zeros(3))).max(axis=0)
+    return BOUNDS_ARITHMETIC_ULPS * 2.0 ** -53 * (size + np.abs(translation))
+
+
+def measure_bounds_agreement(engine, meshes=None, *, poses: int = 200, seed: int = 0):
+    """Agreement counts of refsim's boxes with an ``aabb`` engine
+    (:mod:`refsim.engines`) on random poses of the bundled-style meshes
+    (list of :class:`BoundsAgreement`)."""
     meshes = meshes or [shapes.box(), shapes.icosahedron(), shapes.geodesic_sphere(10),
                         shapes.torus(), shapes.l_beam()]
     rows = []
@@ -413,7 +435,7 @@ def measure_bounds_agreement(meshes=None, *, poses: int = 200, seed: int = 0):
             if tracker is not None:
                 ilo, ihi = tracker.update(pose)
                 exact += bool(np.array_equal(ilo, lo) and np.array_equal(ihi, hi))
-            tlo, thi = oracle.transformed_bounds(mesh.vertices, mesh.faces, pose)
+            tlo, thi = engine.aabb(mesh.vertices, pose)
             difference = np.maximum(np.abs(tlo - lo), np.abs(thi - hi))
             tolerance = bounds_tolerance(mesh.vertices, pose)
             bitwise += bool(not difference.any())

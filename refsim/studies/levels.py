@@ -421,23 +421,6 @@ BODY_DISAGREEMENT_KINDS = ("containment", "float32 transform", "touching", "tole
 BODY_TOLERANCE = 1e-6
 
 
-@dataclass(frozen=True)
-class BodyOracle:
-    """A body-level engine: ``collide(mesh_a, pose_a, mesh_b, pose_b) -> bool``.
-
-    ``pose_used(pose)`` is the pose the engine really applies (trimesh rounds
-    it to float32), None when it applies the pose as given. ``is_solid(mesh)``
-    tells whether the engine treats the mesh as a solid (volume semantics:
-    trimesh's ``fcl.Convex`` for convex meshes), None when every mesh is a
-    surface (FCL's BVHModel, refsim).
-    """
-
-    name: str
-    collide: Callable
-    pose_used: Callable | None = None
-    is_solid: Callable | None = None
-
-
 def solid_contains(mesh, pose: Pose, point) -> bool:
     """Whether ``point`` lies inside the closed mesh at ``pose``: its winding
     number, the sum of the signed solid angles of the triangles seen from the
@@ -468,16 +451,19 @@ def _moved(pose_a, pose_b, mesh_a, mesh_b, toward: bool) -> Pose:
 
 
 def classify_body_disagreement(mesh_a, pose_a, mesh_b, pose_b, ours: bool,
-                               oracle: BodyOracle, kernel: str | None = None) -> str:
-    """Why a body-level oracle's answer differs from refsim's exact ``ours``.
+                               engine, kernel: str | None = None) -> str:
+    """Why a ``collide`` engine's answer differs from refsim's exact ``ours``.
 
+    The engine may declare two conventions (:mod:`refsim.engines`):
+    ``is_solid(vertices, faces) -> bool``, whether it treats a mesh as a
+    solid, and ``pose_used(pose) -> pose``, the pose it really applies.
     Tried in order:
 
-    - ``"containment"``: refsim False, oracle True, one body lies inside the
+    - ``"containment"``: refsim False, engine True, one body lies inside the
       other (:func:`solid_contains` of a vertex) and the engine treats the
       container as a solid (volume against surface semantics);
     - ``"float32 transform"``: refsim, run on the poses the engine really
-      applies (``oracle.pose_used``), gives the oracle's answer;
+      applies (``engine.pose_used``), gives the engine's answer;
     - ``"touching"``: refsim True, oracle False, and no intersecting triangle
       pair has an edge crossing the other's open interior with strict signs:
       the bodies meet only where an orientation is exactly zero (a shared
@@ -488,14 +474,16 @@ def classify_body_disagreement(mesh_a, pose_a, mesh_b, pose_b, ours: bool,
     - ``"bug"``: anything else.
     """
     theirs = not ours
-    if not ours and oracle.is_solid is not None:
-        if ((oracle.is_solid(mesh_a)
+    is_solid = getattr(engine, "is_solid", None)
+    pose_used = getattr(engine, "pose_used", None)
+    if not ours and is_solid is not None:
+        if ((is_solid(mesh_a.vertices, mesh_a.faces)
              and solid_contains(mesh_a, pose_a, world_vertices(mesh_b, pose_b)[0]))
-                or (oracle.is_solid(mesh_b)
+                or (is_solid(mesh_b.vertices, mesh_b.faces)
                     and solid_contains(mesh_b, pose_b, world_vertices(mesh_a, pose_a)[0]))):
             return "containment"
-    if oracle.pose_used is not None:
-        if bodies_collide(mesh_a, oracle.pose_used(pose_a), mesh_b, oracle.pose_used(pose_b),
+    if pose_used is not None:
+        if bodies_collide(mesh_a, pose_used(pose_a), mesh_b, pose_used(pose_b),
                           kernel=kernel) == theirs:
             return "float32 transform"
     if ours:
@@ -593,8 +581,7 @@ def _cases(configurations, random_pairs, random_per_pair, seed):
             yield ("random", f"{label} #{k}", mesh_a, pose_a, mesh_b, pose_b)
 
 
-def measure_body_oracles(body_oracles: tuple[BodyOracle, ...] = (),
-                         fcl_pairs: Callable | None = None, *,
+def measure_body_oracles(collide_engines: tuple = (), pairs_engine=None, *,
                          configurations: tuple[Configuration, ...] = CONFIGURATIONS,
                          random_pairs=RANDOM_MODEL_PAIRS, random_per_pair: int = 50,
                          seed: int = 0, kernel: str | None = None) -> OracleAgreement:
@@ -602,10 +589,10 @@ def measure_body_oracles(body_oracles: tuple[BodyOracle, ...] = (),
     configurations and on seeded random poses (:func:`random_poses`) of
     ``random_pairs``; every disagreement classified, none dropped.
 
-    ``body_oracles``: boolean engines (:class:`BodyOracle`), compared with
-    ``bodies_collide(level="exact")``. ``fcl_pairs(mesh_a, pose_a, mesh_b,
-    pose_b) -> (k, 2)`` face pairs, compared with ``intersecting_pairs``;
-    each pair in one set only is classified by
+    ``collide_engines``: engines with the ``collide`` capability
+    (:mod:`refsim.engines`), compared with ``bodies_collide(level="exact")``.
+    ``pairs_engine``: an engine with the ``pairs`` capability, compared with
+    ``intersecting_pairs``; each pair in one set only is classified by
     :func:`refsim.studies.triangles.classify_disagreement` on refsim's world
     triangles.
     """
@@ -615,14 +602,15 @@ def measure_body_oracles(body_oracles: tuple[BodyOracle, ...] = (),
     for source, case, mesh_a, pose_a, mesh_b, pose_b in _cases(
             configurations, random_pairs, random_per_pair, seed):
         ours = bool(bodies_collide(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel))
-        for oracle in body_oracles:
-            theirs = bool(oracle.collide(mesh_a, pose_a, mesh_b, pose_b))
+        arrays = (mesh_a.vertices, mesh_a.faces, pose_a, mesh_b.vertices, mesh_b.faces, pose_b)
+        for engine in collide_engines:
+            theirs = bool(engine.bodies_collide(*arrays))
             kind = "" if theirs == ours else classify_body_disagreement(
-                mesh_a, pose_a, mesh_b, pose_b, ours, oracle, kernel)
-            body_rows.setdefault((oracle.name, source), []).append((case, ours, theirs, kind))
-        if fcl_pairs is not None:
+                mesh_a, pose_a, mesh_b, pose_b, ours, engine, kernel)
+            body_rows.setdefault((engine.name, source), []).append((case, ours, theirs, kind))
+        if pairs_engine is not None:
             mine = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel)
-            other = np.asarray(fcl_pairs(mesh_a, pose_a, mesh_b, pose_b), dtype=np.int64)
+            other = np.asarray(pairs_engine.intersecting_pairs(*arrays), dtype=np.int64)
             ours_set = set(map(tuple, mine.tolist()))
             theirs_set = set(map(tuple, other.reshape(-1, 2).tolist()))
             found = []
@@ -809,10 +797,10 @@ def measure_hierarchy_speed(fcl=None, repeats: int = 21, *,
                             compile_cost: bool = True) -> HierarchySpeed:
     """The hierarchy against FCL on the benchmark configurations.
 
-    ``fcl``: an object with ``intersecting_pairs(mesh_a, pose_a, mesh_b,
-    pose_b)`` and ``collide(...)`` (``refsim.oracles.fcl_adapter.FCLOracle``), or
-    None to time refsim alone. FCL's models are built once per mesh before
-    timing, as refsim's trees are. The seed's path is timed with
+    ``fcl``: an engine with the ``pairs`` and ``collide`` capabilities
+    (``refsim.oracles.fcl_adapter.FCLOracle``), or None to time refsim
+    alone. Its models are built once per mesh before timing, as refsim's
+    trees are. The seed's path is timed with
     ``max(3, repeats // 4)`` repeats (it takes up to ~0.1 s a call).
     ``compile_cost``: also measure the numba compile cost (two fresh
     interpreters for the hierarchy, one for the triangle kernel: ~10 s).
@@ -824,6 +812,7 @@ def measure_hierarchy_speed(fcl=None, repeats: int = 21, *,
         mesh_a, mesh_b = c.meshes()
         pose_a, pose_b = c.poses()
         args = (mesh_a, pose_a, mesh_b, pose_b)
+        arrays = (mesh_a.vertices, mesh_a.faces, pose_a, mesh_b.vertices, mesh_b.faces, pose_b)
 
         def pairs(method, level="exact", args=args):
             return intersecting_pairs(*args, level=level, method=method, kernel=kernel)
@@ -831,10 +820,10 @@ def measure_hierarchy_speed(fcl=None, repeats: int = 21, *,
         exact = pairs("bvh")
         fcl_pairs = fcl_seconds = fcl_bool = None
         if fcl is not None:
-            fcl_pairs = len(fcl.intersecting_pairs(*args))
-            fcl_seconds = _median_seconds(functools.partial(fcl.intersecting_pairs, *args),
+            fcl_pairs = len(fcl.intersecting_pairs(*arrays))
+            fcl_seconds = _median_seconds(functools.partial(fcl.intersecting_pairs, *arrays),
                                           repeats)
-            fcl_bool = _median_seconds(functools.partial(fcl.collide, *args), repeats)
+            fcl_bool = _median_seconds(functools.partial(fcl.bodies_collide, *arrays), repeats)
         cases.append(SpeedCase(
             model=sc.model, kind=sc.kind, description=sc.description,
             candidate_pairs=len(pairs("bvh", "triangle-aabb")), exact_pairs=len(exact),
@@ -855,31 +844,28 @@ def measure_hierarchy_speed(fcl=None, repeats: int = 21, *,
 # the command line
 # --------------------------------------------------------------------------
 
-def default_body_oracles() -> tuple[tuple[BodyOracle, ...], Callable | None, object | None]:
-    """``(body oracles, fcl_pairs, fcl adapter)`` from the installed engines;
-    an engine that is missing is left out (and said so on stderr)."""
+def default_body_oracles():
+    """``(collide engines, pairs engine, fcl engine)`` from the installed
+    engines; an engine that is missing is left out (and said so on stderr)."""
     import sys
 
     from refsim.oracles import OracleUnavailable
 
-    body, fcl_pairs, fcl = [], None, None
+    body, fcl = [], None
     try:
         from refsim.oracles.fcl_adapter import FCLOracle
 
         fcl = FCLOracle()
-        fcl_pairs = fcl.intersecting_pairs
-        body.append(BodyOracle("fcl", fcl.collide))
+        body.append(fcl)
     except OracleUnavailable as exc:
         print(f"python-fcl unavailable: {exc}", file=sys.stderr)
     try:
         from refsim.oracles.trimesh_collision import TrimeshCollisionOracle
 
-        tm = TrimeshCollisionOracle()
-        body.append(BodyOracle("trimesh", tm.bodies_collide, pose_used=tm.pose_used,
-                               is_solid=tm.uses_convex))
+        body.append(TrimeshCollisionOracle())
     except OracleUnavailable as exc:
         print(f"trimesh collision unavailable: {exc}", file=sys.stderr)
-    return tuple(body), fcl_pairs, fcl
+    return tuple(body), fcl, fcl
 
 
 def _us(seconds) -> str:

@@ -40,7 +40,8 @@ def test_all_pairs(benchmark, fcl, name, engine):
     mesh_a, pose_a, mesh_b, pose_b, expected = _setup(name)
     benchmark.group = f"all pairs: {name}"
     if engine == "fcl":
-        query = lambda: fcl.intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b)  # noqa: E731
+        arrays = (mesh_a.vertices, mesh_a.faces, pose_a, mesh_b.vertices, mesh_b.faces, pose_b)
+        query = lambda: fcl.intersecting_pairs(*arrays)  # noqa: E731
     else:
         method = engine.removeprefix("refsim-")
         query = lambda: intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b,  # noqa: E731
@@ -56,7 +57,8 @@ def test_boolean(benchmark, fcl, name, engine):
     mesh_a, pose_a, mesh_b, pose_b, expected = _setup(name)
     benchmark.group = f"boolean: {name}"
     if engine == "fcl":
-        query = lambda: fcl.collide(mesh_a, pose_a, mesh_b, pose_b)  # noqa: E731
+        arrays = (mesh_a.vertices, mesh_a.faces, pose_a, mesh_b.vertices, mesh_b.faces, pose_b)
+        query = lambda: fcl.bodies_collide(*arrays)  # noqa: E731
     else:
         query = lambda: bodies_collide(mesh_a, pose_a, mesh_b, pose_b)  # noqa: E731
     query()

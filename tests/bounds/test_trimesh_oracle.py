@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 from refsim.oracles.trimesh_adapter import (
     TrimeshOracle,
-    bounds_tolerance,
     pose_matrix,
     trimesh_skips_transform,
 )
@@ -14,7 +13,7 @@ from refsim.oracles.trimesh_adapter import (
 from refsim.bounds.aabb_incremental import IncrementalAABB
 from refsim.bounds.aabb_linear import aabb_linear
 from refsim.models import shapes
-from refsim.studies.bounds import perturbed_sphere
+from refsim.studies.bounds import bounds_tolerance, perturbed_sphere
 from refsim.types import random_rotation
 
 pytestmark = pytest.mark.oracle
@@ -39,7 +38,7 @@ def test_scan_equals_trimesh_bounds_within_arithmetic_tolerance(oracle, mesh):
     for _ in range(50):
         pose = (random_rotation(rng), rng.uniform(-5.0, 5.0, 3))
         lo, hi = aabb_linear(mesh, pose)
-        t_lo, t_hi = trimesh.transformed_bounds(mesh.vertices, mesh.faces, pose)
+        t_lo, t_hi = trimesh.aabb(mesh.vertices, pose)
         tol = bounds_tolerance(mesh.vertices, pose)
         difference = np.maximum(np.abs(lo - t_lo), np.abs(hi - t_hi))
         assert (difference <= tol).all()
@@ -55,7 +54,7 @@ def test_incremental_equals_trimesh_bounds_within_arithmetic_tolerance(oracle, m
     for _ in range(30):
         pose = (random_rotation(rng), rng.uniform(-5.0, 5.0, 3))
         lo, hi = tracker.update(pose)
-        t_lo, t_hi = trimesh.transformed_bounds(mesh.vertices, mesh.faces, pose)
+        t_lo, t_hi = trimesh.aabb(mesh.vertices, pose)
         tol = bounds_tolerance(mesh.vertices, pose)
         assert (np.abs(lo - t_lo) <= tol).all() and (np.abs(hi - t_hi) <= tol).all()
 
@@ -66,7 +65,7 @@ def test_trimesh_skips_near_identity_transforms(oracle):
     mesh = shapes.box()
     pose = (np.eye(3), np.array([1e-9, 0.0, 0.0]))
     assert trimesh_skips_transform(pose)
-    t_lo, _ = trimesh.transformed_bounds(mesh.vertices, mesh.faces, pose)
+    t_lo, _ = trimesh.aabb(mesh.vertices, pose)
     lo, _ = aabb_linear(mesh, pose)
     assert t_lo[0] == -0.5 and lo[0] == -0.5 + 1e-9
 

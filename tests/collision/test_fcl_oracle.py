@@ -113,14 +113,16 @@ def test_intersecting_pairs_match_refsim(fcl):
         pose_a = (random_rotation(rng), rng.uniform(-0.2, 0.2, 3))
         pose_b = (random_rotation(rng), rng.uniform(-1.5, 1.5, 3))
         ours, ta, tb = _brute_force_pairs(mesh_a, pose_a, mesh_b, pose_b)
-        theirs = fcl.intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b)
+        theirs = fcl.intersecting_pairs(mesh_a.vertices, mesh_a.faces, pose_a, mesh_b.vertices,
+                                         mesh_b.faces, pose_b)
         assert theirs.dtype == np.int64 and theirs.ndim == 2 and theirs.shape[1] == 2
         assert np.array_equal(theirs, np.unique(theirs, axis=0))
         ours_set = {tuple(p) for p in ours.tolist()}
         theirs_set = {tuple(p) for p in theirs.tolist()}
         for i, j in ours_set ^ theirs_set:
             assert classify_disagreement(ta[i], tb[j]) != "bug"
-        assert fcl.collide(mesh_a, pose_a, mesh_b, pose_b) == bool(theirs_set)
+        assert fcl.bodies_collide(mesh_a.vertices, mesh_a.faces, pose_a, mesh_b.vertices,
+                                  mesh_b.faces, pose_b) == bool(theirs_set)
         total += len(ours_set)
     assert total > 0
     # The BVH model is built once per mesh and reused.
@@ -130,8 +132,10 @@ def test_intersecting_pairs_match_refsim(fcl):
 def test_collide_far_apart(fcl):
     mesh = _octahedron()
     far = (np.eye(3), np.array([5.0, 0.0, 0.0]))
-    assert not fcl.collide(mesh, (np.eye(3), np.zeros(3)), mesh, far)
-    assert len(fcl.intersecting_pairs(mesh, (np.eye(3), np.zeros(3)), mesh, far)) == 0
+    assert not fcl.bodies_collide(mesh.vertices, mesh.faces, (np.eye(3), np.zeros(3)),
+                                  mesh.vertices, mesh.faces, far)
+    assert len(fcl.intersecting_pairs(mesh.vertices, mesh.faces, (np.eye(3), np.zeros(3)),
+                                      mesh.vertices, mesh.faces, far)) == 0
 
 
 def test_c4_near_parallel_planes(fcl):

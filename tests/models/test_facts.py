@@ -4,10 +4,12 @@ with trimesh."""
 from __future__ import annotations
 
 import pytest
+from refsim.oracles.trimesh_adapter import TrimeshOracle
 
 from refsim.bundled import bundled_models, models_dir
-from refsim.models.facts import describe, format_facts, measure_trimesh_agreement
+from refsim.models.facts import describe, format_facts
 from refsim.models.loading import load_model
+from refsim.studies.models import measure_mesh_facts_agreement
 
 #: Volumes and centroids from two summation orders agree to a few ulps times
 #: the number of triangles; 1e-12 relative leaves room and still catches a
@@ -41,7 +43,7 @@ def test_l_beam_centroids_differ():
 
 
 def test_every_bundled_model_agrees_with_trimesh():
-    rows = measure_trimesh_agreement(bundled_models())
+    rows = measure_mesh_facts_agreement(TrimeshOracle(), bundled_models())
     assert len(rows) == len(bundled_models())
     for row in rows:
         assert row.convex_agrees and row.closed_agrees, row.name

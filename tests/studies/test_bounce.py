@@ -138,7 +138,7 @@ ROUNDING_LEVEL = 1e-9
 def test_refsim_apex_ratio_meets_the_target(simulate, e):
     """The issue's target: with RK4 at h = 1e-3, the mean apex ratio over the
     first BOUNCES bounces is within APEX_RATIO_TARGET (0.5%) of e^2."""
-    row = measure_apex_row(SPHERE, e, step=STEP, solver="rk4", with_pybullet=False)
+    row = measure_apex_row(SPHERE, e, step=STEP, solver="rk4")
     print(f"refsim e={e}: apex ratio {row.refsim_ratio:.6f} (e^2 {e * e:.6f}), "
           f"relative error {row.refsim_error:.2e}; heights {row.refsim_heights}")
     assert row.refsim_error <= APEX_RATIO_TARGET
@@ -150,7 +150,7 @@ def test_refsim_apex_times_follow_the_analytic_ones(simulate):
     """Bounce k+1 comes 2 e^k v0 / g after bounce k; refsim's apex times are
     off by at most a step per bounce."""
     e = 0.8
-    row = measure_apex_row(SPHERE, e, with_pybullet=False)
+    row = measure_apex_row(SPHERE, e)
     error = np.abs(np.subtract(row.refsim_times, row.analytic_times))
     assert error.max() <= (BOUNCES + 1) * STEP
 
@@ -160,7 +160,7 @@ def test_seed_literal_wall_speed_also_meets_the_target(simulate, e):
     """The seed's literal flip (speed at the penetrated position) gains about
     delta / h0 per bounce, delta <= v h: 0.2% here, inside the 0.5% target,
     and above e^2 (it adds energy)."""
-    row = measure_apex_row(SPHERE, e, with_pybullet=False)
+    row = measure_apex_row(SPHERE, e)
     print(f"refsim, seed's wall speed, e={e}: apex ratio {row.seed_speed_ratio:.6f}, "
           f"relative error {row.seed_speed_error:.2e}")
     assert row.seed_speed_error <= APEX_RATIO_TARGET
@@ -170,7 +170,7 @@ def test_seed_literal_wall_speed_also_meets_the_target(simulate, e):
 def test_cube_face_down_bounces_like_the_sphere(simulate):
     """Without rotation the seed's box-based wall test sees the same interval
     problem for a face-down cube as for the sphere: same ratio target."""
-    row = measure_apex_row(CUBE, 0.8, rotation="off", with_pybullet=False)
+    row = measure_apex_row(CUBE, 0.8, rotation="off")
     assert row.refsim_error <= APEX_RATIO_TARGET
 
 
@@ -179,7 +179,7 @@ def test_seed_rotation_spins_a_face_down_cube(simulate):
     its single contact vertex (one of four tied, AMBIGUITY A4) gives a torque
     Pi x I that a symmetric bounce should not have: the cube spins and its
     later apexes leave e^2 (measured 5% at e = 0.8; reported, not a target)."""
-    row = measure_apex_row(CUBE, 0.8, rotation="seed", with_pybullet=False)
+    row = measure_apex_row(CUBE, 0.8, rotation="seed")
     assert row.refsim_first_ratio == pytest.approx(0.64, rel=1e-9)
     assert row.refsim_max_spin > 1.0
     assert row.refsim_error > APEX_RATIO_TARGET
@@ -188,7 +188,7 @@ def test_seed_rotation_spins_a_face_down_cube(simulate):
 def test_refsim_lateral_velocity_is_the_seed_s_damping(simulate):
     """The seed's friction keeps (1 - friction) of the lateral velocity,
     whatever the normal speed (not Coulomb's mu (1 + e) |v_n| loss)."""
-    rows = measure_oblique(models=(SPHERE,), with_pybullet=False)
+    rows = measure_oblique(models=(SPHERE,))
     for row in rows:
         assert row.refsim == pytest.approx(row.seed_analytic, rel=1e-12)
 
@@ -205,8 +205,8 @@ def test_pybullet_lateral_velocity_is_coulomb_s(simulate, oracle):
     """
     from refsim.oracles.pybullet_adapter import PybulletOracle
 
-    oracle(PybulletOracle).close()                     # skip when pybullet is missing
-    rows = measure_oblique(models=(SPHERE,))
+    with oracle(PybulletOracle) as pybullet:           # skip when pybullet is missing
+        rows = measure_oblique(models=(SPHERE,), oracle=pybullet)
     for row in rows:
         print(row)
         assert row.pybullet == pytest.approx(row.coulomb_ball, abs=0.02 * row.v_t)
@@ -215,7 +215,7 @@ def test_pybullet_lateral_velocity_is_coulomb_s(simulate, oracle):
 def test_refsim_time_to_rest_matches_the_analytic_settling(simulate):
     """Apexes stay below REST_FRACTION h0 after the same bounce as the
     analytic series, within a few steps per bounce of its time."""
-    rows = measure_rest(restitutions=(0.5,), with_pybullet=False)
+    rows = measure_rest(restitutions=(0.5,))
     for row in rows:
         assert row.refsim_bounces == row.analytic_bounces
         assert row.refsim_settle == pytest.approx(row.analytic_settle,

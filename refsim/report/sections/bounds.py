@@ -26,7 +26,9 @@ def build(ctx) -> Section:
               for e in measure.measure_incremental_error(motion=motion, frames=error_frames,
                                                          seed=ctx.seed)]
     ctx.progress.announce("bounds: agreement with trimesh")
-    agreement = measure.measure_bounds_agreement(poses=poses, seed=ctx.seed)
+    from refsim.oracles.trimesh_adapter import TrimeshOracle
+
+    agreement = measure.measure_bounds_agreement(TrimeshOracle(), poses=poses, seed=ctx.seed)
 
     methods = sorted({r.method for r in study.rows}, key=list(STYLES).index)
     figures = [_cost_figure(study, motion, methods) for motion in ("coherent", "jump")]
@@ -155,7 +157,8 @@ def _agreement_table(agreement) -> Table:
 
 
 AGREEMENT_COMMAND = ("python -c \"from refsim.studies.bounds import "
-                     "measure_bounds_agreement as m; [print(r) for r in m()]\"")
+                     "measure_bounds_agreement as m; from refsim.oracles.trimesh_adapter import "
+                     "TrimeshOracle; [print(r) for r in m(TrimeshOracle())]\"")
 
 
 def _agreements(agreement) -> list[Agreement]:

@@ -50,8 +50,8 @@ def _oracles():
     installed."""
     from refsim.studies.levels import default_body_oracles
 
-    body, fcl_pairs, fcl = default_body_oracles()
-    return body, fcl_pairs, fcl, (None if fcl is None else fcl.triangles_intersect)
+    body, pairs_engine, fcl = default_body_oracles()
+    return body, pairs_engine, fcl, (None if fcl is None else fcl.triangles_intersect)
 
 
 def build(ctx) -> Section:

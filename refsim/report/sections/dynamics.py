@@ -37,16 +37,39 @@ STYLES = {"euler": "o-", "averaged-euler": "s--", "backwards-euler": "^-", "midp
           "rk4": "D-", "rk4, seed wall speed": "D--", "pybullet": "*-"}
 
 
-def _pybullet_available() -> tuple[bool, str]:
+def _pybullet_available():
+    """``(engine, "")``: the pybullet oracle, or ``(None, why)`` without it.
+    One client serves every scene (each ``simulate`` resets it)."""
     from refsim.oracles import OracleUnavailable
 
     try:
         from refsim.oracles.pybullet_adapter import PybulletOracle
 
-        PybulletOracle().close()
+        return PybulletOracle(), ""
     except OracleUnavailable as exc:
-        return False, str(exc)
-    return True, ""
+        return None, str(exc)
+
+
+def _pybullet_variants():
+    """pybullet with the oracle's settings, then with one setting at a time
+    back at (or near) pybullet's default: ``(label, engine)`` pairs."""
+    from dataclasses import replace
+
+    from refsim.oracles.pybullet_adapter import PybulletOracle, PybulletSettings
+
+    base = PybulletSettings()
+    changes = (
+        ("none (the oracle's settings)", base),
+        ("useMaximalCoordinates=False (multibody)", replace(base, use_maximal_coordinates=False)),
+        ("contactProcessingThreshold=1e30 (Bullet's default: all)",
+         replace(base, contact_processing_threshold=1e30)),
+        ("useSplitImpulse=0", replace(base, use_split_impulse=0)),
+        ("restitutionVelocityThreshold=0.2 (Bullet's default)",
+         replace(base, restitution_velocity_threshold=0.2)),
+        ("linear/angular damping 0.04 (pybullet's default)",
+         replace(base, linear_damping=0.04, angular_damping=0.04)),
+    )
+    return [(label, PybulletOracle(settings)) for label, settings in changes]
 
 
 def _f(x, digits: int = 5) -> str:
@@ -88,33 +111,33 @@ def build(ctx) -> Section:
     # -- measurements ------------------------------------------------------------------
     say("dynamics: apex ratios")
     if quick:
-        apex_rows = bounce.measure_apexes(models=(bounce.SPHERE,), with_pybullet=pb)
+        apex_rows = bounce.measure_apexes(models=(bounce.SPHERE,), oracle=pb)
         apex_rows.append(bounce.measure_apex_row(bounce.CUBE, 0.8, rotation="seed",
-                                                 with_pybullet=pb))
+                                                 oracle=pb))
     else:
-        apex_rows = bounce.measure_apexes(with_pybullet=pb)
+        apex_rows = bounce.measure_apexes(oracle=pb)
     say("dynamics: oblique bounces")
-    oblique_rows = bounce.measure_oblique(with_pybullet=pb)
+    oblique_rows = bounce.measure_oblique(oracle=pb)
     say("dynamics: time to rest")
     rest_rows = bounce.measure_rest(restitutions=(0.5,) if quick else (0.5, 0.8),
-                                    with_pybullet=pb)
+                                    oracle=pb)
     say("dynamics: energy over time")
-    series = bounce.measure_energy(with_pybullet=pb)
+    series = bounce.measure_energy(oracle=pb)
     say("dynamics: error against cost")
     cost = bounce.measure_cost(bounce.COST_STEPS_QUICK if quick else bounce.COST_STEPS,
                                bounce.COST_SOLVERS_QUICK if quick else bounce.COST_SOLVERS,
-                               with_pybullet=pb)
+                               oracle=pb)
     settings_rows = []
     if pb and not quick:
         say("dynamics: pybullet's settings")
-        settings_rows = bounce.measure_pybullet_settings()
+        settings_rows = bounce.measure_engine_variants(_pybullet_variants())
     say("dynamics: step cost against pybullet")
     step_rows = bounce.measure_step_cost(steps=50 if quick else 200, warmup=10 if quick else 20,
-                                         repeats=3 if quick else 5, with_pybullet=pb)
+                                         repeats=3 if quick else 5, oracle=pb)
     if not quick:
         step_rows += bounce.measure_step_cost(counts=(bounce.BENCH_COUNTS[-1],),
                                               warmup=bounce.LATE_WARMUP, repeats=3,
-                                              with_pybullet=pb)
+                                              oracle=pb)
     say("dynamics: C12 spin")
     # C12 runs its full 6 s in the quick report too: a shorter run stops
     # before the corrected model comes to rest and would change the verdict.
@@ -356,7 +379,7 @@ def build(ctx) -> Section:
                      "spin": s.spin, "rotational_energy": s.rotational_energy}
                     for s in spin_rows]
     results = _jsonable({
-        "pybullet": pb,
+        "pybullet": pb is not None,
         "apex_ratios": apex_rows,
         "oblique": oblique_rows,
         "rest": rest_rows,

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from refsim.bundled import bundled_models
-from refsim.models.facts import describe, measure_trimesh_agreement
+from refsim.models.facts import describe
 from refsim.report.charts import bar_chart
 from refsim.report.section import Agreement, Figure, Section, Table
 
@@ -13,8 +13,9 @@ from refsim.report.section import Agreement, Figure, Section, Table
 SHOWN_AS_ZERO = 1e-12
 
 AGREEMENT_COMMAND = ("python -c \"from refsim.bundled import bundled_models; "
-                     "from refsim.models.facts import measure_trimesh_agreement as m; "
-                     "[print(r) for r in m(bundled_models())]\"")
+                     "from refsim.oracles.trimesh_adapter import TrimeshOracle; "
+                     "from refsim.studies.models import measure_mesh_facts_agreement as m; "
+                     "[print(r) for r in m(TrimeshOracle(), bundled_models())]\"")
 
 
 def _point(p) -> str:
@@ -40,7 +41,10 @@ def build(ctx) -> Section:
         rows=rows,
         caption="Read by refsim's own AC3D reader, welded to shared-vertex form. "
                 "Reproduce one row: refsim info models/NAME.ac")
-    agreement = measure_trimesh_agreement(bundled_models())
+    from refsim.oracles.trimesh_adapter import TrimeshOracle
+    from refsim.studies.models import measure_mesh_facts_agreement
+
+    agreement = measure_mesh_facts_agreement(TrimeshOracle(), bundled_models())
     agree_table = Table(
         id="models-trimesh", title="Agreement with trimesh",
         columns=("model", "convex agrees", "closed agrees", "volume |difference| / volume",
