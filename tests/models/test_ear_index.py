@@ -3,6 +3,9 @@ triangles, bit for bit, compiled and readable alike, with near-linear work."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -44,6 +47,9 @@ def _existing_test_polygons():
     for scale in (1e300, 8.5e307, 1e-300, 2e-323):
         out[f"L times {scale}"] = _l_shape() * scale
     out["unit quad"] = _xy((5, 0), (6, 0), (6, 1), (5, 1))
+    out["triangle"] = _xy((0, 0), (1, 0), (0, 1))
+    out["degenerate line"] = _xy((0, 0), (1, 0), (2, 0), (3, 0), (1.5, 0))
+    out["degenerate point"] = np.zeros((4, 3))
     return out
 
 
@@ -103,10 +109,17 @@ def test_families_obey_the_contract_at_20k_corners(kind):
 
 
 def test_below_the_threshold_ear_clip_is_the_reference():
-    # Nothing to observe but the triangles; both sides of the threshold agree.
+    # Both sides of the threshold agree with the reference ...
     for k in (INDEX_MIN_CORNERS - 1, INDEX_MIN_CORNERS):
         p = polygons.random_star(k, seed=3)
         assert ear_clip(p).tolist() == ear_clip_reference(p).tolist()
+    # ... and below it numba is never imported (a fresh interpreter).
+    code = ("import sys; from refsim.models import polygons; "
+            "from refsim.models.triangulate import ear_clip, INDEX_MIN_CORNERS; "
+            "ear_clip(polygons.star(INDEX_MIN_CORNERS - 1)); print('numba' in sys.modules)")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert run.stdout.strip() == "False"
 
 
 # -- the lemma's cases, one polygon each --------------------------------------------------
