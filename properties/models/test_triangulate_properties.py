@@ -13,7 +13,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from properties.strategies import star_polygons
-from refsim.models.triangulate import ear_clip, newell_normal
+from refsim.models.triangulate import ear_clip, ear_clip_reference, newell_normal
 from refsim.types import rotation_about_axis
 
 #: The triangles' areas are computed from the same coordinates as the
@@ -23,6 +23,9 @@ AREA_RTOL = 1e-12
 
 
 def _laws(p, tri):
+    # ear_clip is the reference below 16 corners, the index from there on:
+    # both give the reference's triangles (test_ear_index_properties.py).
+    assert tri.tolist() == ear_clip_reference(p).tolist()
     k = len(p)
     assert tri.shape == (k - 2, 3)
     assert sorted(set(tri.ravel().tolist())) == list(range(k))
