@@ -144,6 +144,127 @@ def meshes(draw, max_vertices=12, max_faces=10):
 
 
 # ===========================================================================
+# Models: polygons to ear-clip (refsim.models.triangulate, ear_index; seed S1)
+# ===========================================================================
+# Float stars (angles on a 1/96-turn grid, radii on a 1/16 grid) are the
+# polygons the triangulation's laws were first checked on. Lattice polygons
+# have small integer (or quarter-integer) corners, so every orientation is
+# computed exactly and ear_index's lemma applies as proved; collinear runs,
+# repeated points, spikes that overlap and bridges to holes occur on purpose.
+
+import math as _math  # noqa: E402
+
+#: Float stars: angles on a 1/96-turn grid and radii on a 1/16 grid, so exact
+#: collinear and repeated-direction cases occur, yet every polygon is simple.
+POLYGON_ANGLE_STEPS, POLYGON_RADIUS_STEPS = 96, 16
+
+
+@_st.composite
+def star_polygons(draw):
+    """A simple polygon (k, 3), 3 <= k <= 24 (plus gap fillers), star-shaped
+    about the origin: corners sorted by angle about a point that sees the
+    whole boundary, in the plane z = 0, counter-clockwise."""
+    steps = draw(_st.lists(_st.integers(0, POLYGON_ANGLE_STEPS - 1), min_size=3, max_size=24,
+                           unique=True))
+    steps.sort()
+    # the centre must see every edge: no angular gap of half a turn or more
+    while True:
+        gaps = _np.diff(steps + [steps[0] + POLYGON_ANGLE_STEPS])
+        if gaps.max() < POLYGON_ANGLE_STEPS // 2:
+            break
+        steps = sorted(steps + [(steps[int(_np.argmax(gaps))] + POLYGON_ANGLE_STEPS // 4)
+                                % POLYGON_ANGLE_STEPS])
+    t = 2.0 * _np.pi * _np.array(steps) / POLYGON_ANGLE_STEPS
+    r = _np.array([draw(_st.integers(1, POLYGON_RADIUS_STEPS)) for _ in steps])
+    r = r / POLYGON_RADIUS_STEPS
+    return _np.c_[r * _np.cos(t), r * _np.sin(t), _np.zeros(len(t))]
+
+
+#: Lattice stars have corners in [-LATTICE_RADIUS, LATTICE_RADIUS]^2: distinct
+#: directions differ by more than 1 / (2 R^2) rad, far above atan2's rounding.
+LATTICE_RADIUS = 24
+
+
+def _plane(xy):
+    return _np.array([(x, y, 0.0) for x, y in xy], dtype=_np.float64)
+
+
+@_st.composite
+def lattice_star_polygons(draw, max_corners=40, radius=LATTICE_RADIUS):
+    """A simple polygon (k, 3), 4 <= k <= ``max_corners``, with integer
+    corners, star-shaped about the origin: one corner on each half axis (so
+    no angular gap reaches half a turn) and random lattice points, one per
+    direction (the first drawn wins), sorted by angle. Collinear neighbours
+    occur (lattice points on a line); the corner on the positive x axis is
+    ``(x, 0)`` with ``x > 0``."""
+    length = _st.integers(1, radius)
+    axes = [(draw(length), 0), (0, draw(length)), (-draw(length), 0), (0, -draw(length))]
+    coordinate = _st.integers(-radius, radius)
+    more = draw(_st.lists(_st.tuples(coordinate, coordinate), max_size=max_corners - 4))
+    kept = []
+    for p in axes + [q for q in more if q != (0, 0)]:
+        if not any(p[0] * q[1] - p[1] * q[0] == 0 and p[0] * q[0] + p[1] * q[1] > 0
+                   for q in kept):
+            kept.append(p)
+    kept.sort(key=lambda p: _math.atan2(p[1], p[0]))
+    return _plane(kept)
+
+
+@_st.composite
+def decorated_polygons(draw, max_operations=12):
+    """A lattice star, scaled by 4, with collinear runs, repeated points and
+    spikes: each operation at a random corner ``p`` (edge ``p -> q``) adds one
+    to three corners at quarter points of the edge, or repeats ``p`` (a
+    zero-length edge), or adds a spike towards the origin, to ``p / 2`` or
+    ``p / 4`` and back to ``p``. Spikes may start on other spikes or on
+    collinear corners, so spikes overlap and corners lie on other edges: the
+    polygon touches itself but never crosses. Corners are multiples of 1/16,
+    so orientations stay exact."""
+    xy = [(4.0 * x, 4.0 * y) for x, y, _ in draw(lattice_star_polygons(max_corners=24))]
+    for _ in range(draw(_st.integers(1, max_operations))):
+        j = draw(_st.integers(0, len(xy) - 1))
+        (px, py), (qx, qy) = xy[j], xy[(j + 1) % len(xy)]
+        kind = draw(_st.sampled_from(["run", "repeat", "spike"]))
+        if kind == "run":
+            count = draw(_st.integers(1, 3))
+            xy[j + 1:j + 1] = [(px + (qx - px) * t / 4.0, py + (qy - py) * t / 4.0)
+                               for t in range(1, count + 1)]
+        elif kind == "repeat":
+            xy.insert(j, (px, py))
+        else:
+            f = draw(_st.sampled_from([0.5, 0.25]))
+            xy[j + 1:j + 1] = [(f * px, f * py), (px, py)]
+    return _plane(xy)
+
+
+@_st.composite
+def bridged_polygons(draw):
+    """A lattice star with a lattice-star hole, joined as modellers export a
+    face with a hole: the outline to its corner ``(X, 0)``, across the
+    positive x axis to the hole's ``(h, 0)``, round the hole clockwise, back
+    to ``(h, 0)`` and across to ``(X, 0)``. The outline is scaled (by an
+    integer) until its inradius about the origin exceeds the hole's radius,
+    so the bridge and the hole cross nothing. Returns ``(points, area)``
+    with the exact area (outline minus hole)."""
+    outer = draw(lattice_star_polygons(max_corners=24))[:, :2]
+    hole = draw(lattice_star_polygons(max_corners=12, radius=4))[:, :2]
+    nxt = _np.roll(outer, -1, axis=0)
+    inradius = float(((outer[:, 0] * nxt[:, 1] - outer[:, 1] * nxt[:, 0])
+                      / _np.hypot(*(nxt - outer).T)).min())
+    outer = outer * (_math.ceil(6.0 / inradius) + 1)  # hole radius <= 4 sqrt 2 < 6
+    o = int(_np.flatnonzero((outer[:, 1] == 0) & (outer[:, 0] > 0))[0])
+    h = int(_np.flatnonzero((hole[:, 1] == 0) & (hole[:, 0] > 0))[0])
+    hole_cw = _np.vstack([hole[h::-1], hole[:h:-1]])
+    ring = _np.vstack([outer[:o + 1], hole_cw, hole_cw[:1], outer[o:]])
+
+    def shoelace(q):
+        r = _np.roll(q, -1, axis=0)
+        return 0.5 * float((q[:, 0] * r[:, 1] - r[:, 0] * q[:, 1]).sum())
+
+    return _np.c_[ring, _np.zeros(len(ring))], shoelace(outer) - shoelace(hole)
+
+
+# ===========================================================================
 # Bounds: convex meshes and pose sequences (refsim.bounds, seeds S2, S3)
 # ===========================================================================
 # Meshes are convex hulls of random points, wound outward, stretched by an

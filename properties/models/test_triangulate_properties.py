@@ -12,12 +12,9 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from refsim.models.triangulate import ear_clip, newell_normal
+from properties.strategies import star_polygons
+from refsim.models.triangulate import ear_clip, ear_clip_reference, newell_normal
 from refsim.types import rotation_about_axis
-
-#: Angles on a 1/96-turn grid and radii on a 1/16 grid: exact collinear and
-#: repeated-direction cases occur, yet every polygon is simple.
-ANGLE_STEPS, RADIUS_STEPS = 96, 16
 
 #: The triangles' areas are computed from the same coordinates as the
 #: polygon's by sums of a few dozen products of size <= 1; 1e-12 relative is
@@ -25,24 +22,10 @@ ANGLE_STEPS, RADIUS_STEPS = 96, 16
 AREA_RTOL = 1e-12
 
 
-@st.composite
-def star_polygons(draw):
-    steps = draw(st.lists(st.integers(0, ANGLE_STEPS - 1), min_size=3, max_size=24,
-                          unique=True))
-    steps.sort()
-    # the centre must see every edge: no angular gap of half a turn or more
-    while True:
-        gaps = np.diff(steps + [steps[0] + ANGLE_STEPS])
-        if gaps.max() < ANGLE_STEPS // 2:
-            break
-        steps = sorted(steps + [(steps[int(np.argmax(gaps))] + ANGLE_STEPS // 4)
-                                % ANGLE_STEPS])
-    t = 2.0 * np.pi * np.array(steps) / ANGLE_STEPS
-    r = np.array([draw(st.integers(1, RADIUS_STEPS)) for _ in steps]) / RADIUS_STEPS
-    return np.c_[r * np.cos(t), r * np.sin(t), np.zeros(len(t))]
-
-
 def _laws(p, tri):
+    # ear_clip is the reference below 16 corners, the index from there on:
+    # both give the reference's triangles (test_ear_index_properties.py).
+    assert tri.tolist() == ear_clip_reference(p).tolist()
     k = len(p)
     assert tri.shape == (k - 2, 3)
     assert sorted(set(tri.ravel().tolist())) == list(range(k))

@@ -43,9 +43,24 @@ rounding (or self-intersection, which is outside the method's contract)
 leaves no ear: the most convex remaining corner is clipped, so the function
 always returns ``k - 2`` triangles and never fails on finite input.
 
-Cost: O(k^2) for ``k`` corners (each clip re-examines two corners against at
-most ``k`` others; finding the next ear walks at most the whole ring).
-AC3D polygons are small; this is plain Python over floats, fast for them.
+Two implementations of step 3, one result. :func:`ear_clip_reference` is
+the specification: it tests each candidate ear against every other corner
+and walks the ring to the next ear, O(k^2) for ``k`` corners, which AC3D
+files with polygons of thousands of corners make minutes.
+:func:`ear_clip_indexed` clips the same ears in the same order, asking the
+same ear test only of the corners that can block an ear (Eberly's
+reflex-corner observation, made exact for closed triangles, repeated points
+and touching edges), found through a k-d tree, and taking the next ear from
+a queue; :mod:`refsim.models.ear_index` gives the argument and the cost,
+O(k log k) for typical polygons. It returns the reference's triangles bit
+for bit on simple polygons and on polygons that touch themselves without
+crossing (collinear runs, repeated corners, spikes, bridges to holes;
+tests/models/test_ear_index.py, properties/models/test_ear_index_properties.py).
+On self-intersecting input, and on the pinched polygons the reference itself
+turns self-intersecting, the two may clip differently, both within the
+contract above (:mod:`refsim.models.ear_index`, DEVIATION).
+:func:`ear_clip` uses the reference below ``INDEX_MIN_CORNERS`` corners and
+the compiled indexed clipping from there on.
 """
 
 from __future__ import annotations
@@ -53,6 +68,7 @@ from __future__ import annotations
 import numpy as np
 
 from refsim.errors import ModelError
+from refsim.models.ear_index import clip_indexed
 
 #: A polygon is degenerate (no plane) when the length of Newell's normal is at
 #: most this many times the sum of the lengths of its terms
@@ -60,6 +76,11 @@ from refsim.errors import ModelError
 #: ``k`` unit roundoffs of that sum; 64 eps covers polygons of a few dozen
 #: corners with margin and is still far below any polygon drawn on purpose.
 DEGENERATE_RTOL = 64 * np.finfo(np.float64).eps
+
+#: :func:`ear_clip` runs the reference below this many corners: there its
+#: O(k^2) costs at most a few hundred microseconds, no more than setting up
+#: the index, and a model of quads and other small polygons never loads numba.
+INDEX_MIN_CORNERS = 16
 
 
 def newell_normal(points: np.ndarray) -> np.ndarray:
@@ -77,6 +98,11 @@ def newell_normal(points: np.ndarray) -> np.ndarray:
 def ear_clip(points) -> np.ndarray:
     """Triangulate one planar polygon by ear clipping.
 
+    The triangles of :func:`ear_clip_reference`, bit for bit, for every
+    simple polygon and every polygon that touches itself without crossing
+    (module docstring): below ``INDEX_MIN_CORNERS`` corners by the reference
+    itself, from there on by :func:`ear_clip_indexed` (compiled).
+
     Parameters
     ----------
     points : array_like, shape (k, 3)
@@ -92,14 +118,54 @@ def ear_clip(points) -> np.ndarray:
     ModelError
         When ``points`` is not a (k, 3) array with ``k >= 3`` of finite values.
     """
-    p = np.asarray(points, dtype=np.float64)
-    if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 3:
-        raise ModelError(f"a polygon needs shape (k, 3) with k >= 3, got {p.shape}")
-    if not np.isfinite(p).all():
-        raise ModelError("a polygon corner has a non-finite coordinate")
+    p = _checked(points)
+    if len(p) < INDEX_MIN_CORNERS:
+        return ear_clip_reference(p)
+    return ear_clip_indexed(p)
+
+
+def ear_clip_reference(points) -> np.ndarray:
+    """The specification: steps 1 to 3 of the module docstring as written,
+    each ear test against every other corner, each next ear found by walking
+    the ring. O(k^2); the tests compare :func:`ear_clip_indexed` with it.
+    Same parameters, result and errors as :func:`ear_clip`."""
+    p = _checked(points)
     k = len(p)
     if k == 3:
         return np.array([[0, 1, 2]], dtype=np.int64)
+    plane = project_polygon(p)
+    if plane is None:
+        return _fan(k)
+    xs, ys = plane
+    return _clip_by_walking(xs.tolist(), ys.tolist())
+
+
+def ear_clip_indexed(points, *, compiled: bool = True, work=None) -> np.ndarray:
+    """:func:`ear_clip_reference`'s triangles by the indexed clipping of
+    :mod:`refsim.models.ear_index`: O(k log k) for typical polygons.
+
+    ``compiled=True`` runs numba's build of that module's source (plain
+    Python without numba), ``compiled=False`` the source as Python.
+    ``work``, if given, is an int64 array (4,) that receives the counters of
+    :func:`refsim.models.ear_index.clip_ears` (zeros for the fan and the
+    triangle, which clip nothing). Same parameters, result and errors as
+    :func:`ear_clip`.
+    """
+    p = _checked(points)
+    k = len(p)
+    if k == 3:
+        return np.array([[0, 1, 2]], dtype=np.int64)
+    plane = project_polygon(p)
+    if plane is None:
+        return _fan(k)
+    return clip_indexed(*plane, compiled=compiled, work=work)
+
+
+def project_polygon(p: np.ndarray):
+    """Steps 1 and 2: the 2-D corners ``(xs, ys)``, two float64 arrays (k,) in
+    which the polygon runs counter-clockwise, every coordinate in (-1, 1);
+    or None when the polygon has no plane (degenerate). ``p`` is a checked
+    (k, 3) float64 array."""
     # Scale by a power of two so that the largest coordinate is in [0.5, 1):
     # exact (orientation signs cannot change), and the products below can
     # neither overflow (coordinates near 1e308) nor underflow (near 1e-308).
@@ -113,17 +179,29 @@ def ear_clip(points) -> np.ndarray:
     scale = float((np.linalg.norm(q, axis=1) * np.linalg.norm(np.roll(q, -1, axis=0),
                                                                axis=1)).sum())
     if not np.linalg.norm(n) > DEGENERATE_RTOL * scale:
-        return _fan(k)
+        return None
 
     # Step 2: project by dropping the dominant axis; orient counter-clockwise.
     a = int(np.argmax(np.abs(n)))
     u, v = (a + 1) % 3, (a + 2) % 3
     if n[a] < 0.0:
         u, v = v, u
-    xs = p[:, u].tolist()
-    ys = p[:, v].tolist()
+    return np.ascontiguousarray(p[:, u]), np.ascontiguousarray(p[:, v])
 
-    # Step 3: clip ears around a doubly linked ring.
+
+def _checked(points) -> np.ndarray:
+    """``points`` as a (k, 3) float64 array, or ModelError."""
+    p = np.asarray(points, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 3 or p.shape[0] < 3:
+        raise ModelError(f"a polygon needs shape (k, 3) with k >= 3, got {p.shape}")
+    if not np.isfinite(p).all():
+        raise ModelError("a polygon corner has a non-finite coordinate")
+    return p
+
+
+def _clip_by_walking(xs: list, ys: list) -> np.ndarray:
+    """Step 3 as the specification states it, on the projected corners."""
+    k = len(xs)
     prev = [(i - 1) % k for i in range(k)]
     nxt = [(i + 1) % k for i in range(k)]
     ear = [_is_ear(i, prev, nxt, xs, ys) for i in range(k)]

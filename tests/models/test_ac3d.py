@@ -11,6 +11,7 @@ import pytest
 from refsim.errors import ModelError, ModelWarning
 from refsim.models.ac3d import format_ac3d, parse_ac3d, read_ac3d, write_ac3d
 from refsim.models.mesh import Material, Mesh
+from refsim.types import rotation_about_axis
 from tests.helpers import assert_meshes_identical
 
 REST = "amb 0.2 0.2 0.2  emis 0 0 0  spec 0.5 0.5 0.5  shi 10  trans 0"
@@ -158,6 +159,42 @@ def test_quads_and_non_convex_polygons_are_triangulated(tmp_path):
     for tri in mesh.vertices[mesh.faces[:4]].tolist():
         assert not ([2, 1, 0] in tri and [1, 2, 0] in tri)
     assert mesh.materials[0].name == ""
+
+
+#: The 20 000 triangle areas are products of coordinates ~3 rotated with
+#: relative rounding ~1e-16; their sum is good to ~k u = 2e-12 relative,
+#: and a missing or doubled triangle would change it by 5e-5.
+LARGE_POLYGON_AREA_RTOL = 1e-10
+
+
+def test_a_polygon_of_20000_corners_is_read(tmp_path):
+    # About 1 MB: one surface whose ear clipping the O(k^2) reference took
+    # minutes over. A 20 000-gon approximating a circle of radius 3, tilted out of
+    # the coordinate planes; its refs start at corner 5 and wrap around.
+    k = 20_000
+    t = 2.0 * np.pi * np.arange(k) / k
+    points = np.column_stack([3.0 * np.cos(t), 3.0 * np.sin(t), np.zeros(k)])
+    points = points @ rotation_about_axis([1.0, 2.0, 3.0], 0.7).T + np.array([1.0, -2.0, 0.5])
+    refs = (np.arange(k) + 5) % k
+    lines = ["AC3Db", f"MATERIAL \"\" rgb 1 1 1  {REST}", "OBJECT world", "kids 1",
+             "OBJECT poly", 'name "disc"', f"numvert {k}"]
+    lines += [f"{x!r} {y!r} {z!r}" for x, y, z in points.tolist()]
+    lines += ["numsurf 1", "SURF 0x10", "mat 0", f"refs {k}"]
+    lines += [f"{r} 0 0" for r in refs.tolist()]
+    lines += ["kids 0", ""]
+    path = _write(tmp_path, "\n".join(lines))
+    assert path.stat().st_size > 1_000_000
+    mesh = _read_quiet(path)
+    assert mesh.n_faces == k - 2
+    assert sorted(set(mesh.faces.ravel().tolist())) == list(range(k))
+    v = mesh.vertices[mesh.faces]
+    normals = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+    axis = rotation_about_axis([1.0, 2.0, 3.0], 0.7)[:, 2]  # the disc's normal
+    assert (normals @ axis > 0.0).all()  # every triangle turns the polygon's way
+    # the areas add up to the 20 000-gon's, 0.5 k r^2 sin(2 pi / k), to rounding
+    area = 0.5 * k * 9.0 * np.sin(2.0 * np.pi / k)
+    assert 0.5 * np.linalg.norm(normals, axis=1).sum() == pytest.approx(
+        area, rel=LARGE_POLYGON_AREA_RTOL)
 
 
 def test_line_surfaces_are_skipped_with_a_warning(tmp_path):
