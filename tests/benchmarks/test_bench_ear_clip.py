@@ -2,7 +2,7 @@
 (compiled) on a circle, a star and a comb of 1000 to 100 000 corners, the
 other families of :mod:`refsim.models.polygons` at 20 000, and the O(k^2)
 reference at 1000 corners (it takes seconds at 4000, minutes at 20 000:
-:func:`refsim.models.measure.measure_ear_clip_seconds` times it once when
+:func:`refsim.studies.ear_clip.measure_ear_clip_seconds` times it once when
 asked).
 
 Run: ``pytest tests/benchmarks/test_bench_ear_clip.py --benchmark-only``.

@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 
 from refsim.models import ear_index, polygons
-from refsim.models.measure import measure_ear_clip_work
 from refsim.models.triangulate import (
     INDEX_MIN_CORNERS,
     ear_clip,
@@ -18,6 +17,7 @@ from refsim.models.triangulate import (
     ear_clip_reference,
     newell_normal,
 )
+from refsim.studies.ear_clip import measure_ear_clip_work
 from refsim.types import rotation_about_axis
 from tests.models.test_triangulate import POLYGONS, _l_shape
 

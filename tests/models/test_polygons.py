@@ -8,8 +8,8 @@ import pytest
 
 from refsim.errors import OptionError
 from refsim.models import polygons
-from refsim.models.measure import measure_ear_clip_seconds, measure_ear_clip_work
 from refsim.models.triangulate import newell_normal
+from refsim.studies.ear_clip import measure_ear_clip_seconds, measure_ear_clip_work
 
 #: Shoelace sums of ~100 products of coordinates <= 2 (the comb: <= 100):
 #: rounding ~1e-14 relative; any wrong corner changes an area by > 1e-3.
