@@ -8,6 +8,9 @@ process because refsim's tasks are CPU-bound Python and numba code, which
 threads of one process would run one at a time (the GIL), and because a
 task that dies then takes only itself down.
 
+The workers of a scheduler refsim did not start must be able to import
+refsim (the same version) and each task's module, as the client does.
+
 Calls are submitted with ``pure=False`` (every attempt a new Dask key, never
 a cached result) and the client does not become the process's default
 (``set_as_default=False``: no global state left behind). Each finished

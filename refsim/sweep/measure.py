@@ -16,7 +16,10 @@ cluster of W single-thread worker processes):
   workers (1 in-process), so that both start the same workers;
   ``(T(trivial) - T(W)) / (trivial - W)`` is the marginal cost of one task
   (submit, run the wrapper, return and decode the result), and ``T(W)``,
-  the start-up, is reported apart.
+  the start-up, is reported apart;
+- **store cost per task**: the in-process sweep of ``trivial`` tasks with a
+  new store directory against the same without one, per task (a result
+  file written and fsync'd, whatever the backend).
 
 In-process sweeps run after one warm-up call, in a process that has refsim
 loaded and compiled kernels cached: the state of a session that calls
@@ -30,6 +33,7 @@ Cost: about ``repeats * (tasks * task time * (1 + 2/W) + 3 start-ups)``.
 from __future__ import annotations
 
 import statistics
+import tempfile
 import time
 from dataclasses import dataclass
 
@@ -63,15 +67,19 @@ class SweepSpeed:
     trivial: int
     repeats: int
     task_seconds: float           # median wall time of one benchmark task in-process
+    store_per_task_seconds: float  # added per task by a store
     backends: tuple[BackendSpeed, ...]
 
 
-def _median_seconds(tasks: list[Task], repeats: int, **options) -> float:
+def _median_seconds(tasks: list[Task], repeats: int, *, stored: bool = False,
+                    **options) -> float:
     times = []
     for _ in range(repeats):
-        start = time.perf_counter()
-        result = run_sweep(tasks, progress=False, **options)
-        times.append(time.perf_counter() - start)
+        with tempfile.TemporaryDirectory() as folder:      # a new store each time
+            start = time.perf_counter()
+            result = run_sweep(tasks, progress=False, store=folder if stored else None,
+                               **options)
+            times.append(time.perf_counter() - start)
         if not result.ok:
             raise RuntimeError(f"benchmark sweep failed: {result.failures}")
     return statistics.median(times)
@@ -103,8 +111,11 @@ def measure_sweep_speed(*, tasks: int = 16, duration: float = BENCH_DURATION, wo
             speedup=(reference / bench_seconds) if reference else float("nan"),
             startup_seconds=startup, trivial_seconds=many,
             per_task_seconds=(many - startup) / max(1, trivial_tasks - started)))
+    store_cost = (_median_seconds(nothing, repeats, stored=True)
+                  - _median_seconds(nothing, repeats)) / trivial_tasks
     return SweepSpeed(tasks=tasks, duration=duration, trivial=trivial_tasks, repeats=repeats,
-                      task_seconds=task_seconds, backends=tuple(rows))
+                      task_seconds=task_seconds, store_per_task_seconds=store_cost,
+                      backends=tuple(rows))
 
 
 def main(argv=None) -> None:
@@ -131,6 +142,8 @@ def main(argv=None) -> None:
         print(f"{b.backend:10s} {b.workers or '-':>7} {b.bench_seconds:9.2f} {b.speedup:8.2f} "
               f"{b.startup_seconds:10.3f} {b.trivial_seconds:9.3f} "
               f"{b.per_task_seconds * 1e3:11.3f}")
+    print(f"a store adds {speed.store_per_task_seconds * 1e3:.3f} ms per task "
+          "(one fsync'd result file)")
 
 
 if __name__ == "__main__":

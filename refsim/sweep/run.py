@@ -197,7 +197,7 @@ def _run(runner, tasks, seeds, waiting: deque, results: list, saved: Store | Non
     def submit(index: int) -> None:
         attempts[index] += 1
         in_flight.add(index)
-        runner.submit(index, tasks[index].function, tasks[index].kwargs, seeds[index])
+        runner.submit(index, tasks[index].function, dict(tasks[index].kwargs), seeds[index])
 
     while waiting or suspects or in_flight:
         if suspects:

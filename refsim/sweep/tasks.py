@@ -43,6 +43,7 @@ import hashlib
 import importlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -63,7 +64,8 @@ class Task:
         A function defined at the top level of an importable module, taking
         ``seed`` (an int) as a keyword argument and returning a plain record.
     kwargs : mapping of str to plain data
-        Its other keyword arguments (no ``seed``).
+        Its other keyword arguments (no ``seed``); kept as a read-only copy,
+        so that the call cannot change after its fingerprint is taken.
 
     Raises
     ------
@@ -92,7 +94,11 @@ class Task:
         except (TypeError, ValueError) as error:
             raise ArgumentTypeError(f"task {self.key!r}: kwargs must be plain data: "
                                     f"{error}") from None
-        object.__setattr__(self, "kwargs", kwargs)
+        object.__setattr__(self, "kwargs", MappingProxyType(kwargs))   # read-only
+
+    def __reduce__(self):
+        # pickled as the call that makes it (a read-only mapping does not pickle)
+        return Task, (self.key, self.function, dict(self.kwargs))
 
 
 def function_name(function, key: str = "?") -> str:
@@ -133,4 +139,4 @@ def task_seed(sweep_seed: int, key: str) -> int:
 def fingerprint(task: Task, seed: int) -> str:
     """SHA-256 (hex) of the call ``task`` makes with ``seed``."""
     return digest(canonical({"function": function_name(task.function, task.key),
-                             "kwargs": task.kwargs, "seed": seed}))
+                             "kwargs": dict(task.kwargs), "seed": seed}))

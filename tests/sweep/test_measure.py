@@ -15,6 +15,7 @@ def test_the_in_process_row_is_the_reference():
     assert (row.backend, row.workers, row.speedup) == ("inprocess", None, 1.0)
     assert speed.tasks == 2 and speed.trivial == 3 and speed.task_seconds > 0
     assert row.bench_seconds > 0 and row.trivial_seconds > 0 and math.isfinite(row.per_task_seconds)
+    assert math.isfinite(speed.store_per_task_seconds)
 
 
 def test_the_trivial_task_returns_its_seed():

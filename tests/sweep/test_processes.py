@@ -58,7 +58,7 @@ from tests.sweep import tasks
 if __name__ == "__main__":
     markers, store = sys.argv[1], sys.argv[2]
     sweep = [Task(f"c{i}", tasks.counted, {"marker_dir": markers, "key": f"c{i}", "pause": 0.15})
-             for i in range(12)]
+             for i in range(16)]
     run_sweep(sweep, backend="processes", workers=2, store=store, progress=False)
 """
 
@@ -94,11 +94,11 @@ def test_ctrl_c_stops_the_workers_and_the_sweep_resumes(tmp_path):
     assert not [p for p in alive if p.status() != psutil.STATUS_ZOMBIE]
     assert not list(store.rglob("*.tmp"))
     stored = len(list((store / "results").glob("*.json")))
-    assert 3 <= stored < 12
+    assert 3 <= stored < 16
     before = tasks.executions(markers)
 
     sweep = [Task(f"c{i}", tasks.counted, {"marker_dir": str(markers), "key": f"c{i}",
-                                           "pause": 0.15}) for i in range(12)]
+                                           "pause": 0.15}) for i in range(16)]
     result = run_sweep(sweep, store=store, progress=False)
     assert result.ok and sum(r.resumed for r in result.results) == stored
     after = tasks.executions(markers)

@@ -67,3 +67,21 @@ def test_the_fingerprint_tells_calls_apart_and_ignores_dict_order():
     assert fingerprint(a, 1) != fingerprint(a, 2)
     assert fingerprint(a, 1) != fingerprint(Task("k", tasks.draws, {"n": 5, "m": [1.5, 2]}), 1)
     assert fingerprint(a, 1) != fingerprint(Task("k", tasks.fail, {"n": 4, "m": [1.5, 2]}), 1)
+
+
+def test_a_tasks_arguments_cannot_change_after_it_is_made():
+    given = {"n": 4}
+    task = Task("k", tasks.draws, given)
+    given["n"] = 5
+    assert task.kwargs == {"n": 4}
+    with pytest.raises(TypeError):
+        task.kwargs["n"] = 6
+
+
+def test_a_task_pickles_as_the_same_call():
+    import pickle
+
+    task = Task("k", tasks.draws, {"n": 4})
+    again = pickle.loads(pickle.dumps(task))
+    assert again == task and again.function is tasks.draws and fingerprint(again, 1) == \
+        fingerprint(task, 1)
