@@ -21,17 +21,19 @@ cluster of W single-thread worker processes):
   new store directory against the same without one, per task (a result
   file written and fsync'd, whatever the backend).
 
-In-process sweeps run after one warm-up call, in a process that has refsim
+In-process sweeps run after a warm-up call, in a process that has refsim
 loaded and compiled kernels cached: the state of a session that calls
 ``run_sweep``. Timings vary between runs and machines, and this machine's
 cores may be shared: quote medians with the command
-``python -m refsim.sweep.measure``.
+``python -m refsim.sweep.measure`` (which prints the load average too).
 
 Cost: about ``repeats * (tasks * task time * (1 + 2/W) + 3 start-ups)``.
 """
 
 from __future__ import annotations
 
+import math
+import os
 import statistics
 import tempfile
 import time
@@ -68,54 +70,58 @@ class SweepSpeed:
     repeats: int
     task_seconds: float           # median wall time of one benchmark task in-process
     store_per_task_seconds: float  # added per task by a store
+    load_average: tuple[float, float]   # the machine's 1-minute load, before and after
     backends: tuple[BackendSpeed, ...]
 
 
-def _median_seconds(tasks: list[Task], repeats: int, *, stored: bool = False,
-                    **options) -> float:
-    times = []
-    for _ in range(repeats):
-        with tempfile.TemporaryDirectory() as folder:      # a new store each time
-            start = time.perf_counter()
-            result = run_sweep(tasks, progress=False, store=folder if stored else None,
-                               **options)
-            times.append(time.perf_counter() - start)
-        if not result.ok:
-            raise RuntimeError(f"benchmark sweep failed: {result.failures}")
-    return statistics.median(times)
+def _seconds(tasks: list[Task], *, stored: bool = False, **options) -> float:
+    """Wall time of one sweep of ``tasks`` (in a new store when ``stored``)."""
+    with tempfile.TemporaryDirectory() as folder:
+        start = time.perf_counter()
+        result = run_sweep(tasks, progress=False, store=folder if stored else None, **options)
+        seconds = time.perf_counter() - start
+    if not result.ok:
+        raise RuntimeError(f"benchmark sweep failed: {result.failures}")
+    return seconds
 
 
 def measure_sweep_speed(*, tasks: int = 16, duration: float = BENCH_DURATION, workers: int = 2,
                         trivial_tasks: int = 200, repeats: int = 3,
                         backends=BACKENDS) -> SweepSpeed:
-    """Time every backend in ``backends`` (see the module docstring)."""
+    """Time every backend in ``backends`` (see the module docstring).
+
+    The repeats are interleaved (every backend once, then again), so that a
+    change in the machine's load over the run hits every backend alike.
+    """
+    load_before = os.getloadavg()[0]
     bench = [Task(f"bounce-{i}", bounce, {"duration": duration}) for i in range(tasks)]
     nothing = [Task(f"trivial-{i}", trivial) for i in range(trivial_tasks)]
-    warm = run_sweep(bench[:1], progress=False)                    # imports, kernels
-    task_seconds = warm.results[0].wall_seconds
-    rows, reference = [], None
-    for backend in backends:
-        options = {"backend": backend}
-        if backend != "inprocess":
-            options["workers"] = workers
-        bench_seconds = _median_seconds(bench, repeats, **options)
-        if backend == "inprocess":
-            reference = bench_seconds
-            task_seconds = statistics.median(
-                r.wall_seconds for r in run_sweep(bench[:3], progress=False).results)
-        started = options.get("workers", 1)
-        startup = _median_seconds(nothing[:started], repeats, **options)
-        many = _median_seconds(nothing, repeats, **options)
-        rows.append(BackendSpeed(
-            backend=backend, workers=options.get("workers"), bench_seconds=bench_seconds,
-            speedup=(reference / bench_seconds) if reference else float("nan"),
-            startup_seconds=startup, trivial_seconds=many,
-            per_task_seconds=(many - startup) / max(1, trivial_tasks - started)))
-    store_cost = (_median_seconds(nothing, repeats, stored=True)
-                  - _median_seconds(nothing, repeats)) / trivial_tasks
+    warm = run_sweep(bench[:3], progress=False)                  # imports, kernels
+    task_seconds = statistics.median(r.wall_seconds for r in warm.results)
+    options = {b: {"backend": b} if b == "inprocess" else {"backend": b, "workers": workers}
+               for b in backends}
+    started = {b: options[b].get("workers", 1) for b in backends}
+    times = {(b, what): [] for b in backends for what in ("bench", "startup", "trivial")}
+    stored, plain = [], []
+    for _ in range(repeats):
+        for b in backends:
+            times[b, "bench"].append(_seconds(bench, **options[b]))
+            times[b, "startup"].append(_seconds(nothing[:started[b]], **options[b]))
+            times[b, "trivial"].append(_seconds(nothing, **options[b]))
+        stored.append(_seconds(nothing, stored=True))
+        plain.append(_seconds(nothing))
+    median = {k: statistics.median(v) for k, v in times.items()}
+    reference = median.get(("inprocess", "bench"), math.nan)
+    rows = tuple(BackendSpeed(
+        backend=b, workers=options[b].get("workers"), bench_seconds=median[b, "bench"],
+        speedup=reference / median[b, "bench"], startup_seconds=median[b, "startup"],
+        trivial_seconds=median[b, "trivial"],
+        per_task_seconds=(median[b, "trivial"] - median[b, "startup"])
+        / max(1, trivial_tasks - started[b])) for b in backends)
+    store_cost = (statistics.median(stored) - statistics.median(plain)) / trivial_tasks
     return SweepSpeed(tasks=tasks, duration=duration, trivial=trivial_tasks, repeats=repeats,
                       task_seconds=task_seconds, store_per_task_seconds=store_cost,
-                      backends=tuple(rows))
+                      load_average=(load_before, os.getloadavg()[0]), backends=rows)
 
 
 def main(argv=None) -> None:
@@ -135,7 +141,8 @@ def main(argv=None) -> None:
                                 backends=args.backends)
     print(f"{speed.tasks} bounce.toml tasks of {speed.duration:g} simulated s "
           f"({speed.task_seconds:.3f} s each in-process); {speed.trivial} trivial tasks; "
-          f"medians of {speed.repeats} sweeps")
+          f"medians of {speed.repeats} sweeps; load average {speed.load_average[0]:.1f} "
+          f"before, {speed.load_average[1]:.1f} after, on {os.cpu_count()} CPUs")
     print(f"{'backend':10s} {'workers':>7s} {'bench s':>9s} {'speed-up':>8s} "
           f"{'start-up s':>10s} {'trivial s':>9s} {'per task ms':>11s}")
     for b in speed.backends:

@@ -1,4 +1,5 @@
-"""A Dask cluster of separate processes on 127.0.0.1, for the sweep tests.
+"""A Dask cluster of separate processes on 127.0.0.1, for the sweep tests,
+and a bound on every sweep test's time.
 
 ``dask scheduler`` and one ``dask worker`` command with two worker
 processes (one thread each, under nannies that restart a killed worker),
@@ -6,10 +7,16 @@ each command in its own session so that it and every process it starts can
 be stopped as a group. Readiness is polled (the scheduler file, then the
 workers through a client), every wait is bounded, and the fixture checks at
 the end that none of the processes it started is left running.
+
+A sweep that hangs (a worker that never answers) would hang the test run:
+each test here is bounded by ``HANG_SECONDS``, after which every thread's
+stack is printed and the test process exits (the cluster's processes then
+stop by themselves: ``--death-timeout``, ``--idle-timeout``).
 """
 
 from __future__ import annotations
 
+import faulthandler
 import json
 import os
 import signal
@@ -30,9 +37,21 @@ START_SECONDS = 60.0
 STOP_SECONDS = 15.0
 POLL_SECONDS = 0.05
 
+#: The longest a sweep test may take: the slowest takes a few seconds (20 s
+#: on a loaded machine); minutes mean a hang.
+HANG_SECONDS = 180.0
+
 #: A scheduler that somehow outlives the tests stops itself after this much
 #: idleness, and its workers follow it (``--death-timeout``).
 IDLE_TIMEOUT = "300s"
+
+
+@pytest.fixture(autouse=True)
+def hang_guard():
+    """Print the stacks and exit when a test outlives ``HANG_SECONDS``."""
+    faulthandler.dump_traceback_later(HANG_SECONDS, exit=True)
+    yield
+    faulthandler.cancel_dump_traceback_later()
 
 
 def _dask(*args: str, log: Path) -> subprocess.Popen:
