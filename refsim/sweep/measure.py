@@ -10,7 +10,10 @@ cluster of W single-thread worker processes):
   backend's time includes starting its workers, as every sweep call does
   (spawned interpreters importing numpy and refsim and loading the compiled
   kernels; a Dask cluster besides), so it is the speed-up a caller sees, not
-  the workers' ideal W;
+  the workers' ideal W. The CPU time of the sweep (this process and its
+  workers) is reported beside it: unlike the wall time it hardly depends on
+  what else the machine runs, and its excess over in-process is the CPU cost
+  of the backend (workers' imports, kernel loading, a scheduler);
 - **overhead per task**: sweeps of W and of ``trivial`` tasks that do
   nothing (:func:`refsim.sweep.examples.trivial`), W being the number of
   workers (1 in-process), so that both start the same workers;
@@ -56,6 +59,7 @@ class BackendSpeed:
     backend: str
     workers: int | None
     bench_seconds: float          # the sweep of the CPU-bound tasks
+    bench_cpu_seconds: float      # CPU time of that sweep, this process and its workers
     speedup: float                # in-process bench_seconds over this one's
     startup_seconds: float        # a sweep of one trivial task per worker
     trivial_seconds: float        # a sweep of ``trivial`` trivial tasks
@@ -74,15 +78,36 @@ class SweepSpeed:
     backends: tuple[BackendSpeed, ...]
 
 
-def _seconds(tasks: list[Task], *, stored: bool = False, **options) -> float:
-    """Wall time of one sweep of ``tasks`` (in a new store when ``stored``)."""
+def _cpu_seconds() -> float:
+    """User and system CPU time of this process and of its finished children
+    (worker processes count once the backend has stopped and reaped them);
+    NaN where there is no ``getrusage`` (Windows)."""
+    try:
+        import resource
+    except ImportError:
+        return math.nan
+    own, children = (resource.getrusage(who) for who in (resource.RUSAGE_SELF,
+                                                          resource.RUSAGE_CHILDREN))
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def _load_average() -> float:
+    """The 1-minute load average (NaN where the system has none)."""
+    try:
+        return os.getloadavg()[0]
+    except (AttributeError, OSError):
+        return math.nan
+
+
+def _seconds(tasks: list[Task], *, stored: bool = False, **options) -> tuple[float, float]:
+    """Wall and CPU time of one sweep of ``tasks`` (in a new store when ``stored``)."""
     with tempfile.TemporaryDirectory() as folder:
-        start = time.perf_counter()
+        cpu, start = _cpu_seconds(), time.perf_counter()
         result = run_sweep(tasks, progress=False, store=folder if stored else None, **options)
-        seconds = time.perf_counter() - start
+        seconds, cpu = time.perf_counter() - start, _cpu_seconds() - cpu
     if not result.ok:
         raise RuntimeError(f"benchmark sweep failed: {result.failures}")
-    return seconds
+    return seconds, cpu
 
 
 def measure_sweep_speed(*, tasks: int = 16, duration: float = BENCH_DURATION, workers: int = 2,
@@ -93,7 +118,7 @@ def measure_sweep_speed(*, tasks: int = 16, duration: float = BENCH_DURATION, wo
     The repeats are interleaved (every backend once, then again), so that a
     change in the machine's load over the run hits every backend alike.
     """
-    load_before = os.getloadavg()[0]
+    load_before = _load_average()
     bench = [Task(f"bounce-{i}", bounce, {"duration": duration}) for i in range(tasks)]
     nothing = [Task(f"trivial-{i}", trivial) for i in range(trivial_tasks)]
     warm = run_sweep(bench[:3], progress=False)                  # imports, kernels
@@ -101,19 +126,23 @@ def measure_sweep_speed(*, tasks: int = 16, duration: float = BENCH_DURATION, wo
     options = {b: {"backend": b} if b == "inprocess" else {"backend": b, "workers": workers}
                for b in backends}
     started = {b: options[b].get("workers", 1) for b in backends}
-    times = {(b, what): [] for b in backends for what in ("bench", "startup", "trivial")}
+    times = {(b, what): [] for b in backends
+             for what in ("bench", "bench_cpu", "startup", "trivial")}
     stored, plain = [], []
     for _ in range(repeats):
         for b in backends:
-            times[b, "bench"].append(_seconds(bench, **options[b]))
-            times[b, "startup"].append(_seconds(nothing[:started[b]], **options[b]))
-            times[b, "trivial"].append(_seconds(nothing, **options[b]))
-        stored.append(_seconds(nothing, stored=True))
-        plain.append(_seconds(nothing))
+            wall, cpu = _seconds(bench, **options[b])
+            times[b, "bench"].append(wall)
+            times[b, "bench_cpu"].append(cpu)
+            times[b, "startup"].append(_seconds(nothing[:started[b]], **options[b])[0])
+            times[b, "trivial"].append(_seconds(nothing, **options[b])[0])
+        stored.append(_seconds(nothing, stored=True)[0])
+        plain.append(_seconds(nothing)[0])
     median = {k: statistics.median(v) for k, v in times.items()}
     reference = median.get(("inprocess", "bench"), math.nan)
     rows = tuple(BackendSpeed(
         backend=b, workers=options[b].get("workers"), bench_seconds=median[b, "bench"],
+        bench_cpu_seconds=median[b, "bench_cpu"],
         speedup=reference / median[b, "bench"], startup_seconds=median[b, "startup"],
         trivial_seconds=median[b, "trivial"],
         per_task_seconds=(median[b, "trivial"] - median[b, "startup"])
@@ -121,7 +150,7 @@ def measure_sweep_speed(*, tasks: int = 16, duration: float = BENCH_DURATION, wo
     store_cost = (statistics.median(stored) - statistics.median(plain)) / trivial_tasks
     return SweepSpeed(tasks=tasks, duration=duration, trivial=trivial_tasks, repeats=repeats,
                       task_seconds=task_seconds, store_per_task_seconds=store_cost,
-                      load_average=(load_before, os.getloadavg()[0]), backends=rows)
+                      load_average=(load_before, _load_average()), backends=rows)
 
 
 def main(argv=None) -> None:
@@ -143,12 +172,12 @@ def main(argv=None) -> None:
           f"({speed.task_seconds:.3f} s each in-process); {speed.trivial} trivial tasks; "
           f"medians of {speed.repeats} sweeps; load average {speed.load_average[0]:.1f} "
           f"before, {speed.load_average[1]:.1f} after, on {os.cpu_count()} CPUs")
-    print(f"{'backend':10s} {'workers':>7s} {'bench s':>9s} {'speed-up':>8s} "
+    print(f"{'backend':10s} {'workers':>7s} {'bench s':>9s} {'cpu s':>7s} {'speed-up':>8s} "
           f"{'start-up s':>10s} {'trivial s':>9s} {'per task ms':>11s}")
     for b in speed.backends:
-        print(f"{b.backend:10s} {b.workers or '-':>7} {b.bench_seconds:9.2f} {b.speedup:8.2f} "
-              f"{b.startup_seconds:10.3f} {b.trivial_seconds:9.3f} "
-              f"{b.per_task_seconds * 1e3:11.3f}")
+        print(f"{b.backend:10s} {b.workers or '-':>7} {b.bench_seconds:9.2f} "
+              f"{b.bench_cpu_seconds:7.2f} {b.speedup:8.2f} {b.startup_seconds:10.3f} "
+              f"{b.trivial_seconds:9.3f} {b.per_task_seconds * 1e3:11.3f}")
     print(f"a store adds {speed.store_per_task_seconds * 1e3:.3f} ms per task "
           "(one fsync'd result file)")
 
