@@ -24,6 +24,7 @@ _EXPORTS = {
     "OptionError": "refsim.errors",
     "ArgumentTypeError": "refsim.errors",
     "OutputError": "refsim.errors",
+    "SweepError": "refsim.errors",
     "Mesh": "refsim.models.mesh",
     "Material": "refsim.models.mesh",
     "aabb_linear": "refsim.bounds.aabb_linear",

@@ -19,6 +19,7 @@ for Python's conventions (``except ValueError``) catches them too:
     ├── OptionError         (ValueError)  an option not among its choices
     ├── ArgumentTypeError   (TypeError)   an argument of the wrong type
     ├── OutputError         (OSError)     an output file that cannot be written
+    ├── SweepError          (ValueError)  a sweep's task list or result store
     └── DivergenceError                   a simulation that blew up
 """
 
@@ -106,6 +107,11 @@ class ArgumentTypeError(RefsimError, TypeError):
 
 class OutputError(RefsimError, OSError):
     """An output file that cannot be written (the message names it)."""
+
+
+class SweepError(RefsimError, ValueError):
+    """A sweep that cannot run as asked: two tasks with one key, or a result
+    store written by another task list (see :mod:`refsim.sweep`)."""
 
 
 def check_option(name: str, value, choices) -> str:

@@ -1,0 +1,57 @@
+"""The progress line: counts and time left, on a terminal only."""
+
+from __future__ import annotations
+
+import io
+
+from refsim.sweep.progress import Progress
+
+
+class Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+class Clock:
+    def __init__(self):
+        self.now = 100.0
+
+    def __call__(self):
+        return self.now
+
+
+def test_the_line_shows_counts_failures_and_time_left():
+    clock, stream = Clock(), Terminal()
+    shown = Progress(10, resumed=2, stream=stream, clock=clock)
+    assert shown.line() == "sweep: 2/10 done, time left unknown"
+    clock.now += 4.0
+    shown.update(4, 1)                   # 2 finished in this run in 4 s: 2 s each, 6 left
+    assert shown.seconds_left(clock.now) == 12.0
+    assert stream.getvalue() == "\rsweep: 4/10 done, 1 failed, about 0:00:12 left"
+    clock.now += 3600.5
+    shown.update(9, 1)                   # 7 in 3604.5 s, 1 left: 514.9 s, rounded up
+    assert shown.line().endswith("9/10 done, 1 failed, about 0:08:35 left")
+    shown.update(10, 1, force=True)
+    shown.close()
+    assert stream.getvalue().endswith("\rsweep: 10/10 done, 1 failed\n")
+
+
+def test_redraws_are_limited_and_a_shorter_line_wipes_a_longer_one():
+    clock, stream = Clock(), Terminal()
+    shown = Progress(3, stream=stream, clock=clock)
+    shown.update(1, 1)
+    shown.update(2, 1)                   # within MIN_REDRAW_SECONDS: not drawn
+    assert stream.getvalue().count("\r") == 1
+    clock.now += 1.0
+    shown.update(2, 0)
+    last = stream.getvalue().split("\r")[-1]
+    assert last.rstrip() == "sweep: 2/3 done, about 0:00:01 left"
+    assert len(last) == len("sweep: 1/3 done, 1 failed, about 0:00:00 left")
+
+
+def test_nothing_is_drawn_off_a_terminal_or_when_disabled():
+    for stream, enabled in ((io.StringIO(), True), (Terminal(), False)):
+        shown = Progress(2, stream=stream, enabled=enabled)
+        shown.update(1, 0, force=True)
+        shown.close()
+        assert stream.getvalue() == ""
