@@ -51,6 +51,7 @@ _EXPORTS = {
     "simulate": "refsim.dynamics.simulation",
     "Simulation": "refsim.dynamics.simulation",
     "Trajectory": "refsim.dynamics.trajectory",
+    "view": "refsim.viewer.live",
 }
 
 __all__ = sorted(_EXPORTS)
