@@ -49,11 +49,19 @@ def _with(scene, **dynamics):
     return replace(scene, dynamics=replace(scene.dynamics, **dynamics))
 
 
-def demo_c12(path, *, scene=None, max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
-    """C12: the seed's rotation model beside the corrected one (side by side)."""
+def _for(scene, duration: float | None):
+    if duration is None:
+        return scene
+    return replace(scene, integration=replace(scene.integration, duration=duration))
+
+
+def demo_c12(path, *, scene=None, duration: float | None = None,
+             max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
+    """C12: the seed's rotation model beside the corrected one (side by side);
+    ``duration`` (s) shortens the scene's."""
     from refsim.dynamics.simulation import simulate
 
-    scene = scene or _bundled("spinning-cube.toml")
+    scene = _for(scene or _bundled("spinning-cube.toml"), duration)
     runs = []
     for model, label in (("seed", "rotation = seed (S9): never stops"),
                          ("impulse", "rotation = impulse (corrected)")):
@@ -64,7 +72,8 @@ def demo_c12(path, *, scene=None, max_bytes: int = REPLAY_MAX_BYTES) -> ReplayIn
                               "corrected one")
 
 
-def demo_c11(path, *, case: str = C11_CASE, max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
+def demo_c11(path, *, case: str = C11_CASE, duration: float = C11_SECONDS,
+             max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
     """C11: the seed's velocity exchange beside the corrected impulse (side by side)."""
     from refsim.dynamics.measure import c11_scene
     from refsim.dynamics.simulation import simulate
@@ -72,7 +81,7 @@ def demo_c11(path, *, case: str = C11_CASE, max_bytes: int = REPLAY_MAX_BYTES) -
     runs = []
     for response, label in (("seed", "body_response = seed (S8): interpenetrates"),
                             ("impulse", "body_response = impulse (corrected)")):
-        s = c11_scene(case, response, duration=C11_SECONDS)
+        s = c11_scene(case, response, duration=duration)
         traj = simulate(s)
         runs.append(run_from_scene(label, s, traj,
                                    settings={"case": case, **traj.settings}))
@@ -92,13 +101,13 @@ def pybullet_trajectory(scene):
 
 
 def demo_wall_bounce(path, *, external=pybullet_trajectory, label: str = "pybullet",
-                     scene=None, max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
+                     scene=None, duration: float = BOUNCE_SECONDS,
+                     max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
     """One wall bounce by refsim beside another engine's run of the same
     scene (``external(scene) -> Trajectory``; default pybullet)."""
     from refsim.dynamics.simulation import simulate
 
-    scene = scene or _bundled("bounce.toml")
-    scene = replace(scene, integration=replace(scene.integration, duration=BOUNCE_SECONDS))
+    scene = _for(scene or _bundled("bounce.toml"), duration)
     runs = [run_from_scene("refsim", scene, simulate(scene)),
             run_from_scene(label, scene, external(scene))]
     return write_replay(runs, path, max_bytes=max_bytes,

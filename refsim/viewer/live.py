@@ -546,6 +546,12 @@ def view(scene, *, host: str = LOCAL_HOST, port: int = 0, every: int | None = No
 def serve(scene, *, host: str = LOCAL_HOST, port: int = 8080, every: int | None = None) -> None:
     """``refsim view``: serve until interrupted (KeyboardInterrupt propagates,
     after the server is stopped)."""
+    import logging
+
+    # A connection that is not a browser's (a port probe, a client gone mid
+    # handshake) is the client's business: the websockets library would log
+    # it with a traceback on the command line's stderr.
+    logging.getLogger("websockets.server").setLevel(logging.CRITICAL)
     viewer = Viewer(scene, host=host, port=port, every=every)
     try:
         print(f"refsim view: {viewer.url} (Ctrl-C stops)", flush=True)

@@ -273,6 +273,9 @@ def write_replay(runs, path, *, overlay: bool = False, max_bytes: int = DEFAULT_
         raise RefsimError("no runs to replay")
     if isinstance(max_bytes, bool) or not isinstance(max_bytes, int) or max_bytes < 1:
         raise RefsimError(f"max_bytes must be a positive whole number, got {max_bytes!r}")
+    path = Path(path)
+    if not path.parent.is_dir():
+        raise OutputError(f"{path}: cannot write: no directory {path.parent}")
     times = timeline(runs)
     title = title or " | ".join(r.label for r in runs)
     page = _Page(runs, times, overlay=overlay, boxes=boxes, title=title)
@@ -285,7 +288,6 @@ def write_replay(runs, path, *, overlay: bool = False, max_bytes: int = DEFAULT_
     if size > max_bytes:
         raise RefsimError(f"the replay takes {size / 1e6:.2f} MB at stride {stride}, over "
                           f"the budget of {max_bytes / 1e6:g} MB (--max-bytes)")
-    path = Path(path)
     try:
         write_text_atomic(path, text)
     except OSError as exc:
@@ -460,9 +462,26 @@ def _with_panel(page: str, panel: str) -> str:
     return page[:body] + panel + page[body:]
 
 
-def embedded_recording(page: str) -> bytes:
-    """The recording a replay page carries (viser's serialized scene, zstd
-    compressed), for checks that the page is whole."""
+def read_recording(page: str) -> dict:
+    """The recording a replay page carries, decoded: viser's serialized scene
+    (``durationSeconds``, ``messages``, ``viserVersion``, ...), for checks
+    that a page is whole. Raises ValueError when the page carries none.
+
+    The layout (viser's ``StateSerializer.serialize``): 8 bytes of the
+    uncompressed size, then zstd of [8 bytes of the msgpack length, the
+    msgpack header, the binary buffers].
+    """
+    import msgspec
+    import zstandard
+
     marker = 'window.__VISER_EMBED_DATA__="'
+    if marker not in page:
+        raise ValueError("the page carries no viser recording")
     start = page.index(marker) + len(marker)
-    return base64.b64decode(page[start:page.index('"', start)])
+    data = base64.b64decode(page[start:page.index('"', start)], validate=True)
+    size = int.from_bytes(data[:8], "little")
+    inner = zstandard.ZstdDecompressor().decompress(data[8:], max_output_size=size)
+    if len(inner) != size:
+        raise ValueError(f"the recording is {len(inner)} bytes, its header says {size}")
+    header = int.from_bytes(inner[:8], "little")
+    return msgspec.msgpack.decode(inner[8:8 + header])

@@ -92,6 +92,12 @@ def start_server(host: str = LOCAL_HOST, port: int = 0, *, label: str | None = N
         stop_server(server)
         raise RefsimError(f"port {port} is in use")
     server.scene.set_up_direction("+y")
+    # Plain lights, no shadows and no environment map: viser's default image-
+    # based lighting costs seconds of shader work per page in a software
+    # renderer (SwiftShader, headless Chromium, a machine without a GPU),
+    # stalling the page; refsim's flat-shaded bodies need none of it.
+    server.scene.configure_environment_map(hdri=None)
+    server.scene.configure_default_lights(enabled=True, cast_shadow=False)
     return server
 
 
