@@ -25,6 +25,9 @@ CONTACT_COLOR = (220, 20, 60)
 NORMAL_COLOR = (30, 90, 220)
 IMPULSE_COLOR = (240, 120, 0)
 
+#: Contacting triangles are drawn this fraction of the body's size off its faces.
+CONTACT_LIFT = 0.003
+
 #: Lines drawn in screen pixels, so that they stay visible at any zoom.
 CUBE_LINE_PX = 2.0
 BOX_LINE_PX = 1.5
@@ -45,18 +48,29 @@ FOV_DEGREES = 45.0
 #: direction is taken of it), the cube's floor in view.
 VIEW_DIRECTION = (0.45, 0.5, 1.0)
 
+#: Distance beyond the fit, for the GUI panel beside the view.
+CAMERA_MARGIN = 1.1
 
-def place_camera(camera, width: float, height: float, center=(0.0, 0.0, 0.0)) -> None:
+#: A box this many times wider than high is fitted to the window's width.
+WIDE = 1.5
+
+
+def place_camera(camera, width: float, height: float, depth: float | None = None,
+                 center=(0.0, 0.0, 0.0)) -> None:
     """Point viser's camera (``server.initial_camera``) at a box of
-    ``width`` (along x) and ``height`` (along y) about ``center``, so that
-    it fits a window about 1.6 times as wide as high."""
+    ``width`` (x), ``height`` (y) and ``depth`` (z, default the height)
+    about ``center``, from VIEW_DIRECTION, far enough that the box's
+    bounding sphere fits the view of a window about 1.6 times as wide as high
+    (a sphere, since the view is oblique), with a margin for the panels."""
     import math
 
+    depth = height if depth is None else depth
     half_v = math.radians(FOV_DEGREES) / 2.0
     half_h = math.atan(math.tan(half_v) * 1.6)
-    # distance at which the larger of the two extents fills the view, and some margin
-    d = 1.25 * max(0.5 * width / math.tan(half_h), 0.5 * height / math.tan(half_v)) \
-        + 0.5 * width
+    radius = 0.5 * math.sqrt(width * width + height * height + depth * depth)
+    # a wide box (runs side by side) fills the window's width; a cube its height
+    half = half_h if width > WIDE * height else half_v
+    d = CAMERA_MARGIN * radius / math.sin(half)
     direction = np.asarray(VIEW_DIRECTION, dtype=np.float64)
     direction /= np.sqrt(direction @ direction)
     camera.fov = math.radians(FOV_DEGREES)
@@ -114,7 +128,13 @@ def contact_mesh(meshes, rotations, positions, found) -> tuple[np.ndarray, np.nd
     for hit in found:
         for body, column in ((hit.a, 0), (hit.b, 1)):
             faces = np.unique(hit.pairs[:, column])
-            soups.append(triangle_soup(meshes[body], rotations[body], positions[body], faces))
+            soup = triangle_soup(meshes[body], rotations[body], positions[body], faces)
+            # lifted off the body's own faces along their outward normals,
+            # so that the two do not fight for the same pixels
+            n = np.cross(soup[:, 1] - soup[:, 0], soup[:, 2] - soup[:, 0])
+            n /= np.maximum(np.sqrt((n * n).sum(axis=1, keepdims=True)), 1e-300)
+            extent = float(np.ptp(meshes[body].vertices, axis=0).max())
+            soups.append(soup + CONTACT_LIFT * extent * n[:, None, :])
     if not soups:
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
     corners = np.concatenate(soups).reshape(-1, 3)

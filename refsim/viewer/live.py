@@ -223,7 +223,7 @@ class Viewer:
                  {"label": "potential", "stroke": "#009e73", "width": 1.5},
                  {"label": "rotational", "stroke": "#d55e00", "width": 1.5},
                  {"label": "total", "stroke": "#333333", "width": 2.0}),
-                aspect=1.6, visible=bodies)
+                scales={"x": {"time": False}}, aspect=1.6, visible=bodies)
 
         self.play_button.on_click(lambda _: self.pause() if self.playing else self.play())
         self.step_buttons.on_click(

@@ -33,6 +33,10 @@ INSTALL_HINT = "pip install 'refsim[viewer]'"
 LOCAL_HOST = "127.0.0.1"
 
 
+#: Intensity of the ambient light added to viser's default lights (a display choice).
+AMBIENT_LIGHT = 1.5
+
+
 class ViewerUnavailable(RefsimError, ImportError):
     """viser, the viewer's one dependency, is not installed."""
 
@@ -98,6 +102,8 @@ def start_server(host: str = LOCAL_HOST, port: int = 0, *, label: str | None = N
     # stalling the page; refsim's flat-shaded bodies need none of it.
     server.scene.configure_environment_map(hdri=None)
     server.scene.configure_default_lights(enabled=True, cast_shadow=False)
+    # what the environment map gave: light on the faces turned away
+    server.scene.add_light_ambient("/lights/ambient", intensity=AMBIENT_LIGHT)
     return server
 
 
