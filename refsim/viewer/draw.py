@@ -48,6 +48,9 @@ FOV_DEGREES = 45.0
 #: direction is taken of it), the cube's floor in view.
 VIEW_DIRECTION = (0.45, 0.5, 1.0)
 
+#: Runs side by side are seen nearly from the front, so that heights compare.
+FRONT_DIRECTION = (0.12, 0.3, 1.0)
+
 #: Distance beyond the fit, for the GUI panel beside the view.
 CAMERA_MARGIN = 1.1
 
@@ -56,7 +59,8 @@ WIDE = 1.5
 
 
 def place_camera(camera, width: float, height: float, depth: float | None = None,
-                 center=(0.0, 0.0, 0.0)) -> None:
+                 center=(0.0, 0.0, 0.0), direction=VIEW_DIRECTION,
+                 margin: float = CAMERA_MARGIN) -> None:
     """Point viser's camera (``server.initial_camera``) at a box of
     ``width`` (x), ``height`` (y) and ``depth`` (z, default the height)
     about ``center``, from VIEW_DIRECTION, far enough that the box's
@@ -70,8 +74,8 @@ def place_camera(camera, width: float, height: float, depth: float | None = None
     radius = 0.5 * math.sqrt(width * width + height * height + depth * depth)
     # a wide box (runs side by side) fills the window's width; a cube its height
     half = half_h if width > WIDE * height else half_v
-    d = CAMERA_MARGIN * radius / math.sin(half)
-    direction = np.asarray(VIEW_DIRECTION, dtype=np.float64)
+    d = margin * radius / math.sin(half)
+    direction = np.asarray(direction, dtype=np.float64)
     direction /= np.sqrt(direction @ direction)
     camera.fov = math.radians(FOV_DEGREES)
     camera.look_at = tuple(np.asarray(center, dtype=np.float64))

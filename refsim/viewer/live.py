@@ -295,6 +295,14 @@ class Viewer:
             return self.run
 
     def _work(self, generation: int, scene) -> None:
+        try:
+            self._run_and_show(generation, scene)
+        except Exception:
+            if self._stop.is_set():        # closed mid-run: the page is gone, nothing to say
+                return
+            raise
+
+    def _run_and_show(self, generation: int, scene) -> None:
         def cancelled() -> bool:
             return self._generation != generation or self._stop.is_set()
 

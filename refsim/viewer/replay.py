@@ -54,6 +54,10 @@ GAP = 0.25
 #: and recorded as float64 is far below it.
 START_RTOL = 1e-9
 
+#: The replay's camera stands farther back than the live viewer's: less
+#: perspective between runs side by side, and room for the settings panel.
+REPLAY_CAMERA_MARGIN = 1.4
+
 #: Opacity of the bodies when runs are overlaid, so that both show where
 #: they coincide.
 OVERLAY_OPACITY = 0.65
@@ -237,9 +241,9 @@ class ReplayInfo:
     max_bytes: int
 
     def summary(self) -> str:
-        layout = "overlaid" if self.overlay else "side by side"
         n = len(self.runs)
-        return (f"wrote {self.path}: {n} run{'s' if n != 1 else ''} {layout}, "
+        layout = "" if n == 1 else " overlaid" if self.overlay else " side by side"
+        return (f"wrote {self.path}: {n} run{'s' if n != 1 else ''}{layout}, "
                 f"{self.frames} of {self.timeline_frames} frames (stride {self.stride}), "
                 f"{self.bytes / 1e6:.2f} MB (budget {self.max_bytes / 1e6:g} MB)")
 
@@ -345,7 +349,9 @@ class _Page:
         try:
             n = 1 if self.overlay else len(self.runs)
             draw.place_camera(server.initial_camera, 2.0 * self.H * (n + GAP * (n - 1)),
-                              2.0 * self.H)
+                              2.0 * self.H,
+                              direction=draw.VIEW_DIRECTION if n == 1 else draw.FRONT_DIRECTION,
+                              margin=REPLAY_CAMERA_MARGIN)
             s = server.scene
             serializer = server.get_scene_serializer()
             nodes = self._add_nodes(s, draw)
@@ -416,11 +422,12 @@ class _Page:
             rows.append(f"<details open><summary>{swatches}<b>{html.escape(run.label)}</b>"
                         f"</summary><div>{html.escape('; '.join(facts))}</div>"
                         f"<table>{settings}</table></details>")
-        layout = "overlaid" if self.overlay else "side by side (along x)"
+        layout = ("" if len(self.runs) == 1 else " overlaid" if self.overlay
+                  else " side by side (along x)")
         every = "every frame" if stride == 1 else f"stride {stride}: one frame in {stride}"
         return (f'<div id="refsim-replay"><details open><summary><b>refsim replay</b>: '
                 f'{html.escape(self.title)}</summary>'
-                f'<div>{len(self.runs)} run{"s" if len(self.runs) != 1 else ""} {layout}; '
+                f'<div>{len(self.runs)} run{"s" if len(self.runs) != 1 else ""}{layout}; '
                 f'{kept} of {len(self.times)} frames kept ({every}); 1x plays one '
                 f'simulated second per second.</div>{"".join(rows)}</details></div>')
 
@@ -440,14 +447,15 @@ def _value(v) -> str:
 
 
 PANEL_STYLE = """<style>
-#refsim-replay { position: fixed; top: 8px; right: 8px; z-index: 1000; max-width: 22em;
+#refsim-replay { position: fixed; top: 8px; left: 8px; z-index: 1000; max-width: 22em;
   max-height: 70vh; overflow: auto; font: 12px/1.35 system-ui, sans-serif; color: #222;
   background: rgba(255, 255, 255, 0.92); border: 1px solid #ccc; border-radius: 6px;
   padding: 6px 8px; }
 #refsim-replay details details { margin-top: 6px; }
 #refsim-replay summary { cursor: pointer; }
 #refsim-replay table { border-collapse: collapse; margin-top: 2px; }
-#refsim-replay td { padding: 0 6px 0 0; vertical-align: top; }
+#refsim-replay table { table-layout: fixed; width: 100%; }
+#refsim-replay td { padding: 0 6px 0 0; vertical-align: top; overflow-wrap: anywhere; }
 #refsim-replay td:first-child { color: #666; }
 #refsim-replay .sw { display: inline-block; width: 10px; height: 10px; margin-right: 3px;
   border-radius: 2px; vertical-align: baseline; }
