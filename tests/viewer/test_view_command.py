@@ -197,3 +197,26 @@ def test_particles_are_a_point_cloud():
         v.show_frame(run.n_frames - 1)
         assert np.allclose(v.points.points, run.particles.position[-1], atol=1e-2)
         assert v.controls["rotation"].disabled and not v.controls["solver"].disabled
+
+
+def test_overlays_at_a_contact_and_at_a_wall_hit():
+    from refsim.dynamics.measure import c11_scene
+
+    with Viewer(c11_scene("stack", "seed", duration=1.2), play=False, every=10) as v:
+        run = v.wait(timeout=START_TIMEOUT)
+        v.show_boxes.value = True
+        sunk = [k for k in range(run.n_frames) if v.contacts(k)]
+        assert sunk                                        # C11: the top body sinks in
+        v.show_frame(sunk[len(sunk) // 2])
+        found = v.contacts(v.frame)
+        faces = sum(len(np.unique(f.pairs[:, 0])) + len(np.unique(f.pairs[:, 1]))
+                    for f in found)
+        assert v.contact_node is not None and len(v.contact_node.faces) == faces
+        assert len(v.boxes.points) == 2 * 12               # two boxes, twelve edges each
+        v.show_frame(0)
+        assert v.contact_node is None                      # apart at the start
+        hit = run.hits[0]                                  # the first wall hit
+        v.show_frame(hit.frame)
+        assert v.normal_node is not None and v.impulse_node is not None
+        v.show_hits.value = False
+        assert v.normal_node is None
