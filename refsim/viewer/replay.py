@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from refsim.errors import OutputError, RefsimError
+from refsim.errors import OutputError, RefsimError, check_count
 from refsim.viewer import REPLAY_MAX_BYTES as DEFAULT_MAX_BYTES
 
 #: Space between two runs side by side, as a fraction of the larger cube's size.
@@ -96,7 +96,8 @@ class ReplayRun:
     def __post_init__(self):
         B = len(self.trajectory.names)
         if len(self.meshes) != B:
-            raise RefsimError(f"run {self.label!r}: {len(self.meshes)} meshes for {B} bodies")
+            raise RefsimError(f"run {self.label!r}: {len(self.meshes)} meshes for {B} "
+                              f"bod{'y' if B == 1 else 'ies'}")
         if self.trajectory.n_frames == 0:
             raise RefsimError(f"run {self.label!r} has no frames")
         if not self.settings:
@@ -287,6 +288,7 @@ def write_replay(runs, path, *, overlay: bool = False, max_bytes: int = DEFAULT_
     if stride is None:
         stride, text = page.fit(max_bytes)
     else:
+        stride = check_count("stride", stride, minimum=1)
         text = page.render(stride)
     size = len(text.encode("utf-8"))
     if size > max_bytes:
