@@ -5,7 +5,7 @@ FCL (J. Pan, S. Chitta, D. Manocha, "FCL: A General Purpose Library for
 Collision and Proximity Queries", ICRA 2012) tests mesh pairs with a bounding
 volume hierarchy and a floating-point triangle-triangle test. Its answers are
 float answers: on touching and near-degenerate pairs they may differ from
-refsim's exact ones, and ``refsim.collision.measure`` classifies every such
+refsim's exact ones, and ``refsim.studies.triangles`` classifies every such
 difference.
 
 Conventions converted here and nowhere else:

@@ -40,7 +40,7 @@ Every setting, and why (:class:`PybulletSettings` holds them)
 
 - ``useMaximalCoordinates=True``: a single free body is a plain
   ``btRigidBody``, not a ``btMultiBody``. Measured here (sphere, e = 0.8,
-  h = 1e-3, :func:`refsim.dynamics.bounce.measure_pybullet_settings`): the
+  h = 1e-3, :func:`refsim.studies.bounce.measure_pybullet_settings`): the
   multibody path returns apex ratios 12% above e^2, the rigid-body path
   0.04% below.
 - ``setTimeStep(scene.integration.step)``, ``numSubSteps=0``: one Bullet step

@@ -28,7 +28,7 @@ from scipy.integrate import solve_ivp
 #: the global error on the problems here is ~1e-12 relative (checked against
 #: closed forms in tests/solvers/test_scipy_oracle.py), far below the
 #: fixed-step errors being measured (floor: ERROR_FLOOR_REL in
-#: refsim.solvers.measure).
+#: refsim.studies.solvers).
 REFERENCE_TOL = 1e-13
 
 

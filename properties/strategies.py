@@ -356,8 +356,8 @@ POSED_MODELS = (("cube", 1.0), ("icosahedron", 1.0), ("star", 1.0), ("l-beam", 1
 @_st.composite
 def posed_model_pairs(draw, models=POSED_MODELS):
     """``(mesh_a, pose_a, mesh_b, pose_b, label)`` for two bundled models."""
-    from refsim.collision.measure_levels import bundled_mesh, model_label
     from refsim.collision.spheres import bounding_sphere
+    from refsim.studies.levels import bundled_mesh, model_label
 
     (name_a, scale_a), (name_b, scale_b) = draw(_st.sampled_from(models)), \
         draw(_st.sampled_from(models))

@@ -20,14 +20,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 import warnings
 from dataclasses import asdict
 from pathlib import Path
 
-from refsim.errors import DivergenceError, RefsimError, SceneError
-from refsim.io import write_npz_atomic
+from refsim.errors import DivergenceError, OutputError, RefsimError, SceneError
+from refsim.signals import Interrupted, signals_raise
 
 EXIT_USER_ERROR = 2
 EXIT_DIVERGED = 3
@@ -91,48 +90,72 @@ def _with_duration(scene, duration: float):
 
 
 def _write(out: Path, save) -> None:
+    """``save(out)``; an ``OSError`` (a full disk, a refused target) becomes
+    an :class:`OutputError` naming ``out`` (refsim.io leaves no file)."""
+    from refsim.io import output_error
+
     try:
         save(out)
+    except OutputError:
+        raise
     except OSError as exc:
-        raise RefsimError(f"{out}: cannot write: {exc.strerror or exc}") from exc
+        raise output_error(out, exc.strerror or str(exc)) from exc
 
 
 def _run_bodies(scene, out: Path, every: int | None) -> int:
-    """Rigid bodies: ``refsim.simulate``, written as a Trajectory (.npz)."""
-    from refsim.dynamics.simulation import simulate
+    """Rigid bodies: ``refsim.simulate`` with the frames spilled beside
+    ``out`` as they are computed (:class:`refsim.frames.SpillSink`: memory
+    does not grow with the steps), then written as a Trajectory (.npz)."""
+    from refsim.dynamics.simulation import default_every, simulate
+    from refsim.frames import SpillSink, check_disk_space
+    from refsim.io import output_target
 
-    try:
-        trajectory = simulate(scene, every=every)
-    except DivergenceError as exc:
-        partial = exc.partial
-        _write(out, partial.save)
-        raise DivergenceError(
-            f"{exc.args[0].split(', ', 2)[-1]}; wrote the {partial.n_frames} frames before it "
-            f"(t = 0 to {partial.t[-1]:.6g}) to {out}", step=exc.step, time=exc.time,
-            body=exc.body) from None
-    _write(out, trajectory.save)
+    output_target(out)                  # a FIFO, device or directory: refused before running
+    B = len(scene.bodies)
+    n_steps = scene.integration.n_steps
+    # t, then position, velocity, angular_velocity (B, 3) and orientation (B, 3, 3)
+    check_disk_space(out, [8, 24 * B, 24 * B, 24 * B, 72 * B], n_steps,
+                     default_every(n_steps) if every is None else every, compressed=True,
+                     frames_of=f"{B} {'body' if B == 1 else 'bodies'}",
+                     size_hint=f"{scene.path}: fewer [[body]] tables")
+    with SpillSink(out) as sink:
+        try:
+            trajectory = simulate(scene, every=every, sink=sink)
+        except DivergenceError as exc:
+            partial = exc.partial
+            _write(out, partial.save)
+            raise DivergenceError(
+                f"{exc.message}; wrote the {partial.n_frames} frames before "
+                f"it (t = 0 to {partial.t[-1]:.6g}) to {out}", step=exc.step, time=exc.time,
+                body=exc.body) from None
+        _write(out, trajectory.save)
+        n_frames, t_end = trajectory.n_frames, float(trajectory.t[-1])
     ran = ", ".join(trajectory.stages)
-    bodies = len(trajectory.names)
-    print(f"wrote {out}: {trajectory.n_frames} frames of {bodies} "
-          f"{'body' if bodies == 1 else 'bodies'}, "
-          f"t = 0 to {trajectory.t[-1]:.6g} ({scene.integration.solver}, "
+    print(f"wrote {out}: {n_frames} frames of {B} {'body' if B == 1 else 'bodies'}, "
+          f"t = 0 to {t_end:.6g} ({scene.integration.solver}, "
           f"h = {scene.integration.step:g}); stages: {ran}")
     return 0
 
 
 def _run_particles(scene, out: Path, every: int | None) -> int:
-    """Particles: :func:`refsim.particles.run.run_particles`, frames as .npz."""
+    """Particles: :func:`refsim.particles.run.run_particles` with the frames
+    spilled beside ``out`` as they are computed, then written as .npz
+    (uncompressed: random floats do not compress, and it is faster)."""
     import numpy as np
 
-    from refsim.particles.run import MAX_FRAME_BYTES, frame_stride, run_particles
+    from refsim.frames import SpillSink, check_disk_space
+    from refsim.io import output_target, write_npz_atomic
+    from refsim.particles.run import FRAME_BYTES_PER_PARTICLE, frame_stride, run_particles
 
+    output_target(out)                  # a FIFO, device or directory: refused before running
     config = scene.particles
     n_steps, every = frame_stride(scene, every)
-    n_frames = math.ceil(n_steps / every) + 1
-    if n_frames * config.count * 48 > MAX_FRAME_BYTES:
-        raise RefsimError(f"{n_frames} frames of {config.count} particles would take "
-                          f"{n_frames * config.count * 48 / 1e9:.1f} GB; store fewer with "
-                          f"--every (at most {MAX_FRAME_BYTES / 1e9:g} GB)")
+    N = config.count
+    # t, step, then position and velocity (N, 3)
+    check_disk_space(out, [8, 8, FRAME_BYTES_PER_PARTICLE // 2 * N,
+                           FRAME_BYTES_PER_PARTICLE // 2 * N], n_steps, every,
+                     compressed=False, frames_of=f"{N} particles",
+                     size_hint=f"{scene.path}: particles.count")
 
     def save(frames, status: str):
         arrays = {"t": frames.t, "step": frames.step, "position": frames.position,
@@ -141,17 +164,20 @@ def _run_particles(scene, out: Path, every: int | None) -> int:
                   "status": np.array(status)}
         _write(out, lambda path: write_npz_atomic(path, arrays))
 
-    try:
-        frames = run_particles(config, n_steps, every)
-    except DivergenceError as exc:
-        partial = exc.partial
-        save(partial, f"diverged at step {exc.step}, t = {exc.time:.6g}")
-        raise DivergenceError(
-            f"particle state is not finite; wrote the {len(partial.t)} frames before it "
-            f"(t = 0 to {partial.t[-1]:.6g}) to {out}", step=exc.step, time=exc.time) from None
-    save(frames, "complete")
-    print(f"wrote {out}: {len(frames.t)} frames of {config.count} particles, "
-          f"t = 0 to {frames.t[-1]:.6g} ({config.solver}, h = {config.step:g}, "
+    with SpillSink(out) as sink:
+        try:
+            frames = run_particles(config, n_steps, every, sink=sink)
+        except DivergenceError as exc:
+            partial = exc.partial
+            save(partial, f"diverged at step {exc.step}, t = {exc.time:.6g}")
+            raise DivergenceError(
+                f"particle state is not finite; wrote the {len(partial.t)} frames before it "
+                f"(t = 0 to {partial.t[-1]:.6g}) to {out}", step=exc.step,
+                time=exc.time) from None
+        save(frames, "complete")
+        n_frames, t_end = len(frames.t), float(frames.t[-1])
+    print(f"wrote {out}: {n_frames} frames of {config.count} particles, "
+          f"t = 0 to {t_end:.6g} ({config.solver}, h = {config.step:g}, "
           f"every {every} steps)")
     return 0
 
@@ -288,7 +314,9 @@ def main(argv: list[str] | None = None) -> int:
     if not args.debug:
         warnings.showwarning = _one_line_warning
     try:
-        return args.run(args)
+        # SIGTERM and SIGHUP unwind like Ctrl-C, so temporary files are removed
+        with signals_raise():
+            return args.run(args)
     except DivergenceError as exc:
         if args.debug:
             raise
@@ -299,6 +327,9 @@ def main(argv: list[str] | None = None) -> int:
             raise
         print(f"refsim: error: {exc}", file=sys.stderr)
         return EXIT_USER_ERROR
+    except Interrupted as exc:
+        print(f"refsim: interrupted ({exc.name})", file=sys.stderr)
+        return exc.exit_status
     except KeyboardInterrupt:
         print("refsim: interrupted", file=sys.stderr)
         return 130

@@ -14,6 +14,7 @@ for Python's conventions (``except ValueError``) catches them too:
     RefsimError
     ├── ModelError          (ValueError)  a model file or mesh
     ├── SceneError          (ValueError)  a scene file or scene key
+    ├── NpzFileError        (ValueError)  a recorded run (.npz) that cannot be read
     ├── StateError          (ValueError)  a number, array or state
     ├── OptionError         (ValueError)  an option not among its choices
     ├── ArgumentTypeError   (TypeError)   an argument of the wrong type
@@ -77,6 +78,20 @@ class SceneError(RefsimError, ValueError):
         super().__init__(f"{where}: {message}")
 
 
+class NpzFileError(RefsimError, ValueError):
+    """An .npz that cannot be read as the expected content: missing,
+    unreadable, truncated, another format, an entry missing or of the wrong
+    shape. ``path`` is the file, ``entry`` the entry's name when one is at
+    fault (:mod:`refsim.npz` raises it)."""
+
+    def __init__(self, message: str, path: str | PathLike, entry: str | None = None):
+        self.message = message
+        self.path = str(path)
+        self.entry = entry
+        where = self.path if entry is None else f"{self.path}: entry {entry!r}"
+        super().__init__(f"{where}: {message}")
+
+
 class StateError(RefsimError, ValueError):
     """A non-finite or otherwise invalid numeric input (coordinates, a state)."""
 
@@ -112,6 +127,7 @@ class DivergenceError(RefsimError):
 
     def __init__(self, message: str, step: int, time: float, body: str | None = None,
                  partial=None):
+        self.message = message
         self.step = step
         self.time = time
         self.body = body

@@ -25,8 +25,9 @@ def as_path(value, what: str = "path") -> Path:
                             f"{type(value).__name__}")
 
 
-def read_regular_file(path, error: type) -> bytes:
-    """The bytes of the regular file at ``path``, or ``error(message, path)``."""
+def require_regular_file(path, error: type) -> Path:
+    """``path`` as a Path when it names a regular file (a symlink to one
+    included); else ``error(message, path)``, without opening it."""
     path = as_path(path)
     try:
         mode = path.stat().st_mode
@@ -36,6 +37,12 @@ def read_regular_file(path, error: type) -> bytes:
         raise error(f"cannot read: {exc.strerror or exc}", path) from None
     if not stat.S_ISREG(mode):
         raise error(f"not a regular file ({file_kind(mode)})", path)
+    return path
+
+
+def read_regular_file(path, error: type) -> bytes:
+    """The bytes of the regular file at ``path``, or ``error(message, path)``."""
+    path = require_regular_file(path, error)
     try:
         return path.read_bytes()
     except OSError as exc:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -196,8 +197,9 @@ def test_a_diverging_rigid_run_keeps_its_frames(tmp_path, capsys, monkeypatch):
 
     real = simulation.simulate
 
-    def diverging(scene, every=None):
-        partial = real(scene, every=every, duration=0.1)
+    def diverging(scene, every=None, **kwargs):
+        # kwargs: the sink the command line streams the frames to
+        partial = real(scene, every=every, duration=0.1, **kwargs)
         raise DivergenceError("energy grew without bound", step=51, time=0.102, body="b",
                               partial=partial)
 
@@ -207,8 +209,9 @@ def test_a_diverging_rigid_run_keeps_its_frames(tmp_path, capsys, monkeypatch):
     assert main(["run", str(scene), "-o", str(out), "--every", "10"]) == EXIT_DIVERGED
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err
-    assert "diverged at step 51" in err and "'b'" in err and "energy grew" in err
-    assert "wrote the 6 frames" in err and str(out) in err
+    assert err.startswith("refsim: error: diverged at step 51, t = 0.102, body 'b', energy "
+                          "grew without bound; wrote the 6 frames")
+    assert err.count("'b'") == 1 and str(out) in err        # the body named once
     assert Trajectory.load(out).n_frames == 6
 
 
@@ -256,11 +259,14 @@ def test_divergence_names_step_and_time_and_keeps_the_frames(tmp_path, capsys):
 
 def test_an_interrupted_write_leaves_no_file(tmp_path, monkeypatch):
     import refsim.cli as cli
+    import refsim.npz
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(np, "savez", interrupted)
+    # Ctrl-C while the .npz is assembled from the spilled frames: neither the
+    # temporary .npz nor the spill files stay
+    monkeypatch.setattr(refsim.npz, "npy_header", interrupted)
     scene = write(tmp_path, TINY)
     out = tmp_path / "out.npz"
     assert cli.main(["run", str(scene), "-o", str(out)]) == 130
@@ -291,10 +297,156 @@ def test_a_scene_with_bodies_and_particles_is_refused(tmp_path, capsys):
     assert files(tmp_path) == ["scene.toml"]
 
 
-def test_too_many_frames_is_refused_before_running(tmp_path, capsys):
+def _free(monkeypatch, free_bytes):
+    """Pretend every file system has ``free_bytes`` free."""
+    import shutil
+
+    monkeypatch.setattr(shutil, "disk_usage",
+                        lambda path: shutil._ntuple_diskusage(10**13, 10**13 - free_bytes,
+                                                              free_bytes))
+
+
+def test_frames_beyond_the_free_disk_are_refused_before_running(tmp_path, capsys,
+                                                                monkeypatch):
+    # 2e6 particles, 101 frames of 96 MB: about 19.4 GB on disk at the end
+    # (the spilled frames and the .npz made from them); 1 GB free. The
+    # smallest stride that fits: 2 F 96e6 + overhead <= 1e9 needs F <= 5
+    # frames, 1 + ceil(100 / k) <= 5, k >= 25.
+    _free(monkeypatch, 10**9)
     scene = write(tmp_path, TINY.replace("count = 12", "count = 2000000"))
-    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz"), "--every", "1"]) == \
-        EXIT_USER_ERROR
+    out = tmp_path / "o.npz"
+    assert main(["run", str(scene), "-o", str(out), "--every", "1"]) == EXIT_USER_ERROR
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "--every" in err and "GB" in err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert str(out) in err and "101 frames of 2000000 particles" in err
+    assert "19.4 GB on disk" in err and "1.0 GB free" in err
+    assert "--every 25 or more" in err
     assert files(tmp_path) == ["scene.toml"]
+
+
+def test_a_stride_that_fits_is_not_refused(tmp_path, monkeypatch):
+    # the stride the refusal above names: 5 frames of 12 particles fit in 1 MB
+    _free(monkeypatch, 10**6)
+    scene = write(tmp_path, TINY)
+    out = tmp_path / "o.npz"
+    assert main(["run", str(scene), "-o", str(out), "--every", "25"]) == 0
+    with np.load(out) as data:
+        assert list(data["step"]) == [0, 25, 50, 75, 100]
+
+
+def test_a_frame_too_large_for_the_disk_names_the_count(tmp_path, capsys, monkeypatch):
+    # 1e7 particles: one frame is 480 MB, two frames 960 MB, plus the .npz;
+    # with 1 GB free no --every helps, the scene's particles.count does
+    _free(monkeypatch, 10**9)
+    scene = write(tmp_path, TINY.replace("count = 12", "count = 10000000"))
+    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert f"{scene}: particles.count" in err and "even 2 frames need 1.9 GB" in err
+    assert "--every" not in err
+    assert files(tmp_path) == ["scene.toml"]
+
+
+# -- streamed output: the library's frames, bit for bit; safe output paths -------------
+
+
+def test_streamed_rigid_frames_are_the_librarys(tmp_path):
+    from refsim.dynamics.simulation import simulate
+    from refsim.dynamics.trajectory import Trajectory
+    from refsim.scenes.loader import load_scene
+
+    scene = write(tmp_path, RIGID)
+    out = tmp_path / "out.npz"
+    assert main(["run", str(scene), "-o", str(out), "--every", "7"]) == 0
+    kept = simulate(load_scene(scene), every=7)           # in memory
+    loaded = Trajectory.load(out)
+    assert loaded.n_frames == kept.n_frames == 1 + 300 // 7 + 1
+    for name in ("t", "position", "velocity", "angular_velocity", "orientation"):
+        assert np.array_equal(getattr(loaded, name), getattr(kept, name)), name
+    assert files(tmp_path) == ["out.npz", "scene.toml"]
+
+
+def test_streamed_particle_frames_are_the_librarys(tmp_path):
+    from refsim.particles.run import run_particles
+    from refsim.scenes.loader import load_scene
+
+    scene = write(tmp_path, TINY)
+    out = tmp_path / "out.npz"
+    assert main(["run", str(scene), "-o", str(out), "--every", "7"]) == 0
+    kept = run_particles(load_scene(scene).particles, 100, 7)   # in memory
+    with np.load(out) as data:
+        assert data.files == ["t", "step", "position", "velocity", "scene", "status"]
+        for name in ("t", "step", "position", "velocity"):
+            assert data[name].dtype == getattr(kept, name).dtype
+            assert np.array_equal(data[name], getattr(kept, name)), name
+
+
+def test_output_through_a_symlink_keeps_the_link(tmp_path):
+    scene = write(tmp_path, TINY)
+    (tmp_path / "runs").mkdir()
+    target = tmp_path / "runs" / "run-1.npz"
+    target.write_bytes(b"old")
+    link = tmp_path / "latest.npz"
+    link.symlink_to(target)
+    assert main(["run", str(scene), "-o", str(link), "--every", "50"]) == 0
+    assert link.is_symlink() and link.resolve() == target.resolve()
+    with np.load(target) as data:
+        assert list(data["step"]) == [0, 50, 100]
+    assert files(tmp_path / "runs") == ["run-1.npz"]
+    assert files(tmp_path) == ["latest.npz", "runs", "scene.toml"]
+
+
+@pytest.mark.parametrize("kind", ["fifo", "device", "directory"])
+def test_a_special_output_is_refused_before_running(tmp_path, capsys, monkeypatch, kind):
+    import os
+
+    import refsim.particles.run
+
+    def not_run(*args, **kwargs):
+        raise AssertionError("ran the scene although its output is refused")
+
+    monkeypatch.setattr(refsim.particles.run, "run_particles", not_run)
+    scene = write(tmp_path, TINY)
+    if kind == "fifo":
+        out = tmp_path / "pipe"
+        os.mkfifo(out)
+    elif kind == "device":
+        out = Path(os.devnull)
+    else:
+        out = tmp_path / "dir"
+        out.mkdir()
+    before = os.lstat(out)
+    assert main(["run", str(scene), "-o", str(out)]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith(f"refsim: error: {out}: cannot write: it is a ")
+    assert os.lstat(out).st_mode == before.st_mode and os.lstat(out).st_ino == before.st_ino
+
+
+#: A file-size limit for the child below. With 1000 particles the spill of
+#: position (101 frames, 2.4 MB) passes it part way through the run; with 250
+#: each spill file stays under it (606 kB) and the .npz (1.2 MB) passes it
+#: while it is assembled.
+FILE_SIZE_LIMIT = 10**6
+
+
+def _limit_file_size():
+    import resource
+    import signal
+
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)    # EFBIG instead of a kill
+    resource.setrlimit(resource.RLIMIT_FSIZE, (FILE_SIZE_LIMIT, FILE_SIZE_LIMIT))
+
+
+@pytest.mark.parametrize("count", [1000, 250], ids=["while-spilling", "while-assembling"])
+def test_a_full_disk_is_one_line_and_leaves_no_file(tmp_path, count):
+    # a real write failure (EFBIG past RLIMIT_FSIZE, as ENOSPC on a full disk)
+    scene = write(tmp_path, TINY.replace("count = 12", f"count = {count}"))
+    out = tmp_path / "out.npz"
+    out.write_bytes(b"old")
+    result = subprocess.run([sys.executable, "-m", "refsim.cli", "run", str(scene), "-o",
+                             str(out), "--every", "1"], capture_output=True, text=True,
+                            preexec_fn=_limit_file_size)
+    assert result.returncode == EXIT_USER_ERROR and result.stdout == ""
+    assert result.stderr == f"refsim: error: {out}: cannot write: File too large\n"
+    assert files(tmp_path) == ["out.npz", "scene.toml"] and out.read_bytes() == b"old"

@@ -31,8 +31,8 @@ from refsim.bounds.aabb_linear import (
     rotated_coordinates,
     transform_vertices,
 )
-from refsim.bounds.measure import perturbed_sphere
 from refsim.models import shapes
+from refsim.studies.bounds import perturbed_sphere
 
 KERNELS = ["python"] + (["numba"] if numba_available() else [])
 

@@ -18,7 +18,7 @@ from refsim.oracles import OracleUnavailable
 from properties.strategies import posed_model_pairs
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
-from refsim.collision.measure import classify_disagreement
+from refsim.studies.triangles import classify_disagreement
 
 
 def as_set(pairs) -> set:

@@ -5,7 +5,7 @@
   vertex-neighbour graph from last frame's six extreme vertices.
 - :mod:`~refsim.bounds.tracker`: the scene option ``aabb`` choosing between them.
 - :mod:`~refsim.bounds.world_cube`: the per-axis interval test against the cube.
-- :mod:`~refsim.bounds.measure`: claims C1 (cost) and C2 (convexity) measured.
+- :mod:`~refsim.studies.bounds`: claims C1 (cost) and C2 (convexity) measured.
 
 The public names (``refsim.aabb_linear``, ``refsim.IncrementalAABB``, ...) are
 exported by ``refsim`` itself; this package re-exports nothing, so that

@@ -14,7 +14,7 @@ the two kernels bit for bit.
 
 Cache: ``cache=True`` writes the compiled code next to this file (or to
 ``NUMBA_CACHE_DIR``), so only the first process on a machine pays the compile
-(measured by :func:`refsim.bounds.measure.measure_numba_compile_cost`).
+(measured by :func:`refsim.studies.bounds.measure_numba_compile_cost`).
 
 This module imports numba at import time; import it only when the numba kernel
 is chosen.

@@ -57,7 +57,7 @@ bit. On a generic mesh in coherent motion no neighbour lies within the window
 On a non-convex mesh the walk can stop at a local extreme: the box is then
 too small. The tracker refuses such meshes unless ``allow_nonconvex=True``,
 which exists so the error can be measured (claim C2,
-:func:`refsim.bounds.measure.measure_incremental_error`).
+:func:`refsim.studies.bounds.measure_incremental_error`).
 
 Counting: ``visits`` is the number of distinct vertices the last update
 examined (computed a rotated coordinate of), over all six walks: ``n`` for the

@@ -90,7 +90,7 @@ Cost: O(m log m) once per mesh for the boxes (a 3x3 eigenproblem per node;
 about 0.06 s for 2000 triangles here); per query about O(k log m) node
 tests for k overlapping node pairs, plus O(1) per vertex and triangle of the
 leaves reached. The speed against FCL is measured in
-:func:`refsim.collision.measure_levels.measure_hierarchy_speed`.
+:func:`refsim.studies.levels.measure_hierarchy_speed`.
 """
 
 from __future__ import annotations

@@ -36,7 +36,7 @@ multiplying all coordinates by the largest denominator turns them into
 Python integers without changing the sign of either determinant, and integer
 arithmetic is exact. Shewchuk's adaptive stages B to D are not reproduced;
 the exact fallback is slower than his expansions but simple to check, and it
-fires rarely (``refsim.collision.measure.measure_filter_fallback``).
+fires rarely (``refsim.studies.triangles.measure_filter_fallback``).
 
 DEVIATION (from Shewchuk): his analysis assumes no underflow or overflow. We
 trust the filter only when every nonzero coordinate has magnitude in

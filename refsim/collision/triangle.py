@@ -114,7 +114,7 @@ def triangles_intersect_float(a, b) -> bool:
     """The same test with plain float signs (no filter, no exact fallback).
 
     This is what an unrobust 1997 implementation of the seed's test computes;
-    refsim keeps it only to measure claim C4 (``refsim.collision.measure``).
+    refsim keeps it only to measure claim C4 (``refsim.studies.triangles``).
     Its answer can be wrong on near-degenerate input.
     """
     return intersect_point_sets(as_triangle(a, "a"), as_triangle(b, "b"), FLOAT)

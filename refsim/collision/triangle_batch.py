@@ -29,7 +29,7 @@ Fast Robust Geometric Predicates" (1997), section 4, for the error bounds.
 Cost: O(k) for k pairs, about 30 vectorized determinants per pair still
 undecided after the plane rejection, plus the readable kernel's cost for
 each fallback pair (none in 20 000 uniform random pairs, 42% of contrived
-near-touching ones: ``refsim.collision.measure.measure_filter_fallback``).
+near-touching ones: ``refsim.studies.triangles.measure_filter_fallback``).
 About 1e6 pairs per second against 8e4 for the readable kernel; the numba
 kernel (``triangle_numba``) does the same math per pair with early exits,
 about 5e6 pairs per second.

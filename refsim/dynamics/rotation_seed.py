@@ -54,7 +54,7 @@ dimensionally a velocity, not an impulse. Only for a purely rotational
 contact (``v_lin = 0``) is the component of w along u scaled by
 ``1 - e |u|^2``, a partial damping, which overshoots when ``e |u|^2 > 2``.
 
-What the simulation then shows (``refsim.dynamics.measure.measure_spin``):
+What the simulation then shows (``refsim.studies.dynamics.measure_spin``):
 the cube of ``scenes/spinning-cube.toml`` keeps its vertical spin ``w_y``
 exactly, the horizontal components are kicked at every bounce and by the
 corners that dip below the floor while it slides, and |w| and the rotational

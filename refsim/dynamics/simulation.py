@@ -79,7 +79,7 @@ from refsim.dynamics.rotation_seed import (
     contact_vertex_seed,
     orientation_step_seed_compiled,
 )
-from refsim.dynamics.trajectory import Event, Trajectory
+from refsim.dynamics.trajectory import FRAME_ENTRIES, Event, Trajectory
 from refsim.dynamics.walls import SPEEDS, wall_name, wall_response_seed, wall_speed
 from refsim.errors import (
     ArgumentTypeError,
@@ -88,9 +88,10 @@ from refsim.errors import (
     check_count,
     check_option,
 )
+from refsim.frames import FrameSink, MemorySink, frame_count
 from refsim.models.mesh import Mesh
 from refsim.scenes.schema import Scene
-from refsim.solvers.integrate import resolve_method
+from refsim.solvers.integrate import resolve_method, whole_steps
 
 #: At most about this many frames by default (``every`` is chosen so).
 MAX_FRAMES = 1000
@@ -148,6 +149,10 @@ class Simulation:
         the same boxes, bit for bit (the incremental walk finds the linear
         scan's extreme vertex on a convex mesh and adds the translation the
         same way); only the cost differs.
+    sink : refsim.frames.FrameSink, optional
+        Where :meth:`record` puts frames: a :class:`refsim.frames.MemorySink`
+        by default (growing by doubling), or e.g. a
+        :class:`refsim.frames.SpillSink` that writes them to disk as they come.
 
     Attributes
     ----------
@@ -162,7 +167,8 @@ class Simulation:
     stage_seconds : dict of str -> float
     """
 
-    def __init__(self, scene, *, wall_speed: str = "wall", boxes: str = "auto"):
+    def __init__(self, scene, *, wall_speed: str = "wall", boxes: str = "auto",
+                 sink: FrameSink | None = None):
         if not isinstance(scene, Scene):
             raise ArgumentTypeError(f"scene must be a refsim.Scene (refsim.load_scene(path)), "
                                     f"got {type(scene).__name__}")
@@ -247,7 +253,7 @@ class Simulation:
         self._touching: set[tuple[str, str]] = set()
         self.stages = tuple(s for s in STAGES if self._needs(s))
         self.stage_seconds = dict.fromkeys(self.stages, 0.0)
-        self._frames: list[tuple] = []
+        self._frames: FrameSink = MemorySink() if sink is None else sink
         # the largest principal moment of each body: 1/2 lambda_max |w|^2 bounds
         # the rotational energy without a rotation of the inertia tensor
         self._lambda_max = np.linalg.eigvalsh(self.I_body)[:, -1]
@@ -560,15 +566,24 @@ class Simulation:
     # -- frames ---------------------------------------------------------------------------
 
     def record(self) -> None:
-        """Append the current state as a frame."""
-        self._frames.append((self.t, self.position.copy(), self.v.copy(), self.w.copy(),
-                             self.R.copy()))
+        """Append the current state to the sink as a frame: ``t``, and the
+        (B, 3) ``position``, ``velocity``, ``angular_velocity`` and (B, 3, 3)
+        ``orientation`` (the sink copies them)."""
+        self._frames.append({"t": self.t, "position": self.position, "velocity": self.v,
+                             "angular_velocity": self.w, "orientation": self.R})
 
     def trajectory(self, settings: dict | None = None) -> Trajectory:
-        """The frames recorded so far as a :class:`Trajectory`."""
+        """The frames recorded so far as a :class:`Trajectory`.
+
+        Its arrays are what the sink holds: with the default memory sink,
+        views of its buffers (no copy; later records do not change them);
+        with a spill sink, :class:`refsim.frames.SpilledArray` views of its
+        files, valid while the sink is open.
+        """
         B = len(self.bodies)
-        if self._frames:
-            t, x, v, w, R = (np.array(a) for a in zip(*self._frames, strict=True))
+        if self._frames.n_frames:
+            frames = self._frames.arrays()
+            t, x, v, w, R = (frames[name] for name in FRAME_ENTRIES)
         else:
             t = np.empty(0)
             x, v, w = (np.empty((0, B, 3)) for _ in range(3))
@@ -593,7 +608,8 @@ def default_every(n_steps: int) -> int:
 
 
 def simulate(scene, *, every: int | None = None, duration: float | None = None,
-             wall_speed: str = "wall", boxes: str = "auto") -> Trajectory:
+             wall_speed: str = "wall", boxes: str = "auto",
+             sink: FrameSink | None = None) -> Trajectory:
     """Run ``scene`` and return its trajectory.
 
     Parameters
@@ -606,20 +622,34 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
         Override ``integration.duration`` (seconds).
     wall_speed, boxes : str
         See :class:`Simulation`.
+    sink : refsim.frames.FrameSink, optional
+        Where the frames go as they are computed. Default: a
+        :class:`refsim.frames.MemorySink` sized for the run's frames, and the
+        trajectory holds numpy arrays. ``refsim run`` passes a
+        :class:`refsim.frames.SpillSink`, so that memory does not grow with
+        the steps; the trajectory's frames are then views of its files, to be
+        saved before the sink closes. Both give the same frames, bit for bit.
 
     Raises
     ------
     DivergenceError
         With the frames so far in ``partial``.
+    StateError, ArgumentTypeError
+        A ``duration`` that is not a whole number (>= 1) of steps; an
+        ``every`` that is not an integer >= 1.
     """
+    if not isinstance(scene, Scene):
+        raise ArgumentTypeError(f"scene must be a refsim.Scene (refsim.load_scene(path)), "
+                                f"got {type(scene).__name__}")
     if duration is not None:
+        whole_steps(duration, scene.integration.step)          # refuse before any work
         scene = replace(scene, integration=replace(scene.integration, duration=duration))
     n_steps = scene.integration.n_steps
-    if every is None:
-        every = default_every(n_steps)
-    if every < 1:
-        raise StateError(f"every must be >= 1, got {every}")
-    sim = Simulation(scene, wall_speed=wall_speed, boxes=boxes)
+    every = default_every(n_steps) if every is None else check_count("every", every, 1)
+    if sink is None:
+        # the initial state, every every-th step, and the last step
+        sink = MemorySink(capacity=frame_count(n_steps, every))
+    sim = Simulation(scene, wall_speed=wall_speed, boxes=boxes, sink=sink)
     sim.record()
     sim.run(n_steps, every=every)
     if sim.steps % every:

@@ -16,6 +16,17 @@ Shapes, for F frames and B bodies:
 
 ``events`` lists wall hits and body contacts. ``stages`` names the stages of
 the loop that ran; ``stage_seconds`` the wall time spent in each.
+
+The frame arrays are numpy arrays, except in a trajectory whose frames were
+spilled to disk as they were computed (``simulate(scene, sink=SpillSink(out))``,
+what ``refsim run`` does): there they are :class:`refsim.frames.SpilledArray`
+views of the spill files, enough to :meth:`Trajectory.save` it in bounded
+memory, and valid while the sink is open.
+
+File format (:meth:`Trajectory.save`, :meth:`Trajectory.load`): an .npz,
+compressed, with the entries ``t``, ``position``, ``velocity``,
+``angular_velocity``, ``orientation`` (the frames), ``names``, ``events``
+(JSON), ``stages``, ``stage_seconds`` (JSON) and ``settings`` (JSON).
 """
 
 from __future__ import annotations
@@ -26,7 +37,13 @@ from pathlib import Path
 
 import numpy as np
 
+from refsim.errors import NpzFileError
 from refsim.io import write_npz_atomic
+from refsim.npz import read_npz
+
+#: The .npz entries of a trajectory, in the order they are written.
+FRAME_ENTRIES = ("t", "position", "velocity", "angular_velocity", "orientation")
+ENTRIES = (*FRAME_ENTRIES, "names", "events", "stages", "stage_seconds", "settings")
 
 
 @dataclass(frozen=True)
@@ -59,7 +76,17 @@ class Trajectory:
         return len(self.t)
 
     def save(self, path) -> Path:
-        """Write the trajectory as .npz, atomically (never half a file)."""
+        """Write the trajectory as a compressed .npz, atomically (never half a
+        file), in bounded memory (:func:`refsim.io.write_npz_atomic`).
+
+        Raises
+        ------
+        OutputError
+            ``path`` is a directory, device, FIFO or socket, or its directory
+            is missing (a symlink is written through, see :mod:`refsim.io`).
+        OSError
+            As the file system reports it (e.g. a full disk); no file left.
+        """
         events = json.dumps([e.__dict__ for e in self.events])
         return write_npz_atomic(path, dict(
             t=self.t, position=self.position, velocity=self.velocity,
@@ -71,12 +98,60 @@ class Trajectory:
 
     @classmethod
     def load(cls, path) -> Trajectory:
-        with np.load(path) as data:
-            return cls(
-                t=data["t"], position=data["position"], velocity=data["velocity"],
-                angular_velocity=data["angular_velocity"], orientation=data["orientation"],
-                names=tuple(str(n) for n in data["names"]),
-                events=[Event(**e) for e in json.loads(str(data["events"]))],
-                stages=tuple(str(s) for s in data["stages"]),
-                stage_seconds=json.loads(str(data["stage_seconds"])),
-                settings=json.loads(str(data["settings"])))
+        """The trajectory saved at ``path``.
+
+        Raises
+        ------
+        refsim.npz.NpzFileError
+            (a :class:`~refsim.errors.RefsimError` and ``ValueError``) naming
+            ``path`` and the entry: no such file, not an .npz (another
+            format, or truncated), an entry missing or corrupt, or content
+            that is not a trajectory (shapes that disagree, bad JSON).
+        """
+        data = read_npz(path, ENTRIES)
+        t = data["t"]
+        if t.ndim != 1 or not np.issubdtype(t.dtype, np.floating):
+            raise NpzFileError(f"expected a 1-d float array of times, got {t.dtype} "
+                               f"{t.shape}", path, "t")
+        names = data["names"]
+        if names.ndim != 1 or (names.size and names.dtype.kind != "U"):
+            raise NpzFileError(f"expected a 1-d array of body names, got {names.dtype} "
+                               f"{names.shape}", path, "names")
+        F, B = len(t), len(names)
+        for name, shape in (("position", (F, B, 3)), ("velocity", (F, B, 3)),
+                            ("angular_velocity", (F, B, 3)), ("orientation", (F, B, 3, 3))):
+            a = data[name]
+            if a.shape != shape or not np.issubdtype(a.dtype, np.floating):
+                raise NpzFileError(f"expected float {shape} ({F} frames of {B} bodies), "
+                                   f"got {a.dtype} {a.shape}", path, name)
+        stages = data["stages"]
+        if stages.ndim != 1 or (stages.size and stages.dtype.kind != "U"):
+            raise NpzFileError(f"expected a 1-d array of stage names, got {stages.dtype} "
+                               f"{stages.shape}", path, "stages")
+        events = _json(data, "events", list, path)
+        try:
+            events = [Event(**e) for e in events]
+        except TypeError as exc:
+            raise NpzFileError(f"not a list of events ({exc})", path, "events") from None
+        return cls(
+            t=t, position=data["position"], velocity=data["velocity"],
+            angular_velocity=data["angular_velocity"], orientation=data["orientation"],
+            names=tuple(str(n) for n in names), events=events,
+            stages=tuple(str(s) for s in stages),
+            stage_seconds=_json(data, "stage_seconds", dict, path),
+            settings=_json(data, "settings", dict, path))
+
+
+def _json(data: dict, name: str, kind: type, path):
+    """Entry ``name``: a 0-d string holding JSON of type ``kind``."""
+    a = data[name]
+    if a.ndim != 0 or a.dtype.kind != "U":
+        raise NpzFileError(f"expected a JSON string, got {a.dtype} {a.shape}", path, name)
+    try:
+        value = json.loads(str(a))
+    except ValueError as exc:
+        raise NpzFileError(f"not valid JSON ({exc})", path, name) from None
+    if not isinstance(value, kind):
+        raise NpzFileError(f"expected a JSON {kind.__name__}, got "
+                           f"{type(value).__name__}", path, name)
+    return value

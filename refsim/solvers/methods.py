@@ -155,7 +155,7 @@ Inconsistent (order 0): one step is ``y0 + (5/3) h f(t0, y0) + O(h^2)``, so as
 ``y' = f``. Its stability function is ``1 + 5/3 z + 5/6 z^2 + 1/4 z^3 +
 1/24 z^4``. Written in terms of ``g = (5/3) f`` it is a 4-stage method with
 weights ``(1/10, 2/5, 2/5, 1/10)`` and ``sum b_i c_i = 3/10``: first order for
-that scaled equation (:func:`refsim.solvers.measure.measure_seed_literal_rk4`
+that scaled equation (:func:`refsim.studies.solvers.measure_seed_literal_rk4`
 measures both).
 """
 

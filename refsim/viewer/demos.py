@@ -5,7 +5,7 @@
   which keeps it spinning, beside the corrected ``rotation = "impulse"``,
   which brings it to rest. Same scene otherwise.
 - :func:`demo_c11`: claim C11, "slow or same-direction bodies
-  interpenetrate": the "stack" case of :func:`refsim.dynamics.measure.c11_scene`
+  interpenetrate": the "stack" case of :func:`refsim.studies.dynamics.c11_scene`
   (an icosahedron dropped onto another resting on the floor) under the
   seed's velocity exchange (``body_response = "seed"``, S8), where the top
   body sinks into the bottom one, beside ``"impulse"``, where it does not.
@@ -75,8 +75,8 @@ def demo_c12(path, *, scene=None, duration: float | None = None,
 def demo_c11(path, *, case: str = C11_CASE, duration: float = C11_SECONDS,
              max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
     """C11: the seed's velocity exchange beside the corrected impulse (side by side)."""
-    from refsim.dynamics.measure import c11_scene
     from refsim.dynamics.simulation import simulate
+    from refsim.studies.dynamics import c11_scene
 
     runs = []
     for response, label in (("seed", "body_response = seed (S8): interpenetrates"),

@@ -56,6 +56,10 @@ SPEEDS = ("0.1x", "0.25x", "0.5x", "1x", "2x", "4x")
 #: Progress is sent to the page at most this often (s).
 PROGRESS_INTERVAL = 0.1
 
+#: How long :meth:`Viewer.close` waits for its threads (s): a chunk of
+#: steps of the slowest bundled scene, and the overlays of a finished run.
+CLOSE_SECONDS = 5.0
+
 #: Particles drawn as points of this size, in metres.
 PARTICLE_SIZE = 0.03
 
@@ -146,6 +150,7 @@ class Viewer:
         self._hit_key: tuple = ()
         self._contact_key = None
         self._stop = threading.Event()
+        self._workers: list[threading.Thread] = []
         name = scene.path.name if scene.path is not None else "scene"
         self.server = start_server(host, port, label=f"refsim: {name}")
         self.url = url(self.server)
@@ -280,6 +285,7 @@ class Viewer:
         self.progress.animated = True
         worker = threading.Thread(target=self._work, args=(generation, scene),
                                   name=f"refsim-run-{generation}", daemon=True)
+        self._workers = [w for w in self._workers if w.is_alive()] + [worker]
         worker.start()
         return generation
 
@@ -523,10 +529,19 @@ class Viewer:
     # -- lifetime -------------------------------------------------------------------
 
     def close(self) -> None:
-        """Stop the player, any run and the server."""
+        """Stop the player, any run and the server.
+
+        A run stops at its next chunk of steps; the threads are given
+        ``CLOSE_SECONDS`` to finish before the server stops, so that none
+        of them sends to a closed page (they are daemons: a straggler never
+        keeps the process alive)."""
         self._stop.set()
         with self._finished:
             self._finished.notify_all()
+        deadline = time.monotonic() + CLOSE_SECONDS
+        for thread in [getattr(self, "_player", None), *self._workers]:
+            if thread is not None and thread is not threading.current_thread():
+                thread.join(max(0.0, deadline - time.monotonic()))
         stop_server(self.server)
 
     def __enter__(self):

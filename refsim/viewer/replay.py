@@ -164,8 +164,10 @@ def _load_trajectory(path: Path):
 
     from refsim.dynamics.trajectory import Trajectory
 
-    if not path.is_file():
+    if not path.exists():
         raise RefsimError(f"{path}: no such file")
+    if not path.is_file():                   # a FIFO or a device is never opened
+        raise RefsimError(f"{path}: not a regular file")
     try:
         with np.load(path) as data:
             keys = set(data.files)
@@ -177,6 +179,8 @@ def _load_trajectory(path: Path):
                           f"(refsim run of a scene with [[body]] tables)")
     try:
         return Trajectory.load(path)
+    except RefsimError:
+        raise                                # it names the file and the entry
     except (KeyError, ValueError, TypeError, json.JSONDecodeError) as exc:
         raise RefsimError(f"{path}: not a refsim trajectory ({exc})") from None
 

@@ -8,7 +8,7 @@ Each benchmark times one update; the pose advances by one frame per call and
 wraps after a full turn (360 frames), so the tracker always sees coherent
 motion. Under ``--benchmark-disable`` (``make test``) each runs once.
 The per-update figures for the report come from
-``refsim.bounds.measure.measure_update_cost``; these are the same calls.
+``refsim.studies.bounds.measure_update_cost``; these are the same calls.
 """
 
 from __future__ import annotations
@@ -20,8 +20,8 @@ from refsim.oracles import OracleUnavailable
 from refsim.oracles.trimesh_adapter import TrimeshOracle
 
 from refsim.bounds.aabb_incremental import numba_available
-from refsim.bounds.measure import make_method, pose_sequence
 from refsim.models import shapes
+from refsim.studies.bounds import make_method, pose_sequence
 from refsim.types import as_pose
 
 FREQUENCIES = {180: 3, 2000: 10, 20480: 32}  # triangles -> geodesic frequency

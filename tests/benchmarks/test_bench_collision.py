@@ -6,7 +6,7 @@ one run; and the boolean query against FCL's.
 
 Read the ratios from the medians of one ``make bench`` run; the same figures,
 with the ratios computed, come from
-``python -m refsim.collision.measure_levels`` (the report's collision
+``python -m refsim.studies.levels`` (the report's collision
 section). No speed is asserted; each benchmark checks its answer instead.
 """
 
@@ -17,7 +17,7 @@ import pytest
 from refsim.oracles.fcl_adapter import FCLOracle
 
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
-from refsim.collision.measure_levels import SPEED_CONFIGURATIONS
+from refsim.studies.levels import SPEED_CONFIGURATIONS
 
 CASES = {f"{c.model}-{c.kind}": c.as_configuration() for c in SPEED_CONFIGURATIONS}
 

@@ -1,15 +1,15 @@
 """Speed of a simulation step against pybullet on the same scene.
 
 1, 10 and 40 unit cubes on a grid in the world cube with seeded random
-velocities (:func:`refsim.dynamics.bounce.cubes_scene`), collision level
+velocities (:func:`refsim.studies.bounce.cubes_scene`), collision level
 "aabb", rotation "off" and "seed". One benchmark round is one
 ``Simulation.step()`` (refsim) or one ``stepSimulation`` plus the drag
 forces (pybullet, :meth:`oracles.pybullet_adapter.PybulletOracle.step`),
 both in the same run; ``make bench`` groups them per scene, so the two
 medians side by side give the ratio. The issue's target is refsim at most
 2x pybullet at 40 bodies; these benchmarks measure it and assert no timing.
-``python -m refsim.dynamics.bounce`` (or
-:func:`refsim.dynamics.bounce.measure_step_cost`) prints the ratios.
+``python -m refsim.studies.bounce`` (or
+:func:`refsim.studies.bounce.measure_step_cost`) prints the ratios.
 
 With ``--benchmark-disable`` (``make test``) each function runs one step.
 """
@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.dynamics.bounce import BENCH_COUNTS, BENCH_ROTATIONS, cubes_scene
+from refsim.studies.bounce import BENCH_COUNTS, BENCH_ROTATIONS, cubes_scene
 
 
 @pytest.mark.parametrize("rotation", BENCH_ROTATIONS)

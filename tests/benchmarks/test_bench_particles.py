@@ -2,13 +2,13 @@
 memory, at N = 1e3, 1e5, 1e6, for Euler and RK4.
 
 One benchmark round is one step of the whole system. The streaming baseline
-(``refsim.particles.measure.streaming_step``) is ``x += h v`` done with
+(``refsim.studies.particles.streaming_step``) is ``x += h v`` done with
 numpy's in-place ``multiply(v, h, out=scratch)`` and ``add(x, scratch,
 out=x)`` over the system's own (N, 3) arrays: 5 x 24 N bytes moved, the
 least any step can move. ``make bench`` reports min / median / max per
 group (one group per N); divide N by the time for particle-steps per
 second, and each case also stores that figure in ``extra_info``.
-``refsim.particles.measure.measure_throughput`` gives the same ratio as
+``refsim.studies.particles.measure_throughput`` gives the same ratio as
 numbers for the report. No timing asserts: each benchmark checks the state
 it stepped.
 
@@ -23,8 +23,8 @@ import numpy as np
 import pytest
 
 from refsim.particles.config import ParticleConfig
-from refsim.particles.measure import STREAMING_BYTES_PER_PARTICLE, streaming_step
 from refsim.particles.system import ParticleSystem
+from refsim.studies.particles import STREAMING_BYTES_PER_PARTICLE, streaming_step
 
 COUNTS = (1_000, 100_000, 1_000_000)
 

@@ -3,7 +3,7 @@ readable, numpy batch, numba, and python-fcl (one-face BVH models per pair,
 as ``FCLOracle.triangles_intersect`` builds them). ``make bench`` reports
 min / median / max; divide 2000 by the time for pairs per second. The numba
 kernel is compiled before timing; its compile time is measured separately by
-``refsim.collision.measure.measure_throughput``. No timing asserts: each
+``refsim.studies.triangles.measure_throughput``. No timing asserts: each
 benchmark checks its answers against the readable kernel's.
 """
 

@@ -9,7 +9,6 @@ import pytest
 
 import refsim
 from properties.strategies import midpoint_subdivision
-from refsim.bounds import measure
 from refsim.bounds.aabb_incremental import (
     IncrementalAABB,
     extreme_vertex_python,
@@ -19,6 +18,7 @@ from refsim.bounds.aabb_linear import LinearAABB, aabb_linear
 from refsim.bounds.tracker import make_aabb_tracker
 from refsim.errors import ModelError, RefsimError
 from refsim.models import shapes
+from refsim.studies import bounds as measure
 
 KERNELS = ["python"] + (["numba"] if numba_available() else [])
 needs_numba = pytest.mark.skipif(not numba_available(), reason="numba (extra 'fast') missing")

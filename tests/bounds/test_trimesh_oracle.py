@@ -13,8 +13,8 @@ from refsim.oracles.trimesh_adapter import (
 
 from refsim.bounds.aabb_incremental import IncrementalAABB
 from refsim.bounds.aabb_linear import aabb_linear
-from refsim.bounds.measure import perturbed_sphere
 from refsim.models import shapes
+from refsim.studies.bounds import perturbed_sphere
 from refsim.types import random_rotation
 
 pytestmark = pytest.mark.oracle

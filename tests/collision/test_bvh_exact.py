@@ -74,7 +74,7 @@ def test_candidates_compiled_equal_readable_and_lie_between_exact_and_test2(
 def test_the_node_test_drops_test2_pairs_of_rotated_bodies():
     """With the second body rotated, the oriented node boxes drop pairs that
     test 2's world boxes keep (the separated torus benchmark pose)."""
-    from refsim.collision.measure_levels import SPEED_CONFIGURATIONS
+    from refsim.studies.levels import SPEED_CONFIGURATIONS
 
     config = next(c for c in SPEED_CONFIGURATIONS
                   if c.model == "torus" and c.kind == "separated-boxes-overlap")
@@ -280,7 +280,7 @@ def test_oriented_boxes_prune_the_separated_benchmark_early():
     """The separated sphere benchmark pose: 751 node pairs visited with
     axis-aligned node boxes (commit 762e5f1), 117 with oriented ones here,
     and no candidate pair left for the exact test."""
-    from refsim.collision.measure_levels import SPEED_CONFIGURATIONS
+    from refsim.studies.levels import SPEED_CONFIGURATIONS
     from refsim.types import as_pose
 
     config = next(c for c in SPEED_CONFIGURATIONS

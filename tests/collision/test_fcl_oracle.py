@@ -14,7 +14,10 @@ import numpy as np
 import pytest
 from refsim.oracles.fcl_adapter import FCLOracle
 
-from refsim.collision.measure import (
+from refsim.collision.triangle_batch import triangles_intersect_batch
+from refsim.models.mesh import Mesh
+from refsim.report.sections.collision import ROUNDING_TILT
+from refsim.studies.triangles import (
     NEAR_DEGENERATE_MARGIN,
     classify_disagreement,
     compare_with_oracle,
@@ -22,9 +25,6 @@ from refsim.collision.measure import (
     measure_float_errors,
     near_degenerate_pairs,
 )
-from refsim.collision.triangle_batch import triangles_intersect_batch
-from refsim.models.mesh import Mesh
-from refsim.report.sections.collision import ROUNDING_TILT
 from refsim.types import random_rotation, transform_points
 
 from .test_triangle import CASES, T
@@ -174,7 +174,7 @@ def test_float_tests_are_wrong_only_near_degeneracy(fcl):
 
 
 def test_c4_sweep_over_random_frames(fcl):
-    from refsim.collision.measure import measure_c4_sweep
+    from refsim.studies.triangles import measure_c4_sweep
 
     sweep = measure_c4_sweep(frames=50, oracle=fcl.triangles_intersect)
     for config in sweep.configs:

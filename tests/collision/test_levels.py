@@ -1,13 +1,13 @@
 """The four levels of body-body collision (claim C3) on constructed
 configurations, the oracles' body-level answers classified, and the
-hierarchy benchmark's configurations (refsim.collision.measure_levels).
+hierarchy benchmark's configurations (refsim.studies.levels).
 
 Known answers come from exactly representable geometry: cube.ac is
 [-0.5, 0.5]^3, so a translation by (1, 0, 0) makes two cubes share the face
 x = 0.5 with no rounding anywhere, and (1, 1, 1) makes them share one corner.
 
 Measured (seed 0, 10 random poses per model pair; reproduce with
-``python -m refsim.collision.measure_levels --quick``): zero false negatives
+``python -m refsim.studies.levels --quick``): zero false negatives
 at every level; FCL's face pairs and boolean answers equal refsim's on every
 query; trimesh's CollisionManager differs only by "containment" (a small
 convex body inside a convex one: a solid for trimesh, two surfaces apart for
@@ -24,7 +24,7 @@ from refsim.oracles.trimesh_collision import TrimeshCollisionOracle, float32_pos
 
 import refsim
 from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
-from refsim.collision.measure_levels import (
+from refsim.studies.levels import (
     CONFIGURATIONS,
     SPEED_CONFIGURATIONS,
     BodyOracle,

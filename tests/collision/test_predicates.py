@@ -8,7 +8,6 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from refsim.collision.measure import measure_filter_fallback
 from refsim.collision.predicates import (
     FILTER_MAX_ABS,
     FILTER_MIN_ABS,
@@ -22,6 +21,7 @@ from refsim.collision.predicates import (
     orient3d_float,
 )
 from refsim.errors import StateError
+from refsim.studies.triangles import measure_filter_fallback
 
 
 def _fraction_sign3(a, b, c, d):

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.collision.measure import classify_disagreement, near_degenerate_pairs
 from refsim.collision.sat_exact import triangles_intersect_sat
 from refsim.collision.triangle import triangles_intersect
+from refsim.studies.triangles import classify_disagreement, near_degenerate_pairs
 
 from .test_triangle import CASES, T
 
@@ -52,7 +52,7 @@ def test_a_wrong_refsim_answer_is_classified_as_a_bug(monkeypatch):
     # A clean crossing pair (no exact zero, well conditioned): if refsim
     # answered it wrongly, the ground truth must expose it as "bug" even
     # though no margin heuristic would.
-    import refsim.collision.measure as measure
+    import refsim.studies.triangles as measure
 
     a = [[0.0, 0.0, -1.0], [1.0, 0.1, 1.0], [0.2, 1.0, 1.0]]
     b = [[-1.0, 0.3, 0.0], [2.0, 0.4, 0.1], [0.5, 2.0, -0.1]]

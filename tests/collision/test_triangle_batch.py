@@ -7,10 +7,10 @@ import itertools
 import numpy as np
 import pytest
 
-from refsim.collision.measure import NEAR_DEGENERATE_FAMILIES, near_degenerate_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_batch import certified_batch, triangles_intersect_batch
 from refsim.errors import StateError
+from refsim.studies.triangles import NEAR_DEGENERATE_FAMILIES, near_degenerate_pairs
 
 from .test_triangle import CASES, T
 

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.collision.measure import measure_throughput, near_degenerate_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_batch import triangles_intersect_batch
 from refsim.errors import StateError
+from refsim.studies.triangles import measure_throughput, near_degenerate_pairs
 
 from .test_triangle import CASES, T
 

@@ -8,7 +8,8 @@ import pytest
 from refsim.oracles.pybullet_adapter import PybulletOracle, mass_properties
 
 from refsim.dynamics import analytic
-from refsim.dynamics.bounce import (
+from refsim.scenes.loader import scene_from_dict
+from refsim.studies.bounce import (
     DROP_HEIGHT,
     GRAVITY,
     SPHERE,
@@ -18,7 +19,6 @@ from refsim.dynamics.bounce import (
     read_bounces,
     touch_height,
 )
-from refsim.scenes.loader import scene_from_dict
 
 pytestmark = pytest.mark.oracle
 

@@ -10,10 +10,10 @@ import pytest
 
 import refsim
 from refsim.bundled import scenes_dir
-from refsim.dynamics.measure import REST_SPEED, REST_SPIN
 from refsim.dynamics.simulation import MAX_FRAMES, Simulation, default_every, simulate
 from refsim.errors import DivergenceError, StateError
 from refsim.scenes.loader import scene_from_dict
+from refsim.studies.dynamics import REST_SPEED, REST_SPIN
 
 #: Exact rotations composed 10 000 times: rounding grows like sqrt(steps) ulps,
 #: ~1e-14; 1e-10 leaves room and still catches any drift (the seed's Euler

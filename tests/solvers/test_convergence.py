@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.solvers.measure import (
+from refsim.solvers.problems import harmonic_oscillator, kepler_orbit
+from refsim.studies.solvers import (
     ERROR_FLOOR_REL,
     fit_order,
     measure_convergence,
@@ -13,7 +14,6 @@ from refsim.solvers.measure import (
     reference_at_t1,
     standard_problems,
 )
-from refsim.solvers.problems import harmonic_oscillator, kepler_orbit
 
 #: The orders derived from the tableaux (test_tableaux.DERIVED_ORDER).
 DERIVED_ORDER = {"euler": 1, "averaged-euler": 2, "backwards-euler": 1, "midpoint": 2, "rk4": 4}

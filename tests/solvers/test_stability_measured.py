@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from refsim.solvers.measure import (
+from refsim.studies.solvers import (
     energy_per_period,
     measure_oscillator_energy,
     measure_stability,

@@ -6,13 +6,13 @@ import math
 
 import pytest
 
-from refsim.solvers.measure import (
+from refsim.solvers.problems import kepler_orbit
+from refsim.studies.solvers import (
     WorkPoint,
     cost_for_error,
     error_at_cost,
     measure_work_precision,
 )
-from refsim.solvers.problems import kepler_orbit
 
 
 @pytest.fixture(scope="module")

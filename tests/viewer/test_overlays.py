@@ -11,7 +11,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import refsim
-from refsim.dynamics.measure import c11_scene
+from refsim.studies.dynamics import c11_scene
 from refsim.viewer import overlays
 from refsim.viewer.runs import Cancelled, run_bodies, run_particles
 from refsim.viewer.server import wxyz

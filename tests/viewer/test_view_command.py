@@ -200,7 +200,7 @@ def test_particles_are_a_point_cloud():
 
 
 def test_overlays_at_a_contact_and_at_a_wall_hit():
-    from refsim.dynamics.measure import c11_scene
+    from refsim.studies.dynamics import c11_scene
 
     with Viewer(c11_scene("stack", "seed", duration=1.2), play=False, every=10) as v:
         run = v.wait(timeout=START_TIMEOUT)

@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from refsim.bounds import measure
 from refsim.report.charts import Series, line_chart
 from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Verdict
+from refsim.studies import bounds as measure
 
 STYLES = {"scan-numpy": "s--", "scan-numba": "s-", "incremental-python": "o--",
           "incremental-numba": "o-"}
-C1_COMMAND = "python -m refsim.bounds.measure c1"
-C2_COMMAND = "python -m refsim.bounds.measure c2"
+C1_COMMAND = "python -m refsim.studies.bounds c1"
+C2_COMMAND = "python -m refsim.studies.bounds c2"
 
 
 def build(ctx) -> Section:
@@ -154,7 +154,7 @@ def _agreement_table(agreement) -> Table:
                 f"Reproduce: {AGREEMENT_COMMAND}")
 
 
-AGREEMENT_COMMAND = ("python -c \"from refsim.bounds.measure import "
+AGREEMENT_COMMAND = ("python -c \"from refsim.studies.bounds import "
                      "measure_bounds_agreement as m; [print(r) for r in m()]\"")
 
 

@@ -1,8 +1,8 @@
 """Report section: body-body collision (seed S4; claims C3, C4).
 
-Arranges the numbers of :mod:`refsim.collision.measure_levels` (the four
+Arranges the numbers of :mod:`refsim.studies.levels` (the four
 levels, the body-level oracles, the hierarchy against FCL) and of
-:mod:`refsim.collision.measure` (the triangle test against FCL, claim C4).
+:mod:`refsim.studies.triangles` (the triangle test against FCL, claim C4).
 Nothing is computed here beyond picking and formatting those numbers.
 """
 
@@ -14,8 +14,8 @@ from dataclasses import asdict
 from refsim.report.charts import Series, line_chart
 from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Verdict
 
-LEVELS_COMMAND = "python -m refsim.collision.measure_levels"
-C4_COMMAND = "python -m refsim.collision.measure"
+LEVELS_COMMAND = "python -m refsim.studies.levels"
+C4_COMMAND = "python -m refsim.studies.triangles"
 
 #: (quick, full) sizes of each measurement. Quick keeps the section within
 #: ~15 s (after numba's first compile); full within ~2 min.
@@ -48,7 +48,7 @@ def _yes(value: bool) -> str:
 def _oracles():
     """(body oracles, fcl pairs, fcl adapter, fcl triangle test) from what is
     installed."""
-    from refsim.collision.measure_levels import default_body_oracles
+    from refsim.studies.levels import default_body_oracles
 
     body, fcl_pairs, fcl = default_body_oracles()
     return body, fcl_pairs, fcl, (None if fcl is None else fcl.triangles_intersect)
@@ -57,8 +57,9 @@ def _oracles():
 def build(ctx) -> Section:
     import numpy as np
 
-    from refsim.collision import measure, measure_levels
     from refsim.collision.bodies import LEVELS
+    from refsim.studies import levels as measure_levels
+    from refsim.studies import triangles as measure
 
     seed = ctx.seed
     body_oracles, fcl_pairs, fcl, fcl_triangles = _oracles()
@@ -149,7 +150,7 @@ def build(ctx) -> Section:
         id="collision-fcl-pairs", title="Exact triangle test against python-fcl, by class",
         columns=("pairs", "n", "agree", *measure.DISAGREEMENT_KINDS),
         rows=tuple(pair_rows),
-        caption=("Every disagreement classified (refsim.collision.measure."
+        caption=("Every disagreement classified (refsim.studies.triangles."
                  "classify_disagreement): coplanar, touching (the contact rests on an exact "
                  "zero), tolerance (decision margin <= "
                  f"{measure.NEAR_DEGENERATE_MARGIN:g}), bug. For posed meshes n is the "
@@ -217,7 +218,7 @@ def build(ctx) -> Section:
                                       "the exact one",
         svg=line_chart(series, xlabel="angle between the planes (rad, log scale)",
                        ylabel=f"wrong answers (of {sweep.frames} frames)", logx=True),
-        caption=("The C4 family (refsim.collision.measure.C4_CONFIGS) in "
+        caption=("The C4 family (refsim.studies.triangles.C4_CONFIGS) in "
                  f"{sweep.frames} seeded random rigid frames per angle: how often the same "
                  "test in plain floats, and FCL, answer differently from refsim's exact test "
                  f"on the same float coordinates. Reproduce: {C4_COMMAND}")))
@@ -403,7 +404,8 @@ KIND_MEANING = {
 
 def _divergences(triangle_rows, agreement) -> list[Divergence]:
     """One catalogue entry per class of oracle disagreement that occurred."""
-    from refsim.collision import measure, measure_levels
+    from refsim.studies import levels as measure_levels
+    from refsim.studies import triangles as measure
 
     entries = []
     for kind in measure.DISAGREEMENT_KINDS:

@@ -1,9 +1,9 @@
 """Report section: rigid-body dynamics (S5, S7, S8, S9), claims C11 and C12.
 
 Every number comes from a ``measure_*`` function: the bounce studies of
-:mod:`refsim.dynamics.bounce` (refsim against the analytic answers of
+:mod:`refsim.studies.bounce` (refsim against the analytic answers of
 :mod:`refsim.dynamics.analytic` and the pybullet oracle), and the C11/C12
-measurements of :mod:`refsim.dynamics.measure`. This module only arranges
+measurements of :mod:`refsim.studies.dynamics`. This module only arranges
 them (STYLE.md, rule 9).
 
 ``ctx.quick`` runs fewer restitutions, step sizes and solvers, shorter C11
@@ -26,8 +26,8 @@ from refsim.report.charts import Series, line_chart
 from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Verdict
 
 CHART_SIZE = (7.0, 4.0)
-CMD_BOUNCE = "python -m refsim.dynamics.bounce"
-CMD_MEASURE = "python -m refsim.dynamics.measure"
+CMD_BOUNCE = "python -m refsim.studies.bounce"
+CMD_MEASURE = "python -m refsim.studies.dynamics"
 #: Errors below this are rounding (RK4 integrates the parabola of free
 #: flight exactly; refsim's wall response is then exact too): the cost chart
 #: draws them at this floor so that a log axis can show them.
@@ -77,9 +77,9 @@ def _jsonable(obj):
 
 
 def build(ctx) -> Section:
-    from refsim.dynamics import bounce
-    from refsim.dynamics import measure as dyn_measure
     from refsim.dynamics.choices import choices
+    from refsim.studies import bounce
+    from refsim.studies import dynamics as dyn_measure
 
     quick = ctx.quick
     say = ctx.progress.announce
@@ -390,7 +390,7 @@ def build(ctx) -> Section:
 #: time per step at the largest body count.
 STEP_COST_TARGET = 2.0
 #: The C11 cases where bodies meet slowly or moving the same way (the claim's
-#: "slow or same-direction"; refsim.dynamics.measure.c11_scene): the chase,
+#: "slow or same-direction"; refsim.studies.dynamics.c11_scene): the chase,
 #: the slow head-on approach and the body dropped onto another. "glancing"
 #: (an offset pass at 1 m/s) is neither.
 C11_CLAIM_CASES = ("chase", "slow", "stack")

@@ -1,13 +1,13 @@
 """Report section: the ODE solvers (S6) and the particle system (S10).
 
 Claims C5-C10. Every number comes from a ``measure_*`` function of
-:mod:`refsim.solvers.measure` or :mod:`refsim.particles.measure` (or from the
+:mod:`refsim.studies.solvers` or :mod:`refsim.studies.particles` (or from the
 stability polynomial of :mod:`refsim.solvers.stability`); this module only
 arranges them into charts, tables and verdicts (STYLE.md, rule 9).
 
 The full report runs each measurement with the parameters of its command
-line (``python -m refsim.solvers.measure ...``,
-``python -m refsim.particles.measure ...``), so each table can be checked
+line (``python -m refsim.studies.solvers ...``,
+``python -m refsim.studies.particles ...``), so each table can be checked
 with the command named under it. ``ctx.quick`` drops the Kepler problem from
 the order study, caps step counts and shrinks the particle systems: the
 section then takes seconds, not a minute, and its numbers differ from the
@@ -131,8 +131,8 @@ PROBLEM_TITLES = {
     "particles": "20 particles, quadratic drag, no walls",
 }
 
-CMD_SOLVERS = "python -m refsim.solvers.measure"
-CMD_PARTICLES = "python -m refsim.particles.measure"
+CMD_SOLVERS = "python -m refsim.studies.solvers"
+CMD_PARTICLES = "python -m refsim.studies.particles"
 
 
 # -- formatting helpers (no arithmetic on the measurements) --------------------------
@@ -183,9 +183,9 @@ def _evaluations(x: float) -> str:
 
 def _measure(ctx) -> dict:
     """Run every measurement of the section; returns the raw objects."""
-    from refsim.particles import measure as pm
-    from refsim.solvers import measure as sm
     from refsim.solvers.problems import exponential_decay, harmonic_oscillator, kepler_orbit
+    from refsim.studies import particles as pm
+    from refsim.studies import solvers as sm
 
     quick = ctx.quick
     say = ctx.progress.announce
@@ -276,11 +276,11 @@ def _measure(ctx) -> dict:
 
 
 def _quick_choice(m) -> list:
-    """:class:`refsim.particles.measure.SolverChoice` rows from the quick
+    """:class:`refsim.studies.particles.SolverChoice` rows from the quick
     run's measurements, by the helpers measure_solver_choice itself uses."""
-    from refsim.particles.measure import SolverChoice
-    from refsim.solvers.measure import cost_for_error, error_at_cost
     from refsim.solvers.methods import SOLVERS
+    from refsim.studies.particles import SolverChoice
+    from refsim.studies.solvers import cost_for_error, error_at_cost
 
     limits = {s.method: s for s in m["stability"]}
     hop = {j.method: j.max_height_gh2 for j in m["jitter"]
@@ -296,8 +296,8 @@ def _quick_choice(m) -> list:
 
 
 def _convergence(m):
-    from refsim.solvers.measure import ERROR_CEILING_REL, ERROR_FLOOR_REL, FIT_POINTS
     from refsim.solvers.methods import SOLVERS
+    from refsim.studies.solvers import ERROR_CEILING_REL, ERROR_FLOOR_REL, FIT_POINTS
 
     problems = list(dict.fromkeys(p for p, _ in m["orders"]))
     figures = []

@@ -34,7 +34,7 @@ refined by the parabola through it and its two neighbours (so that coarse
 steps do not read a low apex just because no frame fell on it). The apex
 ratio over K bounces is the geometric mean ``(h_K / h_0)^(1/K)``.
 
-Run ``python -m refsim.dynamics.bounce`` to print every figure
+Run ``python -m refsim.studies.bounce`` to print every figure
 (``--quick`` for the short version the quick report uses).
 
 Cost: each study is a few simulations of 10^3 - 10^4 steps.
@@ -731,7 +731,7 @@ def _fmt(x: float, digits: int = 5) -> str:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(prog="python -m refsim.dynamics.bounce",
+    parser = argparse.ArgumentParser(prog="python -m refsim.studies.bounce",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer step sizes and solvers")
     parser.add_argument("--no-pybullet", action="store_true", help="refsim and analytic only")

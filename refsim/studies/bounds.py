@@ -457,10 +457,10 @@ def _print_errors(results) -> None:
 
 
 def main(argv=None) -> None:
-    """``python -m refsim.bounds.measure {c1,c2,compile}``: print one figure."""
+    """``python -m refsim.studies.bounds {c1,c2,compile}``: print one figure."""
     import argparse
 
-    parser = argparse.ArgumentParser(prog="python -m refsim.bounds.measure")
+    parser = argparse.ArgumentParser(prog="python -m refsim.studies.bounds")
     parser.add_argument("figure", choices=["c1", "c2", "compile"])
     parser.add_argument("--frames", type=int, default=None)
     parser.add_argument("--repeats", type=int, default=5)

@@ -568,7 +568,7 @@ def measure_throughput(n: int = 20_000, seed: int = 0,
 
 
 def main(argv=None) -> None:
-    """Print every figure of this module: ``python -m refsim.collision.measure``.
+    """Print every figure of this module: ``python -m refsim.studies.triangles``.
 
     The oracle is python-fcl when it is installed (``--no-oracle`` to skip).
     """

@@ -36,8 +36,8 @@ import numpy as np
 
 from refsim.particles.config import ParticleConfig
 from refsim.particles.system import ParticleSystem, particle_rhs
-from refsim.solvers.measure import WorkPoint, fit_order
 from refsim.solvers.methods import SOLVERS
+from refsim.studies.solvers import WorkPoint, fit_order
 
 # --------------------------------------------------------------------------
 # Resting contact jitter (C6, C7)
@@ -369,7 +369,7 @@ def measure_particle_work_precision(config: ParticleConfig | None = None, t1: fl
 def observed_orders(points: list[WorkPoint], floor: float = 1e-10,
                     ceiling: float = 1e-1) -> dict[str, float]:
     """Observed order per fixed-step method from work-precision points (the
-    slope of ``log error`` on ``log h``; see refsim.solvers.measure.fit_order).
+    slope of ``log error`` on ``log h``; see refsim.studies.solvers.fit_order).
     ``floor``/``ceiling`` in the points' error unit (m)."""
     out = {}
     for method in dict.fromkeys(p.method for p in points):
@@ -600,8 +600,8 @@ def measure_solver_choice(target_free: float = 1e-4, budget_walls: float = 512,
     """One :class:`SolverChoice` per solver, from the particle work-precision
     runs (``count`` particles, 1 s, with and without walls), the stability
     polynomials and the resting-contact jitter."""
-    from refsim.solvers.measure import cost_for_error, error_at_cost
     from refsim.solvers.stability import imaginary_axis_limit, real_axis_limit
+    from refsim.studies.solvers import cost_for_error, error_at_cost
 
     free = measure_particle_work_precision(particle_test_config(count=count), methods=SOLVERS,
                                            steps=tuple(8 * 2**k for k in range(12)),
@@ -619,14 +619,14 @@ def measure_solver_choice(target_free: float = 1e-4, budget_walls: float = 512,
 
 
 # --------------------------------------------------------------------------
-# Printing the figures: python -m refsim.particles.measure {jitter,...}
+# Printing the figures: python -m refsim.studies.particles {jitter,...}
 # --------------------------------------------------------------------------
 
 def main(argv=None) -> None:
     """Print one table of figures; ``which`` names it."""
     import argparse
 
-    parser = argparse.ArgumentParser(prog="python -m refsim.particles.measure")
+    parser = argparse.ArgumentParser(prog="python -m refsim.studies.particles")
     parser.add_argument("which", choices=["jitter", "drag", "work-precision",
                                           "work-precision-walls", "frame", "choice",
                                           "throughput", "memory"])

@@ -2,7 +2,7 @@
 
 What: the numbers behind claims C6, C7, C9 and C10 for the solvers on their
 own (the particle-system measurements, C5 and C8, are in
-:mod:`refsim.particles.measure`). Every function returns plain numbers or
+:mod:`refsim.studies.particles`). Every function returns plain numbers or
 frozen dataclasses; the tests gate on them and the report draws them.
 
 - :func:`measure_convergence` / :func:`measure_orders`: error at ``t1``
@@ -539,14 +539,14 @@ def error_at_cost(points: list[WorkPoint], method: str, budget: float,
 
 
 # --------------------------------------------------------------------------
-# Printing the figures: python -m refsim.solvers.measure {orders,...}
+# Printing the figures: python -m refsim.studies.solvers {orders,...}
 # --------------------------------------------------------------------------
 
 def main(argv=None) -> None:
     """Print one table of figures; ``which`` names it."""
     import argparse
 
-    parser = argparse.ArgumentParser(prog="python -m refsim.solvers.measure")
+    parser = argparse.ArgumentParser(prog="python -m refsim.studies.solvers")
     parser.add_argument("which", choices=["orders", "seed-literal", "stability", "energy",
                                           "work-precision"])
     which = parser.parse_args(argv).which

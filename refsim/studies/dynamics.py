@@ -16,7 +16,7 @@ energy of a bouncing body, the seed's model against the corrected one.
   spinning cube, seed against corrected.
 
 Every function returns frozen dataclasses of numbers; the report draws them
-and computes nothing itself. ``python -m refsim.dynamics.measure`` prints them.
+and computes nothing itself. ``python -m refsim.studies.dynamics`` prints them.
 """
 
 from __future__ import annotations

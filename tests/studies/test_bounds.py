@@ -1,4 +1,4 @@
-"""The C1/C2 measurements (refsim.bounds.measure): shapes of the results and
+"""The C1/C2 measurements (refsim.studies.bounds): shapes of the results and
 the facts the report states. Timings are returned, never asserted."""
 
 from __future__ import annotations
@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.bounds import measure
 from refsim.bounds.aabb_incremental import numba_available
 from refsim.models import shapes
+from refsim.studies import bounds as measure
 
 needs_numba = pytest.mark.skipif(not numba_available(), reason="numba (extra 'fast') missing")
 

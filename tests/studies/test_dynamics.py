@@ -5,7 +5,7 @@ from __future__ import annotations
 import pytest
 
 from refsim.dynamics.choices import choices
-from refsim.dynamics.measure import (
+from refsim.studies.dynamics import (
     REST_SPEED,
     measure_energy,
     measure_interpenetration,

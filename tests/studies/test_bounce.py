@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from refsim.dynamics import analytic
-from refsim.dynamics.bounce import (
+from refsim.studies.bounce import (
     APEX_RATIO_TARGET,
     BOUNCES,
     CUBE,

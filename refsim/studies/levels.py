@@ -4,7 +4,7 @@ the triangle hierarchy against FCL (seed S4).
 
 What: ``measure_*`` functions return frozen dataclasses of numbers that the
 tests gate on and the report draws; nothing here prints or plots (the
-``main`` entry point prints them: ``python -m refsim.collision.measure_levels``).
+``main`` entry point prints them: ``python -m refsim.studies.levels``).
 
 - :func:`measure_levels` (C3, "3 levels of accuracy [...] to trade accuracy
   for speed"): every level of :func:`refsim.collision.bodies.bodies_collide`
@@ -18,7 +18,7 @@ tests gate on and the report draws; nothing here prints or plots (the
   intersecting face pairs, FCL's boolean query and trimesh's
   ``CollisionManager``, every disagreement classified
   (:func:`classify_body_disagreement`; pairs by
-  :func:`refsim.collision.measure.classify_disagreement`).
+  :func:`refsim.studies.triangles.classify_disagreement`).
 - :func:`measure_hierarchy_speed`: the 2k-triangle sphere and torus pairs in
   three configurations (:data:`SPEED_CONFIGURATIONS`): all intersecting pairs
   by the hierarchy, by the seed's path and by FCL, and the boolean query
@@ -47,8 +47,8 @@ import numpy as np
 from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
 from refsim.collision.bvh import default_kernel
-from refsim.collision.measure import DISAGREEMENT_KINDS, _strict_crossing, classify_disagreement
 from refsim.collision.spheres import bounding_sphere
+from refsim.studies.triangles import DISAGREEMENT_KINDS, _strict_crossing, classify_disagreement
 from refsim.types import Pose, random_rotation, rotation_about_axis
 
 # --------------------------------------------------------------------------
@@ -606,7 +606,7 @@ def measure_body_oracles(body_oracles: tuple[BodyOracle, ...] = (),
     ``bodies_collide(level="exact")``. ``fcl_pairs(mesh_a, pose_a, mesh_b,
     pose_b) -> (k, 2)`` face pairs, compared with ``intersecting_pairs``;
     each pair in one set only is classified by
-    :func:`refsim.collision.measure.classify_disagreement` on refsim's world
+    :func:`refsim.studies.triangles.classify_disagreement` on refsim's world
     triangles.
     """
     kernel = kernel or default_kernel()
@@ -887,7 +887,7 @@ def _us(seconds) -> str:
 
 
 def main(argv=None) -> None:
-    """Print every figure of this module: ``python -m refsim.collision.measure_levels``
+    """Print every figure of this module: ``python -m refsim.studies.levels``
     (``--quick`` for fewer repeats and poses, ``--no-compile`` to skip the
     compile-cost subprocesses)."""
     import argparse

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from refsim.particles.config import ParticleConfig
-from refsim.particles.measure import (
+from refsim.solvers.methods import SOLVERS
+from refsim.studies.particles import (
     euler_jitter_estimate,
     exact_integrator_hop,
     measure_drag_models,
@@ -18,8 +19,7 @@ from refsim.particles.measure import (
     particle_test_config,
     wall_reference,
 )
-from refsim.solvers.measure import error_at_cost
-from refsim.solvers.methods import SOLVERS
+from refsim.studies.solvers import error_at_cost
 
 # -- C6, C7: resting contact ---------------------------------------------------
 

@@ -1,0 +1,70 @@
+"""SIGTERM and SIGHUP as exceptions, so that they unwind like Ctrl-C.
+
+Python turns SIGINT into ``KeyboardInterrupt``, which unwinds the stack and
+runs every ``finally`` and ``except BaseException`` on the way: the
+temporary and spill files of :mod:`refsim.io` and :mod:`refsim.frames` are
+removed. SIGTERM (``kill``, a batch system's time limit) and SIGHUP (a
+closed terminal) kill the process by default without any of that, leaving
+the hidden files behind. :func:`signals_raise` installs handlers that raise
+:class:`Interrupted`, a ``KeyboardInterrupt``, so the same clean-up runs;
+the command line then exits with status 128 + the signal's number, as a
+shell reports a process killed by it.
+
+After the first signal both handlers ignore further ones, so a second
+``kill`` cannot cut the clean-up short (SIGKILL still ends the process).
+
+Only the command line installs these (an application that imports refsim
+keeps its own handlers). A signal that is ignored when they are installed
+stays ignored (``nohup refsim run ...`` survives a closed terminal). Python
+runs signal handlers in the main thread only; elsewhere this is a no-op.
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+#: The signals :func:`signals_raise` turns into :class:`Interrupted`.
+RAISED = tuple(getattr(signal, name) for name in ("SIGTERM", "SIGHUP")
+               if hasattr(signal, name))                    # no SIGHUP on Windows
+
+
+class Interrupted(KeyboardInterrupt):
+    """The process received ``signum`` (SIGTERM or SIGHUP) and is unwinding."""
+
+    def __init__(self, signum: int):
+        self.signum = int(signum)
+        self.name = signal.Signals(signum).name
+        super().__init__(f"interrupted ({self.name})")
+
+    @property
+    def exit_status(self) -> int:
+        """128 + the signal's number (the shell's convention)."""
+        return 128 + self.signum
+
+
+def _raise(signum, frame):
+    for s in RAISED:
+        signal.signal(s, signal.SIG_IGN)          # once: let the clean-up finish
+    raise Interrupted(signum)
+
+
+@contextmanager
+def signals_raise() -> Iterator[None]:
+    """Within the body, SIGTERM and SIGHUP raise :class:`Interrupted`; the
+    previous handlers are restored afterwards. Call from the main thread."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {s: signal.getsignal(s) for s in RAISED}
+    for s, handler in previous.items():
+        if handler is not signal.SIG_IGN:
+            signal.signal(s, _raise)
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            # None: a handler installed outside Python, not restorable from here
+            signal.signal(s, signal.SIG_DFL if handler is None else handler)

@@ -1,0 +1,23 @@
+"""Studies: the measurements behind the seed's claims and the report's charts.
+
+A study receives the engines it compares (refsim's own algorithms, or the
+adapters of :mod:`refsim.oracles`) and its settings as arguments, and returns
+plain result records: numbers, counts and classified disagreements, with
+timings marked as timings. It prints nothing and decides no verdict: the
+claims (:mod:`refsim.claims`) judge the records, and the views (the report,
+the command line) show them. Studies import algorithms and engines, never the
+report, the claims or a particular oracle (DESIGN.md, Architecture).
+
+- ``bounds``: box update cost and visits, the incremental box's error,
+  agreement with an AABB oracle (C1, C2);
+- ``triangles``: the exact triangle test against a float oracle,
+  near-parallel planes (C4);
+- ``levels``: the four collision levels, agreement with body oracles, the
+  hierarchy's speed (C3);
+- ``solvers``: orders, stability limits, work against precision (C5, C7, C10);
+- ``particles``: resting jitter, drag models, particle work-precision,
+  throughput (C5, C6, C8, C9);
+- ``bounce``: wall bounces against analytic answers and a rigid-body oracle;
+- ``dynamics``: spin that never damps, interpenetration, energy (C11, C12);
+- ``models``: model facts against a mesh oracle.
+"""

@@ -1,0 +1,180 @@
+"""SIGTERM and SIGHUP unwind ``refsim run`` like Ctrl-C: exit status 128 +
+the signal, one line on stderr, no temporary or spill file left, an old
+output file untouched. Checked on a real process, signalled while it writes
+its .npz and while it runs."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from refsim.signals import Interrupted, signals_raise
+
+#: Longest wait for the child to reach the state the test signals it in:
+#: far beyond the few seconds it takes, so only a hang fails the test.
+DEADLINE_SECONDS = 120.0
+
+#: Poll interval while waiting for the child (polling, not synchronisation:
+#: the test acts on what it sees, whatever the interval).
+POLL_SECONDS = 0.01
+
+SCENE = """
+[world]
+half_size = 1.0
+
+[integration]
+solver = "rk4"
+step = 0.01
+duration = {duration}
+
+[particles]
+count = 12
+seed = 5
+box_lo = [-0.5, -0.5, -0.5]
+box_hi = [0.5, 0.5, 0.5]
+"""
+
+#: A child that runs ``refsim run`` and stops inside the .npz assembly, at
+#: the header of its third entry (``t`` and ``step`` written, ``position``
+#: begun): it touches the marker file and waits for a signal there.
+CHILD = """
+import signal, sys
+from pathlib import Path
+
+import refsim.npz
+from refsim.cli import main
+
+marker = Path(sys.argv[1])
+real = refsim.npz.npy_header
+calls = []
+
+
+def header_then_wait(shape, dtype):
+    calls.append(shape)
+    if len(calls) == 3:
+        marker.touch()
+        while True:
+            signal.pause()
+    return real(shape, dtype)
+
+
+refsim.npz.npy_header = header_then_wait
+sys.exit(main(sys.argv[2:]))
+"""
+
+EXPECTED = {
+    signal.SIGTERM: (128 + 15, "refsim: interrupted (SIGTERM)\n"),
+    signal.SIGHUP: (128 + 1, "refsim: interrupted (SIGHUP)\n"),
+    signal.SIGINT: (130, "refsim: interrupted\n"),       # Python's KeyboardInterrupt
+}
+
+
+def _wait_for(child: subprocess.Popen, ready) -> None:
+    """Poll until ``ready()``; fail if the child exits first or time runs out."""
+    deadline = time.monotonic() + DEADLINE_SECONDS
+    while not ready():
+        if child.poll() is not None:
+            out, err = child.communicate()
+            pytest.fail(f"child exited with {child.returncode} before the signal:\n{err}")
+        if time.monotonic() > deadline:
+            child.kill()
+            pytest.fail("child did not reach the point to signal it at")
+        time.sleep(POLL_SECONDS)
+
+
+def _setup(tmp_path, duration: float):
+    work = tmp_path / "work"
+    work.mkdir()
+    scene = work / "scene.toml"
+    scene.write_text(SCENE.format(duration=duration))
+    out = work / "out.npz"
+    out.write_bytes(b"the old output")
+    return work, scene, out
+
+
+def _signal_and_check(child, signum, work, out):
+    child.send_signal(signum)
+    _, err = child.communicate(timeout=DEADLINE_SECONDS)
+    status, line = EXPECTED[signum]
+    assert (child.returncode, err) == (status, line)
+    assert sorted(p.name for p in work.iterdir()) == ["out.npz", "scene.toml"]
+    assert out.read_bytes() == b"the old output"
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP, signal.SIGINT],
+                         ids=["SIGTERM", "SIGHUP", "SIGINT"])
+def test_a_signal_during_the_write_leaves_no_file(tmp_path, signum):
+    work, scene, out = _setup(tmp_path, duration=1.0)
+    child_script = tmp_path / "child.py"
+    child_script.write_text(CHILD)
+    marker = tmp_path / "assembling"
+    child = subprocess.Popen(
+        [sys.executable, str(child_script), str(marker), "run", str(scene), "-o", str(out),
+         "--every", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _wait_for(child, marker.exists)
+    # mid-write: the temporary .npz and the four spill files are there
+    hidden = sorted(p.name for p in work.iterdir() if p.name.startswith(".out.npz."))
+    assert len(hidden) == 5
+    assert sum(n.endswith(".tmp") for n in hidden) == 1
+    assert sum(n.endswith(".spill") for n in hidden) == 4
+    _signal_and_check(child, signum, work, out)
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP], ids=["SIGTERM", "SIGHUP"])
+def test_a_signal_during_a_long_run_leaves_no_file(tmp_path, signum):
+    # 10^7 steps of 12 particles (minutes): signalled once its frames spill
+    work, scene, out = _setup(tmp_path, duration=1e5)
+    child = subprocess.Popen(
+        [sys.executable, "-m", "refsim.cli", "run", str(scene), "-o", str(out),
+         "--every", "1000000"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    def spilling():
+        return sum(p.name.endswith(".spill") for p in work.iterdir()) == 4
+
+    _wait_for(child, spilling)
+    _signal_and_check(child, signum, work, out)
+
+
+# -- in this process -----------------------------------------------------------------
+
+
+def test_signals_raise_turns_sigterm_into_interrupted():
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(Interrupted) as info:
+        with signals_raise():
+            signal.raise_signal(signal.SIGTERM)   # the handler runs before this returns
+    assert isinstance(info.value, KeyboardInterrupt)
+    assert (info.value.signum, info.value.name, info.value.exit_status) == \
+        (signal.SIGTERM, "SIGTERM", 143)
+    assert str(info.value) == "interrupted (SIGTERM)"
+    assert signal.getsignal(signal.SIGTERM) is before
+
+
+def test_an_ignored_signal_stays_ignored():
+    # nohup: SIGHUP ignored before, so it is not turned into an exception
+    previous = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        with signals_raise():
+            assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+            assert signal.getsignal(signal.SIGTERM) is not signal.SIG_IGN
+        assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGHUP, previous)
+
+
+def test_after_the_first_signal_the_next_ones_are_ignored():
+    # so that a second kill cannot cut the clean-up short
+    with pytest.raises(Interrupted):
+        with signals_raise():
+            try:
+                signal.raise_signal(signal.SIGHUP)
+            finally:
+                assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN
+                assert signal.getsignal(signal.SIGHUP) is signal.SIG_IGN
+                signal.raise_signal(signal.SIGTERM)   # ignored: the finally completes
+                finished = True
+    assert finished
