@@ -52,6 +52,7 @@ _EXPORTS = {
     "simulate": "refsim.dynamics.simulation",
     "Simulation": "refsim.dynamics.simulation",
     "Trajectory": "refsim.dynamics.trajectory",
+    "view": "refsim.viewer.live",
 }
 
 __all__ = sorted(_EXPORTS)

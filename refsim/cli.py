@@ -4,6 +4,9 @@
     refsim run SCENE [-o OUT.npz] [--every K]
                                        simulate a scene (bodies or particles), write frames
     refsim report [--quick] [-o DIR]   write the HTML accuracy report
+    refsim view SCENE [--port N]       the scene in the browser, re-run from its controls
+    refsim replay RUN.npz ... -o OUT.html
+                                       recorded runs as one standalone replay page
 
 A user's mistake (a missing or malformed file, a bad scene) prints one line
 naming the file and the line or key, and exits with status 2; ``--debug``
@@ -191,6 +194,66 @@ def _report(args) -> int:
     return 0
 
 
+def _view(args) -> int:
+    from refsim.scenes.loader import load_scene
+    from refsim.viewer.live import serve
+    from refsim.viewer.server import check_port, require_viser
+
+    require_viser()
+    check_port(args.port)
+    serve(load_scene(args.scene), host=args.host, port=args.port)   # until Ctrl-C
+    return 0
+
+
+def _replay(args) -> int:
+    from refsim.viewer.replay import load_runs, write_replay
+
+    runs = load_runs(args.runs, scenes=args.scene or ())
+    info = write_replay(runs, args.output, overlay=args.overlay, max_bytes=args.max_bytes,
+                        boxes=args.boxes)
+    print(info.summary())
+    return 0
+
+
+def _add_viewer_commands(commands) -> None:
+    """``refsim view`` and ``refsim replay`` (refsim.viewer; the ``viewer`` extra)."""
+    from refsim.viewer import REPLAY_MAX_BYTES as DEFAULT_MAX_BYTES
+
+    view = commands.add_parser(
+        "view", help="show a scene in the browser, with controls that re-run it",
+        description="Serve SCENE in the browser (viser): the bodies in the world cube, "
+                    "playback, the scene's options as controls that re-run the simulation, "
+                    "boxes, contacts, wall hits and energy. Prints the address; Ctrl-C "
+                    "stops. Needs the viewer extra: pip install 'refsim[viewer]'.")
+    view.add_argument("scene", metavar="SCENE", help="a scene file (TOML)")
+    view.add_argument("--port", type=int, default=8080, metavar="N",
+                      help="port to serve on (default 8080; 0 for any free port)")
+    view.add_argument("--host", default="127.0.0.1", metavar="ADDRESS",
+                      help="address to bind (default 127.0.0.1, this machine only)")
+    view.set_defaults(run=_view)
+
+    replay = commands.add_parser(
+        "replay", help="write recorded runs (.npz) as one standalone replay page",
+        description="Write the runs (refsim run SCENE -o RUN.npz) side by side, or "
+                    "overlaid, as one HTML file that plays offline (play/pause, scrub, "
+                    "speed). Each run's meshes come from its scene file: --scene, or the "
+                    "scene the run records. Needs the viewer extra.")
+    replay.add_argument("runs", nargs="+", metavar="RUN.npz", help="recorded trajectories")
+    replay.add_argument("-o", "--output", required=True, metavar="OUT.html",
+                        help="the replay page to write")
+    replay.add_argument("--scene", action="append", metavar="SCENE.toml",
+                        help="the scene of the runs (once for all, or once per run in order)")
+    replay.add_argument("--overlay", action="store_true",
+                        help="draw the runs in one cube, each in its own colour "
+                             "(default: side by side along x)")
+    replay.add_argument("--max-bytes", type=int, default=DEFAULT_MAX_BYTES, metavar="N",
+                        help="size budget of the page; frames are skipped to fit "
+                             f"(default {DEFAULT_MAX_BYTES // 10**6} MB)")
+    replay.add_argument("--boxes", action="store_true",
+                        help="draw each body's box (AABB) too")
+    replay.set_defaults(run=_replay)
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with its usage errors on one line (it prints the usage first)."""
 
@@ -237,6 +300,7 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("-o", "--output", default="reports/out", metavar="DIR",
                         help="output directory (default: reports/out)")
     report.set_defaults(run=_report)
+    _add_viewer_commands(commands)
     return parser
 
 
