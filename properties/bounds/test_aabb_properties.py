@@ -23,7 +23,7 @@ from refsim.oracles.trimesh_adapter import (
 )
 
 from properties.strategies import convex_hull_meshes, pose_sequences, rotations
-from refsim.bounds.aabb_incremental import IncrementalAABB, numba_available
+from refsim.bounds.aabb_incremental import IncrementalAABB
 from refsim.bounds.aabb_linear import (
     aabb_linear,
     rotated_coordinate,
@@ -33,7 +33,7 @@ from refsim.bounds.aabb_linear import (
 from refsim.models import shapes
 from refsim.studies.bounds import bounds_tolerance, perturbed_sphere
 
-KERNELS = ["python"] + (["numba"] if numba_available() else [])
+KERNELS = ["readable", "compiled"]
 
 
 def _same(a, b) -> bool:
@@ -47,19 +47,17 @@ def test_incremental_box_equals_scan_bitwise(mesh, sequence):
     trackers = [IncrementalAABB(mesh, kernel=k) for k in KERNELS]
     for frame, pose in enumerate(poses):
         scan = aabb_linear(mesh, pose)
-        if "numba" in KERNELS:
-            assert _same(aabb_linear(mesh, pose, kernel="numba"), scan)
+        assert _same(aabb_linear(mesh, pose, kernel="compiled"), scan)
         for tracker in trackers:
             box = tracker.update(pose)
             assert _same(box, scan), (tracker.kernel, frame, box, scan)
 
 
-@pytest.mark.skipif(not numba_available(), reason="numba (extra 'fast') not installed")
 @given(mesh=convex_hull_meshes(), sequence=pose_sequences())
 def test_kernels_agree_on_extremes_and_counts(mesh, sequence):
     _, poses = sequence
-    python = IncrementalAABB(mesh, kernel="python")
-    numba = IncrementalAABB(mesh, kernel="numba")
+    python = IncrementalAABB(mesh, kernel="readable")
+    numba = IncrementalAABB(mesh, kernel="compiled")
     for pose in poses:
         assert _same(python.update(pose), numba.update(pose))
         assert np.array_equal(python.extremes, numba.extremes)

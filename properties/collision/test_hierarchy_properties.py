@@ -49,11 +49,9 @@ def test_boolean_query_matches_pairs(case):
         assert bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level=level) == (len(pairs) > 0)
 
 
-@pytest.mark.parametrize("kernel", ["numba", "python"])
+@pytest.mark.parametrize("kernel", ["compiled", "readable"])
 @given(case=posed_model_pairs())
 def test_bvh_equals_seed_path(kernel, case):
-    if kernel == "numba":
-        pytest.importorskip("numba", reason="numba (refsim[fast]) is not installed")
     mesh_a, pose_a, mesh_b, pose_b, _ = case
     for level in ("triangle-aabb", "exact"):
         bvh = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level=level, method="bvh",

@@ -11,7 +11,6 @@ from __future__ import annotations
 import itertools
 
 import numpy as np
-import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -88,7 +87,6 @@ def test_batch_equals_readable(pairs):
 @given(st.lists(st.one_of(triangle_pairs(), constructed_contact_pairs().map(lambda c: c[:2])),
                 min_size=1, max_size=40))
 def test_numba_equals_readable(pairs):
-    pytest.importorskip("numba", reason="numba (refsim[fast]) is not installed")
     from refsim.collision.triangle_numba import triangles_intersect_numba
 
     A = np.array([p[0] for p in pairs])

@@ -92,5 +92,5 @@ def test_bridges_to_holes_give_the_reference_triangles(polygon):
 @given(st.one_of(lattice_star_polygons(), decorated_polygons(),
                  bridged_polygons().map(lambda polygon: polygon[0])))
 def test_compiled_and_readable_give_the_same_bytes(p):
-    assert (ear_clip_indexed(p, compiled=True).tobytes()
-            == ear_clip_indexed(p, compiled=False).tobytes())
+    assert (ear_clip_indexed(p, kernel="compiled").tobytes()
+            == ear_clip_indexed(p, kernel="readable").tobytes())

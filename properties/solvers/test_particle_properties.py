@@ -11,8 +11,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from properties.strategies import particle_configs
+from refsim.dynamics.walls import wall_response_points
 from refsim.particles.system import ParticleSystem, plain_step
-from refsim.particles.walls import wall_response
 
 
 @settings(max_examples=50)
@@ -48,7 +48,7 @@ def test_one_bounce_scales_normal_by_e_and_lateral_by_k_friction(e, friction, de
     v[0, axis] = sign * 2.0                        # moving outward
     others = [a for a in range(3) if a != axis]
     v[0, others] = lateral_1, lateral_2
-    x2, v2, bounces = wall_response(x, v, 1.0, e, friction)
+    x2, v2, bounces = wall_response_points(x, v, 1.0, e, friction, speed="seed")
     assert bounces == 1
     assert x2[0, axis] == sign * 1.0
     assert v2[0, axis] == -e * v[0, axis]

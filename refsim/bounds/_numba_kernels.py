@@ -28,7 +28,9 @@ import numpy as np
 
 @numba.njit(cache=True, nogil=True)
 def aabb_linear_numba(vertices_t, rotation, translation):
-    """Linear scan; ``vertices_t`` is (3, n) contiguous. Returns (lo, hi)."""
+    """Mirrors :func:`refsim.bounds.aabb_linear.aabb_linear_kernel`.
+
+    Linear scan; ``vertices_t`` is (3, n) contiguous. Returns (lo, hi)."""
     x, y, z = vertices_t[0], vertices_t[1], vertices_t[2]
     lo = np.empty(3)
     hi = np.empty(3)
@@ -51,7 +53,9 @@ def aabb_linear_numba(vertices_t, rotation, translation):
 def incremental_update_numba(vertices_t, offsets, indices, rotation, translation,
                              extremes, tie_window, value, stamp, touched, seen, queue,
                              generation, counts, lo, hi):
-    """One tracker update; ``extremes`` (2, 3) is read and written in place.
+    """Mirrors :meth:`refsim.bounds.aabb_incremental.IncrementalAABB.update` (its readable kernel).
+
+    One tracker update; ``extremes`` (2, 3) is read and written in place.
 
     ``extremes[0, k] < 0`` means "no previous frame": initialize by a full scan.
     Writes the box to ``lo``, ``hi`` and visits/evaluations to ``counts``.

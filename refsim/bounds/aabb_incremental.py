@@ -72,10 +72,11 @@ For a sphere-like mesh of n vertices turning by a fixed angle per frame the
 steps grow like sqrt(n) once the vertex spacing is below that angle. O(n) for
 the first update and for a plateau search over a large flat face.
 
-Kernels: ``kernel="python"`` is the readable one (below); ``kernel="numba"``
-is the same loops compiled (:mod:`refsim.bounds._numba_kernels`, optional extra
-``fast``); the default is numba when it is installed. Both give the same
-boxes, extremes, visits and evaluations.
+Kernels: ``kernel="readable"`` is the readable one (below);
+``kernel="compiled"`` is the same loops compiled
+(:mod:`refsim.bounds._numba_kernels`), the default where numba works
+(:mod:`refsim.kernels`). Both give the same boxes, extremes, visits and
+evaluations.
 """
 
 from __future__ import annotations
@@ -84,12 +85,11 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from refsim.bounds.aabb_linear import _require_numba, numba_available, rotated_coordinates
-from refsim.errors import ModelError, check_option
+from refsim.bounds.aabb_linear import rotated_coordinates
+from refsim.errors import ModelError
+from refsim.kernels import choose_kernel
 from refsim.models.mesh import Mesh, require_mesh
 from refsim.types import Pose, as_pose
-
-INCREMENTAL_KERNELS = ("python", "numba")
 
 #: Width of the near-plateau search (step 2), relative to the largest vertex
 #: norm ``|v|``. One rotated coordinate is within ``3u |v|`` of the exact value
@@ -165,8 +165,8 @@ class IncrementalAABB:
     ----------
     mesh : Mesh
         Must be convex (``mesh.is_convex``) unless ``allow_nonconvex``.
-    kernel : {"numba", "python"}, optional
-        Compiled or readable kernel; default numba when installed.
+    kernel : {"readable", "compiled"}, optional
+        Readable or compiled kernel; default compiled where numba works.
     allow_nonconvex : bool, default False
         Track a non-convex mesh anyway; the box may then be too small (to
         measure claim C2). Never chosen by ``aabb = "auto"``.
@@ -192,11 +192,7 @@ class IncrementalAABB:
     def __init__(self, mesh: Mesh, *, kernel: str | None = None,
                  allow_nonconvex: bool = False):
         require_mesh(mesh)
-        if kernel is None:
-            kernel = "numba" if numba_available() else "python"
-        check_option("IncrementalAABB: kernel", kernel, INCREMENTAL_KERNELS)
-        if kernel == "numba":
-            _require_numba("IncrementalAABB")
+        kernel = choose_kernel(kernel)
         if not allow_nonconvex and not mesh.is_convex:
             raise ModelError(
                 "the incremental AABB update is exact only for convex meshes; use the "
@@ -212,7 +208,7 @@ class IncrementalAABB:
         # yet) and the counters of the last update (visits, evaluations).
         self._extremes = np.full((2, 3), -1, np.int64)
         self._counts = np.zeros(2, np.int64)
-        if kernel == "python":
+        if kernel == "readable":
             # Plain lists: indexing them is several times faster than numpy
             # scalars, and the kernel reads like the algorithm.
             self._xyz = mesh.vertices.tolist()
@@ -260,7 +256,7 @@ class IncrementalAABB:
         """:meth:`update` without the pose check, for a loop whose poses are
         known to be finite float64 (3, 3) orthonormal and (3,) (the check
         costs more than the compiled update itself)."""
-        if self.kernel == "numba":
+        if self.kernel == "compiled":
             return self._update_numba(rotation, translation)
         return self._update_python(rotation, translation)
 

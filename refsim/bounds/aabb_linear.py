@@ -40,42 +40,19 @@ sweep and prune; C. Ericson, *Real-Time Collision Detection*, 2005, section
 4.2 (axis-aligned bounding boxes: computing and updating them).
 
 Cost: O(n) per update for n vertices: 9n multiplications and additions and 6n
-comparisons. ``kernel="numpy"`` (default) vectorizes them; ``kernel="numba"``
-is the same loop compiled (optional extra ``fast``), for a like-for-like
-comparison with the compiled incremental tracker.
+comparisons. ``kernel="readable"`` vectorizes them with numpy;
+``kernel="compiled"`` is the same loop compiled by numba
+(:func:`refsim.bounds._numba_kernels.aabb_linear_numba`), the default, and
+like for like with the compiled incremental tracker (:mod:`refsim.kernels`).
 """
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
-from refsim.errors import OptionError, check_option
+from refsim.kernels import choose_kernel
 from refsim.models.mesh import Mesh, require_mesh
 from refsim.types import Pose, as_pose, transform_points
-
-LINEAR_KERNELS = ("numpy", "numba")
-
-
-@functools.cache
-def numba_available() -> bool:
-    """Whether the optional numba kernels can be used (extra ``fast``).
-
-    Tries the import once (about 0.2 s), so that a numba that is installed
-    but cannot load counts as missing and the readable kernels are used.
-    """
-    try:
-        import numba  # noqa: F401
-    except Exception:  # ImportError, or a numba built against another numpy
-        return False
-    return True
-
-
-def _require_numba(what: str) -> None:
-    if not numba_available():
-        raise OptionError(f"{what}: kernel 'numba' needs a working numba, which does not "
-                          "import here")
 
 
 def rotated_coordinate(rotation, vertex, k: int) -> float:
@@ -121,7 +98,7 @@ def aabb_linear_kernel(vertices_t: np.ndarray, rotation: np.ndarray,
     return r.min(axis=1) + translation, r.max(axis=1) + translation
 
 
-def aabb_linear(mesh: Mesh, pose: Pose, *, kernel: str = "numpy"
+def aabb_linear(mesh: Mesh, pose: Pose, *, kernel: str | None = None
                 ) -> tuple[np.ndarray, np.ndarray]:
     """World-space axis-aligned box of ``mesh`` under ``pose`` by an O(n) scan.
 
@@ -131,8 +108,9 @@ def aabb_linear(mesh: Mesh, pose: Pose, *, kernel: str = "numpy"
         Shared-vertex mesh; its ``vertices`` (n, 3) are scanned.
     pose : (rotation (3, 3), translation (3,))
         Checked with :func:`refsim.types.as_pose`.
-    kernel : {"numpy", "numba"}
-        The vectorized scan (default) or the compiled loop; identical results.
+    kernel : {"readable", "compiled"}, optional
+        The vectorized scan or the compiled loop (default where numba works,
+        :mod:`refsim.kernels`); identical results.
 
     Returns
     -------
@@ -140,17 +118,13 @@ def aabb_linear(mesh: Mesh, pose: Pose, *, kernel: str = "numpy"
         The box corners: ``lo[k] = min_v r_k(v) + t_k``, ``hi`` likewise.
     """
     require_mesh(mesh)
+    kernel = choose_kernel(kernel)
     rotation, translation = as_pose(pose)
-    if kernel == "numpy":
+    if kernel == "readable":
         return aabb_linear_kernel(mesh.vertices.T, rotation, translation)
-    if kernel == "numba":
-        _require_numba("aabb_linear")
-        from refsim.bounds import _numba_kernels as nk
+    from refsim.bounds import _numba_kernels as nk
 
-        return nk.aabb_linear_numba(np.ascontiguousarray(mesh.vertices.T), rotation,
-                                    translation)
-    check_option("aabb_linear: kernel", kernel, LINEAR_KERNELS)
-    raise AssertionError("unreachable")
+    return nk.aabb_linear_numba(np.ascontiguousarray(mesh.vertices.T), rotation, translation)
 
 
 class LinearAABB:
@@ -162,16 +136,15 @@ class LinearAABB:
 
     method = "linear"
 
-    def __init__(self, mesh: Mesh, *, kernel: str = "numpy"):
+    def __init__(self, mesh: Mesh, *, kernel: str | None = None):
         require_mesh(mesh)
-        check_option("LinearAABB: kernel", kernel, LINEAR_KERNELS)
+        kernel = choose_kernel(kernel)
         self.mesh = mesh
         self.kernel = kernel
         n = mesh.n_vertices
         self.visits, self.evaluations = n, 3 * n  # the same for every update
         self._vertices_t = np.ascontiguousarray(mesh.vertices.T)  # (3, n), once
-        if kernel == "numba":
-            _require_numba("LinearAABB")
+        if kernel == "compiled":
             from refsim.bounds._numba_kernels import aabb_linear_numba
 
             self._kernel_numba = aabb_linear_numba
@@ -185,6 +158,6 @@ class LinearAABB:
         """:meth:`update` without the pose check, for a loop whose poses are
         known to be finite float64 (3, 3) orthonormal and (3,) (the check
         costs more than the compiled update itself)."""
-        if self.kernel == "numpy":
+        if self.kernel == "readable":
             return aabb_linear_kernel(self._vertices_t, rotation, translation)
         return self._kernel_numba(self._vertices_t, rotation, translation)

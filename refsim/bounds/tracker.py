@@ -45,8 +45,8 @@ def make_aabb_tracker(mesh: Mesh, mode: str = "auto", *, kernel: str | None = No
         "auto": incremental for a convex mesh, the linear scan otherwise (the
         seed's rule). "incremental" on a non-convex mesh raises ModelError.
     kernel : str, optional
-        Passed on: "numpy"/"numba" for the scan, "python"/"numba" for the
-        tracker; default the fastest available.
+        "readable" or "compiled" (:mod:`refsim.kernels`); default compiled
+        where numba works.
     """
     check_option("aabb mode", mode, AABB_MODES)
     require_mesh(mesh)
@@ -54,4 +54,4 @@ def make_aabb_tracker(mesh: Mesh, mode: str = "auto", *, kernel: str | None = No
         mode = "incremental" if mesh.is_convex else "linear"
     if mode == "incremental":
         return IncrementalAABB(mesh, kernel=kernel)
-    return LinearAABB(mesh, kernel=kernel or "numpy")
+    return LinearAABB(mesh, kernel=kernel)

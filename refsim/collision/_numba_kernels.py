@@ -143,7 +143,9 @@ def certify_pair(a, b):
 
 @numba.njit(cache=True)
 def certified(A, B):
-    """``certify_pair`` for every pair of two (k, 3, 3) arrays."""
+    """Mirrors :func:`refsim.collision.triangle_batch.triangles_intersect_batch`'s float filter.
+
+    ``certify_pair`` for every pair of two (k, 3, 3) arrays."""
     k = A.shape[0]
     answer = np.zeros(k, dtype=np.bool_)
     certain = np.zeros(k, dtype=np.bool_)
@@ -179,6 +181,8 @@ def certified_indexed(world_a, faces_a, world_b, faces_b, pairs):
 
 @numba.njit(cache=True)
 def prepare(vertices, faces, rotation, translation, left, right, start, count, order):
+    """Mirrors :func:`refsim.collision.boxes.world_vertices`,
+    :func:`refsim.collision.boxes.triangle_boxes` and :func:`refsim.collision.bvh.refit`."""
     n = vertices.shape[0]
     world = np.empty((n, 3))
     for i in range(n):
@@ -220,7 +224,9 @@ def prepare(vertices, faces, rotation, translation, left, right, start, count, o
 def traverse(left_a, right_a, start_a, count_a, order_a, lo_a, hi_a, tlo_a, thi_a,
              left_b, right_b, start_b, count_b, order_b, lo_b, hi_b, tlo_b, thi_b,
              first_only):
-    """The triangle-box pairs (i, j) whose world boxes overlap (seed test 2),
+    """Mirrors :func:`refsim.collision.bvh._pairs_python`.
+
+    The triangle-box pairs (i, j) whose world boxes overlap (seed test 2),
     by simultaneous descent of the refit trees; at most one with ``first_only``."""
     out = np.empty((64, 2), dtype=np.int64)
     found = 0
@@ -319,7 +325,9 @@ def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotatio
                 vertices_b, faces_b, links_b, order_b, boxes_b, reach_b, rotation_b,
                 translation_b,
                 axes_deviation, mode, tol, margin_rounding, margin_per_deviation):
-    """Returns ``(status, found, uncertain)``.
+    """Mirrors :func:`refsim.collision.bvh_exact.descend` with the filter of :func:`certified`.
+
+    Returns ``(status, found, uncertain)``.
 
     axes_deviation: the larger ``FrameTree.axes_deviation`` of the two meshes.
 

@@ -31,11 +31,12 @@ from __future__ import annotations
 import numpy as np
 
 from refsim.collision.boxes import boxes_overlap, world_vertices
-from refsim.collision.bvh import check_kernel, prepare_body, tree_box_pairs
+from refsim.collision.bvh import prepare_body, tree_box_pairs
 from refsim.collision.bvh_exact import collide_bvh, intersecting_pairs_bvh
 from refsim.collision.seed_levels import exact_pairs, triangle_box_pairs
 from refsim.collision.spheres import spheres_overlap
 from refsim.errors import check_option
+from refsim.kernels import choose_kernel
 from refsim.models.mesh import require_mesh
 from refsim.types import as_pose
 
@@ -67,15 +68,16 @@ def intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
     level : "exact" (triangles intersect, touching counts) or
         "triangle-aabb" (their world boxes overlap)
     method : "bvh" (hierarchy) or "seed" (pairwise triangle boxes)
-    kernel : "numba" (compiled traversal and exact filter; the default when
-        numba is installed) or "python" (readable traversal, numpy filter)
+    kernel : "compiled" (compiled traversal and exact filter; the default
+        where numba works) or "readable" (readable traversal, numpy filter);
+        see :mod:`refsim.kernels`
 
     Returns
     -------
     (k, 2) int64 array, rows sorted.
     """
     _check(level, PAIR_LEVELS, method, mesh_a, mesh_b)
-    kernel = check_kernel(kernel)
+    kernel = choose_kernel(kernel)
     if level == "exact" and method == "bvh":
         return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
     pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
@@ -93,7 +95,7 @@ def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
                    method: str = "bvh", *, kernel: str | None = None) -> bool:
     """Whether two bodies collide at ``level`` (see the module's table)."""
     _check(level, LEVELS, method, mesh_a, mesh_b)
-    kernel = check_kernel(kernel)
+    kernel = choose_kernel(kernel)
     if level == "exact" and method == "bvh":
         return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
     pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")

@@ -32,8 +32,9 @@ apart, and at pairs of leaves test the triangle boxes themselves. Each pair
 of leaves is reached at most once, so each triangle pair is reported once.
 
 Two kernels do the same arithmetic: ``refit`` and ``_pairs_python`` (plain
-loops, the reference) and a numba-compiled copy (``refsim[fast]``), selected
-by ``kernel=``.
+loops, the reference) and a numba-compiled mirror of them
+(:mod:`refsim.collision._numba_kernels`), selected by ``kernel=``
+(:mod:`refsim.kernels`: "readable" or "compiled").
 
 This path serves level "triangle-aabb", whose answer is test 2's pairs. The
 exact level only needs a superset of the intersecting pairs and uses the
@@ -53,7 +54,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.boxes import triangle_boxes, world_vertices
-from refsim.errors import OptionError, check_option
 from refsim.types import unit_exponent
 
 #: Triangles per leaf. Small leaves prune more; each leaf-leaf visit costs
@@ -196,7 +196,7 @@ def _size(lo, hi) -> float:
 
 @functools.cache
 def _compiled():
-    """``(prepare, traverse)`` compiled with numba, or None without numba.
+    """``(prepare, traverse)`` compiled with numba.
 
     The same steps as ``world_vertices``, ``triangle_boxes``, ``refit`` and
     ``_pairs_python`` in plain loops (:mod:`refsim.collision._numba_kernels`),
@@ -211,19 +211,9 @@ def _compiled():
     :mod:`refsim.collision.bvh_exact`, is lazy too but tests the rotated box
     itself, by separating axes, which is as tight as the body-space box.)
     """
-    try:
-        from refsim.collision import _numba_kernels as nk
-    except ImportError:
-        return None
+    from refsim.collision import _numba_kernels as nk
+
     return nk.prepare, nk.traverse
-
-
-KERNELS = ("numba", "python")
-
-
-def default_kernel() -> str:
-    """"numba" when numba is installed, else "python"."""
-    return "numba" if _compiled() is not None else "python"
 
 
 @dataclass(frozen=True)
@@ -243,7 +233,7 @@ class PreparedBody:
 def prepare_body(mesh, pose, kernel: str) -> PreparedBody:
     """Transform, box and refit one body."""
     tree = tree_of(mesh)
-    if kernel == "python":
+    if kernel == "readable":
         world = world_vertices(mesh, pose)
         tri_lo, tri_hi = triangle_boxes(world, mesh.faces)
         lo, hi = refit(tree, tri_lo, tri_hi)
@@ -254,21 +244,13 @@ def prepare_body(mesh, pose, kernel: str) -> PreparedBody:
     return PreparedBody(mesh, tree, world, lo, hi, tri_lo, tri_hi)
 
 
-def check_kernel(kernel: str | None) -> str:
-    kernel = kernel or default_kernel()
-    check_option("kernel", kernel, KERNELS)
-    if kernel == "numba" and _compiled() is None:
-        raise OptionError("kernel 'numba' needs a working numba, which does not import here")
-    return kernel
-
-
 def tree_box_pairs(pa: PreparedBody, pb: PreparedBody, kernel: str,
                    first_only: bool = False) -> np.ndarray:
     """Every (i, j) whose world triangle boxes overlap, via the hierarchy.
 
     Returns (k, 2) int64 with rows sorted; with ``first_only`` at most one row.
     """
-    if kernel == "python":
+    if kernel == "readable":
         found = _pairs_python(pa.tree, pa.lo, pa.hi, pa.tri_lo, pa.tri_hi,
                               pb.tree, pb.lo, pb.hi, pb.tri_lo, pb.tri_hi, first_only)
         pairs = np.array(found, dtype=np.int64).reshape(-1, 2)

@@ -403,11 +403,11 @@ def _resolve(mesh_a, pose_a, mesh_b, pose_b, uncertain: np.ndarray) -> np.ndarra
 
 def intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> np.ndarray:
     """All intersecting face pairs, (k, 2) int64 with rows sorted."""
-    if kernel == "python":
+    if kernel == "readable":
         pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
         candidates = candidate_pairs(mesh_a, pose_a, mesh_b, pose_b)
         return exact_pairs(world_vertices(mesh_a, pose_a), mesh_a.faces,
-                           world_vertices(mesh_b, pose_b), mesh_b.faces, candidates, "python")
+                           world_vertices(mesh_b, pose_b), mesh_b.faces, candidates, "readable")
     found, uncertain = query_compiled(mesh_a, pose_a, mesh_b, pose_b, ALL_HITS)
     if len(uncertain):
         hit = _resolve(mesh_a, pose_a, mesh_b, pose_b, uncertain)
@@ -417,7 +417,7 @@ def intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> np.nd
 
 def collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> bool:
     """Whether any pair of triangles intersects; stops at the first."""
-    if kernel == "python":
+    if kernel == "readable":
         return len(intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)) > 0
     found, uncertain = query_compiled(mesh_a, pose_a, mesh_b, pose_b, FIRST_HIT)
     if len(found):

@@ -65,16 +65,16 @@ def triangle_box_pairs(world_a, faces_a, world_b, faces_b) -> np.ndarray:
 
 
 def exact_pairs(world_a, faces_a, world_b, faces_b, candidates: np.ndarray,
-                kernel: str = "python") -> np.ndarray:
+                kernel: str = "readable") -> np.ndarray:
     """Test 3: the candidate pairs whose triangles really intersect.
 
-    ``kernel``: "python" uses the numpy batch kernel, "numba" its compiled
+    ``kernel``: "readable" uses the numpy batch kernel, "compiled" its compiled
     copy; both hand the pairs their float filter cannot certify to the
     readable exact kernel, so the answers are the same.
     """
     if len(candidates) == 0:
         return candidates
-    if kernel == "numba":
+    if kernel == "compiled":
         from refsim.collision.triangle_numba import intersecting_indexed
 
         if not (np.isfinite(world_a).all() and np.isfinite(world_b).all()):

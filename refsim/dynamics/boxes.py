@@ -19,11 +19,9 @@ Cost: O(B n) for B bodies of n vertices.
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
-from refsim.jit import compiled_or_none
+from refsim.kernels import choose_kernel, compile_kernel
 
 
 def boxes_numpy(vertices_t: np.ndarray, R: np.ndarray, origin: np.ndarray
@@ -54,17 +52,20 @@ def boxes_loops(vertices_t: np.ndarray, R: np.ndarray, origin: np.ndarray, lo: n
             hi[b, k] = greatest + origin[b, k]
 
 
-@functools.cache
-def _compiled():
-    return compiled_or_none(boxes_loops)
-
-
 def boxes_compiled(vertices_t, R, origin) -> tuple[np.ndarray, np.ndarray]:
-    """The compiled loops (numpy path when numba is missing)."""
-    kernel = _compiled()
-    if kernel is None:
-        return boxes_numpy(vertices_t, R, origin)
+    """Mirrors :func:`boxes_numpy`: its loops (:func:`boxes_loops`) compiled
+    by numba, the same bits."""
     lo = np.empty((R.shape[0], 3))
     hi = np.empty((R.shape[0], 3))
-    kernel(vertices_t, np.ascontiguousarray(R), np.ascontiguousarray(origin), lo, hi)
+    compile_kernel(boxes_loops)(vertices_t, np.ascontiguousarray(R),
+                                np.ascontiguousarray(origin), lo, hi)
     return lo, hi
+
+
+def boxes_kernel(vertices_t, R, origin, *, kernel: str | None = None
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The boxes of all bodies of one mesh on the chosen kernel
+    (:mod:`refsim.kernels`)."""
+    if choose_kernel(kernel) == "compiled":
+        return boxes_compiled(vertices_t, R, origin)
+    return boxes_numpy(vertices_t, R, origin)

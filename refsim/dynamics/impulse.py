@@ -63,12 +63,11 @@ DESIGN's "per-contact loops" case); the plain Python function is kept as
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
 
-from refsim.jit import compiled_or_none
+from refsim.kernels import choose_kernel, compile_kernel
 
 #: Sweeps of phase 1. Gauss-Seidel over the four corners of a face landing
 #: flat converges linearly: the cube's bounce speed is off by 2e-3 (relative)
@@ -268,17 +267,43 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
 
 
 
-def solve_contacts(*args):
-    """:func:`solve_contacts_python`, compiled by numba when it is installed
-    (compiled on first use, once per process; see :func:`compiled_kernel`)."""
-    return compiled_kernel()(*args)
+def solve_contacts_compiled(*args):
+    """:func:`solve_contacts_python` compiled by numba as it stands (the same
+    source; compiled on first use, then cached on disk)."""
+    return compile_kernel(solve_contacts_python)(*args)
 
 
-@functools.cache
-def compiled_kernel():
-    """The numba-compiled solve, or the plain one when numba is missing."""
-    return _compile_kernel() or solve_contacts_python
+def solve_contacts(*args, kernel: str | None = None):
+    """:func:`solve_contacts_python` on the chosen kernel (:mod:`refsim.kernels`)."""
+    if choose_kernel(kernel) == "compiled":
+        return solve_contacts_compiled(*args)
+    return solve_contacts_python(*args)
 
 
-def _compile_kernel():
-    return compiled_or_none(solve_contacts_python)
+def wall_impulses(r_a, n, inv_mass: float, I_inv, v, w, restitution: float,
+                  friction: float, *, kernel: str | None = None) -> np.ndarray:
+    """Impulses of one body against a wall at contacts ``r_a`` (k, 3) (from
+    its centre of mass), wall normal ``n`` (into the body); ``v``, ``w`` (3,)
+    updated in place. The wall is body B of the solve: static, so no mass
+    (``m_inv_b = 0``), no inertia (``I_inv_b = 0``) and at rest (``v_b =
+    w_b = 0``), and ``r_b`` does not matter. Returns the (k, 4) impulses."""
+    r_a = np.ascontiguousarray(r_a, dtype=np.float64)
+    P = np.empty((len(r_a), 4))
+    solve_contacts(r_a, np.zeros_like(r_a), n, inv_mass, I_inv, v, w, 0.0,
+                   np.zeros((3, 3)), np.zeros(3), np.zeros(3), restitution, friction,
+                   RESTITUTION_THRESHOLD, ITERATIONS, P, kernel=kernel)
+    return P
+
+
+def body_impulse(r_a, r_b, n, inv_mass_a: float, I_inv_a, v_a, w_a, inv_mass_b: float,
+                 I_inv_b, v_b, w_b, restitution: float, friction: float, *,
+                 kernel: str | None = None) -> np.ndarray:
+    """The impulse at one contact point between bodies A and B: ``r_a``,
+    ``r_b`` (3,) from each centre of mass, ``n`` from B into A; the (3,)
+    velocities updated in place. Returns the (1, 4) impulse."""
+    P = np.empty((1, 4))
+    solve_contacts(np.asarray(r_a, dtype=np.float64)[None, :],
+                   np.asarray(r_b, dtype=np.float64)[None, :], n, inv_mass_a, I_inv_a,
+                   v_a, w_a, inv_mass_b, I_inv_b, v_b, w_b, restitution, friction,
+                   RESTITUTION_THRESHOLD, ITERATIONS, P, kernel=kernel)
+    return P

@@ -72,12 +72,11 @@ Cost: O(B) per orientation step; O(n) per contact to find the vertex.
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
 
-from refsim.jit import compiled_or_none
+from refsim.kernels import choose_kernel, compile_kernel
 
 
 def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -163,20 +162,21 @@ def orientation_step_seed_loops(R: np.ndarray, w: np.ndarray, h: float,
         out[b, 2, 2] = x0 * y1 - x1 * y0
 
 
-@functools.cache
-def _compiled_step():
-    return compiled_or_none(orientation_step_seed_loops)
-
-
 def orientation_step_seed_compiled(R: np.ndarray, w: np.ndarray, h: float) -> np.ndarray:
-    """:func:`orientation_step_seed` compiled by numba (about 1 us for 40
-    bodies against ~25 us; the numpy path when numba is missing)."""
-    kernel = _compiled_step()
-    if kernel is None:
-        return orientation_step_seed(R, w, h)
+    """Mirrors :func:`orientation_step_seed`: its loops
+    (:func:`orientation_step_seed_loops`) compiled by numba, the same bits."""
     out = np.empty_like(R)
-    kernel(np.ascontiguousarray(R), np.ascontiguousarray(w), float(h), out)
+    compile_kernel(orientation_step_seed_loops)(np.ascontiguousarray(R),
+                                                np.ascontiguousarray(w), float(h), out)
     return out
+
+
+def orientation_step_seed_kernel(R: np.ndarray, w: np.ndarray, h: float, *,
+                                 kernel: str | None = None) -> np.ndarray:
+    """:func:`orientation_step_seed` on the chosen kernel (:mod:`refsim.kernels`)."""
+    if choose_kernel(kernel) == "compiled":
+        return orientation_step_seed_compiled(R, w, h)
+    return orientation_step_seed(R, w, h)
 
 
 @dataclass(frozen=True)

@@ -53,20 +53,22 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
 from refsim.bounds.aabb_linear import transform_vertices
 from refsim.bounds.tracker import make_aabb_tracker
 from refsim.bounds.world_cube import world_cube_test
+from refsim.collision.bodies import bodies_collide
+from refsim.collision.broad_phase import overlapping_pairs
 from refsim.dynamics import impulse
 from refsim.dynamics.body_response import (
     contact_geometry,
     exchange_velocities_seed,
     separate_bodies,
 )
-from refsim.dynamics.boxes import boxes_compiled
-from refsim.dynamics.broad_phase import overlapping_pairs_compiled
+from refsim.dynamics.boxes import boxes_kernel
 from refsim.dynamics.forces import translational_rhs
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
 from refsim.dynamics.rotation_impulse import (
@@ -77,7 +79,7 @@ from refsim.dynamics.rotation_impulse import (
 from refsim.dynamics.rotation_seed import (
     contact_spin_seed,
     contact_vertex_seed,
-    orientation_step_seed_compiled,
+    orientation_step_seed_kernel,
 )
 from refsim.dynamics.trajectory import FRAME_ENTRIES, Event, Trajectory
 from refsim.dynamics.walls import SPEEDS, wall_name, wall_response_seed, wall_speed
@@ -89,6 +91,7 @@ from refsim.errors import (
     check_option,
 )
 from refsim.frames import FrameSink, MemorySink, frame_count
+from refsim.kernels import choose_kernel
 from refsim.models.mesh import Mesh
 from refsim.scenes.schema import Scene
 from refsim.solvers.integrate import resolve_method, whole_steps
@@ -116,6 +119,41 @@ STAGES = ("integrate", "rotation", "check", "bounds", "walls", "broad-phase", "n
           "body-response")
 
 
+class Contact(NamedTuple):
+    """A contact found in a step: ``kind`` "wall" (``other`` names the wall,
+    "x-" .. "z+") or "body" (``other`` is the other body's name)."""
+
+    kind: str
+    body: str
+    other: str
+
+
+class StageTimer:
+    """Wall time per stage of the step: :meth:`lap` adds the time since the
+    last lap (or :meth:`start`) to a stage's total, in ``seconds``."""
+
+    def __init__(self, stages):
+        self.seconds = dict.fromkeys(stages, 0.0)
+        self._last = 0.0
+
+    def start(self) -> None:
+        self._last = time.perf_counter()
+
+    def lap(self, stage: str) -> None:
+        now = time.perf_counter()
+        self.seconds[stage] += now - self._last
+        self._last = now
+
+
+def resolve_wall_response(dynamics) -> str:
+    """``dynamics.wall_response`` with "auto" resolved: the corrected wall
+    impulses when the rotation model is the corrected one, else the seed's
+    per-axis response (the scene key, :mod:`refsim.scenes.schema`)."""
+    if dynamics.wall_response != "auto":
+        return dynamics.wall_response
+    return "impulse" if dynamics.rotation == "impulse" else "seed"
+
+
 @dataclass(frozen=True)
 class Body:
     """What the loop knows of one body that does not change: its (scaled)
@@ -135,10 +173,10 @@ class Simulation:
     Parameters
     ----------
     scene : refsim.Scene
-    wall_speed : {"wall", "seed"}
+    wall_speed : {"wall", "seed"}, optional
         The normal speed the seed's wall response flips (see
-        :mod:`refsim.dynamics.walls`): at the wall (energy-consistent, the
-        default) or the seed's literal one.
+        :mod:`refsim.dynamics.walls`): at the wall (energy-consistent) or the
+        seed's literal one; default the scene's ``world.wall_speed``.
     boxes : {"auto", "trackers", "batched"}
         How the bounds stage gets each body's box. "trackers": each body's own
         :func:`refsim.make_aabb_tracker` (``collision.aabb``: the incremental
@@ -149,10 +187,19 @@ class Simulation:
         the same boxes, bit for bit (the incremental walk finds the linear
         scan's extreme vertex on a convex mesh and adds the translation the
         same way); only the cost differs.
+    kernel : {"readable", "compiled"}, optional
+        The kernels of every stage (:mod:`refsim.kernels`); the same
+        trajectory, bit for bit, on either.
     sink : refsim.frames.FrameSink, optional
         Where :meth:`record` puts frames: a :class:`refsim.frames.MemorySink`
         by default (growing by doubling), or e.g. a
         :class:`refsim.frames.SpillSink` that writes them to disk as they come.
+
+    The scene's choices are made once, here: which rotation step (none, the
+    seed's, the exact one), which wall response (the seed's per-axis one,
+    with S9's spin change when the rotation model is the seed's, or the
+    corrected impulses; ``dynamics.wall_response``), which body response,
+    which stages run at all.
 
     Attributes
     ----------
@@ -164,25 +211,30 @@ class Simulation:
     t : float; steps : int
     events : list of Event (onsets of wall and body contacts)
     stages : tuple of str (the stages this scene runs)
-    stage_seconds : dict of str -> float
+    timer : StageTimer (``timer.seconds``: dict of stage -> seconds)
     """
 
-    def __init__(self, scene, *, wall_speed: str = "wall", boxes: str = "auto",
-                 sink: FrameSink | None = None):
+    def __init__(self, scene, *, wall_speed: str | None = None, boxes: str = "auto",
+                 kernel: str | None = None, sink: FrameSink | None = None):
         if not isinstance(scene, Scene):
             raise ArgumentTypeError(f"scene must be a refsim.Scene (refsim.load_scene(path)), "
                                     f"got {type(scene).__name__}")
-        check_option("wall_speed", wall_speed, SPEEDS)
-        check_option("boxes", boxes, BOXES)
-        self.boxes = boxes
-        self.scene = scene
-        self.wall_speed = wall_speed
         world, dyn, col = scene.world, scene.dynamics, scene.collision
+        self.wall_speed = check_option("wall_speed", wall_speed or world.wall_speed, SPEEDS)
+        self.boxes = check_option("boxes", boxes, BOXES)
+        self.kernel = choose_kernel(kernel)
+        self.scene = scene
         self.h = scene.integration.step
         self.method = resolve_method(scene.integration.solver)
         self.rotation = dyn.rotation
         self.body_response = dyn.body_response
+        self.wall_response = resolve_wall_response(dyn)
         self.level = col.level
+        # the stage functions, chosen once
+        self._rotate = {"off": None, "seed": self._rotate_seed,
+                        "impulse": self._rotate_exact}[self.rotation]
+        self._wall = {"seed": self._wall_seed, "impulse": self._wall_impulse}[
+            self.wall_response]
         B = len(scene.bodies)
         if B == 0:
             raise StateError("the scene has no [[body]] to simulate (a particle-only "
@@ -203,7 +255,8 @@ class Simulation:
             center = (props.center if "impulse" in (dyn.rotation, dyn.body_response)
                       else mesh.centroid_vertex_average)
             bodies.append(Body(name=cfg.name, mesh=mesh,
-                               tracker=make_aabb_tracker(mesh, col.aabb), mass=cfg.mass,
+                               tracker=make_aabb_tracker(mesh, col.aabb, kernel=self.kernel),
+                               mass=cfg.mass,
                                center=np.array(center), inertia=props.inertia))
         self.bodies = tuple(bodies)
         self.names = tuple(b.name for b in bodies)
@@ -245,14 +298,13 @@ class Simulation:
                 and np.isfinite(self.w).all()):
             raise StateError("initial state has a non-finite value")
 
-        self._f = translational_rhs(world.gravity, world.drag, self.inv_mass,
-                                    world.drag_model)
+        self._f = translational_rhs(world.gravity, world.drag, self.mass, world.drag_model)
         self.lo = np.empty((B, 3))
         self.hi = np.empty((B, 3))
         self.events: list[Event] = []
-        self._touching: set[tuple[str, str]] = set()
+        self._touching: set[Contact] = set()
         self.stages = tuple(s for s in STAGES if self._needs(s))
-        self.stage_seconds = dict.fromkeys(self.stages, 0.0)
+        self.timer = StageTimer(self.stages)
         self._frames: FrameSink = MemorySink() if sink is None else sink
         # the largest principal moment of each body: 1/2 lambda_max |w|^2 bounds
         # the rotational energy without a rotation of the inertia tensor
@@ -270,6 +322,11 @@ class Simulation:
         if stage == "narrow-phase":
             return self.body_body and self.level != "aabb"
         return True
+
+    @property
+    def stage_seconds(self) -> dict[str, float]:
+        """Wall time so far of each stage that runs (``timer.seconds``)."""
+        return self.timer.seconds
 
     # -- the reported state ------------------------------------------------------------
 
@@ -334,38 +391,29 @@ class Simulation:
             The state became non-finite or its energy grew without bound; the
             frames recorded so far are in ``error.partial``.
         """
-        clock = time.perf_counter
-        seconds = self.stage_seconds
-        t0 = clock()
+        timer = self.timer
+        timer.start()
         self._integrate()
-        t1 = clock()
-        seconds["integrate"] += t1 - t0
-        if self.rotation != "off":
+        timer.lap("integrate")
+        if self._rotate is not None:
             self._rotate()
-            t0, t1 = t1, clock()
-            seconds["rotation"] += t1 - t0
+            timer.lap("rotation")
         self._check()
-        t0, t1 = t1, clock()
-        seconds["check"] += t1 - t0
+        timer.lap("check")
         self._bounds()
-        t0, t1 = t1, clock()
-        seconds["bounds"] += t1 - t0
-        touching = set()
+        timer.lap("bounds")
+        touching: set[Contact] = set()
         # AMBIGUITY (A9): walls before bodies, the order of the seed's text
         self._walls(touching)
-        t0, t1 = t1, clock()
-        seconds["walls"] += t1 - t0
+        timer.lap("walls")
         if self.body_body:
             pairs = self._broad_phase()
-            t0, t1 = t1, clock()
-            seconds["broad-phase"] += t1 - t0
+            timer.lap("broad-phase")
             if self.level != "aabb":
                 pairs = self._narrow_phase(pairs)
-                t0, t1 = t1, clock()
-                seconds["narrow-phase"] += t1 - t0
+                timer.lap("narrow-phase")
             self._body_response(pairs, touching)
-            t0, t1 = t1, clock()
-            seconds["body-response"] += t1 - t0
+            timer.lap("body-response")
         self.t = (self.steps + 1) * self.h
         self.steps += 1
         self._note_events(touching)
@@ -396,19 +444,20 @@ class Simulation:
         self.v[...] = Y[1]
 
     # 2. orientation (S9, or the corrected exact rotation)
-    def _rotate(self) -> None:
-        if self.rotation == "seed":
-            self.R[...] = orientation_step_seed_compiled(self.R, self.w, self.h)
-        else:
-            self.R[...], self.w[...] = orientation_step_exact(
-                self.R, self.w, self.h, self.I_body, self.I_body_inv)
+    def _rotate_seed(self) -> None:
+        self.R[...] = orientation_step_seed_kernel(self.R, self.w, self.h, kernel=self.kernel)
+
+    def _rotate_exact(self) -> None:
+        self.R[...], self.w[...] = orientation_step_exact(
+            self.R, self.w, self.h, self.I_body, self.I_body_inv)
 
     # 4. boxes (S2)
     def _bounds(self) -> None:
         origin = self.position
         for idx, vertices_t in self._linear_groups:
             # the linear scan's r_k(v) = (R_k0 x + R_k1 y) + R_k2 z, batched
-            self.lo[idx], self.hi[idx] = boxes_compiled(vertices_t, self.R[idx], origin[idx])
+            self.lo[idx], self.hi[idx] = boxes_kernel(vertices_t, self.R[idx], origin[idx],
+                                                      kernel=self.kernel)
         for i in self._tracked:
             tracker = self.bodies[i].tracker
             # The loop's poses are finite and orthonormal by construction (the
@@ -421,19 +470,21 @@ class Simulation:
         beyond = np.flatnonzero(((self.lo < -H) | (self.hi > H)).any(axis=1))
         for i in beyond:
             correction = world_cube_test(self.lo[i], self.hi[i], H).correction
-            if self.rotation == "impulse":
-                self._wall_impulse(i, correction)
-            else:
-                if self.rotation == "seed":
-                    self._wall_spin_seed(i, correction)
-                world = self.scene.world
-                self.x[i], self.v[i] = wall_response_seed(
-                    self.x[i], self.v[i], correction, world.restitution, world.friction,
-                    world.gravity, self.wall_speed)
+            self._wall(i, correction)
             self.lo[i] += correction
             self.hi[i] += correction
             for k in np.flatnonzero(correction):
-                touching.add((self.names[i], wall_name(k, correction[k])))
+                touching.add(Contact("wall", self.names[i], wall_name(k, correction[k])))
+
+    def _wall_seed(self, i: int, correction: np.ndarray) -> None:
+        """The seed's per-axis response (S7), after S9's change of w at the
+        contact vertex when the rotation model is the seed's."""
+        if self.rotation == "seed":
+            self._wall_spin_seed(i, correction)
+        world = self.scene.world
+        self.x[i], self.v[i] = wall_response_seed(
+            self.x[i], self.v[i], correction, world.restitution, world.friction,
+            world.gravity, self.wall_speed)
 
     def _wall_spin_seed(self, i: int, correction: np.ndarray) -> None:
         """S9 at each crossed wall: the contact vertex, then w += Pi x I."""
@@ -471,12 +522,8 @@ class Simulation:
                 continue
             n = np.zeros(3)
             n[k] = 1.0 if low else -1.0
-            P = np.empty((len(r_a), 4))
-            impulse.solve_contacts(
-                np.ascontiguousarray(r_a), np.zeros_like(r_a), n, self.inv_mass[i], I_inv,
-                self.v[i], self.w[i], 0.0, np.zeros((3, 3)), np.zeros(3), np.zeros(3),
-                world.restitution, world.friction, impulse.RESTITUTION_THRESHOLD,
-                impulse.ITERATIONS, P)
+            impulse.wall_impulses(r_a, n, self.inv_mass[i], I_inv, self.v[i], self.w[i],
+                                  world.restitution, world.friction, kernel=self.kernel)
 
     # 6. broad phase (S4 test 1)
     def _broad_phase(self) -> np.ndarray:
@@ -489,18 +536,16 @@ class Simulation:
                 c, radii[i] = bounding_sphere(b.mesh)
                 R, origin = self.pose(i)
                 centres[i] = R @ c + origin
-            return overlapping_pairs_compiled(centres - radii[:, None],
-                                              centres + radii[:, None])
-        return overlapping_pairs_compiled(self.lo, self.hi)
+            return overlapping_pairs(centres - radii[:, None], centres + radii[:, None],
+                                     kernel=self.kernel)
+        return overlapping_pairs(self.lo, self.hi, kernel=self.kernel)
 
     # 7. narrow phase (S4 at the scene's level)
     def _narrow_phase(self, pairs: np.ndarray) -> list:
-        from refsim.collision.bodies import bodies_collide
-
         hits = []
         for a, b in pairs:
             if bodies_collide(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
-                              self.pose(b), level=self.level):
+                              self.pose(b), level=self.level, kernel=self.kernel):
                 hits.append((a, b))
         return hits
 
@@ -509,7 +554,7 @@ class Simulation:
         world = self.scene.world
         for a, b in pairs:
             a, b = int(a), int(b)
-            touching.add((self.names[a], self.names[b]))
+            touching.add(Contact("body", self.names[a], self.names[b]))
             if self.body_response == "seed":
                 self.v[a], self.v[b], _ = exchange_velocities_seed(
                     self.x[a], self.x[b], self.v[a], self.v[b])
@@ -522,12 +567,11 @@ class Simulation:
                 I_inv_a = I_inv_b = np.zeros((3, 3))
             else:
                 I_inv_a, I_inv_b = world_inertia(self.R[[a, b]], self.I_body_inv[[a, b]])
-            P = np.empty((1, 4))
-            impulse.solve_contacts(
-                (geometry.point - self.x[a])[None, :], (geometry.point - self.x[b])[None, :],
-                geometry.n, self.inv_mass[a], I_inv_a, self.v[a], self.w[a],
+            impulse.body_impulse(
+                geometry.point - self.x[a], geometry.point - self.x[b], geometry.n,
+                self.inv_mass[a], I_inv_a, self.v[a], self.w[a],
                 self.inv_mass[b], I_inv_b, self.v[b], self.w[b], world.restitution,
-                world.friction, impulse.RESTITUTION_THRESHOLD, impulse.ITERATIONS, P)
+                world.friction, kernel=self.kernel)
             dx_a, dx_b = separate_bodies(geometry, self.inv_mass[a], self.inv_mass[b])
             self.x[a] += dx_a
             self.x[b] += dx_b
@@ -555,12 +599,12 @@ class Simulation:
         raise DivergenceError(message, step=self.steps + 1, time=(self.steps + 1) * self.h,
                               body=self.names[i], partial=self.trajectory())
 
-    def _note_events(self, touching: set) -> None:
-        for body, other in sorted(touching - self._touching):
-            kind = "wall" if other[:1] in "xyz" and other[1:] in ("-", "+") \
-                and other not in self.names else "body"
-            self.events.append(Event(kind=kind, step=self.steps, time=self.t, body=body,
-                                     other=other))
+    def _note_events(self, touching: set[Contact]) -> None:
+        """An event for each contact that began in this step (in the order of
+        the bodies' and the others' names, so that runs compare)."""
+        for contact in sorted(touching - self._touching, key=lambda c: (c.body, c.other)):
+            self.events.append(Event(kind=contact.kind, step=self.steps, time=self.t,
+                                     body=contact.body, other=contact.other))
         self._touching = touching
 
     # -- frames ---------------------------------------------------------------------------
@@ -591,15 +635,16 @@ class Simulation:
         ran = tuple(s for s in self.stages)
         return Trajectory(t=t, position=x, velocity=v, angular_velocity=w, orientation=R,
                           names=self.names, events=list(self.events), stages=ran,
-                          stage_seconds=dict(self.stage_seconds),
+                          stage_seconds=dict(self.timer.seconds),
                           settings=dict(settings or self._settings()))
 
     def _settings(self) -> dict:
         s = self.scene
         return {"solver": s.integration.solver, "step": self.h,
                 "rotation": self.rotation, "body_response": self.body_response,
-                "collision_level": self.level, "aabb": s.collision.aabb,
-                "wall_speed": self.wall_speed, "boxes": self.boxes, "steps": self.steps}
+                "wall_response": self.wall_response, "collision_level": self.level,
+                "aabb": s.collision.aabb, "wall_speed": self.wall_speed, "boxes": self.boxes,
+                "kernel": self.kernel, "steps": self.steps}
 
 
 def default_every(n_steps: int) -> int:

@@ -1,4 +1,6 @@
-"""Translational response of a body to the walls of the world cube (seed S7).
+"""Translational response to the walls of the world cube (seed S7), for a
+body's box and for point masses (the particle system, S10): one law, with
+the wall-speed option for both.
 
 The seed: "Using the current axis-aligned bounding box that surrounds the
 object, we simply handle each component (or dimension) separately as a one
@@ -17,11 +19,13 @@ So, for each axis k whose wall the box crosses (detection:
 3. damp the lateral parts: ``v_j <- kFriction v_j`` for the two other axes,
    ``kFriction = 1 - friction`` (``world.friction``).
 
-The particle system does the same to points
-(:func:`refsim.particles.walls.wall_response`). AMBIGUITY (A8): as there, the
-velocity is flipped whenever the box is beyond the wall, without asking
-whether it still moves outward (the seed's words: "push it back ... and flip
-the velocity").
+For a point (a particle) the "box" is the point itself:
+:func:`wall_response_points` and its in-place twin
+:func:`wall_response_points_inplace` apply the same rule, with the same wall
+speed, to N points at once; a point on the wall (``x == -half_size``) is
+inside. AMBIGUITY (A8): the velocity is flipped whenever the box (or point)
+is beyond the wall, without asking whether it still moves outward (the
+seed's words: "push it back ... and flip the velocity").
 
 Energy of the push-back. The push-back is a discretization artefact: the
 body reached the wall some time during the step and is found past it by
@@ -48,12 +52,17 @@ Reference: Newton's restitution law ``v_n' = -e v_n`` as in B. Mirtich,
 *Impulse-based Dynamic Simulation of Rigid Body Systems*, PhD thesis, UC
 Berkeley 1996, chapter 3; the lateral scaling is the seed's simplification.
 
-Cost: O(1) per crossed wall.
+Cost: O(1) per crossed wall of a body; for N points O(N) comparisons per
+axis and wall (the in-place kernel first checks the whole array's min and
+max and stops there when nothing is beyond) plus O(N) masked updates for
+each wall that was hit (no allocation).
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from refsim.errors import check_option
 
 SPEEDS = ("wall", "seed")
 _LATERAL = ((1, 2), (0, 2), (0, 1))          # the two other axes of each axis
@@ -97,8 +106,7 @@ def wall_response_seed(x: np.ndarray, v: np.ndarray, correction: np.ndarray,
     -------
     (x, v) : new (3,) arrays.
     """
-    if speed not in SPEEDS:
-        raise ValueError(f"speed must be one of {SPEEDS}, got {speed!r}")
+    check_option("speed", speed, SPEEDS)
     x = np.array(x, dtype=np.float64)
     v = np.array(v, dtype=np.float64)
     k_friction = 1.0 - friction                              # the seed's kFriction
@@ -118,3 +126,77 @@ def wall_name(axis: int, correction_k: float) -> str:
     """``"x-"``, ``"y+"``, ...: the wall a push-back of this sign came from
     (a positive correction pushes away from the low wall)."""
     return "xyz"[axis] + ("-" if correction_k > 0 else "+")
+
+
+def wall_response_points(x: np.ndarray, v: np.ndarray, half_size: float, restitution: float,
+                         friction: float, gravity: float = 0.0, speed: str = "wall"
+                         ) -> tuple[np.ndarray, np.ndarray, int]:
+    """The per-axis response of N points (N, 3): new positions and velocities,
+    and the number of (point, wall) bounces handled. The plain kernel: for
+    each axis, the low wall then the high one, each point beyond it pushed
+    back onto it, its normal speed (at the wall, or the seed's literal one)
+    flipped and damped by ``e``, its lateral speed damped by ``kFriction``."""
+    check_option("speed", speed, SPEEDS)
+    x = x.copy()
+    v = v.copy()
+    bounces = 0
+    k_friction = 1.0 - friction
+    for axis in range(3):
+        a_k = -gravity if axis == 1 else 0.0
+        for wall in (-half_size, half_size):
+            beyond = x[:, axis] < wall if wall < 0 else x[:, axis] > wall
+            for i in np.flatnonzero(beyond):
+                correction = wall - x[i, axis]
+                x[i, axis] = wall                           # push back along this axis only
+                v_k = v[i, axis]
+                if speed == "wall":
+                    v_k = wall_speed(v_k, a_k, correction)
+                v[i, axis] = -restitution * v_k             # flip, damp the normal part
+                for lateral in _LATERAL[axis]:
+                    v[i, lateral] = k_friction * v[i, lateral]   # kFriction
+                bounces += 1
+    return x, v, bounces
+
+
+def wall_response_points_inplace(x: np.ndarray, v: np.ndarray, half_size: float,
+                                 restitution: float, friction: float, beyond: np.ndarray,
+                                 gravity: float = 0.0, speed: str = "wall",
+                                 scratch: np.ndarray | None = None) -> int:
+    """:func:`wall_response_points` on ``x`` and ``v`` in place: the same
+    arithmetic, masked. ``beyond`` is an (N,) bool scratch array, and
+    ``scratch`` an (N,) float one (needed for ``speed="wall"``). Returns the
+    number of bounces."""
+    # Two contiguous reductions decide "no point beyond any wall" (the usual
+    # case) at a third of the cost of the six strided column tests.
+    if x.min() >= -half_size and x.max() <= half_size:
+        return 0
+    bounces = 0
+    k_friction = 1.0 - friction
+    for axis in range(3):
+        a_k = -gravity if axis == 1 else 0.0
+        for wall in (-half_size, half_size):
+            if wall < 0:
+                np.less(x[:, axis], wall, out=beyond)
+            else:
+                np.greater(x[:, axis], wall, out=beyond)
+            if not beyond.any():
+                continue
+            # Masked in-place ufuncs: no index arrays, no O(hits) temporaries.
+            v_k = v[:, axis]
+            if speed == "wall":
+                # wall_speed, masked: copysign(sqrt(max(v^2 + (2 a) (wall - x), 0)), v),
+                # the push-back (wall - x) taking x's column until x is set to the wall
+                s, c = scratch, x[:, axis]
+                np.multiply(v_k, v_k, out=s, where=beyond)
+                np.subtract(wall, c, out=c, where=beyond)
+                np.multiply(c, 2.0 * a_k, out=c, where=beyond)
+                np.add(s, c, out=s, where=beyond)
+                np.maximum(s, 0.0, out=s, where=beyond)
+                np.sqrt(s, out=s, where=beyond)
+                np.copysign(s, v_k, out=v_k, where=beyond)
+            np.copyto(x[:, axis], wall, where=beyond)
+            np.multiply(v_k, -restitution, out=v_k, where=beyond)
+            for lateral in _LATERAL[axis]:
+                np.multiply(v[:, lateral], k_friction, out=v[:, lateral], where=beyond)
+            bounces += int(np.count_nonzero(beyond))
+    return bounces

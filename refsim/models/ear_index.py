@@ -140,6 +140,7 @@ from typing import NamedTuple
 import numpy as np
 
 from refsim.collision.predicates import O2D_ERRBOUND_A
+from refsim.kernels import choose_kernel
 
 #: Corners per leaf of the k-d tree. Smaller leaves prune closer to the
 #: triangle but cost more nodes per query; on the 100 000-corner benchmark
@@ -541,12 +542,10 @@ def clip_ears(xs, ys, marked, tree, ring, best, out, work):
 
 @functools.cache
 def compiled_kernels():
-    """``(build_tree, clip_ears)`` compiled by numba, or None without a
-    usable numba (see :mod:`refsim.models._numba_kernels`)."""
-    try:
-        from refsim.models import _numba_kernels as nk
-    except ImportError:
-        return None
+    """``(build_tree, clip_ears)`` compiled by numba from this module's
+    source (:mod:`refsim.models._numba_kernels`)."""
+    from refsim.models import _numba_kernels as nk
+
     return nk.build_tree, nk.clip_ears
 
 
@@ -563,20 +562,22 @@ def shared_points(xs, ys) -> np.ndarray:
     return shared
 
 
-def clip_indexed(xs, ys, *, compiled: bool = True, work=None) -> np.ndarray:
+def clip_indexed(xs, ys, *, kernel: str | None = None, work=None) -> np.ndarray:
     """Ear-clip projected corners ``xs, ys`` (k,), ``k >= 4``, CCW, |coordinates|
     < 1: the (k - 2, 3) int64 triangles of the specification.
 
-    ``compiled=True`` runs the numba build of this module's source (the plain
-    Python source without numba); ``compiled=False`` runs the source as
-    Python. ``work``, if given, is an int64 array (4,) that receives the
-    counters of :func:`clip_ears`.
+    ``kernel`` (:mod:`refsim.kernels`): "compiled" runs the numba build of
+    this module's source, "readable" the source as Python. ``work``, if
+    given, is an int64 array (4,) that receives the counters of
+    :func:`clip_ears`.
     """
     xs = np.ascontiguousarray(xs, dtype=np.float64)
     ys = np.ascontiguousarray(ys, dtype=np.float64)
     k = len(xs)
-    kernels = compiled_kernels() if compiled else None
-    build, clip = kernels if kernels is not None else (build_tree, clip_ears)
+    if choose_kernel(kernel) == "compiled":
+        build, clip = compiled_kernels()
+    else:
+        build, clip = build_tree, clip_ears
     room = 2 * k
     perm = np.arange(k, dtype=np.int64)
     leaf = np.empty(k, np.int64)

@@ -140,12 +140,12 @@ def ear_clip_reference(points) -> np.ndarray:
     return _clip_by_walking(xs.tolist(), ys.tolist())
 
 
-def ear_clip_indexed(points, *, compiled: bool = True, work=None) -> np.ndarray:
+def ear_clip_indexed(points, *, kernel: str | None = None, work=None) -> np.ndarray:
     """:func:`ear_clip_reference`'s triangles by the indexed clipping of
     :mod:`refsim.models.ear_index`: O(k log k) for typical polygons.
 
-    ``compiled=True`` runs numba's build of that module's source (plain
-    Python without numba), ``compiled=False`` the source as Python.
+    ``kernel`` (:mod:`refsim.kernels`): "compiled" runs numba's build of that
+    module's source, "readable" the source as Python.
     ``work``, if given, is an int64 array (4,) that receives the counters of
     :func:`refsim.models.ear_index.clip_ears` (zeros for the fan and the
     triangle, which clip nothing). Same parameters, result and errors as
@@ -158,7 +158,7 @@ def ear_clip_indexed(points, *, compiled: bool = True, work=None) -> np.ndarray:
     plane = project_polygon(p)
     if plane is None:
         return _fan(k)
-    return clip_indexed(*plane, compiled=compiled, work=work)
+    return clip_indexed(*plane, kernel=kernel, work=work)
 
 
 def project_polygon(p: np.ndarray):

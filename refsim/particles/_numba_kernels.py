@@ -10,7 +10,7 @@ particle's position and velocity once and writes them once.
 Same arithmetic, operation for operation, as
 :meth:`refsim.particles.system.ParticleSystem.step` with the Euler tableau
 (b = 1, so ``h * b`` is ``h`` exactly) and
-:func:`refsim.particles.walls.wall_response_inplace`: the drag product
+:func:`refsim.dynamics.walls.wall_response_points_inplace`: the drag product
 ``v * (-k/m)`` (quadratic: ``v * (|v| * (-k/m))`` with ``|v|`` summed
 ``(vx vx + vy vy) + vz vz``), gravity subtracted from the y component,
 ``x + v h`` and ``v + a h``, then for axis 0, 1, 2 the low wall and then
@@ -31,8 +31,13 @@ import numpy as np
 
 @numba.njit(cache=True)
 def euler_step_fused(x, v, h, gravity, rate, quadratic, walls, half_size, restitution,
-                     k_friction):
-    """One Euler step of all particles, in place; returns the wall hits."""
+                     k_friction, at_wall):
+    """Mirrors :meth:`refsim.particles.system.ParticleSystem.step` with the
+    Euler tableau: :func:`refsim.dynamics.forces.acceleration_into`, the
+    solver's update and :func:`refsim.dynamics.walls.wall_response_points_inplace`
+    (``at_wall``: the wall speed "wall", else the seed's literal one).
+
+    One Euler step of all particles, in place; returns the wall hits."""
     n = x.shape[0]
     bounces = 0
     for i in range(n):
@@ -51,7 +56,7 @@ def euler_step_fused(x, v, h, gravity, rate, quadratic, walls, half_size, restit
             # the order of wall_response_inplace
             p = np.array([px, py, pz])
             u = np.array([ux, uy, uz])
-            bounces += _walls(p, u, half_size, restitution, k_friction)
+            bounces += _walls(p, u, half_size, restitution, k_friction, gravity, at_wall)
             px, py, pz = p[0], p[1], p[2]
             ux, uy, uz = u[0], u[1], u[2]
         x[i, 0], x[i, 1], x[i, 2] = px, py, pz
@@ -60,14 +65,19 @@ def euler_step_fused(x, v, h, gravity, rate, quadratic, walls, half_size, restit
 
 
 @numba.njit(cache=True)
-def _walls(p, u, half_size, restitution, k_friction):
-    """Axis 0, 1, 2; the low wall, then the high one (strict comparisons)."""
+def _walls(p, u, half_size, restitution, k_friction, gravity, at_wall):
+    """Axis 0, 1, 2; the low wall, then the high one (strict comparisons);
+    the speed at the wall as :func:`refsim.dynamics.walls.wall_speed` writes it."""
     bounces = 0
     for axis in range(3):
+        a_k = -gravity if axis == 1 else 0.0
         for side in range(2):
             wall = -half_size if side == 0 else half_size
             beyond = p[axis] < wall if side == 0 else p[axis] > wall
             if beyond:
+                if at_wall:
+                    squared = u[axis] * u[axis] + 2.0 * a_k * (wall - p[axis])
+                    u[axis] = np.copysign(np.sqrt(max(squared, 0.0)), u[axis])
                 p[axis] = wall
                 u[axis] = u[axis] * -restitution
                 for lateral in range(3):

@@ -20,10 +20,11 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from refsim.dynamics.forces import DRAG_MODELS
+from refsim.dynamics.walls import SPEEDS
 from refsim.errors import SceneError
 from refsim.limits import MAX_MAGNITUDE, MAX_PARTICLES, MIN_POSITIVE
-
-DRAG_MODELS = ("linear", "quadratic")
+from refsim.scenes.world import IntegrationConfig, WorldConfig
 
 
 @dataclass(frozen=True)
@@ -58,6 +59,10 @@ class ParticleConfig:
         ``kFriction = 1 - friction``.
     half_size : float
         The world cube spans ``[-half_size, half_size]`` on each axis.
+    wall_speed : {"wall", "seed"}
+        The normal speed a bounce flips: at the wall (energy-consistent,
+        DEVIATION D1) or the seed's literal one
+        (:mod:`refsim.dynamics.walls`, the same law as the bodies').
     walls : bool
         False turns the wall response off (a free particle system, used to
         measure the solvers alone).
@@ -73,16 +78,18 @@ class ParticleConfig:
     box_hi: tuple = (1.0, 1.0, 1.0)
     speed_min: float = 0.0
     speed_max: float = 5.0
-    gravity: float = 9.81
-    drag: float = 0.0
-    drag_model: str = "linear"
+    # the world's and the integration's, with their defaults (refsim.scenes.world)
+    gravity: float = WorldConfig.gravity
+    drag: float = WorldConfig.drag
+    drag_model: str = WorldConfig.drag_model
     mass: float = 1.0
-    restitution: float = 0.8
-    friction: float = 0.0
-    half_size: float = 5.0
+    restitution: float = WorldConfig.restitution
+    friction: float = WorldConfig.friction
+    half_size: float = WorldConfig.half_size
+    wall_speed: str = WorldConfig.wall_speed
     walls: bool = True
-    solver: str = "rk4"
-    step: float = 0.001
+    solver: str = IntegrationConfig.solver
+    step: float = IntegrationConfig.step
 
     def __post_init__(self):
         def bad(field, message):
@@ -133,6 +140,9 @@ class ParticleConfig:
         if self.drag_model not in DRAG_MODELS:
             bad("drag_model", f"expected one of {', '.join(DRAG_MODELS)}, "
                 f"got {self.drag_model!r}")
+        if self.wall_speed not in SPEEDS:
+            bad("wall_speed", f"expected one of {', '.join(SPEEDS)}, "
+                f"got {self.wall_speed!r}")
         number("mass", lo=0.0, lo_open=True)
         number("restitution", lo=0.0, hi=1.0)
         number("friction", lo=0.0, hi=1.0)

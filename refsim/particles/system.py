@@ -3,8 +3,8 @@
 What: positions and velocities of N particles as one float64 array ``Y`` of
 shape (2, N, 3) (structure of arrays: ``Y[0]`` positions, ``Y[1]``
 velocities), advanced by an explicit Runge-Kutta step of
-``Y' = (v, a(v))`` (:mod:`refsim.particles.forces`), followed by the wall
-response (:mod:`refsim.particles.walls`), as the seed advances every body.
+``Y' = (v, a(v))`` (:mod:`refsim.dynamics.forces`), followed by the wall
+response (:mod:`refsim.dynamics.walls`), as the seed advances every body.
 
 Seed section: S10, with S5 forces, S6 solvers and S7 walls.
 
@@ -21,7 +21,7 @@ RK4: 6 state-sized arrays in all, 48 bytes each per particle.
 
 The fast path here does the same arithmetic in the same order as the plain
 path (:func:`plain_step`: :func:`refsim.solvers.explicit_rk.rk_step` on the
-flattened state, then :func:`refsim.particles.walls.wall_response`), so the
+flattened state, then :func:`refsim.dynamics.walls.wall_response_points`), so the
 two agree to the last bit; the tests check that.
 """
 
@@ -29,10 +29,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from refsim.errors import DivergenceError, StateError, check_count, check_option
+from refsim.dynamics.forces import acceleration, acceleration_into
+from refsim.dynamics.walls import wall_response_points, wall_response_points_inplace
+from refsim.errors import DivergenceError, OptionError, StateError, check_count
+from refsim.kernels import choose_kernel
 from refsim.particles.config import ParticleConfig
-from refsim.particles.forces import acceleration, acceleration_into
-from refsim.particles.walls import wall_response, wall_response_inplace
 from refsim.solvers.integrate import resolve_method
 
 
@@ -58,7 +59,8 @@ def plain_step(config: ParticleConfig, x: np.ndarray, v: np.ndarray, t: float = 
     y = resolve_method(config.solver).step(particle_rhs(config, n), t, y, config.step)
     x, v = y.reshape(2, n, 3)
     if config.walls:
-        x, v, _ = wall_response(x, v, config.half_size, config.restitution, config.friction)
+        x, v, _ = wall_response_points(x, v, config.half_size, config.restitution,
+                                       config.friction, config.gravity, config.wall_speed)
     return x, v
 
 
@@ -122,6 +124,9 @@ class ParticleSystem:
         self._product = np.empty((2, n, 3), dtype=np.float64)         # (h a_ij) k_j scratch
         self._speed = np.empty(n, dtype=np.float64)                    # |v| for quadratic drag
         self._beyond = np.empty(n, dtype=bool)                        # wall-test mask
+        # the normal speed at the wall (wall_speed "wall"): an (N,) scratch
+        self._wall_scratch = (np.empty(n, dtype=np.float64)
+                              if self.config.wall_speed == "wall" else None)
 
     @property
     def count(self) -> int:
@@ -138,8 +143,9 @@ class ParticleSystem:
     def buffer_bytes(self) -> int:
         """Bytes held by the step buffers (not counting the state)."""
         arrays = [self._K, self._product, self._speed, self._beyond]
-        if self._stage is not None:
-            arrays.append(self._stage)
+        for optional in (self._stage, self._wall_scratch):
+            if optional is not None:
+                arrays.append(optional)
         return sum(a.nbytes for a in arrays)
 
     def _derivative_into(self, Y: np.ndarray, out: np.ndarray) -> None:
@@ -159,7 +165,7 @@ class ParticleSystem:
             Y_next = Y + (h b_1) k_1 + ... + (h b_s) k_s
         """
         h = self.config.step
-        if self.kernel == "fused":
+        if self.kernel == "compiled":
             self._step_fused(h)
             return
         A, b = self.method.A_, self.method.b_
@@ -184,14 +190,15 @@ class ParticleSystem:
                 np.add(Y, scratch, out=Y)
         if self.config.walls:
             c = self.config
-            self.bounces += wall_response_inplace(Y[0], Y[1], c.half_size, c.restitution,
-                                                  c.friction, self._beyond)
+            self.bounces += wall_response_points_inplace(
+                Y[0], Y[1], c.half_size, c.restitution, c.friction, self._beyond, c.gravity,
+                c.wall_speed, self._wall_scratch)
         self.t += h
         self.steps += 1
         self.nfev += self.method.stages
 
     def _step_fused(self, h: float) -> None:
-        """The Euler step as one compiled loop (``kernel="fused"``): the same
+        """The Euler step as one compiled loop (``kernel="compiled"``): the same
         bits as the generic step above, in one pass over the state."""
         from refsim.particles._numba_kernels import euler_step_fused
 
@@ -199,7 +206,7 @@ class ParticleSystem:
         self.bounces += euler_step_fused(
             self.state[0], self.state[1], h, c.gravity, c.drag / c.mass,
             c.drag_model == "quadratic", c.walls, c.half_size, c.restitution,
-            1.0 - c.friction)
+            1.0 - c.friction, c.wall_speed == "wall")
         self.t += h
         self.steps += 1
         self.nfev += 1
@@ -236,24 +243,16 @@ class ParticleSystem:
         return self.config.mass * self.config.gravity * float(self.positions[:, 1].sum())
 
 
-KERNELS = ("numpy", "fused")
-
-
 def _choose_kernel(kernel: str | None, method) -> str:
-    """"numpy": the generic step over the tableau (any solver). "fused": the
-    Euler step compiled into one loop (solver "euler" only, needs numba).
-    Default: "fused" for Euler when numba is installed, else "numpy"."""
-    if kernel is not None:
-        check_option("kernel", kernel, KERNELS)
+    """"readable": the generic step over the tableau (any solver).
+    "compiled": the Euler step fused into one compiled loop (solver "euler"
+    only). Default: "compiled" for Euler where numba works, else "readable"
+    (:mod:`refsim.kernels`)."""
     euler = method.name == "euler"
-    if kernel == "fused" and not euler:
-        raise StateError(f"kernel 'fused' is the Euler step only, not {method.name!r}")
-    if kernel is None:
-        if not euler:
-            return "numpy"
-        try:
-            import refsim.particles._numba_kernels  # noqa: F401
-        except ImportError:
-            return "numpy"
-        return "fused"
+    if kernel is None and not euler:
+        return "readable"
+    kernel = choose_kernel(kernel)
+    if kernel == "compiled" and not euler:
+        raise OptionError(f"kernel 'compiled' is the fused Euler step only, not "
+                          f"{method.name!r}")
     return kernel

@@ -100,7 +100,7 @@ def scene_from_dict(data: dict, path: Path | None = None) -> Scene:
         if not isinstance(raw, dict):
             raise SceneError("must be a table", path, where)
         values = _read_fields(raw, BODY_FIELDS, where, path)
-        values["name"] = values["name"] or f"body{i}"
+        values["name"] = values.get("name") or f"body{i}"
         values["model"] = _resolve_model(values["model"], path, f"{where}.model")
         bodies.append(BodyConfig(**values))
     names = [b.name for b in bodies]
@@ -163,10 +163,9 @@ def _read_fields(raw: dict, fields: tuple[Field, ...], where: str, path) -> dict
     values = {}
     for f in fields:
         key = f"{where}.{f.name}"
-        if f.name not in raw:
+        if f.name not in raw:                 # the config dataclass's default
             if f.required:
                 raise SceneError("required key is missing", path, key)
-            values[f.name] = f.default
             continue
         value = _convert(raw[f.name], f.kind, path, key)
         if f.check is not None:

@@ -32,16 +32,18 @@ from typing import Any
 
 import numpy as np
 
+from refsim.dynamics.forces import DRAG_MODELS
 from refsim.limits import MIN_POSITIVE
 from refsim.particles.config import ParticleConfig
-from refsim.solvers.integrate import whole_steps
+from refsim.scenes.world import IntegrationConfig, WorldConfig
 
 SOLVER_NAMES = ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4")
 COLLISION_LEVELS = ("none", "sphere", "aabb", "triangle-aabb", "exact")
 AABB_MODES = ("linear", "incremental", "auto")
 ROTATION_MODELS = ("off", "seed", "impulse")
 RESPONSE_MODELS = ("off", "seed", "impulse")
-DRAG_MODELS = ("linear", "quadratic")
+WALL_RESPONSES = ("auto", "seed", "impulse")
+WALL_SPEEDS = ("wall", "seed")
 
 #: A body's starting box may stick out of the world cube by this fraction of
 #: the cube's half size: the rounding of a position written as
@@ -50,28 +52,6 @@ START_INSIDE_RTOL = 1e-9
 
 
 # -- the configuration objects -------------------------------------------------
-
-
-@dataclass(frozen=True)
-class WorldConfig:
-    half_size: float = 5.0
-    gravity: float = 9.81
-    drag: float = 0.0
-    drag_model: str = "linear"
-    restitution: float = 0.8
-    friction: float = 0.0
-
-
-@dataclass(frozen=True)
-class IntegrationConfig:
-    solver: str = "rk4"
-    step: float = 0.001
-    duration: float = 5.0
-
-    @property
-    def n_steps(self) -> int:
-        """The whole number of steps in ``duration`` (the loader checks it is one)."""
-        return whole_steps(self.duration, self.step)
 
 
 @dataclass(frozen=True)
@@ -84,6 +64,7 @@ class CollisionConfig:
 class DynamicsConfig:
     rotation: str = "seed"
     body_response: str = "seed"
+    wall_response: str = "auto"
 
 
 @dataclass(frozen=True)
@@ -131,7 +112,8 @@ Check = Callable[[Any], str | None]
 
 @dataclass(frozen=True)
 class Field:
-    """One key: its kind ("float", "str", "vec3", "mat3"), default and check.
+    """One key: its kind ("float", "str", "vec3", "mat3") and check. Its
+    default is the configuration dataclass's (one place for every default).
 
     ``check`` returns None when the (already type-checked) value is allowed,
     or a phrase saying what is required.
@@ -139,7 +121,6 @@ class Field:
 
     name: str
     kind: str
-    default: Any = None
     check: Check | None = None
     required: bool = False
 
@@ -178,38 +159,39 @@ def orthonormal(value) -> str | None:
 
 TABLES: dict[str, tuple[type, tuple[Field, ...]]] = {
     "world": (WorldConfig, (
-        Field("half_size", "float", 5.0, positive),
-        Field("gravity", "float", 9.81, non_negative),
-        Field("drag", "float", 0.0, non_negative),
-        Field("drag_model", "str", "linear", one_of(*DRAG_MODELS)),
-        Field("restitution", "float", 0.8, unit_interval),
-        Field("friction", "float", 0.0, unit_interval),
+        Field("half_size", "float", positive),
+        Field("gravity", "float", non_negative),
+        Field("drag", "float", non_negative),
+        Field("drag_model", "str", one_of(*DRAG_MODELS)),
+        Field("restitution", "float", unit_interval),
+        Field("friction", "float", unit_interval),
+        Field("wall_speed", "str", one_of(*WALL_SPEEDS)),
     )),
     "integration": (IntegrationConfig, (
-        Field("solver", "str", "rk4", one_of(*SOLVER_NAMES)),
-        Field("step", "float", 0.001, positive),
-        Field("duration", "float", 5.0, positive),
+        Field("solver", "str", one_of(*SOLVER_NAMES)),
+        Field("step", "float", positive),
+        Field("duration", "float", positive),
     )),
     "collision": (CollisionConfig, (
-        Field("level", "str", "exact", one_of(*COLLISION_LEVELS)),
-        Field("aabb", "str", "auto", one_of(*AABB_MODES)),
+        Field("level", "str", one_of(*COLLISION_LEVELS)),
+        Field("aabb", "str", one_of(*AABB_MODES)),
     )),
     "dynamics": (DynamicsConfig, (
-        Field("rotation", "str", "seed", one_of(*ROTATION_MODELS)),
-        Field("body_response", "str", "seed", one_of(*RESPONSE_MODELS)),
+        Field("rotation", "str", one_of(*ROTATION_MODELS)),
+        Field("body_response", "str", one_of(*RESPONSE_MODELS)),
+        Field("wall_response", "str", one_of(*WALL_RESPONSES)),
     )),
 }
 
 BODY_FIELDS: tuple[Field, ...] = (
-    Field("name", "str", None),
-    Field("model", "str", None, required=True),
-    Field("position", "vec3", (0.0, 0.0, 0.0)),
-    Field("velocity", "vec3", (0.0, 0.0, 0.0)),
-    Field("angular_velocity", "vec3", (0.0, 0.0, 0.0)),
-    Field("orientation", "mat3", ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)),
-          orthonormal),
-    Field("mass", "float", 1.0, positive),
-    Field("scale", "float", 1.0, positive),
+    Field("name", "str"),
+    Field("model", "str", required=True),
+    Field("position", "vec3"),
+    Field("velocity", "vec3"),
+    Field("angular_velocity", "vec3"),
+    Field("orientation", "mat3", orthonormal),
+    Field("mass", "float", positive),
+    Field("scale", "float", positive),
 )
 
 #: ParticleConfig fields that other tables set, and the scene key of each.
@@ -220,6 +202,7 @@ PARTICLE_FIELDS_FROM: dict[str, str] = {
     "drag_model": "world.drag_model",
     "restitution": "world.restitution",
     "friction": "world.friction",
+    "wall_speed": "world.wall_speed",
     "half_size": "world.half_size",
     "solver": "integration.solver",
     "step": "integration.step",

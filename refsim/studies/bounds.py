@@ -32,8 +32,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from refsim.bounds.aabb_incremental import IncrementalAABB, numba_available
+from refsim.bounds.aabb_incremental import IncrementalAABB
 from refsim.bounds.aabb_linear import LinearAABB, aabb_linear
+from refsim.kernels import numba_usable
 from refsim.models import shapes
 from refsim.models.mesh import Mesh
 from refsim.types import as_pose, random_rotation, rotation_about_axis, transform_points
@@ -88,9 +89,16 @@ def pose_sequence(frames: int, motion: str = "coherent", *, degrees_per_frame: f
     return [(r, translation.copy()) for r in rotations]
 
 
+#: The kernel (:mod:`refsim.kernels`) behind each method label's second word.
+METHOD_KERNELS = {"numpy": "readable", "python": "readable", "numba": "compiled",
+                  "readable": "readable", "compiled": "compiled"}
+
+
 def make_method(mesh: Mesh, method: str, *, allow_nonconvex: bool = False):
-    """The box updater named by ``method`` (one of ``METHODS``)."""
-    kind, kernel = method.split("-")
+    """The box updater named by ``method`` (one of ``METHODS``: the scan or
+    the incremental tracker, on the readable or the compiled kernel)."""
+    kind, label = method.split("-")
+    kernel = METHOD_KERNELS[label]
     if kind == "scan":
         return LinearAABB(mesh, kernel=kernel)
     return IncrementalAABB(mesh, kernel=kernel, allow_nonconvex=allow_nonconvex)
@@ -169,7 +177,7 @@ def measure_update_cost(meshes=None, *, motions=("coherent", "jump"), methods=No
     if meshes is None:
         meshes = sweep_meshes()
     if methods is None:
-        methods = METHODS if numba_available() else ("scan-numpy", "incremental-python")
+        methods = METHODS if numba_usable() else ("scan-numpy", "incremental-python")
     rows = []
     for motion in motions:
         poses = [as_pose(p) for p in pose_sequence(
@@ -340,11 +348,11 @@ from refsim.bounds.aabb_linear import aabb_linear
 from refsim.models.shapes import geodesic_sphere
 from refsim.types import rotation_about_axis
 mesh = geodesic_sphere(10)
-tracker = IncrementalAABB(mesh, kernel="numba")
+tracker = IncrementalAABB(mesh, kernel="compiled")
 poses = [(rotation_about_axis([1.0, 2.0, 3.0], np.radians(i)), np.zeros(3)) for i in range(50)]
 t2 = time.perf_counter()
 tracker.update(poses[0]); tracker.update(poses[1])
-aabb_linear(mesh, poses[0], kernel="numba")
+aabb_linear(mesh, poses[0], kernel="compiled")
 t3 = time.perf_counter()
 steady = []
 for pose in poses[2:]:

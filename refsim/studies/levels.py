@@ -46,8 +46,8 @@ import numpy as np
 
 from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
-from refsim.collision.bvh import default_kernel
 from refsim.collision.spheres import bounding_sphere
+from refsim.kernels import choose_kernel
 from refsim.studies.triangles import DISAGREEMENT_KINDS, _strict_crossing, classify_disagreement
 from refsim.types import Pose, random_rotation, rotation_about_axis
 
@@ -329,7 +329,7 @@ def measure_levels(configurations: tuple[Configuration, ...] = CONFIGURATIONS,
     be the same. The random poses (:func:`random_poses`, ``random_per_pair``
     per model pair, seeded) give the rates; they are not timed.
     """
-    kernel = kernel or default_kernel()
+    kernel = choose_kernel(kernel)
     done = []
     for c in configurations:
         mesh_a, mesh_b = c.meshes()
@@ -596,7 +596,7 @@ def measure_body_oracles(collide_engines: tuple = (), pairs_engine=None, *,
     :func:`refsim.studies.triangles.classify_disagreement` on refsim's world
     triangles.
     """
-    kernel = kernel or default_kernel()
+    kernel = choose_kernel(kernel)
     body_rows: dict[tuple[str, str], list] = {}
     pair_rows: dict[str, list] = {}
     for source, case, mesh_a, pose_a, mesh_b, pose_b in _cases(
@@ -757,8 +757,8 @@ start = time.perf_counter()
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 identity = (np.eye(3), np.zeros(3))
 for level in ("triangle-aabb", "exact"):
-    bodies_collide(cube, identity, cube, near, level=level, kernel="numba")
-    intersecting_pairs(cube, identity, cube, near, level=level, kernel="numba")
+    bodies_collide(cube, identity, cube, near, level=level, kernel="compiled")
+    intersecting_pairs(cube, identity, cube, near, level=level, kernel="compiled")
 print(time.perf_counter() - start)
 """
 
@@ -805,7 +805,7 @@ def measure_hierarchy_speed(fcl=None, repeats: int = 21, *,
     ``compile_cost``: also measure the numba compile cost (two fresh
     interpreters for the hierarchy, one for the triangle kernel: ~10 s).
     """
-    kernel = kernel or default_kernel()
+    kernel = choose_kernel(kernel)
     cases = []
     for sc in configurations:
         c = sc.as_configuration()
@@ -835,7 +835,7 @@ def measure_hierarchy_speed(fcl=None, repeats: int = 21, *,
             bvh_boolean_seconds=_median_seconds(
                 functools.partial(bodies_collide, *args, kernel=kernel), repeats),
             fcl_boolean_seconds=fcl_bool))
-    compile_result = measure_compile_cost() if compile_cost and kernel == "numba" else None
+    compile_result = measure_compile_cost() if compile_cost and kernel == "compiled" else None
     return HierarchySpeed(kernel=kernel, repeats=repeats, cases=tuple(cases),
                           compile=compile_result)
 

@@ -43,6 +43,12 @@ from refsim.studies.solvers import WorkPoint, fit_order
 # Resting contact jitter (C6, C7)
 # --------------------------------------------------------------------------
 
+#: The wall law of every particle system these studies build: the seed's own
+#: (its literal normal speed, refsim.dynamics.walls), since C6, C8 and C9 are
+#: claims about the seed's particle system, not about refsim's corrected
+#: wall speed (the scene default, "wall").
+SEED_WALLS = "seed"
+
 
 @dataclass(frozen=True)
 class Jitter:
@@ -81,7 +87,8 @@ def measure_resting_jitter(method: str, h: float, restitution: float = 0.8,
     measure the last ``window`` seconds. Exact rest would give zeros."""
     half_size = 5.0
     config = ParticleConfig(count=1, solver=method, step=h, restitution=restitution,
-                            gravity=gravity, drag=drag, half_size=half_size)
+                            gravity=gravity, drag=drag, half_size=half_size,
+                            wall_speed=SEED_WALLS)
     system = ParticleSystem(config, positions=[[0.0, -half_size, 0.0]],
                             velocities=[[0.0, 0.0, 0.0]])
     steps = round(duration / h)
@@ -304,7 +311,7 @@ def particle_test_config(count: int = 200, walls: bool = False, seed: int = 3) -
     return ParticleConfig(count=count, seed=seed, drag=0.1, drag_model="quadratic",
                           half_size=2.0, box_lo=(-1.5, -1.5, -1.5), box_hi=(1.5, 1.5, 1.5),
                           speed_min=1.0, speed_max=5.0, restitution=0.8, friction=0.1,
-                          walls=walls)
+                          walls=walls, wall_speed=SEED_WALLS)
 
 
 def particle_reference(config: ParticleConfig, t1: float) -> np.ndarray:
@@ -470,7 +477,7 @@ def measure_throughput(count: int, solver: str, repeats: int = 10,
                        drag_model: str = "linear") -> Throughput:
     """Best-of-``repeats`` time of one step and of one streaming pass."""
     config = ParticleConfig(count=count, solver=solver, drag=0.1, drag_model=drag_model,
-                            step=1e-3)
+                            step=1e-3, wall_speed=SEED_WALLS)
     system = ParticleSystem(config)
     scratch = np.empty_like(system.positions)
     best_step = best_stream = math.inf
@@ -668,7 +675,8 @@ def main(argv=None) -> None:
     else:
         for solver in SOLVERS:
             m = measure_step_memory(ParticleConfig(count=100_000, solver=solver, drag=0.1,
-                                                   drag_model="quadratic"), 20)
+                                                   drag_model="quadratic",
+                                                   wall_speed=SEED_WALLS), 20)
             print(f"{solver:16s} peak {m.peak_bytes / 1e6:.2f} MB = {m.state_sized_arrays:.2f} "
                   f"states, {m.bytes_per_particle:.1f} B/particle, transient "
                   f"{m.transient_bytes} B")

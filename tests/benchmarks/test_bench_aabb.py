@@ -19,7 +19,6 @@ import pytest
 from refsim.oracles import OracleUnavailable
 from refsim.oracles.trimesh_adapter import TrimeshOracle
 
-from refsim.bounds.aabb_incremental import numba_available
 from refsim.models import shapes
 from refsim.studies.bounds import make_method, pose_sequence
 from refsim.types import as_pose
@@ -30,8 +29,6 @@ POSES = [as_pose(p) for p in pose_sequence(360, "coherent", degrees_per_frame=1.
 
 
 def _method_or_skip(mesh, method):
-    if method.endswith("numba") and not numba_available():
-        pytest.skip("numba (extra 'fast') not installed")
     tracker = make_method(mesh, method)
     tracker.update_unchecked(*POSES[0])  # the tracker's first scan; numba's compile
     return tracker

@@ -39,7 +39,6 @@ def test_batch(benchmark, pairs):
 
 
 def test_numba(benchmark, pairs):
-    pytest.importorskip("numba", reason="numba (refsim[fast]) is not installed")
     from refsim.collision.triangle_numba import triangles_intersect_numba
 
     A, B, expected = pairs

@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-import importlib
-
 import numpy as np
 import pytest
 
 import refsim
 from properties.strategies import midpoint_subdivision
+from refsim import kernels
 from refsim.bounds.aabb_incremental import (
     IncrementalAABB,
     extreme_vertex_python,
-    numba_available,
 )
 from refsim.bounds.aabb_linear import LinearAABB, aabb_linear
 from refsim.bounds.tracker import make_aabb_tracker
@@ -20,8 +18,7 @@ from refsim.errors import ModelError, RefsimError
 from refsim.models import shapes
 from refsim.studies import bounds as measure
 
-KERNELS = ["python"] + (["numba"] if numba_available() else [])
-needs_numba = pytest.mark.skipif(not numba_available(), reason="numba (extra 'fast') missing")
+KERNELS = ["readable", "compiled"]
 
 IDENTITY = (np.eye(3), np.zeros(3))
 #: Half turn about x, exact: y -> -y, z -> -z.
@@ -56,11 +53,10 @@ def test_sphere_box_equals_scan_bitwise_over_a_turn(kernel, motion):
         assert _same(tracker.update(pose), aabb_linear(mesh, pose))
 
 
-@needs_numba
 def test_kernels_agree_on_boxes_extremes_and_counts():
     mesh = shapes.geodesic_sphere(16)
-    python = IncrementalAABB(mesh, kernel="python")
-    numba = IncrementalAABB(mesh, kernel="numba")
+    python = IncrementalAABB(mesh, kernel="readable")
+    numba = IncrementalAABB(mesh, kernel="compiled")
     for motion in ("coherent", "jump"):
         for pose in measure.pose_sequence(150, motion, degrees_per_frame=3.0, seed=4):
             assert _same(python.update(pose), numba.update(pose))
@@ -189,16 +185,12 @@ def test_visits_per_update_stay_flat_as_the_mesh_grows():
 
 
 def test_without_numba_the_readable_kernel_is_the_default(monkeypatch):
-    # (the package re-exports the functions under the modules' names)
-    incremental = importlib.import_module("refsim.bounds.aabb_incremental")
-    linear = importlib.import_module("refsim.bounds.aabb_linear")
-
-    monkeypatch.setattr(incremental, "numba_available", lambda: False)
-    monkeypatch.setattr(linear, "numba_available", lambda: False)
-    tracker = IncrementalAABB(shapes.icosahedron())
-    assert tracker.kernel == "python"
+    monkeypatch.setattr(kernels, "numba_error", lambda: "ImportError: no numba here")
+    with pytest.warns(kernels.KernelWarning, match="no numba here"):
+        tracker = IncrementalAABB(shapes.icosahedron())
+    assert tracker.kernel == "readable"
     assert _same(tracker.update(IDENTITY), aabb_linear(shapes.icosahedron(), IDENTITY))
     with pytest.raises(RefsimError, match="numba"):
-        IncrementalAABB(shapes.icosahedron(), kernel="numba")
+        IncrementalAABB(shapes.icosahedron(), kernel="compiled")
     with pytest.raises(RefsimError, match="numba"):
-        aabb_linear(shapes.icosahedron(), IDENTITY, kernel="numba")
+        aabb_linear(shapes.icosahedron(), IDENTITY, kernel="compiled")

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 import refsim
-from refsim.bounds.aabb_incremental import numba_available
 from refsim.bounds.aabb_linear import (
     LinearAABB,
     aabb_linear,
@@ -17,8 +16,6 @@ from refsim.bounds.aabb_linear import (
 from refsim.errors import RefsimError, StateError
 from refsim.models import shapes
 from refsim.types import random_rotation, rotation_about_axis, transform_points
-
-needs_numba = pytest.mark.skipif(not numba_available(), reason="numba (extra 'fast') missing")
 
 
 def test_identity_pose_gives_the_body_box():
@@ -51,18 +48,17 @@ def test_rotated_sphere_box_lies_just_inside_the_unit_cube():
     assert (hi > 0.99).all() and (lo < -0.99).all()
 
 
-@needs_numba
 def test_numba_kernel_equals_numpy_bitwise():
     rng = np.random.default_rng(5)
     for mesh in (shapes.geodesic_sphere(7), shapes.torus(), shapes.l_beam()):
         for _ in range(20):
             pose = (random_rotation(rng), rng.uniform(-3.0, 3.0, 3))
             a = aabb_linear(mesh, pose)
-            b = aabb_linear(mesh, pose, kernel="numba")
+            b = aabb_linear(mesh, pose, kernel="compiled")
             assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
 
 
-@pytest.mark.parametrize("kernel", ["numpy"] + (["numba"] if numba_available() else []))
+@pytest.mark.parametrize("kernel", ["readable", "compiled"])
 def test_linear_tracker_matches_function_and_counts_all_vertices(kernel):
     mesh = shapes.geodesic_sphere(5)
     tracker = LinearAABB(mesh, kernel=kernel)

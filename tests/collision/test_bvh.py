@@ -10,18 +10,15 @@ from refsim.bundled import models_dir
 from refsim.collision import bvh
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 from refsim.collision.boxes import (
-    overlapping_pairs_all,
-    overlapping_pairs_sweep,
     triangle_boxes,
     world_vertices,
 )
 from refsim.collision.seed_levels import triangle_box_pairs
 from refsim.errors import StateError
+from refsim.kernels import KERNELS
 from refsim.models import shapes
 from refsim.models.loading import load_model
 from refsim.types import random_rotation, rotation_about_axis
-
-numba = pytest.importorskip("numba", reason="numba (refsim[fast]) is not installed")
 
 SPHERE = load_model(models_dir() / "sphere-2k.ac")
 TORUS = load_model(models_dir() / "torus.ac")
@@ -69,8 +66,8 @@ def test_refit_is_the_exact_union_of_triangle_boxes():
 def test_compiled_prepare_equals_readable_bit_for_bit():
     rng = np.random.default_rng(5)
     for pose in _random_poses(rng, 5, 3.0):
-        fast = bvh.prepare_body(TORUS, pose, "numba")
-        slow = bvh.prepare_body(TORUS, pose, "python")
+        fast = bvh.prepare_body(TORUS, pose, "compiled")
+        slow = bvh.prepare_body(TORUS, pose, "readable")
         for name in ("world", "lo", "hi", "tri_lo", "tri_hi"):
             assert np.array_equal(getattr(fast, name), getattr(slow, name)), name
 
@@ -83,13 +80,13 @@ def test_hierarchy_pairs_equal_the_seed_pairs(mesh_a, mesh_b, spread):
     for pose_b in _random_poses(rng, 6, spread):
         world_a, world_b = world_vertices(mesh_a, IDENTITY), world_vertices(mesh_b, pose_b)
         seed = triangle_box_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces)
-        for kernel in bvh.KERNELS:
+        for kernel in KERNELS:
             pa, pb = (bvh.prepare_body(mesh_a, IDENTITY, kernel),
                       bvh.prepare_body(mesh_b, pose_b, kernel))
             assert np.array_equal(bvh.tree_box_pairs(pa, pb, kernel), seed), kernel
         exact = {kernel: intersecting_pairs(mesh_a, IDENTITY, mesh_b, pose_b, method=method,
                                             kernel=kernel)
-                 for kernel in bvh.KERNELS for method in ("bvh", "seed")}
+                 for kernel in KERNELS for method in ("bvh", "seed")}
         first = next(iter(exact.values()))
         assert all(np.array_equal(first, e) for e in exact.values())
         hits += len(first) > 0
@@ -102,7 +99,7 @@ def test_boolean_queries_agree_with_the_pair_lists():
         pairs = intersecting_pairs(TORUS, IDENTITY, STAR, pose_b)
         boxes = intersecting_pairs(TORUS, IDENTITY, STAR, pose_b, level="triangle-aabb")
         for method in ("bvh", "seed"):
-            for kernel in bvh.KERNELS:
+            for kernel in KERNELS:
                 kw = dict(method=method, kernel=kernel)
                 assert bodies_collide(TORUS, IDENTITY, STAR, pose_b, **kw) == (len(pairs) > 0)
                 assert bodies_collide(TORUS, IDENTITY, STAR, pose_b, level="triangle-aabb",
@@ -113,20 +110,10 @@ def test_face_touching_cubes_collide_exactly():
     cube = load_model(models_dir() / "cube.ac")
     touching = (np.eye(3), np.array([1.0, 0.0, 0.0]))       # faces at x = 0.5 meet
     apart = (np.eye(3), np.array([1.0 + 2.0 ** -40, 0.0, 0.0]))
-    for kernel in bvh.KERNELS:
+    for kernel in KERNELS:
         assert bodies_collide(cube, IDENTITY, cube, touching, kernel=kernel)
         assert not bodies_collide(cube, IDENTITY, cube, apart, kernel=kernel)
         assert len(intersecting_pairs(cube, IDENTITY, cube, touching, kernel=kernel)) > 0
-
-
-def test_sweep_equals_all_pairs():
-    rng = np.random.default_rng(2)
-    for n in (0, 1, 2, 7, 40):
-        lo = rng.integers(-5, 5, (n, 3)).astype(float)       # integers: many exact ties
-        hi = lo + rng.integers(0, 4, (n, 3))
-        expected = overlapping_pairs_all(lo, hi)
-        for axis in range(3):
-            assert np.array_equal(overlapping_pairs_sweep(lo, hi, axis), expected)
 
 
 def test_bad_arguments():

@@ -7,14 +7,11 @@ import pytest
 
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_batch import triangles_intersect_batch
+from refsim.collision.triangle_numba import triangles_intersect_numba  # noqa: E402
 from refsim.errors import StateError
 from refsim.studies.triangles import measure_throughput, near_degenerate_pairs
 
 from .test_triangle import CASES, T
-
-pytest.importorskip("numba", reason="numba (refsim[fast]) is not installed")
-
-from refsim.collision.triangle_numba import triangles_intersect_numba  # noqa: E402
 
 
 def _readable(A, B):

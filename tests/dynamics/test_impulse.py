@@ -43,9 +43,9 @@ def _solve(kernel, ma, Ia, xa, va, wa, mb, Ib, xb, vb, wb, p, n, e, mu):
     return va, wa, vb, wb, P
 
 
-@pytest.mark.parametrize("kernel", ["python", "compiled"])
+@pytest.mark.parametrize("kernel", ["readable", "compiled"])
 def test_momentum_conserved_and_energy_not_increased(kernel):
-    solve = impulse.solve_contacts_python if kernel == "python" else impulse.solve_contacts
+    solve = impulse.solve_contacts_python if kernel == "readable" else impulse.solve_contacts
     rng = np.random.default_rng(2024)
     hits = 0
     for _ in range(200):

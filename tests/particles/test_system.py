@@ -7,11 +7,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from refsim.dynamics.forces import acceleration
+from refsim.dynamics.walls import wall_response_points, wall_response_points_inplace
 from refsim.errors import DivergenceError, StateError
 from refsim.particles.config import ParticleConfig
-from refsim.particles.forces import acceleration
 from refsim.particles.system import ParticleSystem, plain_step
-from refsim.particles.walls import wall_response, wall_response_inplace
 from refsim.solvers.methods import SOLVERS
 
 
@@ -44,18 +44,21 @@ def test_friction_scales_the_lateral_components():
 def test_inside_particles_are_untouched_by_walls():
     x = np.array([[0.0, 5.0, 0.0], [-5.0, 0.0, 4.9]])     # on the wall counts as inside
     v = np.ones((2, 3))
-    x2, v2, bounces = wall_response(x, v, 5.0, 0.8, 0.1)
+    x2, v2, bounces = wall_response_points(x, v, 5.0, 0.8, 0.1, 9.81)
     assert bounces == 0
     np.testing.assert_array_equal(x2, x)
     np.testing.assert_array_equal(v2, v)
 
 
-def test_wall_response_inplace_matches_plain():
+@pytest.mark.parametrize("speed", ["wall", "seed"])
+@pytest.mark.parametrize("gravity", [0.0, 9.81])
+def test_wall_response_inplace_matches_plain(speed, gravity):
     rng = np.random.default_rng(0)
     x = rng.uniform(-1.3, 1.3, (1000, 3))
     v = rng.normal(size=(1000, 3))
-    x_plain, v_plain, n_plain = wall_response(x, v, 1.0, 0.7, 0.2)
-    n_fast = wall_response_inplace(x, v, 1.0, 0.7, 0.2, np.empty(1000, dtype=bool))
+    x_plain, v_plain, n_plain = wall_response_points(x, v, 1.0, 0.7, 0.2, gravity, speed)
+    n_fast = wall_response_points_inplace(x, v, 1.0, 0.7, 0.2, np.empty(1000, dtype=bool),
+                                          gravity, speed, np.empty(1000))
     assert n_fast == n_plain > 0
     np.testing.assert_array_equal(x, x_plain)
     np.testing.assert_array_equal(v, v_plain)
@@ -142,3 +145,19 @@ def test_seed_literal_solver_runs_in_the_particle_system():
         x, v = plain_step(config, x, v)
     assert system.steps == 2 and system.nfev == 8          # four stages a step
     assert np.array_equal(system.positions, x) and np.array_equal(system.velocities, v)
+
+
+def test_the_wall_speed_law_is_the_bodies_law_for_points():
+    # a particle found 0.05 below the floor moving down at 3 m/s under gravity:
+    # "seed" flips the speed it has there; "wall" the speed it had at the wall,
+    # by the same formula the bodies' wall response uses (wall_speed)
+    from refsim.dynamics.walls import wall_speed
+
+    x = np.array([[0.0, -1.05, 0.0]])
+    v = np.array([[0.5, -3.0, 0.0]])
+    _, v_seed, _ = wall_response_points(x, v, 1.0, 0.8, 0.0, 9.81, "seed")
+    _, v_wall, _ = wall_response_points(x, v, 1.0, 0.8, 0.0, 9.81, "wall")
+    assert v_seed[0, 1] == -0.8 * -3.0
+    assert v_wall[0, 1] == -0.8 * wall_speed(-3.0, -9.81, 0.05)
+    # energy along the axis: the speed at the wall is lower by 2 g (0.05)
+    assert v_wall[0, 1] == pytest.approx(0.8 * np.sqrt(9.0 - 2 * 9.81 * 0.05), rel=1e-15)

@@ -211,3 +211,28 @@ def test_a_body_resting_on_the_floor_is_inside(tmp_path):
     scene = load_scene(write(tmp_path, MINIMAL.replace("\n", "\nposition = [0, -4.5, 0]\n",
                                                         1)))
     assert scene.bodies[0].position == (0.0, -4.5, 0.0)
+
+
+def test_the_wall_law_keys_and_their_defaults(tmp_path):
+    from refsim.dynamics.simulation import Simulation, resolve_wall_response
+
+    scene = load_scene(write(tmp_path, MINIMAL))
+    assert scene.world.wall_speed == "wall" and scene.dynamics.wall_response == "auto"
+    assert resolve_wall_response(scene.dynamics) == "seed"        # rotation "seed"
+    impulse = load_scene(write(tmp_path, '[dynamics]\nrotation = "impulse"\n' + MINIMAL))
+    assert resolve_wall_response(impulse.dynamics) == "impulse"
+    chosen = load_scene(write(tmp_path, '[world]\nwall_speed = "seed"\n[dynamics]\n'
+                              'rotation = "impulse"\nwall_response = "seed"\n' + MINIMAL))
+    sim = Simulation(chosen)
+    assert (sim.wall_speed, sim.wall_response) == ("seed", "seed")
+    assert sim.trajectory().settings["wall_response"] == "seed"
+    assert_scene_error(tmp_path, '[world]\nwall_speed = "fast"\n' + MINIMAL,
+                       "world.wall_speed", "must be one of 'wall', 'seed'")
+    assert_scene_error(tmp_path, '[dynamics]\nwall_response = "soft"\n' + MINIMAL,
+                       "dynamics.wall_response", "must be one of")
+
+
+def test_particles_take_the_worlds_wall_speed(tmp_path):
+    text = '[world]\nwall_speed = "seed"\n[particles]\ncount = 5\n'
+    assert load_scene(write(tmp_path, text)).particles.wall_speed == "seed"
+    assert load_scene(write(tmp_path, "[particles]\ncount = 5\n")).particles.wall_speed == "wall"

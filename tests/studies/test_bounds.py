@@ -6,11 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.bounds.aabb_incremental import numba_available
 from refsim.models import shapes
 from refsim.studies import bounds as measure
-
-needs_numba = pytest.mark.skipif(not numba_available(), reason="numba (extra 'fast') missing")
 
 
 def test_perturbed_sphere_is_not_convex_and_keeps_the_sphere_topology():
@@ -82,7 +79,6 @@ def test_incremental_error_on_convex_and_nonconvex_meshes():
     assert not torus.convex and torus.wrong_frames == 0
 
 
-@needs_numba
 def test_numba_compile_cost_is_measured_cold_and_cached():
     cost = measure.measure_numba_compile_cost()
     print(cost)

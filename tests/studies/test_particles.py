@@ -193,23 +193,26 @@ FIXED_OVERHEAD = 32 * 1024
 TRANSIENT_FRACTION = 0.05
 
 
+@pytest.mark.parametrize("wall_speed", ["wall", "seed"])
 @pytest.mark.parametrize("solver", sorted(SOLVERS))
-def test_step_allocates_only_its_stage_buffers(solver):
+def test_step_allocates_only_its_stage_buffers(solver, wall_speed):
     config = ParticleConfig(count=20_000, solver=solver, drag=0.1, drag_model="quadratic",
-                            half_size=1.05)
+                            half_size=1.05, wall_speed=wall_speed)
     m = measure_step_memory(config, 20)
     print(m)
     stages = SOLVERS[solver].stages
     # s stage derivatives + the product scratch (+ the stage state when s > 1),
-    # and the (N,) speed (8 bytes) and wall mask (1 byte) scratch.
+    # and the (N,) speed (8 bytes) and wall mask (1 byte) scratch, and for the
+    # speed at the wall one more (N,) float (8 bytes).
     buffers = stages + 1 + (stages > 1)
-    assert m.buffer_bytes == buffers * m.state_bytes + 9 * config.count
+    per_particle = 9 + (8 if wall_speed == "wall" else 0)
+    assert m.buffer_bytes == buffers * m.state_bytes + per_particle * config.count
     transient_cap = TRANSIENT_FRACTION * m.state_bytes + FIXED_OVERHEAD
     assert m.transient_bytes <= transient_cap
     assert m.peak_bytes <= m.state_bytes + m.buffer_bytes + transient_cap
     if solver == "rk4":
-        # At most six state-sized arrays besides the state itself.
-        assert m.buffer_bytes < 6.2 * m.state_bytes
+        # Six state-sized arrays besides the state itself, and the (N,) scratch.
+        assert m.buffer_bytes - per_particle * config.count == 6 * m.state_bytes
 
 
 @pytest.mark.parametrize("solver", ["euler", "rk4"])

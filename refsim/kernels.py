@@ -1,0 +1,152 @@
+"""The one switch between refsim's readable kernels and their compiled twins.
+
+Every algorithm is written once as a plain, readable kernel. Where the
+interpreter's overhead dominates (tree traversals, hill climbing, per-contact
+loops, many small steps), numba compiles a twin that does the same arithmetic
+in the same order, so the two agree bit for bit (DESIGN.md, Speed). Each
+public function that has both takes ``kernel=`` with one vocabulary:
+
+- ``"readable"``: the plain kernel, always available;
+- ``"compiled"``: the numba twin (numba is a core dependency);
+- ``None`` (default): ``"compiled"`` when numba works here, else
+  ``"readable"`` with one :class:`KernelWarning` per process saying so.
+
+The environment variable ``REFSIM_KERNELS`` (``readable`` or ``compiled``)
+changes the default for a whole run, e.g. to time or debug the readable path
+under the command line; an explicit ``kernel=`` wins over it.
+
+:data:`PAIRS` lists every kernel pair, readable and compiled, by dotted
+name; tests/test_kernels.py walks it and checks each pair bit for bit on its
+own cases. A compiled twin is the readable function itself compiled
+(:func:`compile_kernel`) wherever numba takes the readable source; the rest
+are written as plain loops in a module of compiled kernels, and each such
+function's docstring names the readable one it mirrors ("Mirrors: ...").
+
+numba caches machine code on disk only for functions defined at module level
+(``cache=True`` keys a function by its source and globals), so every
+compiled kernel is a module-level function, compiled on first use.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib
+import os
+import warnings
+
+from refsim.errors import OptionError, check_option
+
+KERNELS = ("readable", "compiled")
+
+#: The environment variable that sets the default kernel for a run.
+KERNELS_ENV = "REFSIM_KERNELS"
+
+
+class KernelWarning(UserWarning):
+    """numba does not work here: refsim runs its readable kernels."""
+
+
+@functools.cache
+def numba_error() -> str | None:
+    """Why numba cannot be used here (one line), or None when it can.
+
+    Tried once per process: a numba that is installed but built against
+    another numpy fails at import, and counts as missing.
+    """
+    try:
+        import numba  # noqa: F401
+    except Exception as exc:  # ImportError, or a binary mismatch
+        return f"{type(exc).__name__}: {exc}".splitlines()[0]
+    return None
+
+
+def numba_usable() -> bool:
+    return numba_error() is None
+
+
+def choose_kernel(kernel: str | None) -> str:
+    """The kernel to run: ``kernel`` checked, or the default (module docstring).
+
+    Raises
+    ------
+    OptionError
+        An unknown kernel, or ``"compiled"`` where numba does not work.
+    """
+    if kernel is None:
+        kernel = os.environ.get(KERNELS_ENV) or None
+        if kernel is not None:
+            check_option(KERNELS_ENV, kernel, KERNELS)
+    if kernel is None:
+        if numba_usable():
+            return "compiled"
+        _warn_readable()
+        return "readable"
+    check_option("kernel", kernel, KERNELS)
+    if kernel == "compiled" and not numba_usable():
+        raise OptionError(f"kernel 'compiled' needs numba, which does not work here: "
+                          f"{numba_error()}")
+    return kernel
+
+
+@functools.cache
+def _warn_readable() -> None:
+    warnings.warn(f"numba does not work here ({numba_error()}); refsim runs its readable "
+                  "kernels, tens of times slower (pip install numba)", KernelWarning,
+                  stacklevel=3)
+
+
+@functools.cache
+def compile_kernel(function):
+    """``numba.njit(cache=True)(function)``: the readable kernel compiled as it
+    stands (it must be a module-level function of plain loops over arrays).
+    Compiled once per process, on first call; numba's disk cache then spares
+    the next process the compile."""
+    import numba
+
+    return numba.njit(cache=True)(function)
+
+
+def resolve(dotted: str):
+    """The object ``"package.module:name"`` names (for :data:`PAIRS`)."""
+    module, name = dotted.split(":")
+    return getattr(importlib.import_module(module), name)
+
+
+COMPILED_FROM_SOURCE = "compiled from the readable source"
+MIRRORS = "mirrors the readable kernel"
+
+#: Every kernel pair: name -> (readable, compiled, how the compiled one is
+#: made), by dotted name. tests/test_kernels.py runs each pair on its cases
+#: through the public path with ``kernel="readable"`` and ``"compiled"`` and
+#: checks the answers bit for bit, and checks that each mirror's docstring
+#: names the readable function it mirrors.
+PAIRS: dict[str, tuple[str, str, str]] = {
+    "broad-phase sweep": ("refsim.collision.broad_phase:overlapping_pairs_sweep",
+                          "refsim.collision.broad_phase:overlapping_pairs_sweep_compiled",
+                          COMPILED_FROM_SOURCE),
+    "contact impulses": ("refsim.dynamics.impulse:solve_contacts_python",
+                         "refsim.dynamics.impulse:solve_contacts_compiled",
+                         COMPILED_FROM_SOURCE),
+    "indexed ear clipping": ("refsim.models.ear_index:clip_ears",
+                             "refsim.models._numba_kernels:clip_ears",
+                             COMPILED_FROM_SOURCE),
+    "seed orientation step": ("refsim.dynamics.rotation_seed:orientation_step_seed",
+                              "refsim.dynamics.rotation_seed:orientation_step_seed_compiled",
+                              MIRRORS),
+    "batched boxes": ("refsim.dynamics.boxes:boxes_numpy",
+                      "refsim.dynamics.boxes:boxes_compiled", MIRRORS),
+    "linear box scan": ("refsim.bounds.aabb_linear:aabb_linear_kernel",
+                        "refsim.bounds._numba_kernels:aabb_linear_numba", MIRRORS),
+    "incremental box": ("refsim.bounds.aabb_incremental:IncrementalAABB",
+                        "refsim.bounds._numba_kernels:incremental_update_numba", MIRRORS),
+    "hierarchy refit": ("refsim.collision.bvh:refit",
+                        "refsim.collision._numba_kernels:prepare", MIRRORS),
+    "hierarchy traversal": ("refsim.collision.bvh:_pairs_python",
+                            "refsim.collision._numba_kernels:traverse", MIRRORS),
+    "certified triangle filter": ("refsim.collision.triangle_batch:triangles_intersect_batch",
+                                  "refsim.collision._numba_kernels:certified", MIRRORS),
+    "exact hierarchy query": ("refsim.collision.bvh_exact:descend",
+                              "refsim.collision._numba_kernels:exact_query", MIRRORS),
+    "fused Euler particle step": ("refsim.particles.system:ParticleSystem",
+                                  "refsim.particles._numba_kernels:euler_step_fused", MIRRORS),
+}

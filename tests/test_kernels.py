@@ -1,0 +1,190 @@
+"""The one kernel switch (refsim.kernels) and its registry of kernel pairs:
+every pair gives the same answers, bit for bit, on the readable and the
+compiled kernel; every mirror names the readable function it mirrors; the
+default and the switch behave as documented."""
+
+from __future__ import annotations
+
+import inspect
+
+import numpy as np
+import pytest
+
+import refsim
+from refsim import kernels
+from refsim.collision.broad_phase import overlapping_pairs
+from refsim.collision.seed_levels import exact_pairs, triangle_box_pairs
+from refsim.dynamics import impulse
+from refsim.dynamics.boxes import boxes_kernel
+from refsim.dynamics.rotation_seed import orientation_step_seed_kernel
+from refsim.errors import OptionError
+from refsim.models import polygons
+from refsim.models.triangulate import ear_clip_indexed
+from refsim.types import random_rotation
+
+RNG_SEED = 20261130
+
+
+def _same(a, b) -> bool:
+    """Bitwise equality of nested tuples/lists of arrays and numbers."""
+    if isinstance(a, tuple | list):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b, strict=True))
+    return np.asarray(a).tobytes() == np.asarray(b).tobytes() and \
+        np.asarray(a).shape == np.asarray(b).shape
+
+
+def _poses(n, reach=1.2):
+    rng = np.random.default_rng(RNG_SEED)
+    return [(random_rotation(rng), rng.uniform(-reach, reach, 3)) for _ in range(n)]
+
+
+TORUS, STAR, CUBE = (refsim.load_model(m) for m in ("torus.ac", "star.ac", "cube.ac"))
+IDENTITY = (np.eye(3), np.zeros(3))
+
+
+def _broad_phase(kernel):
+    rng = np.random.default_rng(RNG_SEED)
+    out = []
+    for n in (0, 1, 7, 40):
+        lo = rng.integers(-5, 5, (n, 3)).astype(float)
+        out.append(overlapping_pairs(lo, lo + rng.integers(0, 4, (n, 3)), kernel=kernel))
+    return out
+
+
+def _impulses(kernel):
+    rng = np.random.default_rng(RNG_SEED)
+    out = []
+    for _ in range(20):
+        v, w = rng.normal(size=3), rng.normal(size=3)
+        r_a = rng.normal(size=(4, 3))
+        n = np.array([0.0, 1.0, 0.0])
+        P = impulse.wall_impulses(r_a, n, 0.5, np.eye(3) * 2.0, v, w, 0.8, 0.3, kernel=kernel)
+        out.append((P, v, w))
+    return out
+
+
+def _ear_clipping(kernel):
+    return [ear_clip_indexed(polygons.star(200), kernel=kernel),
+            ear_clip_indexed(polygons.comb(120), kernel=kernel)]
+
+
+def _seed_rotation(kernel):
+    rng = np.random.default_rng(RNG_SEED)
+    R = np.stack([random_rotation(rng) for _ in range(12)])
+    w = rng.normal(size=(12, 3)) * 5.0
+    return [orientation_step_seed_kernel(R, w, h, kernel=kernel) for h in (1e-3, 0.05)]
+
+
+def _batched_boxes(kernel):
+    rng = np.random.default_rng(RNG_SEED)
+    R = np.stack([random_rotation(rng) for _ in range(9)])
+    origin = rng.normal(size=(9, 3))
+    return boxes_kernel(np.ascontiguousarray(CUBE.vertices.T), R, origin, kernel=kernel)
+
+
+def _linear_scan(kernel):
+    return [refsim.aabb_linear(TORUS, pose, kernel=kernel) for pose in _poses(10)]
+
+
+def _incremental(kernel):
+    tracker = refsim.IncrementalAABB(refsim.load_model("sphere-2k.ac"), kernel=kernel)
+    out = []
+    for pose in _poses(20):
+        out.append((tracker.update(pose), tracker.extremes.copy(), tracker.visits))
+    return out
+
+
+def _hierarchy_boxes(kernel):
+    return [refsim.intersecting_pairs(TORUS, IDENTITY, STAR, pose, level="triangle-aabb",
+                                      kernel=kernel) for pose in _poses(6)]
+
+
+def _certified_filter(kernel):
+    out = []
+    for pose in _poses(6):
+        wa = refsim.collision.boxes.world_vertices(TORUS, IDENTITY)
+        wb = refsim.collision.boxes.world_vertices(STAR, pose)
+        candidates = triangle_box_pairs(wa, TORUS.faces, wb, STAR.faces)
+        out.append(exact_pairs(wa, TORUS.faces, wb, STAR.faces, candidates, kernel))
+    return out
+
+
+def _exact_hierarchy(kernel):
+    return [refsim.intersecting_pairs(TORUS, IDENTITY, STAR, pose, kernel=kernel)
+            for pose in _poses(6)] + [
+        refsim.bodies_collide(CUBE, IDENTITY, CUBE, (np.eye(3), np.array([1.0, 0.0, 0.0])),
+                              kernel=kernel)]
+
+
+def _euler_particles(kernel):
+    config = refsim.ParticleConfig(count=300, seed=4, solver="euler", step=0.01, drag=0.7,
+                                   drag_model="quadratic", half_size=0.5, speed_min=5.0,
+                                   speed_max=40.0, box_lo=(-0.5,) * 3, box_hi=(0.5,) * 3)
+    system = refsim.ParticleSystem(config, kernel=kernel)
+    system.run(30)
+    return system.state, system.bounces
+
+
+#: The cases of each registry entry, run with each kernel.
+CASES = {
+    "broad-phase sweep": _broad_phase,
+    "contact impulses": _impulses,
+    "indexed ear clipping": _ear_clipping,
+    "seed orientation step": _seed_rotation,
+    "batched boxes": _batched_boxes,
+    "linear box scan": _linear_scan,
+    "incremental box": _incremental,
+    "hierarchy refit": _hierarchy_boxes,
+    "hierarchy traversal": _hierarchy_boxes,
+    "certified triangle filter": _certified_filter,
+    "exact hierarchy query": _exact_hierarchy,
+    "fused Euler particle step": _euler_particles,
+}
+
+
+def test_every_registered_pair_has_cases_and_every_case_a_pair():
+    assert set(CASES) == set(kernels.PAIRS)
+
+
+@pytest.mark.parametrize("name", sorted(kernels.PAIRS))
+def test_readable_and_compiled_agree_bit_for_bit(name):
+    readable, compiled = CASES[name]("readable"), CASES[name]("compiled")
+    assert _same(readable, compiled), name
+
+
+@pytest.mark.parametrize("name", sorted(kernels.PAIRS))
+def test_each_pair_resolves_and_each_mirror_names_its_readable_function(name):
+    readable_path, compiled_path, how = kernels.PAIRS[name]
+    readable, compiled = kernels.resolve(readable_path), kernels.resolve(compiled_path)
+    assert how in (kernels.COMPILED_FROM_SOURCE, kernels.MIRRORS)
+    if how == kernels.MIRRORS:
+        doc = inspect.getdoc(getattr(compiled, "py_func", compiled)) or ""
+        readable_name = readable_path.split(":")[1]
+        assert doc.startswith("Mirrors") and readable_name in doc, (name, doc[:120])
+    else:
+        # compiled from the readable source: numba's dispatcher wraps that very function
+        source = getattr(compiled, "py_func", None)
+        assert source is None or source is readable or inspect.getsource(compiled).count(
+            readable_path.split(":")[1]) > 0
+
+
+def test_the_default_is_compiled_here_and_the_switch_is_one_word(monkeypatch):
+    assert kernels.choose_kernel(None) == "compiled"
+    monkeypatch.setenv(kernels.KERNELS_ENV, "readable")
+    assert kernels.choose_kernel(None) == "readable"
+    assert kernels.choose_kernel("compiled") == "compiled"         # explicit wins
+    monkeypatch.setenv(kernels.KERNELS_ENV, "fast")
+    with pytest.raises(OptionError, match="REFSIM_KERNELS must be one of"):
+        kernels.choose_kernel(None)
+    with pytest.raises(OptionError, match="kernel must be one of 'readable', 'compiled'"):
+        kernels.choose_kernel("numba")
+
+
+def test_without_numba_compiled_is_refused_and_readable_is_the_default(monkeypatch):
+    monkeypatch.setattr(kernels, "numba_error", lambda: "ImportError: no numba here")
+    monkeypatch.delenv(kernels.KERNELS_ENV, raising=False)
+    with pytest.raises(OptionError, match="no numba here"):
+        kernels.choose_kernel("compiled")
+    kernels._warn_readable.cache_clear()
+    with pytest.warns(kernels.KernelWarning, match="readable kernels"):
+        assert kernels.choose_kernel(None) == "readable"
