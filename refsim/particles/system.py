@@ -34,6 +34,7 @@ from refsim.dynamics.walls import wall_response_points, wall_response_points_inp
 from refsim.errors import DivergenceError, OptionError, StateError, check_count
 from refsim.kernels import choose_kernel
 from refsim.particles.config import ParticleConfig
+from refsim.solvers.explicit_rk import rk_step_into, stages_with_own_state
 from refsim.solvers.integrate import resolve_method
 
 
@@ -113,14 +114,12 @@ class ParticleSystem:
         self.bounces = 0
 
         s = self.method.stages
-        A = self.method.A_
-        # Which stages need a state of their own: stage i is evaluated at
-        # Y + h sum_j a_ij K_j, which is Y itself when row i of A is zero.
-        self._stage_uses_state = [not A[i, :i].any() for i in range(s)]
-        # Buffers (see the module docstring for the count).
+        # Buffers (see the module docstring for the count). A stage is
+        # evaluated at Y + h sum_j a_ij K_j, which is Y itself when row i of A
+        # is zero: only then does it need no state of its own.
         self._K = np.empty((s, 2, n, 3), dtype=np.float64)           # stage derivatives k_i
         self._stage = (np.empty((2, n, 3), dtype=np.float64)          # stage state y_i
-                       if not all(self._stage_uses_state) else None)
+                       if any(stages_with_own_state(self.method)) else None)
         self._product = np.empty((2, n, 3), dtype=np.float64)         # (h a_ij) k_j scratch
         self._speed = np.empty(n, dtype=np.float64)                    # |v| for quadratic drag
         self._beyond = np.empty(n, dtype=bool)                        # wall-test mask
@@ -148,8 +147,8 @@ class ParticleSystem:
                 arrays.append(optional)
         return sum(a.nbytes for a in arrays)
 
-    def _derivative_into(self, Y: np.ndarray, out: np.ndarray) -> None:
-        """``out = (v, a(v))`` for a (2, N, 3) state ``Y``."""
+    def _derivative_into(self, t: float, Y: np.ndarray, out: np.ndarray) -> None:
+        """``out = (v, a(v))`` for a (2, N, 3) state ``Y`` (autonomous: ``t`` unused)."""
         c = self.config
         np.copyto(out[0], Y[1])
         acceleration_into(Y[1], c.gravity, c.drag, c.mass, c.drag_model, out[1], self._speed)
@@ -157,37 +156,18 @@ class ParticleSystem:
     def step(self) -> None:
         """Advance one step of ``config.step``: the solver, then the walls.
 
-        The Runge-Kutta arithmetic of :func:`refsim.solvers.explicit_rk.rk_step`,
-        term by term in the same order, in place::
-
-            y_i    = Y + (h a_i1) k_1 + ... + (h a_i,i-1) k_{i-1}
-            k_i    = f(y_i)
-            Y_next = Y + (h b_1) k_1 + ... + (h b_s) k_s
+        The Runge-Kutta step in place into the system's buffers
+        (:func:`refsim.solvers.explicit_rk.rk_step_into`, the arithmetic of
+        :func:`refsim.solvers.explicit_rk.rk_step` term by term), then the
+        walls in place; or, with the compiled kernel, the fused Euler step.
         """
         h = self.config.step
         if self.kernel == "compiled":
             self._step_fused(h)
             return
-        A, b = self.method.A_, self.method.b_
-        Y, K, scratch = self.state, self._K, self._product
-        for i in range(self.method.stages):
-            if self._stage_uses_state[i]:
-                y_i = Y
-            else:
-                y_i = self._stage
-                terms = [j for j in range(i) if A[i, j] != 0.0]
-                # First term without a copy of Y: (h a_ij) k_j + Y equals
-                # Y + (h a_ij) k_j to the bit (addition commutes exactly).
-                np.multiply(K[terms[0]], h * A[i, terms[0]], out=y_i)
-                np.add(y_i, Y, out=y_i)
-                for j in terms[1:]:
-                    np.multiply(K[j], h * A[i, j], out=scratch)
-                    np.add(y_i, scratch, out=y_i)
-            self._derivative_into(y_i, K[i])
-        for i in range(self.method.stages):
-            if b[i] != 0.0:
-                np.multiply(K[i], h * b[i], out=scratch)
-                np.add(Y, scratch, out=Y)
+        rk_step_into(self.method, self._derivative_into, self.t, self.state, h, self._K,
+                     self._stage, self._product)
+        Y = self.state
         if self.config.walls:
             c = self.config
             self.bounces += wall_response_points_inplace(

@@ -217,3 +217,53 @@ def rk_step(method: ExplicitRungeKutta, f, t: float, y: np.ndarray, h: float) ->
         if b[i] != 0.0:
             y_next = y_next + (h * b[i]) * k[i]
     return y_next
+
+
+def stages_with_own_state(method: ExplicitRungeKutta) -> list[bool]:
+    """For each stage, whether it is evaluated at a state of its own (row i
+    of A has a nonzero entry) rather than at ``y`` itself."""
+    A = method.A_
+    return [bool(A[i, :i].any()) for i in range(method.stages)]
+
+
+def rk_step_into(method: ExplicitRungeKutta, f_into, t: float, Y: np.ndarray, h: float,
+                 K: np.ndarray, stage: np.ndarray | None, scratch: np.ndarray) -> None:
+    """:func:`rk_step` in place, into preallocated buffers: the same terms in
+    the same order, so the same bits.
+
+    Parameters
+    ----------
+    f_into : callable
+        ``f_into(t, y, out)`` writes ``dy/dt`` into ``out`` (same shape as ``y``).
+    Y : numpy.ndarray
+        The state, any shape; overwritten with the state at ``t + h``.
+    K : numpy.ndarray
+        (s, *Y.shape) buffer for the stage derivatives ``k_i``.
+    stage : numpy.ndarray or None
+        Buffer of Y's shape for a stage state ``y_i``; None when no stage
+        needs one (:func:`stages_with_own_state`).
+    scratch : numpy.ndarray
+        Buffer of Y's shape for the products ``(h a_ij) k_j``.
+
+    The first term of a stage state is ``(h a_ij) k_j + Y``, which equals
+    ``Y + (h a_ij) k_j`` to the bit (addition commutes exactly), without a
+    copy of Y.
+    """
+    A, b, c = method.A_, method.b_, method.c_
+    own = stages_with_own_state(method)
+    for i in range(method.stages):
+        if not own[i]:
+            y_i = Y
+        else:
+            y_i = stage
+            terms = [j for j in range(i) if A[i, j] != 0.0]
+            np.multiply(K[terms[0]], h * A[i, terms[0]], out=y_i)
+            np.add(y_i, Y, out=y_i)
+            for j in terms[1:]:
+                np.multiply(K[j], h * A[i, j], out=scratch)
+                np.add(y_i, scratch, out=y_i)
+        f_into(t + c[i] * h, y_i, K[i])
+    for i in range(method.stages):
+        if b[i] != 0.0:
+            np.multiply(K[i], h * b[i], out=scratch)
+            np.add(Y, scratch, out=Y)

@@ -68,3 +68,25 @@ def test_seed_literal_rk4_step_is_five_thirds_of_rk4_increment_for_constant_f():
     literal = refsim.SEED_LITERAL_VARIANTS["rk4-seed-literal"]
     y1 = literal.step(lambda t, y: np.array([2.0]), 0.0, np.array([1.0]), 0.3)
     np.testing.assert_allclose(y1, [1.0 + 5 / 3 * 0.3 * 2.0], rtol=ROUNDING)
+
+
+@pytest.mark.parametrize("name", sorted(refsim.SOLVERS))
+def test_the_step_into_buffers_is_the_step_bit_for_bit(name):
+    from refsim.solvers.explicit_rk import rk_step, rk_step_into
+
+    method = refsim.SOLVERS[name]
+    rng = np.random.default_rng(11)
+    M = rng.normal(size=(6, 6))
+
+    def f(t, y):
+        return np.sin(M @ y) - 0.3 * t * y
+
+    def f_into(t, y, out):
+        np.copyto(out, f(t, y))
+
+    y = rng.normal(size=6)
+    expected = rk_step(method, f, 0.2, y, 0.05)
+    Y = y.copy()
+    K, stage, scratch = np.empty((method.stages, 6)), np.empty(6), np.empty(6)
+    rk_step_into(method, f_into, 0.2, Y, 0.05, K, stage, scratch)
+    assert Y.tobytes() == expected.tobytes()
