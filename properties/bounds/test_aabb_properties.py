@@ -22,7 +22,7 @@ from refsim.oracles.trimesh_adapter import (
     trimesh_skips_transform,
 )
 
-from properties.strategies import convex_hull_meshes, pose_sequences, rotations
+from properties.bounds.strategies import convex_hull_meshes, pose_sequences, rotations
 from refsim.bounds.aabb_incremental import IncrementalAABB
 from refsim.bounds.aabb_linear import (
     aabb_linear,

@@ -15,7 +15,7 @@ import pytest
 from hypothesis import given
 from refsim.oracles import OracleUnavailable
 
-from properties.strategies import posed_model_pairs
+from properties.collision.strategies import posed_model_pairs
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
 from refsim.studies.triangles import classify_disagreement

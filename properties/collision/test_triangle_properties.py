@@ -14,7 +14,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from properties.strategies import (
+from properties.collision.strategies import (
     constructed_contact_pairs,
     exact_rigid_motions,
     triangle_pairs,

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from hypothesis import given
 
-from properties.strategies import contact_pairs, random_two_body_scenes, wall_hit_scenes
+from properties.dynamics.strategies import contact_pairs, random_two_body_scenes, wall_hit_scenes
 from refsim.dynamics import impulse
 from refsim.dynamics.simulation import Simulation
 from refsim.errors import DivergenceError

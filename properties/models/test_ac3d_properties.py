@@ -18,7 +18,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from properties.strategies import meshes
+from properties.models.strategies import meshes
 from refsim.errors import ModelError, ModelWarning
 from refsim.models.ac3d import format_ac3d, parse_ac3d, read_ac3d
 from refsim.models.mesh import Mesh

@@ -22,7 +22,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from properties.strategies import (
+from properties.models.strategies import (
     bridged_polygons,
     decorated_polygons,
     lattice_star_polygons,

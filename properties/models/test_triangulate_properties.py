@@ -12,7 +12,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from properties.strategies import star_polygons
+from properties.models.strategies import star_polygons
 from refsim.models.triangulate import ear_clip, ear_clip_reference, newell_normal
 from refsim.types import rotation_about_axis
 

@@ -10,7 +10,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from properties.strategies import particle_configs
+from properties.solvers.strategies import particle_configs
 from refsim.dynamics.walls import wall_response_points
 from refsim.particles.system import ParticleSystem, plain_step
 

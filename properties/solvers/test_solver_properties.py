@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import refsim
-from properties.strategies import SOLVER_NAMES, STEP_SIZES, linear_test_equations
+from properties.solvers.strategies import SOLVER_NAMES, STEP_SIZES, linear_test_equations
 from refsim.solvers.stability import amplification
 
 EPS = np.finfo(np.float64).eps

@@ -35,10 +35,8 @@ from refsim.collision.predicates import (
 # Points are 3-tuples and triangles 3-tuples of points. Tuples are passed by
 # value; an array passed to a compiled helper, or a row sliced from one
 # (``t[0]``), is a reference-counted object, and doing that a dozen times per
-# pair made the first version of this filter ~3x slower: ``certified`` on
-# 1e5 random pairs took 150-210 ns a pair with (3, 3) arrays and row views,
-# 50-75 ns with tuples (tests/benchmarks/test_triangle_kernels.py times the
-# public function on 2000 pairs).
+# pair made the first version of this filter several times slower
+# (docs/decisions/triangle-filter-arguments.md).
 
 
 @numba.njit(cache=True)
@@ -289,8 +287,8 @@ def grow(rows, used):
 # The same steps as bvh_exact's readable traversal. The separating-axis node
 # test, the preparation of a leaf (once for body a, once for body b) and the
 # loops over a leaf pair are written out in the main loop: a helper taking a
-# dozen arrays cost ~40 ns per call here, which made the whole query ~20%
-# slower on the separated benchmarks (see the note above the triangle filter).
+# dozen arrays made the whole query measurably slower on the separated
+# benchmarks (docs/decisions/triangle-filter-arguments.md).
 
 #: Query modes of ``exact_query``.
 ALL_HITS, FIRST_HIT, CANDIDATES = 0, 1, 2

@@ -9,17 +9,9 @@ Complex Deformable Models using AABB Trees", JGT 1997, which also argues for
 refitting). Of the three axes, the split takes the one whose two halves have
 the least total box surface area (the cost measure of J. D. MacDonald and
 K. S. Booth, "Heuristics for ray tracing using space subdivision", 1990).
-The choice was measured with the exact query's earlier axis-aligned node
-boxes on the separated 2k-triangle benchmark poses (commit 762e5f1): against
-splitting the longest axis of the centroids it visited 9% fewer node pairs
-for the torus (505 against 557) and 9% more for the sphere (751 against 691).
-With the oriented node boxes of :mod:`refsim.collision.bvh_exact`, a one-off
-trial (not kept in the repository) on the six benchmark poses: the
-longest-axis split visited fewer node pairs on the separated and grazing
-sphere (77 and 527 against 117 and 571) and more on the other four (sphere
-deep 2241 against 2185; torus 209, 427, 3169 against 197, 423, 3097); a
-median split across each node's principal axis (as in OBBTree) visited more
-on five of the six.
+Against the longest-axis split and OBBTree's principal-axis split it visits
+fewer node pairs on most of the benchmark poses, not on all of them (the
+trials, counted in node pairs: docs/decisions/hierarchy-split.md).
 Nodes are numbered in pre-order, so every child has a larger index than its
 parent.
 

@@ -86,8 +86,8 @@ within the margin's bound, so both are right; their candidate lists differ
 only if a node pair lies within a few ulps of the margin, which the tests'
 poses do not produce.
 
-Cost: O(m log m) once per mesh for the boxes (a 3x3 eigenproblem per node;
-about 0.06 s for 2000 triangles here); per query about O(k log m) node
+Cost: O(m log m) once per mesh for the boxes (a 3x3 eigenproblem per node);
+per query about O(k log m) node
 tests for k overlapping node pairs, plus O(1) per vertex and triangle of the
 leaves reached. The speed against FCL is measured in
 :func:`refsim.studies.levels.measure_hierarchy_speed`.
@@ -347,8 +347,9 @@ _POSE_LAYOUT = ((3, 3), (24, 8), (3,), (8,))
 
 def _pose_arrays(pose, what: str):
     """The pose as two float64 C-contiguous arrays: as given when it already
-    is (the compiled query checks the values; this check costs ~0.3 us
-    against ~5 us for ``as_pose``), else through ``as_pose``."""
+    is (the compiled query checks the values; this layout check costs a
+    fraction of ``as_pose``: docs/decisions/hierarchy-pose-check.md), else
+    through ``as_pose``."""
     if type(pose) is tuple and len(pose) == 2:
         rotation, translation = pose
         if (type(rotation) is np.ndarray and type(translation) is np.ndarray

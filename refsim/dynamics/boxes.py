@@ -11,8 +11,8 @@ same way).
 
 Two paths doing that arithmetic in that order: :func:`boxes_numpy` (the plain
 kernel, (B, 3, n) arrays) and :func:`boxes_compiled` (the same loops
-compiled by numba, chosen when installed: for 40 cubes about 2 us against
-~20 us, the numpy path being a dozen array calls of call overhead).
+compiled by numba: the numpy path is a dozen array calls of overhead;
+docs/decisions/batched-boxes.md).
 
 Cost: O(B n) for B bodies of n vertices.
 """

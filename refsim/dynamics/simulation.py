@@ -106,11 +106,11 @@ DIVERGENCE_FACTOR = 1e6
 
 #: Meshes with at most this many vertices get their boxes from one batched
 #: linear scan over all their bodies under ``boxes="auto"``: for a cube (8
-#: vertices) the batched scan of 40 bodies costs less than two calls of the
-#: compiled incremental tracker (whose per-call overhead, ~3-5 us, dominates
-#: when the walk visits a handful of vertices). Larger meshes keep the scene's
-#: choice of tracker (``collision.aabb``), where the incremental walk pays off
-#: (claim C1).
+#: vertices) the batched scan of many bodies costs less than a few calls of
+#: the compiled incremental tracker, whose per-call overhead dominates when
+#: the walk visits a handful of vertices (docs/decisions/batched-boxes.md).
+#: Larger meshes keep the scene's choice of tracker (``collision.aabb``),
+#: where the incremental walk pays off (claim C1).
 BATCH_VERTICES = 64
 
 BOXES = ("auto", "trackers", "batched")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import refsim
-from properties.strategies import midpoint_subdivision
+from properties.bounds.strategies import midpoint_subdivision
 from refsim import kernels
 from refsim.bounds.aabb_incremental import (
     IncrementalAABB,
