@@ -93,7 +93,38 @@ def intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
 
 def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
                    method: str = "bvh", *, kernel: str | None = None) -> bool:
-    """Whether two bodies collide at ``level`` (see the module's table)."""
+    """Whether two posed bodies collide at ``level`` (seed S4).
+
+    Parameters
+    ----------
+    mesh_a, mesh_b : Mesh
+    pose_a, pose_b : (rotation (3, 3), translation (3,))
+        Each maps a body-space point ``p`` to the world point ``R p + t``;
+        checked with :func:`refsim.types.as_pose`.
+    level : {"sphere", "aabb", "triangle-aabb", "exact"}
+        The seed's four types of test, coarse to fine (module docstring):
+        bounding spheres, body boxes, triangle boxes, exact triangle overlap
+        (closed triangles: touching counts). Every coarse level is
+        conservative: it never says apart where ``"exact"`` says collide.
+    method : {"bvh", "seed"}
+        The deeper hierarchy or the seed's levels; the same answers.
+    kernel : {"readable", "compiled"}, optional
+        See :mod:`refsim.kernels`; the same answers.
+
+    Returns
+    -------
+    bool
+
+    Raises
+    ------
+    OptionError
+        An unknown level, method or kernel.
+    ArgumentTypeError
+        A mesh that is not a :class:`refsim.Mesh`.
+    StateError
+        A pose that is not finite, not orthonormal or of the wrong shape, or
+        one that puts the body's world coordinates beyond float64's range.
+    """
     _check(level, LEVELS, method, mesh_a, mesh_b)
     kernel = choose_kernel(kernel)
     if level == "exact" and method == "bvh":

@@ -60,6 +60,11 @@ class Event:
 
 @dataclass
 class Trajectory:
+    """A recorded run of F frames of B bodies (the module docstring lists the
+    arrays and their shapes); :meth:`save` writes it as .npz and
+    :meth:`load` reads it back, raising :class:`refsim.errors.NpzFileError`
+    naming the file and entry for anything it cannot read."""
+
     t: np.ndarray
     position: np.ndarray
     velocity: np.ndarray

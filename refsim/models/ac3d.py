@@ -566,7 +566,21 @@ def _parse(text: str, path, weld_tolerance: float, count_encoding: str) -> Mesh:
 
 
 def read_ac3d(path, *, weld_tolerance: float = 0.0) -> Mesh:
-    """Read an AC3D file. UTF-8 text, or Latin-1 when it is not valid UTF-8.
+    """Read an AC3D file (seed S1): its polygons triangulated, its objects,
+    materials and surface flags kept per triangle, welded to shared-vertex form.
+
+    Parameters
+    ----------
+    path : str or PathLike
+        UTF-8 text, or Latin-1 when it is not valid UTF-8.
+    weld_tolerance : float
+        Passed to :class:`Mesh`: 0 welds exactly equal vertices only.
+
+    Returns
+    -------
+    Mesh
+        ``vertices`` (n, 3) float64, ``faces`` (m, 3) int64 and per-face
+        ``face_material``, ``face_flags``, ``face_object`` (m,).
 
     Raises
     ------
@@ -664,7 +678,22 @@ def format_ac3d(mesh: Mesh) -> str:
 
 
 def write_ac3d(mesh: Mesh, path) -> None:
-    """Write ``mesh`` to ``path`` as AC3D, atomically.
+    """Write ``mesh`` to ``path`` as AC3D, atomically; :func:`read_ac3d`
+    reads back the same mesh, bit for bit.
+
+    Parameters
+    ----------
+    mesh : Mesh
+    path : str or PathLike
+        A symlink is written through; a directory, FIFO or device is refused
+        (:mod:`refsim.io`).
+
+    Raises
+    ------
+    ModelError
+        A mesh AC3D cannot hold (a name with a quote, say), naming it.
+    OutputError
+        The file cannot be written.
 
     The text is formatted first (a mesh AC3D cannot hold raises before any
     file is touched), then written by :func:`refsim.io.write_text_atomic`: a

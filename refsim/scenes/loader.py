@@ -44,10 +44,22 @@ from refsim.types import transform_points
 
 
 def load_scene(path) -> Scene:
-    """Read, validate and resolve the scene file at ``path``.
+    """Read, validate and resolve the scene file at ``path`` (seed S11).
 
-    A bare file name that is not in the current directory names a bundled
-    scene (``refsim.bundled.scenes_dir()``), e.g. ``"bounce.toml"``.
+    Parameters
+    ----------
+    path : str or PathLike
+        A TOML scene file (keys: DESIGN.md, Scene files; every key but
+        ``[[body]] model`` has a default). A bare file name that is not in
+        the current directory names a bundled scene
+        (``refsim.bundled.scenes_dir()``), e.g. ``"bounce.toml"``.
+
+    Returns
+    -------
+    Scene
+        Frozen: the world, integration, collision and dynamics settings, the
+        bodies with their models loaded (``scene.mesh(body)``) and the
+        particle configuration of a ``[particles]`` table, or None.
 
     Raises
     ------

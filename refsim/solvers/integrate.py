@@ -208,10 +208,43 @@ def solve_fixed_step(f, y0, t0: float, t1: float, h: float, method="rk4", *,
 
 def integrate(f, y0, t0: float, t1: float, h: float, method="rk4", *,
               last_step: str = "error") -> tuple[np.ndarray, np.ndarray]:
-    """``t, y`` of :func:`solve_fixed_step` (DESIGN.md, Public API).
+    """Integrate ``y' = f(t, y)`` from ``t0`` to ``t1`` with a fixed step ``h``
+    by one of the seed's solvers (S6; DESIGN.md, Public API).
 
-    ``t`` has shape (steps + 1,) and ``y`` (steps + 1, d). Use
-    :func:`solve_fixed_step` for the evaluation count as well.
+    Parameters
+    ----------
+    f : callable
+        ``f(t, y) -> dy/dt`` for ``y`` of shape (d,).
+    y0 : array_like
+        (d,) initial state; a scalar is taken as d = 1.
+    t0, t1 : float
+        The interval, ``t1 >= t0``.
+    h : float
+        The step, > 0; ``(t1 - t0) / h`` must be a whole number of steps
+        unless ``last_step="short"``, and at most ``refsim.limits.MAX_STEPS``.
+    method : str or ExplicitRungeKutta
+        A key of :data:`refsim.SOLVERS` (default "rk4").
+    last_step : {"error", "short"}
+        What to do when ``h`` does not divide the interval (module docstring).
+
+    Returns
+    -------
+    t : numpy.ndarray
+        (steps + 1,) times, ``t[0] = t0``, ``t[-1] = t1``.
+    y : numpy.ndarray
+        (steps + 1, d) states, ``y[0] = y0``.
+
+    Raises
+    ------
+    StateError
+        A non-finite input, ``h <= 0``, ``t1 < t0``, too many steps or too
+        large a result (``refsim.limits``), ``f`` returning the wrong shape.
+    OptionError
+        An unknown method.
+    DivergenceError
+        The state became non-finite; ``partial`` holds the result so far.
+
+    :func:`solve_fixed_step` returns the evaluation count as well.
     """
     result = solve_fixed_step(f, y0, t0, t1, h, method, last_step=last_step)
     return result.t, result.y
