@@ -15,8 +15,9 @@ Left out, because they may differ between two runs of the same code:
   ``"*"`` for any list item; refsim.report.section.to_json). A baseline made
   before timings were marked has none, so the newer file's list is applied to
   both;
-- every list item marked ``"timing": true`` in either file: a verdict, a
-  table or a catalogue entry that rests on timings;
+- every list item marked ``"timing": true``: a verdict, a table or a
+  catalogue entry that rests on timings (left out of its list before the
+  items are paired);
 - with ``--ignore KEY``, every value under a mapping key ``KEY`` at any depth
   (issue 13 changed every ``command`` on purpose: ``--ignore command``).
 
@@ -63,11 +64,15 @@ def differences(base, new, patterns: list[tuple], path: tuple = (), ignored: tup
             else:
                 yield from differences(base[key], new[key], patterns, path + (key,), ignored)
     elif isinstance(base, list) and isinstance(new, list):
+        # Items resting on timings are left out of each list before the two
+        # are compared item by item (a timing verdict may be a catalogue
+        # entry in one run and not in the other); indices are the new file's.
+        base = [item for item in base if not _marked(item)]
+        new = [item for item in new if not _marked(item)]
         if len(base) != len(new):
             yield path + ("<length>",), len(base), len(new)
         for i, (a, b) in enumerate(zip(base, new, strict=False)):
-            if not (_marked(a) or _marked(b)):
-                yield from differences(a, b, patterns, path + (i,), ignored)
+            yield from differences(a, b, patterns, path + (i,), ignored)
     elif base != new:
         yield path, base, new
 
