@@ -4,6 +4,9 @@
     refsim run SCENE [-o OUT.npz] [--every K]
                                        simulate a scene (bodies or particles), write frames
     refsim report [--quick] [-o DIR]   write the HTML accuracy report
+    refsim study NAME [--quick] [--seed S]
+                                       run one of the report's studies, print its
+                                       records and the verdicts they back
     refsim view SCENE [--port N]       the scene in the browser, re-run from its controls
     refsim replay RUN.npz ... -o OUT.html
                                        recorded runs as one standalone replay page
@@ -215,6 +218,50 @@ def _replay(args) -> int:
     return 0
 
 
+def _study(args) -> int:
+    """Run one entry of the report's plan and print its records, then the
+    verdicts on the seed claims it backs (each with its facts)."""
+    from refsim.oracles import OracleUnavailable
+    from refsim.report.plan import STUDIES, Run
+    from refsim.report.text import TIMING_NOTE, format_claim, format_records
+
+    run = Run(quick=args.quick, seed=args.seed,
+              announce=lambda text: print(f"refsim: measuring {text}", file=sys.stderr))
+    try:
+        records = run.get(args.name)
+    except OracleUnavailable as exc:
+        raise RefsimError(f"study {args.name}: {exc}") from None
+    print(format_records(records))
+    for claim in STUDIES[args.name].claims:
+        print()
+        print(format_claim(run.claim(claim)))
+    print()
+    print(TIMING_NOTE)
+    for engine, why in run.missing.items():
+        print(f"refsim: note: {engine} is missing, its columns are empty: {why}",
+              file=sys.stderr)
+    return 0
+
+
+def _add_study_command(commands) -> None:
+    """``refsim study NAME``: the command each figure of the report names."""
+    from refsim.report.plan import REPORT_SEED, STUDIES
+
+    study = commands.add_parser(
+        "study", help="run one of the report's studies and print its records",
+        description="Run the study NAME exactly as the report runs it (the same engines "
+                    "and sizes; --quick as the quick report) and print its records as "
+                    "plain-text tables, then the verdicts on the seed claims it backs. "
+                    "Every figure of the report names the command that reproduces it.")
+    study.add_argument("name", metavar="NAME", choices=sorted(STUDIES),
+                       help="one of: " + ", ".join(sorted(STUDIES)))
+    study.add_argument("--quick", action="store_true",
+                       help="the quick report's sizes (fewer sizes and repeats)")
+    study.add_argument("--seed", type=int, default=REPORT_SEED, metavar="S",
+                       help=f"seed of the random choices (default {REPORT_SEED}, the report's)")
+    study.set_defaults(run=_study)
+
+
 def _add_viewer_commands(commands) -> None:
     """``refsim view`` and ``refsim replay`` (refsim.viewer; the ``viewer`` extra)."""
     from refsim.viewer import REPLAY_MAX_BYTES as DEFAULT_MAX_BYTES
@@ -300,6 +347,7 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("-o", "--output", default="reports/out", metavar="DIR",
                         help="output directory (default: reports/out)")
     report.set_defaults(run=_report)
+    _add_study_command(commands)
     _add_viewer_commands(commands)
     return parser
 

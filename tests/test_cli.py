@@ -68,3 +68,40 @@ def test_report_into_an_unwritable_place_is_a_user_error(tmp_path, capsys):
     assert main(["report", "--quick", "-o", str(blocker / "out")]) == EXIT_USER_ERROR
     err = capsys.readouterr().err
     assert "cannot write the report" in err and "Traceback" not in err
+
+
+def test_study_prints_records_and_the_verdict_they_back(capsys):
+    assert main(["study", "bounds-error", "--quick"]) == 0
+    out = capsys.readouterr().out
+    header = out.splitlines()[0].split()
+    assert header[:6] == ["mesh", "n_triangles", "convex", "motion", "frames", "wrong_frames"]
+    assert "\nC2: partly\n" in out                # the quick run's verdict, as the report's
+    assert "  convex_wrong_frames: 0\n" in out
+
+
+def test_study_marks_timing_fields(capsys):
+    assert main(["study", "particles-drag", "--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "cost_ratio*: " in out and "same_terminal_distance: 13.7563\n" in out
+    assert "C5: " in out and "(rests on timings)" in out
+
+
+def test_study_needs_a_known_name(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["study", "no-such-study"])
+    assert exit_info.value.code == EXIT_USER_ERROR
+    assert "invalid choice" in capsys.readouterr().err
+
+
+def test_study_without_its_oracle_is_a_user_error(capsys, monkeypatch):
+    from refsim.oracles import OracleUnavailable
+
+    from refsim.report import plan
+
+    def missing():
+        raise OracleUnavailable("oracle engine 'trimesh' is not installed")
+
+    monkeypatch.setitem(plan.ENGINES, "trimesh", missing)
+    assert main(["study", "bounds-agreement", "--quick"]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert "bounds-agreement" in err and "trimesh" in err and "Traceback" not in err

@@ -6,6 +6,13 @@ fetched, no network. Each area contributes a section from
 yet is shown as a plain "not measured yet" section. The claims table collects
 the verdicts the sections return; a claim without one says so.
 
+Every measurement is made through the plan (:mod:`refsim.report.plan`),
+which also chooses the oracle engines; a section asks it for records and
+verdicts and arranges them. results.json lists the paths of its timings
+(``timing_paths``: lists of keys, ``"*"`` for every item of a list), the
+only values that may differ between two runs besides the items marked
+``"timing": true``.
+
 Both files are rendered in memory first and then written atomically
 (:mod:`refsim.io`), so a failed run never leaves a half-written page.
 """
@@ -23,15 +30,11 @@ from importlib import metadata
 from pathlib import Path
 
 from refsim.bundled import templates_dir
+from refsim.claims import CLAIMS, TERMINOLOGY
 from refsim.io import write_text_atomic
-from refsim.report.claims import CLAIMS, TERMINOLOGY
+from refsim.report.plan import REPORT_SEED, Run
 from refsim.report.progress import Progress
-from refsim.report.section import Section
-
-#: The seed every random choice in the report derives from. It is the
-#: default seed of every ``python -m refsim.*.measure`` command, so that the
-#: command printed under a figure reproduces the figure as it is.
-REPORT_SEED = 0
+from refsim.report.section import Section, to_json
 
 # (key, title, what the section will measure once its work lands)
 AREAS: tuple[tuple[str, str, str], ...] = (
@@ -84,6 +87,7 @@ class ReportContext:
     quick: bool
     seed: int
     progress: Progress
+    run: Run            # the plan's run: every section's records and verdicts
 
 
 def build_report(out_dir: Path, *, quick: bool = False, stream=None) -> Path:
@@ -92,13 +96,15 @@ def build_report(out_dir: Path, *, quick: bool = False, stream=None) -> Path:
     out_dir.mkdir(parents=True, exist_ok=True)  # fail before the long work, not after
     sections: list[Section] = []
     with Progress(len(AREAS) + 1, stream=stream) as progress:
-        ctx = ReportContext(quick=quick, seed=REPORT_SEED, progress=progress)
+        run = Run(quick=quick, seed=REPORT_SEED, announce=progress.announce)
+        ctx = ReportContext(quick=quick, seed=REPORT_SEED, progress=progress, run=run)
         for key, title, pending in AREAS:
             progress.announce(title)
             sections.append(_build_section(key, title, pending, ctx))
             progress.step(title)
         environment = collect_environment()
         html = render(sections, environment, quick=quick)
+        timings: set[tuple] = set()
         results = {
             "quick": quick,
             "seed": REPORT_SEED,
@@ -106,9 +112,10 @@ def build_report(out_dir: Path, *, quick: bool = False, stream=None) -> Path:
             "claims": claim_rows(sections),
             "agreements": agreement_rows(sections),
             "divergences": divergence_rows(sections),
-            "sections": {s.key: section_json(s) for s in sections},
+            "sections": {s.key: section_json(s, timings) for s in sections},
         }
-        payload = json.dumps(results, indent=2, sort_keys=True, default=_json_default)
+        results["timing_paths"] = [list(p) for p in sorted(timings)]
+        payload = json.dumps(results, indent=2, sort_keys=True, allow_nan=False)
         write_text_atomic(out_dir / "results.json", payload + "\n")
         write_text_atomic(out_dir / "index.html", html)
         progress.step("written")
@@ -171,12 +178,13 @@ def agreement_rows(sections: list[Section]) -> list[dict]:
     return [{"section": s.key, **asdict(a)} for s in sections for a in s.agreements]
 
 
-def section_json(section: Section) -> dict:
+def section_json(section: Section, timings: set | None = None) -> dict:
     """A section as results.json records it: its measured numbers, and every
-    table and chart exactly as the page shows them (cells as displayed)."""
+    table and chart exactly as the page shows them (cells as displayed).
+    ``timings`` receives the paths of the timings among the numbers."""
     return {
         "status": section.status,
-        "results": section.results,
+        "results": to_json(section.results, ("sections", section.key, "results"), timings),
         "tables": [{"id": t.id, "title": t.title, "columns": list(t.columns),
                     "rows": [[str(cell) for cell in row] for row in t.rows],
                     "timing": t.timing, "part": part_of(t.id)}
@@ -243,16 +251,3 @@ def render(sections: list[Section], environment: dict, *, quick: bool) -> str:
                            terminology=TERMINOLOGY, environment=environment,
                            quick=quick, css=css)
 
-
-def _json_default(value):
-    import numpy as np
-
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, Path):
-        return str(value)
-    if hasattr(value, "__dataclass_fields__"):
-        return asdict(value)
-    raise TypeError(f"not serializable: {type(value).__name__}")

@@ -1,26 +1,35 @@
 """What a report section is made of: figures, tables, claim verdicts, numbers.
 
-Each area of refsim contributes one :class:`Section`, built from its
-``measure_*`` functions. The report computes nothing of its own (STYLE.md,
-rule 9): a section only arranges numbers that a measurement returned, and
-``results`` holds those numbers for results.json.
+Each area of refsim contributes one :class:`Section`, built from the records
+of the plan's studies (:mod:`refsim.report.plan`) and the verdicts of
+:mod:`refsim.claims`. The report computes nothing of its own (STYLE.md,
+rule 9): a section only arranges what a measurement returned, and
+``results`` holds those records for results.json.
 
-Timings vary from run to run; everything else must not. A results key that
-holds a timing or a figure derived from timings has one of the words in
-``TIMING_WORDS`` in its name, and a verdict that rests on timings says so
-(``Verdict.timing``), and so does a table with timings in its cells
-(``Table.timing``), so that the determinism test knows what may differ.
+Timings vary from run to run; everything else must not. What is a timing is
+said by metadata, never guessed from a name: a study record marks its timing
+fields (:func:`refsim.studies.timing_field`), a section wraps any other
+timing it puts into ``results`` in :class:`Timing`, a verdict that rests on
+timings says so (``Verdict.timing``), and so does a table with timings in its
+cells (``Table.timing``). :func:`to_json` turns ``results`` into plain JSON
+and collects the paths of the timings, which results.json lists under
+``timing_paths`` for the determinism test.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
+from dataclasses import dataclass, field, fields, is_dataclass
+from pathlib import Path
 from typing import Any
 
-VERDICTS = ("confirmed", "refuted", "partly", "not measured yet")
+from refsim.claims import VERDICTS as CLAIM_VERDICTS
+from refsim.studies import is_timing
 
-TIMING_WORDS = ("time", "seconds", "per_second", "rate", "ratio", "crossover", "speedup",
-                "throughput")
+VERDICTS = (*CLAIM_VERDICTS, "not measured yet")
+
+#: In a timing path, the step that stands for every item of a list.
+EVERY_ITEM = "*"
 
 
 @dataclass(frozen=True)
@@ -90,3 +99,68 @@ class Section:
     agreements: list[Agreement] = field(default_factory=list)
     divergences: list[Divergence] = field(default_factory=list)
     results: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Timing:
+    """A value of a section's ``results`` that is a timing, or derived from
+    timings, and is not a field of a study record (those carry their own
+    mark): e.g. a ratio of two measured times."""
+
+    value: Any
+
+
+def fields_of(record) -> dict:
+    """A study record's fields as a dict, each timing field's value wrapped in
+    :class:`Timing`: for a section that adds keys to a record's fields."""
+    return {f.name: Timing(getattr(record, f.name)) if is_timing(f) else getattr(record, f.name)
+            for f in fields(record)}
+
+
+def _key(key) -> str:
+    """A mapping key as JSON writes it."""
+    if hasattr(key, "item"):            # a numpy scalar
+        key = key.item()
+    if isinstance(key, str):
+        return key
+    if isinstance(key, bool) or key is None:
+        return {True: "true", False: "false", None: "null"}[key]
+    return repr(key) if isinstance(key, float) else str(key)
+
+
+def to_json(value, path: tuple = (), timings: set | None = None):
+    """``value`` as plain JSON data: dataclasses as mappings of their fields,
+    tuples and numpy arrays as lists, numpy scalars as numbers, paths as
+    text, and ``inf`` ("never reached", "no limit") and ``nan`` ("not
+    defined") as None, so that results.json is strict JSON.
+
+    ``timings``, when given, receives the path (a tuple of keys from
+    ``path`` on, :data:`EVERY_ITEM` for any list item) of every timing: each
+    timing field of a record and each :class:`Timing` value.
+    """
+    def note(where):
+        if timings is not None:
+            timings.add(where)
+
+    if isinstance(value, Timing):
+        note(path)
+        return to_json(value.value, path, None)
+    if is_dataclass(value) and not isinstance(value, type):
+        out = {}
+        for f in fields(value):
+            if is_timing(f):
+                note(path + (f.name,))
+            out[f.name] = to_json(getattr(value, f.name), path + (f.name,),
+                                  None if is_timing(f) else timings)
+        return out
+    if isinstance(value, dict):
+        return {_key(k): to_json(v, path + (_key(k),), timings) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [to_json(v, path + (EVERY_ITEM,), timings) for v in value]
+    if hasattr(value, "tolist"):        # numpy arrays and scalars
+        return to_json(value.tolist(), path, timings)
+    if isinstance(value, Path):
+        return str(value)
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value

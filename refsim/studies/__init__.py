@@ -21,3 +21,25 @@ report, the claims or a particular oracle (DESIGN.md, Architecture).
 - ``dynamics``: spin that never damps, interpenetration, energy (C11, C12);
 - ``models``: model facts against a mesh oracle.
 """
+
+from __future__ import annotations
+
+from dataclasses import Field, field
+
+#: The key of a record field's metadata that marks it as a timing: a wall
+#: time, or a figure derived from wall times (a rate, a ratio of times, a
+#: crossover size). Timings vary from run to run and from machine to machine;
+#: every other field of a study record is the same bytes on every run with the
+#: same inputs (DESIGN.md, Conventions), and the report's determinism test
+#: compares those exactly.
+TIMING = "timing"
+
+
+def timing_field(**kwargs) -> Field:
+    """A dataclass field marked as a timing (``metadata={"timing": True}``)."""
+    return field(metadata={TIMING: True}, **kwargs)
+
+
+def is_timing(f: Field) -> bool:
+    """Whether a dataclass field is marked by :func:`timing_field`."""
+    return bool(f.metadata.get(TIMING, False))

@@ -34,15 +34,15 @@ refined by the parabola through it and its two neighbours (so that coarse
 steps do not read a low apex just because no frame fell on it). The apex
 ratio over K bounces is the geometric mean ``(h_K / h_0)^(1/K)``.
 
-Run ``python -m refsim.studies.bounce`` to print every figure
-(``--quick`` for the short version the quick report uses).
+``refsim study dynamics-apex`` (and the other ``dynamics-*`` entries of
+:mod:`refsim.report.plan`) prints each figure; ``--quick`` gives the short
+version the quick report uses.
 
 Cost: each study is a few simulations of 10^3 - 10^4 steps.
 """
 
 from __future__ import annotations
 
-import argparse
 import math
 import time
 from dataclasses import asdict, dataclass, field
@@ -51,6 +51,7 @@ import numpy as np
 
 from refsim.dynamics import analytic
 from refsim.solvers.methods import SOLVERS
+from refsim.studies import timing_field
 
 #: The sphere-like body and the cube of the studies (bundled models).
 SPHERE = "sphere-2k.ac"
@@ -501,7 +502,7 @@ class CostPoint:
     step: float
     ratio: float           # measured apex ratio (geometric mean over BOUNCES)
     error: float           # |ratio - e^2| / e^2
-    seconds_per_second: float   # wall time per simulated second
+    seconds_per_second: float = timing_field()  # wall time per simulated second
 
 
 @dataclass(frozen=True)
@@ -649,10 +650,10 @@ class StepCost:
     bodies: int
     rotation: str
     warmup: int                         # steps taken before the timed ones
-    refsim_seconds: float
-    pybullet_seconds: float
-    ratio: float
-    refsim_stage_seconds: dict          # per step, by stage of refsim's loop
+    refsim_seconds: float = timing_field()
+    pybullet_seconds: float = timing_field()
+    ratio: float = timing_field()
+    refsim_stage_seconds: dict = timing_field()  # per step, by stage of refsim's loop
     steps: int = 0                      # timed steps per repeat
     repeats: int = 0                    # repeats (the fastest kept)
 
@@ -698,89 +699,6 @@ def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: 
     return rows
 
 
-# -- command line -------------------------------------------------------------------
-
-
-def _fmt(x: float, digits: int = 5) -> str:
-    return "nan" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{x:.{digits}g}"
-
-
-def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(prog="python -m refsim.studies.bounce",
-                                     description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="fewer step sizes and solvers")
-    parser.add_argument("--no-pybullet", action="store_true", help="refsim and analytic only")
-    args = parser.parse_args(argv)
-    from refsim.oracles.pybullet_adapter import PybulletOracle
-
-    pb = None if args.no_pybullet else PybulletOracle()
-
-    print(f"Apex ratios (geometric mean of the first {BOUNCES}; ideal e^2), "
-          f"step {STEP}, solver {SOLVER}:")
-    print(f"{'body':14} {'rot':5} {'e':>4} {'e^2':>8} {'refsim':>9} {'err':>8} "
-          f"{'pybullet':>9} {'err':>8} {'refsim h1/h0':>12} {'pyb h1/h0':>10}")
-    for r in measure_apexes(oracle=pb):
-        print(f"{r.body:14} {r.rotation:5} {r.e:4} {r.analytic_ratio:8.5f} "
-              f"{r.refsim_ratio:9.5f} {r.refsim_error:8.2%} {r.pybullet_ratio:9.5f} "
-              f"{r.pybullet_error:8.2%} {r.refsim_first_ratio:12.5f} "
-              f"{r.pybullet_first_ratio:10.5f}")
-        print(f"    seed's literal wall speed: ratio {r.seed_speed_ratio:.5f} "
-              f"(error {r.seed_speed_error:.2%}), h1/h0 {r.seed_speed_first_ratio:.5f}")
-        print(f"    apex heights analytic {[round(x, 4) for x in r.analytic_heights]}")
-        print(f"                 refsim   {[round(x, 4) for x in r.refsim_heights]}")
-        print(f"                 pybullet {[round(x, 4) for x in r.pybullet_heights]}")
-        print(f"                 seed spd {[round(x, 4) for x in r.seed_speed_heights]}")
-        print(f"    apex times   analytic {[round(x, 4) for x in r.analytic_times]}")
-        print(f"                 refsim   {[round(x, 4) for x in r.refsim_times]}")
-        print(f"                 pybullet {[round(x, 4) for x in r.pybullet_times]}")
-        print(f"    max |w| refsim {_fmt(r.refsim_max_spin)} pybullet "
-              f"{_fmt(r.pybullet_max_spin)} rad/s")
-    print(f"\nOblique bounce (friction {OBLIQUE_FRICTION}, e {OBLIQUE_E}): lateral "
-          "velocity after the bounce, m/s")
-    for r in measure_oblique(oracle=pb):
-        print(f"  {r.body:14} v_t {r.v_t} v_n {r.v_n:.3f}: seed {r.seed_analytic:.4f} "
-              f"coulomb(point) {r.coulomb_point:.4f} coulomb(ball) {r.coulomb_ball:.4f} "
-              f"(ball slides: {r.ball_slides}) | refsim {r.refsim:.4f} "
-              f"pybullet {r.pybullet:.4f} (|w| {r.pybullet_spin:.3f})")
-    print(f"\nTime to rest (sphere; settled once apexes stay below {REST_FRACTION} h0), s")
-    for r in measure_rest(oracle=pb):
-        print(f"  e {r.e}: Zeno {r.zeno:.4f}; settle analytic {r.analytic_settle:.4f} "
-              f"(bounce {r.analytic_bounces}) refsim {_fmt(r.refsim_settle)} "
-              f"(bounce {r.refsim_bounces}) pybullet {_fmt(r.pybullet_settle)} "
-              f"(bounce {r.pybullet_bounces})")
-    if pb:
-        print(f"\npybullet settings, one at a time (sphere, e {OBLIQUE_E}; analytic settling "
-              f"bounce {analytic.bounces_until(OBLIQUE_E, REST_FRACTION)}):")
-        from refsim.report.sections.dynamics import _pybullet_variants
-
-        for r in measure_engine_variants(_pybullet_variants()):
-            print(f"  {r.change:58} ratio {r.ratio:.5f} ({r.error:+.2%}) settles after "
-                  f"bounce {r.settle_bounce}, {r.bounces} bounces")
-    print("\nStep cost, cubes in the world cube (collision aabb), seconds per step:")
-    for r in measure_step_cost(oracle=pb):
-        print(f"  {r.bodies:3d} bodies, rotation {r.rotation:4}: refsim {r.refsim_seconds:.3e} "
-              f"pybullet {r.pybullet_seconds:.3e} ratio {r.ratio:.2f}")
-        print("      refsim by stage (us): " + ", ".join(
-            f"{k} {1e6 * v:.1f}" for k, v in r.refsim_stage_seconds.items()))
-    print(f"  after {LATE_WARMUP} steps (the cubes settled on the floor, in contact):")
-    for r in measure_step_cost(counts=(BENCH_COUNTS[-1],), warmup=LATE_WARMUP, repeats=3,
-                               oracle=pb):
-        print(f"  {r.bodies:3d} bodies, rotation {r.rotation:4}: refsim {r.refsim_seconds:.3e} "
-              f"pybullet {r.pybullet_seconds:.3e} ratio {r.ratio:.2f}")
-    steps = COST_STEPS_QUICK if args.quick else COST_STEPS
-    solvers = COST_SOLVERS_QUICK if args.quick else COST_SOLVERS
-    study = measure_cost(steps, solvers, oracle=pb)
-    print(f"\nSpeed vs accuracy (sphere, e {study.e}, apex ratio over {study.bounces} bounces):")
-    print(f"  {'engine':9} {'solver':16} {'step':>9} {'ratio':>9} {'error':>10} {'s/s':>10}")
-    for pt in study.points:
-        print(f"  {pt.engine:9} {pt.solver:16} {pt.step:9.6f} {pt.ratio:9.5f} "
-              f"{pt.error:10.3e} {pt.seconds_per_second:10.3e}")
-
-
 def as_dict(obj) -> dict:
     """A study's dataclass as JSON-able data."""
     return asdict(obj)
-
-
-if __name__ == "__main__":
-    main()

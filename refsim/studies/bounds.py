@@ -28,7 +28,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -37,6 +37,7 @@ from refsim.bounds.aabb_linear import LinearAABB, aabb_linear
 from refsim.kernels import numba_usable
 from refsim.models import shapes
 from refsim.models.mesh import Mesh
+from refsim.studies import timing_field
 from refsim.types import as_pose, random_rotation, rotation_about_axis, transform_points
 
 #: The sweep of C1: box (12 triangles), icosahedron (20) and geodesic spheres
@@ -123,7 +124,7 @@ class UpdateCost:
     n_vertices: int
     motion: str
     method: str
-    seconds_per_update: float
+    seconds_per_update: float = timing_field()
     visits_per_update: float
     max_visits: int
     evaluations_per_update: float
@@ -144,9 +145,9 @@ class UpdateCostStudy:
     frames: int
     repeats: int
     seed: int
-    pose_check_seconds: float
-    crossovers: dict = field(default_factory=dict)
-    speedups: dict = field(default_factory=dict)
+    pose_check_seconds: float = timing_field()
+    crossovers: dict = timing_field(default_factory=dict)
+    speedups: dict = timing_field(default_factory=dict)
 
     def row(self, mesh: str, motion: str, method: str) -> UpdateCost:
         for r in self.rows:
@@ -331,10 +332,10 @@ class CompileCost:
     later tracker update (2000-triangle sphere, 1 degree per frame).
     """
 
-    import_numba: float
-    cold_first_call: float
-    cached_first_call: float
-    steady_call: float
+    import_numba: float = timing_field()
+    cold_first_call: float = timing_field()
+    cached_first_call: float = timing_field()
+    steady_call: float = timing_field()
 
 
 _COMPILE_PROBE = r"""
@@ -453,59 +454,3 @@ def measure_bounds_agreement(engine, meshes=None, *, poses: int = 200, seed: int
                                     exact if tracker is not None else None,
                                     bitwise, within, worst))
     return rows
-
-
-def _print_update_cost(study: UpdateCostStudy) -> None:
-    print(f"C1: seconds per update (median of {study.repeats} x {study.frames} frames), "
-          f"{study.degrees_per_frame} deg/frame or random jumps; pose check "
-          f"{study.pose_check_seconds * 1e6:.1f} us extra per public call")
-    methods = list(dict.fromkeys(r.method for r in study.rows))
-    for motion in dict.fromkeys(r.motion for r in study.rows):
-        print(f"\n{motion}: microseconds per update | visits per update (max)")
-        print(f"{'triangles':>9} {'vertices':>8} " + " ".join(f"{m:>19}" for m in methods)
-              + "   visits(incr)  max")
-        for r0 in (r for r in study.rows if r.motion == motion and r.method == methods[0]):
-            cells = [study.row(r0.mesh, motion, m) for m in methods]
-            inc = [c for c in cells if c.method.startswith("incremental")]
-            visits = f"{inc[0].visits_per_update:12.1f} {inc[0].max_visits:5d}" if inc else ""
-            print(f"{r0.n_triangles:9d} {r0.n_vertices:8d} "
-                  + " ".join(f"{c.seconds_per_update * 1e6:19.2f}" for c in cells)
-                  + f"   {visits}")
-    print("\ncrossover (smallest size from which incremental is faster at every larger size):")
-    for key, value in study.crossovers.items():
-        ratios = ", ".join(f"{s}:{q:.2f}" for s, q in study.speedups[key])
-        print(f"  {key}: {value}   [scan/incremental: {ratios}]")
-
-
-def _print_errors(results) -> None:
-    print(f"{'mesh':>26} {'tri':>6} {'convex':>6} {'motion':>8} {'wrong':>7} {'sides':>7} "
-          f"{'max def':>8} {'med def':>8} {'visits':>7}")
-    for r in results:
-        print(f"{r.mesh:>26} {r.n_triangles:6d} {r.convex!s:>6} {r.motion:>8} "
-              f"{r.wrong_fraction:7.3f} {r.wrong_side_fraction:7.3f} {r.max_deficit:8.4f} "
-              f"{r.median_deficit:8.4f} {r.visits_per_update:7.1f}")
-
-
-def main(argv=None) -> None:
-    """``python -m refsim.studies.bounds {c1,c2,compile}``: print one figure."""
-    import argparse
-
-    parser = argparse.ArgumentParser(prog="python -m refsim.studies.bounds")
-    parser.add_argument("figure", choices=["c1", "c2", "compile"])
-    parser.add_argument("--frames", type=int, default=None)
-    parser.add_argument("--repeats", type=int, default=5)
-    parser.add_argument("--seed", type=int, default=0)
-    args = parser.parse_args(argv)
-    if args.figure == "c1":
-        _print_update_cost(measure_update_cost(frames=args.frames or 200,
-                                               repeats=args.repeats, seed=args.seed))
-    elif args.figure == "c2":
-        for motion in ("coherent", "jump"):
-            _print_errors(measure_incremental_error(motion=motion, frames=args.frames or 720,
-                                                    seed=args.seed))
-    else:
-        print(measure_numba_compile_cost())
-
-
-if __name__ == "__main__":
-    main()

@@ -16,7 +16,8 @@ energy of a bouncing body, the seed's model against the corrected one.
   spinning cube, seed against corrected.
 
 Every function returns frozen dataclasses of numbers; the report draws them
-and computes nothing itself. ``python -m refsim.studies.dynamics`` prints them.
+and computes nothing itself. ``refsim study dynamics-spin``,
+``dynamics-interpenetration`` and ``dynamics-rotation-energy`` print them.
 """
 
 from __future__ import annotations
@@ -248,22 +249,3 @@ def measure_energy(scene=None, *, duration: float | None = None,
                                  increases=int((rise > ENERGY_SLACK).sum()),
                                  max_rise=float(rise.max(initial=0.0))))
     return rows
-
-
-def main() -> None:  # pragma: no cover - printing only
-    for row in measure_spin():
-        print(f"C12 {row.model:8s} final |w| {row.final_spin:.3g} rad/s, |v| "
-              f"{row.final_speed:.3g} m/s, w_y {row.spin_normal[-1]:.3g}, "
-              f"at rest {row.at_rest}, E_rot {row.rotational_energy[0]:.3g} -> "
-              f"{row.rotational_energy[-1]:.3g} J")
-    for row in measure_interpenetration():
-        print(f"C11 {row.case:6s} {row.response:8s} {row.interpenetrating:5d} / "
-              f"{row.frames} frames interpenetrating, longest run {row.longest_run}, "
-              f"{row.contacts} contacts")
-    for row in measure_energy():
-        print(f"energy {row.model:8s} {row.energy[0]:.4g} -> {row.energy[-1]:.4g} J, "
-              f"{row.increases} rises > {ENERGY_SLACK} J, max rise {row.max_rise:.3g} J")
-
-
-if __name__ == "__main__":  # pragma: no cover
-    main()

@@ -3,8 +3,9 @@ C3), agreement of the exact level with body-level oracles, and the speed of
 the triangle hierarchy against FCL (seed S4).
 
 What: ``measure_*`` functions return frozen dataclasses of numbers that the
-tests gate on and the report draws; nothing here prints or plots (the
-``main`` entry point prints them: ``python -m refsim.studies.levels``).
+tests gate on and the report draws; nothing here prints or plots
+(``refsim study collision-levels``, ``collision-body-oracles`` and
+``collision-speed`` print them).
 
 - :func:`measure_levels` (C3, "3 levels of accuracy [...] to trade accuracy
   for speed"): every level of :func:`refsim.collision.bodies.bodies_collide`
@@ -26,7 +27,8 @@ tests gate on and the report draws; nothing here prints or plots (the
   one-off compile cost of the numba kernels.
 
 Oracles are passed in (callables or adapter objects), so refsim does not
-import ``oracles``; ``main`` builds them.
+import ``oracles``; the composition root (:mod:`refsim.report.plan`) builds
+them.
 
 Cost: a query is what :mod:`refsim.collision.bodies` costs (O(n + m) per
 body plus the traversal); every timing is the median of ``repeats`` calls
@@ -48,6 +50,7 @@ from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
 from refsim.collision.spheres import bounding_sphere
 from refsim.kernels import choose_kernel
+from refsim.studies import timing_field
 from refsim.studies.triangles import DISAGREEMENT_KINDS, _strict_crossing, classify_disagreement
 from refsim.types import Pose, random_rotation, rotation_about_axis
 
@@ -250,11 +253,12 @@ class ConfigurationLevels:
     description: str
     intended: bool                  # the exact answer by construction
     answers: dict                   # level -> bool (bodies_collide, method "bvh")
-    seconds: dict                   # level -> median seconds per boolean query ("bvh")
-    seed_seconds: dict              # "triangle-aabb", "exact" -> median seconds, method "seed"
+    seconds: dict = timing_field()  # level -> median seconds per boolean query ("bvh")
+    seed_seconds: dict = timing_field()  # "triangle-aabb", "exact" -> median s, method "seed"
     candidate_pairs: int            # triangle-aabb pairs
     exact_pairs: int
-    pairs_seconds: dict             # "bvh", "seed" -> median seconds of intersecting_pairs exact
+    # "bvh", "seed" -> median seconds of intersecting_pairs at the exact level
+    pairs_seconds: dict = timing_field()
     seed_answers_equal: bool        # method "seed" gave the same answers and pairs
 
     @property
@@ -286,7 +290,7 @@ class RandomLevels:
 @dataclass(frozen=True)
 class LevelSummary:
     level: str
-    median_seconds: float           # median over the configurations of their medians
+    median_seconds: float = timing_field()  # median over the configurations of their medians
     false_positives: int            # configurations + random poses
     negatives: int                  # queries where exact says no (the most FPs possible)
     false_negatives: int
@@ -696,11 +700,11 @@ class SpeedCase:
     candidate_pairs: int            # triangle-box pairs (test 2)
     exact_pairs: int
     fcl_pairs: int | None
-    bvh_seconds: float              # intersecting_pairs, method "bvh"
-    seed_seconds: float             # intersecting_pairs, method "seed"
-    fcl_seconds: float | None       # FCL's all intersecting pairs
-    bvh_boolean_seconds: float      # bodies_collide exact, method "bvh"
-    fcl_boolean_seconds: float | None
+    bvh_seconds: float = timing_field()  # intersecting_pairs, method "bvh"
+    seed_seconds: float = timing_field()  # intersecting_pairs, method "seed"
+    fcl_seconds: float | None = timing_field()  # FCL's all intersecting pairs
+    bvh_boolean_seconds: float = timing_field()  # bodies_collide exact, method "bvh"
+    fcl_boolean_seconds: float | None = timing_field()
 
     @property
     def pairs_ratio(self) -> float | None:
@@ -724,9 +728,10 @@ class CompileCost:
     import plus compilation) and warm (the same, with the cache just written:
     loading the machine code)."""
 
-    triangle_kernel_cold_seconds: float      # triangle_numba.measure_numba_compile_seconds
-    hierarchy_cold_seconds: float            # every compiled kernel the hierarchy uses
-    hierarchy_warm_seconds: float
+    # triangle_numba.measure_numba_compile_seconds
+    triangle_kernel_cold_seconds: float = timing_field()
+    hierarchy_cold_seconds: float = timing_field()  # every compiled kernel the hierarchy uses
+    hierarchy_warm_seconds: float = timing_field()
 
 
 @dataclass(frozen=True)
@@ -838,103 +843,3 @@ def measure_hierarchy_speed(fcl=None, repeats: int = 21, *,
     compile_result = measure_compile_cost() if compile_cost and kernel == "compiled" else None
     return HierarchySpeed(kernel=kernel, repeats=repeats, cases=tuple(cases),
                           compile=compile_result)
-
-
-# --------------------------------------------------------------------------
-# the command line
-# --------------------------------------------------------------------------
-
-def default_body_oracles():
-    """``(collide engines, pairs engine, fcl engine)`` from the installed
-    engines; an engine that is missing is left out (and said so on stderr)."""
-    import sys
-
-    from refsim.oracles import OracleUnavailable
-
-    body, fcl = [], None
-    try:
-        from refsim.oracles.fcl_adapter import FCLOracle
-
-        fcl = FCLOracle()
-        body.append(fcl)
-    except OracleUnavailable as exc:
-        print(f"python-fcl unavailable: {exc}", file=sys.stderr)
-    try:
-        from refsim.oracles.trimesh_collision import TrimeshCollisionOracle
-
-        body.append(TrimeshCollisionOracle())
-    except OracleUnavailable as exc:
-        print(f"trimesh collision unavailable: {exc}", file=sys.stderr)
-    return tuple(body), fcl, fcl
-
-
-def _us(seconds) -> str:
-    return "-" if seconds is None else f"{seconds * 1e6:9.1f}"
-
-
-def main(argv=None) -> None:
-    """Print every figure of this module: ``python -m refsim.studies.levels``
-    (``--quick`` for fewer repeats and poses, ``--no-compile`` to skip the
-    compile-cost subprocesses)."""
-    import argparse
-
-    parser = argparse.ArgumentParser(description=main.__doc__)
-    parser.add_argument("--quick", action="store_true")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--no-compile", action="store_true")
-    args = parser.parse_args(argv)
-    repeats, per_pair = (5, 10) if args.quick else (21, 50)
-
-    levels = measure_levels(repeats=repeats, random_per_pair=per_pair, seed=args.seed)
-    print(f"C3 levels (kernel {levels.kernel}, median of {levels.repeats}; times in us)")
-    print(f"{'configuration':24s} {'kind':24s} " + " ".join(f"{lv:>13s}" for lv in LEVELS)
-          + "   cand  exact  seed-path/bvh(pairs)")
-    for c in levels.configurations:
-        answers = " ".join(f"{'T' if c.answers[lv] else 'F'} {c.seconds[lv] * 1e6:9.1f}"
-                           + ("*" if c.false_positive(lv) else " ") for lv in LEVELS)
-        print(f"{c.name:24s} {c.kind:24s} {answers} {c.candidate_pairs:6d} {c.exact_pairs:6d}"
-              f"  {c.pairs_seconds['seed'] / c.pairs_seconds['bvh']:8.1f}"
-              f"{'' if c.seed_answers_equal else '  SEED PATH DIFFERS'}")
-    print("(* = false positive against exact)")
-    for r in levels.random:
-        print(f"random {r.model_a:>14s} / {r.model_b:14s} n={r.n} exact_true={r.exact_true} "
-              f"FP={r.false_positives} FN={r.false_negatives} "
-              f"pairs cand={r.candidate_pairs} exact={r.exact_pairs} "
-              f"seed_mismatch={r.seed_mismatches}")
-    for s in levels.summary:
-        print(f"level {s.level:14s} median {s.median_seconds * 1e6:9.1f} us  "
-              f"FP {s.false_positives}/{s.negatives} = {s.false_positive_rate:.3f}  "
-              f"FN {s.false_negatives}")
-
-    body, fcl_pairs, fcl = default_body_oracles()
-    agreement = measure_body_oracles(body, fcl_pairs, random_per_pair=per_pair,
-                                     seed=args.seed)
-    for b in agreement.bodies:
-        print(f"body oracle {b.oracle:8s} {b.source:11s} n={b.n} agree={b.agree} "
-              f"refsim_true={b.refsim_true} oracle_true={b.oracle_true} {b.counts}")
-        for d in b.disagreements:
-            print(f"    {d.case}: refsim={d.refsim} oracle={d.oracle} -> {d.kind}")
-    for p in agreement.pairs:
-        print(f"fcl pairs {p.source:11s} queries={p.queries} equal={p.queries_equal} "
-              f"refsim={p.refsim_pairs} fcl={p.oracle_pairs} common={p.common_pairs} "
-              f"{p.counts}")
-
-    speed = measure_hierarchy_speed(fcl, repeats, compile_cost=not args.no_compile)
-    print(f"hierarchy vs FCL (kernel {speed.kernel}, median of {speed.repeats}; us)")
-    for c in speed.cases:
-        ratio = "-" if c.pairs_ratio is None else f"{c.pairs_ratio:.2f}"
-        bool_ratio = "-" if c.boolean_ratio is None else f"{c.boolean_ratio:.2f}"
-        print(f"{c.model:10s} {c.kind:24s} pairs {c.exact_pairs:4d} (fcl {c.fcl_pairs}) "
-              f"cand {c.candidate_pairs:5d} | all pairs bvh {_us(c.bvh_seconds)} "
-              f"seed {_us(c.seed_seconds)} fcl {_us(c.fcl_seconds)} bvh/fcl {ratio} | "
-              f"boolean bvh {_us(c.bvh_boolean_seconds)} fcl {_us(c.fcl_boolean_seconds)} "
-              f"bvh/fcl {bool_ratio}")
-    if speed.compile is not None:
-        cost = speed.compile
-        print(f"numba compile: triangle kernel cold {cost.triangle_kernel_cold_seconds:.2f} s, "
-              f"hierarchy cold {cost.hierarchy_cold_seconds:.2f} s, "
-              f"warm (cached) {cost.hierarchy_warm_seconds:.2f} s")
-
-
-if __name__ == "__main__":
-    main()

@@ -37,6 +37,7 @@ import numpy as np
 from refsim.particles.config import ParticleConfig
 from refsim.particles.system import ParticleSystem, particle_rhs
 from refsim.solvers.methods import SOLVERS
+from refsim.studies import timing_field
 from refsim.studies.solvers import WorkPoint, fit_order
 
 # --------------------------------------------------------------------------
@@ -185,7 +186,7 @@ class DragComparison:
     same_terminal_difference: float
     same_terminal_distance: float
     same_k_difference: float
-    cost_ratio: float
+    cost_ratio: float = timing_field()
 
 
 def _trajectory(config: ParticleConfig, x0, v0, t_eval):
@@ -467,10 +468,10 @@ class Throughput:
 
     count: int
     solver: str
-    particle_steps_per_s: float
-    streaming_particle_steps_per_s: float
-    streaming_bytes_per_s: float
-    ratio: float
+    particle_steps_per_s: float = timing_field()
+    streaming_particle_steps_per_s: float = timing_field()
+    streaming_bytes_per_s: float = timing_field()
+    ratio: float = timing_field()
 
 
 def measure_throughput(count: int, solver: str, repeats: int = 10,
@@ -623,64 +624,3 @@ def measure_solver_choice(target_free: float = 1e-4, budget_walls: float = 512,
             error_at_cost(walls, name, budget_walls),
             measure_resting_jitter(name, 0.01).max_height_gh2))
     return out
-
-
-# --------------------------------------------------------------------------
-# Printing the figures: python -m refsim.studies.particles {jitter,...}
-# --------------------------------------------------------------------------
-
-def main(argv=None) -> None:
-    """Print one table of figures; ``which`` names it."""
-    import argparse
-
-    parser = argparse.ArgumentParser(prog="python -m refsim.studies.particles")
-    parser.add_argument("which", choices=["jitter", "drag", "work-precision",
-                                          "work-precision-walls", "frame", "choice",
-                                          "throughput", "memory"])
-    which = parser.parse_args(argv).which
-    if which == "jitter":
-        for damped in (0.0, 1.0):
-            for j in measure_jitter_table(drag=damped):
-                print(f"drag {j.drag:3.1f} {j.method:16s} h {j.h:.4f}: hop {j.max_height:.3e} m "
-                      f"= {j.max_height_gh2:7.3f} g h^2, rms v {j.rms_velocity:.3e} m/s, "
-                      f"{j.bounces_per_second:6.1f} bounces/s")
-        for h in (1 / 30, 1 / 100, 1 / 1000):
-            print(f"euler estimate 2 g h^2/(1-e^2)^2 at h {h:.4f}: "
-                  f"{euler_jitter_estimate(h, 0.8):.3e} m")
-    elif which == "drag":
-        print(measure_drag_models())
-    elif which in ("work-precision", "work-precision-walls"):
-        walls = which.endswith("walls")
-        steps = PARTICLE_STEPS + ((2048, 4096) if walls else ())
-        points = measure_particle_work_precision(particle_test_config(walls=walls),
-                                                 steps=steps, repeats=3)
-        for p in points:
-            print(f"{p.method:16s} {p.parameter:10.3g} error {p.error:9.2e} m nfev "
-                  f"{p.nfev:6d} time {p.wall_time * 1e3:8.3f} ms")
-        print("observed orders:", {k: round(v, 3) for k, v in observed_orders(points).items()})
-    elif which == "frame":
-        for walls in (False, True):
-            print(f"walls={walls}:", measure_frame_step_difference(
-                particle_test_config(walls=walls)))
-    elif which == "choice":
-        for c in measure_solver_choice():
-            print(c)
-    elif which == "throughput":
-        for count in (1_000, 100_000, 1_000_000):
-            for solver in ("euler", "rk4"):
-                t = measure_throughput(count, solver)
-                print(f"N {count:>9d} {solver:6s}: {t.particle_steps_per_s:.3e} particle-steps/s,"
-                      f" streaming {t.streaming_particle_steps_per_s:.3e} "
-                      f"({t.streaming_bytes_per_s / 1e9:.1f} GB/s), ratio {t.ratio:.1f}")
-    else:
-        for solver in SOLVERS:
-            m = measure_step_memory(ParticleConfig(count=100_000, solver=solver, drag=0.1,
-                                                   drag_model="quadratic",
-                                                   wall_speed=SEED_WALLS), 20)
-            print(f"{solver:16s} peak {m.peak_bytes / 1e6:.2f} MB = {m.state_sized_arrays:.2f} "
-                  f"states, {m.bytes_per_particle:.1f} B/particle, transient "
-                  f"{m.transient_bytes} B")
-
-
-if __name__ == "__main__":
-    main()

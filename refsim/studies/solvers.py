@@ -47,6 +47,7 @@ from refsim.solvers.problems import (
     projectile_linear_drag,
 )
 from refsim.solvers.stability import imaginary_axis_limit, real_axis_limit
+from refsim.studies import timing_field
 
 EPS = np.finfo(np.float64).eps
 
@@ -459,7 +460,7 @@ class WorkPoint:
     parameter: float
     error: float
     nfev: int
-    wall_time: float
+    wall_time: float = timing_field()
 
 
 #: The scipy tolerances of the work-precision anchors.
@@ -536,45 +537,3 @@ def error_at_cost(points: list[WorkPoint], method: str, budget: float,
             w = math.log(budget / ca) / math.log(cb / ca)
             return float(math.exp((1 - w) * math.log(a.error) + w * math.log(b.error)))
     return math.nan
-
-
-# --------------------------------------------------------------------------
-# Printing the figures: python -m refsim.studies.solvers {orders,...}
-# --------------------------------------------------------------------------
-
-def main(argv=None) -> None:
-    """Print one table of figures; ``which`` names it."""
-    import argparse
-
-    parser = argparse.ArgumentParser(prog="python -m refsim.studies.solvers")
-    parser.add_argument("which", choices=["orders", "seed-literal", "stability", "energy",
-                                          "work-precision"])
-    which = parser.parse_args(argv).which
-    if which == "orders":
-        for (problem, method), c in measure_orders().items():
-            print(f"{problem:24s} {method:16s} order {c.order:6.3f}  "
-                  f"(fitted h {c.h[c.fitted].max():.3g}..{c.h[c.fitted].min():.3g}, "
-                  f"errors {c.error[c.fitted].max():.2e}..{c.error[c.fitted].min():.2e})")
-    elif which == "seed-literal":
-        for problem in (exponential_decay(), harmonic_oscillator(), kepler_orbit()):
-            r = measure_seed_literal_rk4(problem)
-            print(f"{problem.name:24s} error vs y'=f as h->0: {r.against_true.error[-1]:.4f} "
-                  f"(limit {r.limit_error:.4f}); order vs y'=(5/3)f: "
-                  f"{r.against_scaled.order:.3f}")
-    elif which == "stability":
-        for s in measure_stability():
-            print(f"{s.method:16s} drag h k/m: predicted {s.drag_predicted:.6f} measured "
-                  f"{s.drag_measured:.6f} | oscillator h omega: predicted "
-                  f"{s.oscillator_predicted:.6f} measured {s.oscillator_measured:.6f}")
-    elif which == "energy":
-        for e in measure_oscillator_energy():
-            print(f"{e.method:16s} omega h {e.omega_h:5.2f}: E(T)/E(0) measured "
-                  f"{e.measured:.9g} predicted {e.predicted:.9g}")
-    else:
-        for p in measure_work_precision(repeats=3):
-            print(f"{p.method:16s} {p.parameter:10.3g} error {p.error:9.2e} nfev {p.nfev:7d} "
-                  f"time {p.wall_time * 1e3:9.3f} ms")
-
-
-if __name__ == "__main__":
-    main()

@@ -28,7 +28,7 @@ In-process sweeps run after a warm-up call, in a process that has refsim
 loaded and compiled kernels cached: the state of a session that calls
 ``run_sweep``. Timings vary between runs and machines, and this machine's
 cores may be shared: quote medians with the command
-``python -m refsim.studies.sweep`` (which prints the load average too).
+``refsim study sweep-speed`` (which prints the load average too).
 
 Cost: about ``repeats * (tasks * task time * (1 + 2/W) + 3 start-ups)``.
 """
@@ -42,6 +42,7 @@ import tempfile
 import time
 from dataclasses import dataclass
 
+from refsim.studies import timing_field
 from refsim.sweep.backend import BACKENDS
 from refsim.sweep.examples import bounce, trivial
 from refsim.sweep.run import run_sweep
@@ -58,12 +59,13 @@ class BackendSpeed:
 
     backend: str
     workers: int | None
-    bench_seconds: float          # the sweep of the CPU-bound tasks
-    bench_cpu_seconds: float      # CPU time of that sweep, this process and its workers
-    speedup: float                # in-process bench_seconds over this one's
-    startup_seconds: float        # a sweep of one trivial task per worker
-    trivial_seconds: float        # a sweep of ``trivial`` trivial tasks
-    per_task_seconds: float       # (trivial_seconds - startup_seconds) / (trivial - workers)
+    bench_seconds: float = timing_field()  # the sweep of the CPU-bound tasks
+    bench_cpu_seconds: float = timing_field()  # CPU time of that sweep, here and in workers
+    speedup: float = timing_field()  # in-process bench_seconds over this one's
+    startup_seconds: float = timing_field()  # a sweep of one trivial task per worker
+    trivial_seconds: float = timing_field()  # a sweep of ``trivial`` trivial tasks
+    # (trivial_seconds - startup_seconds) / (trivial - workers)
+    per_task_seconds: float = timing_field()
 
 
 @dataclass(frozen=True)
@@ -72,9 +74,11 @@ class SweepSpeed:
     duration: float
     trivial: int
     repeats: int
-    task_seconds: float           # median wall time of one benchmark task in-process
-    store_per_task_seconds: float  # added per task by a store
-    load_average: tuple[float, float]   # the machine's 1-minute load, before and after
+    task_seconds: float = timing_field()  # median wall time of one benchmark task in-process
+    store_per_task_seconds: float = timing_field()  # added per task by a store
+    # The machine's 1-minute load, before and after: it varies from run to run
+    # as the timings do.
+    load_average: tuple[float, float] = timing_field()
     backends: tuple[BackendSpeed, ...]
 
 
@@ -151,36 +155,3 @@ def measure_sweep_speed(*, tasks: int = 16, duration: float = BENCH_DURATION, wo
     return SweepSpeed(tasks=tasks, duration=duration, trivial=trivial_tasks, repeats=repeats,
                       task_seconds=task_seconds, store_per_task_seconds=store_cost,
                       load_average=(load_before, _load_average()), backends=rows)
-
-
-def main(argv=None) -> None:
-    """Print the speed of each sweep backend: ``python -m refsim.studies.sweep``."""
-    import argparse
-
-    parser = argparse.ArgumentParser(description=main.__doc__)
-    parser.add_argument("--tasks", type=int, default=16)
-    parser.add_argument("--duration", type=float, default=BENCH_DURATION)
-    parser.add_argument("--workers", type=int, default=2)
-    parser.add_argument("--trivial", type=int, default=200)
-    parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--backends", nargs="+", default=list(BACKENDS), choices=BACKENDS)
-    args = parser.parse_args(argv)
-    speed = measure_sweep_speed(tasks=args.tasks, duration=args.duration, workers=args.workers,
-                                trivial_tasks=args.trivial, repeats=args.repeats,
-                                backends=args.backends)
-    print(f"{speed.tasks} bounce.toml tasks of {speed.duration:g} simulated s "
-          f"({speed.task_seconds:.3f} s each in-process); {speed.trivial} trivial tasks; "
-          f"medians of {speed.repeats} sweeps; load average {speed.load_average[0]:.1f} "
-          f"before, {speed.load_average[1]:.1f} after, on {os.cpu_count()} CPUs")
-    print(f"{'backend':10s} {'workers':>7s} {'bench s':>9s} {'cpu s':>7s} {'speed-up':>8s} "
-          f"{'start-up s':>10s} {'trivial s':>9s} {'per task ms':>11s}")
-    for b in speed.backends:
-        print(f"{b.backend:10s} {b.workers or '-':>7} {b.bench_seconds:9.2f} "
-              f"{b.bench_cpu_seconds:7.2f} {b.speedup:8.2f} {b.startup_seconds:10.3f} "
-              f"{b.trivial_seconds:9.3f} {b.per_task_seconds * 1e3:11.3f}")
-    print(f"a store adds {speed.store_per_task_seconds * 1e3:.3f} ms per task "
-          "(one fsync'd result file)")
-
-
-if __name__ == "__main__":
-    main()

@@ -46,6 +46,7 @@ from refsim.collision.triangle import (
     triangles_intersect_float,
 )
 from refsim.collision.triangle_batch import certified_batch, triangles_intersect_batch
+from refsim.studies import timing_field
 from refsim.types import random_rotation, rotation_about_axis, transform_points
 
 TriangleTest = Callable[[np.ndarray, np.ndarray], bool]
@@ -514,13 +515,13 @@ class Throughput:
     """Pairs per second on the same random pairs (higher is faster)."""
 
     n: int
-    readable: float
-    batch: float
-    oracle: float | None
+    readable: float = timing_field()
+    batch: float = timing_field()
+    oracle: float | None = timing_field()
     batch_fallback_fraction: float
-    numba: float | None = None              # None when numba is not installed
+    numba: float | None = timing_field(default=None)  # None when numba is not installed
     # Compiling the kernel from nothing (fresh interpreter, empty numba cache).
-    numba_compile_seconds: float | None = None
+    numba_compile_seconds: float | None = timing_field(default=None)
 
 
 def measure_throughput(n: int = 20_000, seed: int = 0,
@@ -564,53 +565,3 @@ def measure_throughput(n: int = 20_000, seed: int = 0,
     return Throughput(n=n, readable=readable, batch=batch, oracle=oracle_rate,
                       batch_fallback_fraction=float((~certain).mean()),
                       numba=numba_rate, numba_compile_seconds=compile_seconds)
-
-
-
-def main(argv=None) -> None:
-    """Print every figure of this module: ``python -m refsim.studies.triangles``.
-
-    The oracle is python-fcl when it is installed (``--no-oracle`` to skip).
-    """
-    import argparse
-
-    parser = argparse.ArgumentParser(description=main.__doc__)
-    parser.add_argument("--n", type=int, default=20_000, help="random pairs")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--no-oracle", action="store_true")
-    args = parser.parse_args(argv)
-    oracle = None
-    if not args.no_oracle:
-        try:
-            from refsim.oracles.fcl_adapter import FCLOracle
-            oracle = FCLOracle().triangles_intersect
-        except Exception as exc:  # the oracle is optional here
-            print(f"oracle unavailable: {exc}")
-    print(measure_filter_fallback(args.n, args.seed))
-    print(measure_throughput(args.n, args.seed, oracle))
-    if oracle is not None:
-        rng = np.random.default_rng(args.seed)
-        A, B = rng.uniform(-1.0, 1.0, (2, args.n, 3, 3))
-        r = compare_with_oracle(A, B, oracle)
-        print(f"random pairs: n={r.n} agree={r.agree} {r.counts}")
-        A, B, _ = near_degenerate_pairs(args.n, args.seed)
-        r = compare_with_oracle(A, B, oracle)
-        print(f"near-degenerate pairs: n={r.n} agree={r.agree} {r.counts} "
-              f"largest margin {max((d.margin for d in r.disagreements), default=0.0):.2e}")
-    print(measure_float_errors(min(args.n, 5000), args.seed, oracle))
-    for s in measure_c4(oracle, args.seed).series:
-        print(f"C4 {s.frame:12s} {s.config:11s} flip exact={s.flip_exact} "
-              f"float={s.flip_float} oracle={s.flip_oracle} "
-              f"float_wrong={s.float_wrong} oracle_wrong={s.oracle_wrong}")
-    sweep = measure_c4_sweep(100, oracle, args.seed)
-    print(f"C4 sweep over {sweep.frames} frames, thetas {sweep.thetas[0]:g} .. "
-          f"{sweep.thetas[-1]:g}")
-    for config in sweep.configs:
-        print(f"  {config:11s} exact_true={sweep.exact_true[config]}")
-        print(f"  {'':11s} float_wrong={sweep.float_wrong[config]}")
-        if sweep.oracle_wrong:
-            print(f"  {'':11s} oracle_wrong={sweep.oracle_wrong[config]}")
-
-
-if __name__ == "__main__":
-    main()

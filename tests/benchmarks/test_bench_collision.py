@@ -6,7 +6,7 @@ one run; and the boolean query against FCL's.
 
 Read the ratios from the medians of one ``make bench`` run; the same figures,
 with the ratios computed, come from
-``python -m refsim.studies.levels`` (the report's collision
+``refsim study collision-speed`` (the report's collision
 section). No speed is asserted; each benchmark checks its answer instead.
 """
 

@@ -8,7 +8,7 @@ forces (pybullet, :meth:`oracles.pybullet_adapter.PybulletOracle.step`),
 both in the same run; ``make bench`` groups them per scene, so the two
 medians side by side give the ratio. The issue's target is refsim at most
 2x pybullet at 40 bodies; these benchmarks measure it and assert no timing.
-``python -m refsim.studies.bounce`` (or
+``refsim study dynamics-step-cost`` (or
 :func:`refsim.studies.bounce.measure_step_cost`) prints the ratios.
 
 With ``--benchmark-disable`` (``make test``) each function runs one step.

@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from refsim.oracles.fcl_adapter import FCLOracle
 
+from refsim.claims.collision import ROUNDING_TILT
 from refsim.collision.triangle_batch import triangles_intersect_batch
 from refsim.models.mesh import Mesh
-from refsim.report.sections.collision import ROUNDING_TILT
 from refsim.studies.triangles import (
     NEAR_DEGENERATE_MARGIN,
     classify_disagreement,

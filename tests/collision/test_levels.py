@@ -7,7 +7,7 @@ Known answers come from exactly representable geometry: cube.ac is
 x = 0.5 with no rounding anywhere, and (1, 1, 1) makes them share one corner.
 
 Measured (seed 0, 10 random poses per model pair; reproduce with
-``python -m refsim.studies.levels --quick``): zero false negatives
+``refsim study collision-levels --quick``): zero false negatives
 at every level; FCL's face pairs and boolean answers equal refsim's on every
 query; trimesh's CollisionManager differs only by "containment" (a small
 convex body inside a convex one: a solid for trimesh, two surfaces apart for

@@ -9,11 +9,11 @@ import re
 import pytest
 
 from refsim.bundled import bundled_models
+from refsim.claims import CLAIMS
 from refsim.io import write_text_atomic
 from refsim.report import build as report_build
 from refsim.report.build import AREAS, build_report
-from refsim.report.claims import CLAIMS
-from refsim.report.section import TIMING_WORDS
+from refsim.report.section import EVERY_ITEM, Section
 
 
 def test_every_area_has_a_section(quick_report):
@@ -59,29 +59,65 @@ def test_page_is_self_contained(quick_report):
 
 
 def test_results_are_deterministic(tmp_path, quick_report):
+    """Two quick builds agree exactly on everything but the timings that
+    results.json lists (``timing_paths``) and the items marked as resting on
+    timings (a verdict, a table of timings, a catalogue entry that exists
+    because of a timing verdict). This test's build is the session's only
+    second one."""
     _, _, first = quick_report
     build_report(tmp_path, quick=True, stream=io.StringIO())
     second = json.loads((tmp_path / "results.json").read_text())
-    assert _without_timings(first) == _without_timings(second)
+    assert first["timing_paths"] == second["timing_paths"]
+    paths = [tuple(p) for p in first["timing_paths"]]
+    assert _without_timings(first, paths) == _without_timings(second, paths)
 
 
-def _without_timings(value):
-    """Drop what may differ between runs: keys named for timings, and every
-    item flagged as resting on timings (a claim's verdict, a table of
-    timings, a catalogue entry that exists because of a timing verdict)."""
+def _timed(path: tuple, patterns: list[tuple]) -> bool:
+    return any(len(path) == len(p) and all(q == k or (q == EVERY_ITEM and isinstance(k, int))
+                                           for q, k in zip(p, path, strict=True))
+               for p in patterns)
+
+
+def _without_timings(value, patterns, path=()):
+    """``value`` without the timing paths and the items marked ``timing``."""
     if isinstance(value, dict):
-        return {k: _without_timings(v) for k, v in value.items()
-                if not any(word in k for word in TIMING_WORDS)}
+        return {k: _without_timings(v, patterns, path + (k,)) for k, v in value.items()
+                if not _timed(path + (k,), patterns)}
     if isinstance(value, list):
-        return [_without_timings(v) for v in value
-                if not (isinstance(v, dict) and v.get("timing") is True)]
+        return [_without_timings(v, patterns, path + (i,)) for i, v in enumerate(value)
+                if not (isinstance(v, dict) and v.get("timing") is True)
+                and not _timed(path + (i,), patterns)]
     return value
 
 
+def test_timings_are_marked_by_metadata_not_by_name(quick_report):
+    """The study records' timing fields are listed, and results whose names
+    sound like timings but are not (counts per configuration, apex ratios)
+    are compared."""
+    _, _, results = quick_report
+    paths = {tuple(p) for p in results["timing_paths"]}
+    section = ("sections",)
+    assert section + ("bounds", "results", "update_cost", "*", "seconds_per_update") in paths
+    assert section + ("bounds", "results", "pose_check_seconds") in paths
+    assert section + ("collision", "results", "levels", "configurations", "*", "seconds") \
+        in paths
+    assert section + ("collision", "results", "hierarchy_speed", "ratios") in paths
+    assert section + ("solvers", "results", "drag_models", "cost_ratio") in paths
+    assert section + ("dynamics", "results", "step_cost", "*", "ratio") in paths
+    assert not any("apex_ratios" in p or "answers" in p or "configurations" == p[-1]
+                   for p in paths)
+    assert all(p[:1] == section and p[2] == "results" for p in paths)
+    # a marked path exists in the results it marks
+    assert results["sections"]["bounds"]["results"]["update_cost"][0]["seconds_per_update"] > 0
+
+
 def test_a_failed_build_leaves_no_file(tmp_path, monkeypatch):
+    """The sections are trivial here: what is tested is the writing."""
     def broken(*args, **kwargs):
         raise RuntimeError("rendering failed")
 
+    monkeypatch.setattr(report_build, "_build_section",
+                        lambda key, title, pending, ctx: Section(key=key, title=title))
     monkeypatch.setattr(report_build, "render", broken)
     with pytest.raises(RuntimeError):
         build_report(tmp_path, quick=True, stream=io.StringIO())

@@ -1,40 +1,31 @@
-"""Report section: bounding boxes and the world cube (seed S2, S3; claims C1, C2)."""
+"""Report section: bounding boxes and the world cube (seed S2, S3; claims C1, C2).
+
+Arranges the plan's ``bounds-cost``, ``bounds-error`` and ``bounds-agreement``
+records and the verdicts of :mod:`refsim.claims.bounds`.
+"""
 
 from __future__ import annotations
 
 from refsim.report.charts import Series, line_chart
-from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Verdict
-from refsim.studies import bounds as measure
+from refsim.report.plan import command
+from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Timing, Verdict
 
 STYLES = {"scan-numpy": "s--", "scan-numba": "s-", "incremental-python": "o--",
           "incremental-numba": "o-"}
-C1_COMMAND = "python -m refsim.studies.bounds c1"
-C2_COMMAND = "python -m refsim.studies.bounds c2"
+C1_COMMAND = command("bounds-cost")
+C2_COMMAND = command("bounds-error")
 
 
 def build(ctx) -> Section:
-    if ctx.quick:
-        meshes = measure.sweep_meshes((3, 7, 10, 16, 32))
-        frames, repeats, error_frames, poses = 50, 3, 180, 50
-    else:
-        meshes = measure.sweep_meshes()
-        frames, repeats, error_frames, poses = 200, 5, 720, 200
-    ctx.progress.announce("bounds: cost per update (C1)")
-    study = measure.measure_update_cost(meshes, frames=frames, repeats=repeats, seed=ctx.seed)
-    ctx.progress.announce("bounds: incremental box on non-convex meshes (C2)")
-    errors = [e for motion in ("coherent", "jump")
-              for e in measure.measure_incremental_error(motion=motion, frames=error_frames,
-                                                         seed=ctx.seed)]
-    ctx.progress.announce("bounds: agreement with trimesh")
-    from refsim.oracles.trimesh_adapter import TrimeshOracle
-
-    agreement = measure.measure_bounds_agreement(TrimeshOracle(), poses=poses, seed=ctx.seed)
+    study = ctx.run.get("bounds-cost")
+    errors = ctx.run.get("bounds-error")
+    agreement = ctx.run.get("bounds-agreement")
 
     methods = sorted({r.method for r in study.rows}, key=list(STYLES).index)
     figures = [_cost_figure(study, motion, methods) for motion in ("coherent", "jump")]
     figures.append(_visits_figure(study))
     tables = [_cost_table(study, methods), _error_table(errors), _agreement_table(agreement)]
-    verdicts = [_c1_verdict(study), _c2_verdict(errors)]
+    verdicts = [_c1_verdict(ctx.run.claim("C1")), _c2_verdict(ctx.run.claim("C2"))]
     agreements = _agreements(agreement)
     poses = sum(a.poses for a in agreement)
     differ = poses - sum(a.trimesh_bitwise for a in agreement)
@@ -54,11 +45,11 @@ def build(ctx) -> Section:
               "(shared, two cores); the vertex counts are exact.",
         figures=figures, tables=tables, verdicts=verdicts, agreements=agreements,
         divergences=divergences,
-        results={"update_cost": [r.__dict__ for r in study.rows],
-                 "pose_check_seconds": study.pose_check_seconds,
-                 "crossovers": {" / ".join(k): v for k, v in study.crossovers.items()},
-                 "incremental_error": [e.__dict__ for e in errors],
-                 "agreement": [a.__dict__ for a in agreement]})
+        results={"update_cost": study.rows,
+                 "pose_check_seconds": Timing(study.pose_check_seconds),
+                 "crossovers": Timing({" / ".join(k): v for k, v in study.crossovers.items()}),
+                 "incremental_error": errors,
+                 "agreement": agreement})
 
 
 def _rows(study, motion, method):
@@ -156,9 +147,7 @@ def _agreement_table(agreement) -> Table:
                 f"Reproduce: {AGREEMENT_COMMAND}")
 
 
-AGREEMENT_COMMAND = ("python -c \"from refsim.studies.bounds import "
-                     "measure_bounds_agreement as m; from refsim.oracles.trimesh_adapter import "
-                     "TrimeshOracle; [print(r) for r in m(TrimeshOracle())]\"")
+AGREEMENT_COMMAND = command("bounds-agreement")
 
 
 def _agreements(agreement) -> list[Agreement]:
@@ -176,49 +165,28 @@ def _agreements(agreement) -> list[Agreement]:
     ]
 
 
-#: "Nearly equal" in the seed's C1: within a factor of two either way. At a few
-#: microseconds per update a factor below two is invisible in a simulation
-#: step; the seed compared whole-simulation frame rates.
-ABOUT_EQUAL = (0.5, 2.0)
-
-
-def _c1_verdict(study) -> Verdict:
-    # The seed measured compiled C; the like-for-like comparison here is the
-    # compiled incremental walk against the compiled scan. The interpreted
-    # crossover is reported beside it, not used for the verdict.
-    key = ("coherent", "incremental-numba", "scan-numba")
-    compiled = study.crossovers.get(key)
-    python = study.crossovers.get(("coherent", "incremental-python", "scan-numpy"))
-    ratios = dict(study.speedups.get(key, []))   # size -> scan time / incremental time
-    at_2k = ratios.get(2000)
-    below = [r for n, r in ratios.items() if compiled is None or n < compiled]
-    equal_below = bool(below) and all(ABOUT_EQUAL[0] <= r <= ABOUT_EQUAL[1] for r in below)
+def _c1_verdict(c1) -> Verdict:
+    f = c1.facts
+    below = f["ratios_below_crossover"]
     band = (f"{min(below):.2f}x to {max(below):.2f}x" if below else "no smaller size")
+    at_large = f["ratio_at_large_model"]
     sentence = (f"Compiled kernels (the seed's setting): the incremental update is faster "
-                f"than the scan from {compiled} triangles on"
-                + (f" ({at_2k:.2f}x at 2000)" if at_2k else "")
+                f"than the scan from {f['compiled_crossover']} triangles on"
+                + (f" ({at_large:.2f}x at {f['large_model']})" if at_large else "")
                 + f"; below that the scan/incremental time ratio is {band} "
-                f"({'within' if equal_below else 'outside'} the factor-of-two band of "
-                f"'nearly equal'). Readable Python against numpy's scan: faster only from "
-                f"{python} triangles, because each vertex the walk visits costs interpreter "
-                "time.")
-    faster_at_2k = compiled is not None and compiled <= 2000
-    verdict = ("confirmed" if faster_at_2k and equal_below
-               else "partly" if faster_at_2k or equal_below else "refuted")
-    return Verdict("C1", sentence, verdict, "bounds-cost-coherent", C1_COMMAND, timing=True)
+                f"({'within' if f['equal_below_crossover'] else 'outside'} the factor-of-two "
+                f"band of 'nearly equal'). Readable Python against numpy's scan: faster only "
+                f"from {f['interpreted_crossover']} triangles, because each vertex the walk "
+                "visits costs interpreter time.")
+    return Verdict("C1", sentence, c1.verdict, "bounds-cost-coherent", C1_COMMAND,
+                   timing=c1.timing)
 
 
-def _c2_verdict(errors) -> Verdict:
-    convex_wrong = sum(e.wrong_frames for e in errors if e.convex)
-    wrong = sorted({e.mesh for e in errors if not e.convex and e.wrong_frames})
-    never = sorted({e.mesh for e in errors if not e.convex and not e.wrong_frames})
-    sentence = (f"Convex meshes: {convex_wrong} wrong frames. Wrong on "
-                f"{', '.join(wrong) or 'none'}; never wrong on {', '.join(never) or 'none'}.")
-    if convex_wrong == 0 and wrong and never:
-        verdict = "partly"
+def _c2_verdict(c2) -> Verdict:
+    f = c2.facts
+    sentence = (f"Convex meshes: {f['convex_wrong_frames']} wrong frames. Wrong on "
+                f"{', '.join(f['nonconvex_wrong']) or 'none'}; never wrong on "
+                f"{', '.join(f['nonconvex_never_wrong']) or 'none'}.")
+    if f["sufficient_not_necessary"]:
         sentence += " Convexity is sufficient but not necessary."
-    elif convex_wrong == 0 and wrong:
-        verdict = "confirmed"
-    else:
-        verdict = "refuted"
-    return Verdict("C2", sentence, verdict, "bounds-c2", C2_COMMAND)
+    return Verdict("C2", sentence, c2.verdict, "bounds-c2", C2_COMMAND, timing=c2.timing)

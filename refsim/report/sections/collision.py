@@ -1,36 +1,35 @@
 """Report section: body-body collision (seed S4; claims C3, C4).
 
-Arranges the numbers of :mod:`refsim.studies.levels` (the four
+Arranges the plan's records of :mod:`refsim.studies.levels` (the four
 levels, the body-level oracles, the hierarchy against FCL) and of
-:mod:`refsim.studies.triangles` (the triangle test against FCL, claim C4).
-Nothing is computed here beyond picking and formatting those numbers.
+:mod:`refsim.studies.triangles` (the triangle test against FCL, claim C4),
+and the verdicts and findings of :mod:`refsim.claims.collision`. Nothing is
+computed here beyond picking and formatting those numbers.
 """
 
 from __future__ import annotations
 
-import sys
 from dataclasses import asdict
 
+from refsim.claims.collision import speed_findings
 from refsim.report.charts import Series, line_chart
-from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Verdict
+from refsim.report.plan import command
+from refsim.report.section import (
+    Agreement,
+    Divergence,
+    Figure,
+    Section,
+    Table,
+    Timing,
+    Verdict,
+    fields_of,
+)
 
-LEVELS_COMMAND = "python -m refsim.studies.levels"
-C4_COMMAND = "python -m refsim.studies.triangles"
-
-#: (quick, full) sizes of each measurement. Quick keeps the section within
-#: ~15 s (after numba's first compile); full within ~2 min.
-SIZES = {
-    "repeats": (3, 21),
-    "random_per_pair": (5, 50),
-    "speed_repeats": (5, 31),
-    "triangle_pairs": (2000, 20_000),
-    "near_degenerate_pairs": (1000, 5000),
-    "c4_frames": (10, 100),
-}
-
-
-def _size(ctx, key: str) -> int:
-    return SIZES[key][0 if ctx.quick else 1]
+LEVELS_COMMAND = command("collision-levels")
+BODY_ORACLES_COMMAND = command("collision-body-oracles")
+SPEED_COMMAND = command("collision-speed")
+TRIANGLES_COMMAND = command("collision-triangles")
+C4_COMMAND = command("collision-c4")
 
 
 def _us(seconds) -> str:
@@ -45,48 +44,18 @@ def _yes(value: bool) -> str:
     return "yes" if value else "no"
 
 
-def _oracles():
-    """(body oracles, fcl pairs, fcl adapter, fcl triangle test) from what is
-    installed."""
-    from refsim.studies.levels import default_body_oracles
-
-    body, pairs_engine, fcl = default_body_oracles()
-    return body, pairs_engine, fcl, (None if fcl is None else fcl.triangles_intersect)
-
-
 def build(ctx) -> Section:
-    import numpy as np
-
-    from refsim.collision.bodies import LEVELS
     from refsim.studies import levels as measure_levels
     from refsim.studies import triangles as measure
 
-    seed = ctx.seed
-    body_oracles, fcl_pairs, fcl, fcl_triangles = _oracles()
-
-    ctx.progress.announce("collision: levels (C3)")
-    levels = measure_levels.measure_levels(repeats=_size(ctx, "repeats"),
-                                           random_per_pair=_size(ctx, "random_per_pair"),
-                                           seed=seed)
-    ctx.progress.announce("collision: body-level oracles")
-    agreement = measure_levels.measure_body_oracles(
-        body_oracles, fcl_pairs, random_per_pair=_size(ctx, "random_per_pair"), seed=seed)
-    ctx.progress.announce("collision: hierarchy against FCL")
-    speed = measure_levels.measure_hierarchy_speed(fcl, _size(ctx, "speed_repeats"),
-                                                   compile_cost=not ctx.quick)
-    ctx.progress.announce("collision: triangle pairs against FCL, C4")
-    triangle_rows = []
-    if fcl_triangles is not None:
-        rng = np.random.default_rng(seed)
-        n = _size(ctx, "triangle_pairs")
-        A, B = rng.uniform(-1.0, 1.0, (2, n, 3, 3))
-        triangle_rows.append(("uniform random triangle pairs",
-                              measure.compare_with_oracle(A, B, fcl_triangles)))
-        A, B, _ = measure.near_degenerate_pairs(_size(ctx, "near_degenerate_pairs"), seed)
-        triangle_rows.append(("near-degenerate triangle pairs",
-                              measure.compare_with_oracle(A, B, fcl_triangles)))
-    c4 = measure.measure_c4(fcl_triangles, seed)
-    sweep = measure.measure_c4_sweep(_size(ctx, "c4_frames"), fcl_triangles, seed)
+    run = ctx.run
+    levels = run.get("collision-levels")
+    level_names = levels.levels
+    agreement = run.get("collision-body-oracles")
+    speed = run.get("collision-speed")
+    triangle_rows = [(t.pairs, t.agreement) for t in run.get("collision-triangles")]
+    c4_run = run.get("collision-c4")
+    c4, sweep = c4_run.c4, c4_run.sweep
 
     figures, tables, verdicts = [], [], []
 
@@ -107,16 +76,16 @@ def build(ctx) -> Section:
     level_rows = []
     for c in levels.configurations:
         marks = [("yes" if c.answers[lv] else "no") + (" (FP)" if c.false_positive(lv) else "")
-                 for lv in LEVELS]
+                 for lv in level_names]
         level_rows.append((c.name, c.kind, *marks, c.candidate_pairs, c.exact_pairs,
-                           *(_us(c.seconds[lv]) for lv in LEVELS),
+                           *(_us(c.seconds[lv]) for lv in level_names),
                            _us(c.seed_seconds["exact"]),
                            _ratio(c.pairs_seconds["seed"] / c.pairs_seconds["bvh"])))
     tables.append(Table(
         id="collision-levels", title="The four levels on constructed configurations",
         timing=True,
-        columns=("configuration", "kind", *LEVELS, "triangle-box pairs", "exact pairs",
-                 *(f"{lv} (us)" for lv in LEVELS), "exact, seed path (us)",
+        columns=("configuration", "kind", *level_names, "triangle-box pairs", "exact pairs",
+                 *(f"{lv} (us)" for lv in level_names), "exact, seed path (us)",
                  "all pairs: seed path / bvh"),
         rows=tuple(level_rows),
         caption=("Answers of bodies_collide per level ('FP': collide where the exact level "
@@ -128,10 +97,10 @@ def build(ctx) -> Section:
     tables.append(Table(
         id="collision-levels-random", title="The four levels on random poses",
         columns=("model pair", "poses", "exact says collide",
-                 *(f"{lv} FP" for lv in LEVELS), "false negatives",
+                 *(f"{lv} FP" for lv in level_names), "false negatives",
                  "triangle-box pairs", "exact pairs", "seed path differs"),
         rows=tuple((f"{r.model_a} / {r.model_b}", r.n, r.exact_true,
-                    *(r.false_positives[lv] for lv in LEVELS),
+                    *(r.false_positives[lv] for lv in level_names),
                     sum(r.false_negatives.values()), r.candidate_pairs, r.exact_pairs,
                     r.seed_mismatches) for r in levels.random),
         caption=("Both bodies turned at random, centres a uniform distance from 0 to 1.1 "
@@ -155,7 +124,8 @@ def build(ctx) -> Section:
                  "zero), tolerance (decision margin <= "
                  f"{measure.NEAR_DEGENERATE_MARGIN:g}), bug. For posed meshes n is the "
                  "number of distinct face pairs either engine reports. Reproduce: "
-                 f"{C4_COMMAND} and {LEVELS_COMMAND}" if triangle_rows or agreement.pairs
+                 f"{TRIANGLES_COMMAND} and {BODY_ORACLES_COMMAND}" if triangle_rows
+                 or agreement.pairs
                  else "python-fcl is not installed: not measured.")))
     tables.append(Table(
         id="collision-body-oracles", title="bodies_collide against FCL and trimesh, by class",
@@ -175,7 +145,7 @@ def build(ctx) -> Section:
                  + ("; ".join(f"{d.case} ({d.source}, refsim {d.refsim}, {b.oracle} "
                               f"{d.oracle}): {d.kind}"
                               for b in agreement.bodies for d in b.disagreements) or "none")
-                 + f". Reproduce: {LEVELS_COMMAND}")))
+                 + f". Reproduce: {BODY_ORACLES_COMMAND}")))
 
     # -- the hierarchy against FCL -----------------------------------------------------
     tables.append(Table(
@@ -196,14 +166,14 @@ def build(ctx) -> Section:
                  "The second body is turned by "
                  f"{measure_levels.FIXED_ANGLE} rad about {measure_levels.FIXED_AXIS}. "
                  + "; ".join(f"{c.model} {c.kind}: {c.description}" for c in speed.cases)
-                 + ". Below 1: refsim faster. " + _speed_findings(speed)
+                 + ". Below 1: refsim faster. " + _speed_findings(speed_findings(speed))
                  + (f"Numba compile cost from a fresh interpreter: triangle kernel "
                     f"{speed.compile.triangle_kernel_cold_seconds:.1f} s; all hierarchy kernels "
                     f"{speed.compile.hierarchy_cold_seconds:.1f} s with an empty cache, "
                     f"{speed.compile.hierarchy_warm_seconds:.1f} s with the cache that run wrote. "
                     if speed.compile else "Numba compile cost: measured in the full report "
                     "only. ")
-                 + f"Reproduce: {LEVELS_COMMAND}")))
+                 + f"Reproduce: {SPEED_COMMAND}")))
 
     # -- C4 ------------------------------------------------------------------------------
     series = []
@@ -236,45 +206,46 @@ def build(ctx) -> Section:
                  f"the same coordinates. Reproduce: {C4_COMMAND}")))
 
     # -- verdicts --------------------------------------------------------------------
-    verdicts.append(_c3_verdict(levels))
-    verdicts.append(_c4_verdict(c4, sweep))
+    verdicts.append(_c3_verdict(run.claim("C3")))
+    verdicts.append(_c4_verdict(run.claim("C4")))
 
     agreements = []
     for label, r in triangle_rows:
         agreements.append(Agreement(
             "python-fcl", f"exact triangle test, {label}",
             f"{r.agree} / {r.n} agree; " + ", ".join(f"{v} {k}" for k, v in r.counts.items()),
-            C4_COMMAND))
+            TRIANGLES_COMMAND))
     for p in agreement.pairs:
         agreements.append(Agreement(
             "python-fcl", f"intersecting face pairs of posed meshes ({p.source})",
             f"{p.queries_equal} / {p.queries} queries identical; "
-            + ", ".join(f"{v} {k}" for k, v in p.counts.items()), LEVELS_COMMAND))
+            + ", ".join(f"{v} {k}" for k, v in p.counts.items()), BODY_ORACLES_COMMAND))
     for b in agreement.bodies:
         agreements.append(Agreement(
             "python-fcl" if b.oracle == "fcl" else b.oracle,
             f"bodies_collide, boolean ({b.source})",
             f"{b.agree} / {b.n} agree; "
-            + ", ".join(f"{v} {k}" for k, v in b.counts.items()), LEVELS_COMMAND))
+            + ", ".join(f"{v} {k}" for k, v in b.counts.items()), BODY_ORACLES_COMMAND))
 
     results = {
-        "levels": asdict(levels),
+        "levels": levels,
         "body_oracles": {
-            "bodies": [asdict(b) for b in agreement.bodies],
+            "bodies": agreement.bodies,
             "pairs": [{k: v for k, v in asdict(p).items() if k != "disagreements"}
                       | {"disagreements": [asdict(d) for d in p.disagreements[:20]]}
                       for p in agreement.pairs],
             "bugs": agreement.bugs,
         },
-        "hierarchy_speed": asdict(speed) | {
-            "ratios": [{"model": c.model, "kind": c.kind, "pairs_bvh_over_fcl": c.pairs_ratio,
-                        "boolean_bvh_over_fcl": c.boolean_ratio,
-                        "seed_over_bvh": c.seed_over_bvh} for c in speed.cases]},
+        "hierarchy_speed": fields_of(speed) | {
+            "ratios": Timing([{"model": c.model, "kind": c.kind,
+                               "pairs_bvh_over_fcl": c.pairs_ratio,
+                               "boolean_bvh_over_fcl": c.boolean_ratio,
+                               "seed_over_bvh": c.seed_over_bvh} for c in speed.cases])},
         "triangle_pairs_vs_fcl": [
             {"pairs": label, "n": r.n, "agree": r.agree, "counts": r.counts,
              "examples": {k: r.examples(k) for k in r.counts}} for label, r in triangle_rows],
-        "c4": asdict(c4),
-        "c4_sweep": asdict(sweep),
+        "c4": c4,
+        "c4_sweep": sweep,
     }
     divergences = _divergences(triangle_rows, agreement)
     return Section(
@@ -291,93 +262,69 @@ def build(ctx) -> Section:
         divergences=divergences, results=results)
 
 
-def _c3_verdict(levels) -> Verdict:
-    """C3 from the measured levels. Its two halves: accuracy (no level misses
-    a contact, and false positives do not fall from a finer to a coarser
-    level) and speed (median times do not fall from a coarser to a finer
-    level: coarser is faster). Confirmed when both hold, partly when one
-    does, refuted when neither."""
-    from refsim.collision.bodies import LEVELS
-
-    summary = {s.level: s for s in levels.summary}
-    fp = {lv: summary[lv].false_positive_rate for lv in LEVELS}
-    median = {lv: summary[lv].median_seconds for lv in LEVELS}
-    queries = summary["exact"].negatives
-    n_random = sum(r.n for r in levels.random)
-    fp_ordered = all(fp[a] >= fp[b] for a, b in zip(LEVELS, LEVELS[1:], strict=False))
-    speed_ordered = all(median[a] <= median[b] for a, b in zip(LEVELS, LEVELS[1:], strict=False))
-    conservative = levels.false_negatives == 0
-    accuracy_half = conservative and fp_ordered
-    halves = accuracy_half + speed_ordered
-    verdict = "confirmed" if halves == 2 else "partly" if halves == 1 else "refuted"
-
-    if conservative:
+def _c3_verdict(c3) -> Verdict:
+    """C3's sentence from :func:`refsim.claims.collision.c3`'s facts."""
+    f = c3.facts
+    levels = f["levels"]
+    fp, median = f["false_positive_rate"], f["median_seconds"]
+    if f["conservative"]:
         text = (f"No level missed a contact (0 false negatives over "
-                f"{len(levels.configurations)} constructed configurations and {n_random} "
+                f"{f['configurations']} constructed configurations and {f['random_poses']} "
                 "random poses).")
     else:
-        where = [f"{c.name} ({lv})" for c in levels.configurations for lv in LEVELS
-                 if c.false_negative(lv)]
-        where += [f"{r.model_a} / {r.model_b} random poses ({lv}: {k})"
-                  for r in levels.random for lv, k in r.false_negatives.items() if k]
-        text = (f"{levels.false_negatives} false negatives (a level said 'apart' where the "
-                f"surfaces meet) over {len(levels.configurations)} constructed configurations "
-                f"and {n_random} random poses: " + "; ".join(where) + ".")
-    text += (f" False positives among the {queries} non-colliding queries: "
-             + ", ".join(f"{lv} {100 * fp[lv]:.0f}%" for lv in LEVELS)
-             + (" (no more at each finer level)." if fp_ordered else
+        text = (f"{f['false_negatives']} false negatives (a level said 'apart' where the "
+                f"surfaces meet) over {f['configurations']} constructed configurations "
+                f"and {f['random_poses']} random poses: " + "; ".join(f["missed"]) + ".")
+    text += (f" False positives among the {f['negative_queries']} non-colliding queries: "
+             + ", ".join(f"{lv} {100 * fp[lv]:.0f}%" for lv in levels)
+             + (" (no more at each finer level)." if f["false_positives_ordered"] else
                 " (more at some finer level than at the coarser one)."))
     text += (" Median time per boolean query: "
-             + ", ".join(f"{lv} {median[lv] * 1e6:.0f} us" for lv in LEVELS)
-             + (": each coarser level is no slower" if speed_ordered else
+             + ", ".join(f"{lv} {median[lv] * 1e6:.0f} us" for lv in levels)
+             + (": each coarser level is no slower" if f["speed_ordered"] else
                 ": some coarser level is slower than a finer one")
-             + f"; exact costs {median['exact'] / median[LEVELS[1]]:.2g}x the "
-             f"{LEVELS[1]} level and {median['exact'] / median[LEVELS[0]]:.2g}x the "
-             f"{LEVELS[0]} level.")
-    slowest = sorted(levels.configurations, key=lambda c: c.seconds["exact"], reverse=True)[:2]
+             + f"; exact costs {f['exact_over_box']:.2g}x the "
+             f"{levels[1]} level and {f['exact_over_coarsest']:.2g}x the "
+             f"{levels[0]} level.")
     text += (" The exact level's slowest configurations: "
-             + ", ".join(f"{c.name} ({c.kind}) {c.seconds['exact'] * 1e6:.0f} us"
-                         for c in slowest)
+             + ", ".join(f"{c['name']} ({c['kind']}) {c['seconds'] * 1e6:.0f} us"
+                         for c in f["slowest_exact"])
              + (" (bodies touching exactly: exact arithmetic decides those pairs)."
-                if all(c.kind == "touching" for c in slowest) else "."))
-    coarse, box = LEVELS[0], LEVELS[1]
-    sphere_only = [c.name for c in levels.configurations
-                   if c.answers[coarse] and not c.answers[box]]
-    box_only = [c.name for c in levels.configurations
-                if c.answers[box] and not c.answers[coarse]]
-    if box_only:
+                if f["slowest_all_touching"] else "."))
+    coarse, box = levels[0], levels[1]
+    if f["box_only"]:
         text += (f" The {coarse} level is not nested with the box levels: it says 'apart' "
-                 f"where the {box} level says 'collide' in " + ", ".join(box_only)
-                 + (f" (and the reverse in {', '.join(sphere_only)})" if sphere_only else "")
+                 f"where the {box} level says 'collide' in " + ", ".join(f["box_only"])
+                 + (f" (and the reverse in {', '.join(f['coarsest_only'])})"
+                    if f["coarsest_only"] else "")
                  + ".")
     else:
         text += (f" On the constructed configurations the {coarse} level says 'collide' "
                  f"wherever the {box} level does.")
-    return Verdict(claim="C3", measured=text, verdict=verdict,
-                   evidence="collision-levels-tradeoff", command=LEVELS_COMMAND, timing=True)
+    return Verdict(claim="C3", measured=text, verdict=c3.verdict,
+                   evidence="collision-levels-tradeoff", command=LEVELS_COMMAND,
+                   timing=c3.timing)
 
 
-def _speed_findings(speed) -> str:
-    """The speed table's findings: refsim over FCL where the bodies are apart
-    but their boxes overlap, and where they meet."""
-    apart = [c for c in speed.cases if c.kind == "separated-boxes-overlap"
-             and c.pairs_ratio is not None]
-    if not apart:
+def _speed_findings(found: dict) -> str:
+    """The speed table's findings (:func:`refsim.claims.collision.speed_findings`):
+    refsim over FCL where the bodies are apart but their boxes overlap, and
+    where they meet."""
+    if not found:
         return ""
-    others = [c for c in speed.cases if c.kind != "separated-boxes-overlap"
-              and c.pairs_ratio is not None]
     text = ("Where the bodies are apart but their boxes overlap, refsim's time over FCL's: "
-            + "; ".join(f"{c.model} {c.pairs_ratio:.2g}x all pairs, "
-                        f"{_ratio_x(c.boolean_ratio)} boolean" for c in apart) + ".")
-    if any(c.pairs_ratio > 1 for c in apart):
+            + "; ".join(f"{c['model']} {c['pairs_ratio']:.2g}x all pairs, "
+                        f"{_ratio_x(c['boolean_ratio'])} boolean" for c in found["apart"]) + ".")
+    if found["apart_slower"]:
         text += (" There the query is all node tests and fixed cost (the call into the "
                  "compiled kernel and its per-query arrays, a few microseconds), with "
                  "little exact testing left to save.")
-    if others:
+    if found["meet"]:
         text += (" Where they meet: "
-                 + "; ".join(f"{c.model} {c.kind} {c.pairs_ratio:.2g}x" for c in others)
+                 + "; ".join(f"{c['model']} {c['kind']} {c['pairs_ratio']:.2g}x"
+                             for c in found["meet"])
                  + " (all pairs).")
-        if max(c.pairs_ratio for c in others) < min(c.pairs_ratio for c in apart):
+        if found["best_with_pairs"]:
             text += " The hierarchy compares best when there are pairs to report."
     return text + " "
 
@@ -431,60 +378,41 @@ def _theta(value) -> str:
     return "never" if value is None else f"{value:g}"
 
 
-#: A tilt within this many double-precision epsilons is at the rounding of
-#: the coordinates (C4: "as large as the tilt").
-ROUNDING_TILT = 1e3
-
-
-def _c4_verdict(c4, sweep) -> Verdict:
-    """C4 from the measured flips: the largest angle at which the plain-float
-    test (the seed's arithmetic) differs from the exact answer, per kind of
-    configuration."""
-    def largest_wrong(counts):
-        wrong = [theta for theta, k in zip(sweep.thetas, counts, strict=True) if k]
-        return max(wrong) if wrong else None
-
-    transversal = {c: largest_wrong(sweep.float_wrong[c]) for c in ("overlap", "miss")}
-    oracle = {c: largest_wrong(sweep.oracle_wrong[c]) for c in ("overlap", "miss")} \
-        if sweep.oracle_wrong else {}
-    oracle_worst = [t for t in oracle.values() if t is not None]
-    touching = {c: largest_wrong(sweep.float_wrong[c]) for c in ("touch", "shared-edge")}
-    aligned_ok = all(s.float_wrong == 0 for s in c4.series if s.frame == "axis-aligned")
-    worst = [t for t in transversal.values() if t is not None]
+def _c4_verdict(c4) -> Verdict:
+    """C4's sentence from :func:`refsim.claims.collision.c4`'s facts."""
+    f = c4.facts
+    worst = f["float_worst"]
     measured = (
         f"Crossing or missing triangles: the plain-float test first differs from the exact "
-        f"answer at an angle of {max(worst):g} rad" if worst else
+        f"answer at an angle of {worst:g} rad" if worst is not None else
         "Crossing or missing triangles: the plain-float test never differs from the exact "
         "answer")
-    measured += f" (over {sweep.frames} random frames per angle"
-    if oracle:
-        measured += (f"; FCL from {max(oracle_worst):g} rad" if oracle_worst
+    measured += f" (over {f['frames']} random frames per angle"
+    if f["oracle_measured"]:
+        measured += (f"; FCL from {f['oracle_worst']:g} rad" if f["oracle_worst"] is not None
                      else "; FCL never")
     measured += (
         "). Triangles touching "
         "along a line: "
         + ", ".join(f"{c} wrong from {_theta(t)} rad" if t else f"{c} never wrong"
-                    for c, t in touching.items())
+                    for c, t in f["touching_wrong_from"].items())
         + (". With axis-aligned coordinates (exact input) no float answer is wrong at any "
-           "angle." if aligned_ok else "."))
-    eps = sys.float_info.epsilon
-    if not worst:
+           "angle." if f["axis_aligned_never_wrong"] else "."))
+    if worst is None:
         measured += " Near-parallel planes alone never made the float test wrong."
-    elif max(worst) <= ROUNDING_TILT * eps:
-        measured += (f" Near-parallel planes alone are harmless down to {max(worst):g} rad, "
-                     f"{max(worst) / eps:.3g} times the double-precision epsilon: where the "
-                     "rounding of the coordinates is as large as the tilt.")
+    elif f["at_rounding"]:
+        measured += (f" Near-parallel planes alone are harmless down to {worst:g} rad, "
+                     f"{f['float_worst_over_eps']:.3g} times the double-precision epsilon: "
+                     "where the rounding of the coordinates is as large as the tilt.")
     else:
-        measured += (f" Near-parallel planes alone already go wrong at {max(worst):g} rad, "
-                     f"{max(worst) / eps:.3g} times the double-precision epsilon.")
-    wrong_touch = [t for t in touching.values() if t is not None]
-    if wrong_touch and max(wrong_touch) >= max(sweep.thetas):
+        measured += (f" Near-parallel planes alone already go wrong at {worst:g} rad, "
+                     f"{f['float_worst_over_eps']:.3g} times the double-precision epsilon.")
+    if f["touching_wrong_at_largest_angle"]:
         measured += (f" Exact contacts go wrong already at the largest angle measured "
-                     f"({max(sweep.thetas):g} rad).")
-    elif wrong_touch:
-        measured += f" Exact contacts go wrong from {max(wrong_touch):g} rad."
+                     f"({f['largest_angle']:g} rad).")
+    elif f["touching_worst"] is not None:
+        measured += f" Exact contacts go wrong from {f['touching_worst']:g} rad."
     else:
         measured += " Exact contacts never went wrong."
-    verdict = "partly" if worst or any(touching.values()) else "confirmed"
-    return Verdict(claim="C4", measured=measured, verdict=verdict,
-                   evidence="collision-c4-sweep", command=C4_COMMAND)
+    return Verdict(claim="C4", measured=measured, verdict=c4.verdict,
+                   evidence="collision-c4-sweep", command=C4_COMMAND, timing=c4.timing)

@@ -1,33 +1,40 @@
 """Report section: rigid-body dynamics (S5, S7, S8, S9), claims C11 and C12.
 
-Every number comes from a ``measure_*`` function: the bounce studies of
+Every number comes from the plan's records: the bounce studies of
 :mod:`refsim.studies.bounce` (refsim against the analytic answers of
 :mod:`refsim.dynamics.analytic` and the pybullet oracle), and the C11/C12
-measurements of :mod:`refsim.studies.dynamics`. This module only arranges
-them (STYLE.md, rule 9).
+measurements of :mod:`refsim.studies.dynamics`; the verdicts and the findings
+that turn on a threshold come from :mod:`refsim.claims.dynamics`. This module
+only arranges them (STYLE.md, rule 9).
 
-``ctx.quick`` runs fewer restitutions, step sizes and solvers, shorter C11
-and C12 runs and fewer timed steps; the captions say what the quick run
-leaves out. Without pybullet the section still measures refsim against the
-analytic answers and says that the oracle's columns are missing. Everything
-is deterministic but the wall times (keys ``seconds_per_second``,
-``*_seconds``, ``ratio`` of the step cost; the step-cost table is marked
-``timing``); no verdict sentence quotes a time.
+A quick run has fewer restitutions, step sizes and solvers, shorter C11 and
+C12 runs and fewer timed steps (:mod:`refsim.report.plan`); the captions say
+what the quick run leaves out. Without pybullet the section still measures
+refsim against the analytic answers and says that the oracle's columns are
+missing. Everything is deterministic but the wall times, which the study
+records mark (the step-cost table is marked ``timing``); no verdict sentence
+quotes a time.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict
 
-import numpy as np
-
+from refsim.claims import dynamics as judged
 from refsim.report.charts import Series, line_chart
+from refsim.report.plan import command
 from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Verdict
 
 CHART_SIZE = (7.0, 4.0)
-CMD_BOUNCE = "python -m refsim.studies.bounce"
-CMD_MEASURE = "python -m refsim.studies.dynamics"
+CMD_APEX = command("dynamics-apex")
+CMD_OBLIQUE = command("dynamics-oblique")
+CMD_REST = command("dynamics-rest")
+CMD_ENERGY = command("dynamics-energy")
+CMD_COST = command("dynamics-cost")
+CMD_SETTINGS = command("dynamics-pybullet-settings")
+CMD_STEP_COST = command("dynamics-step-cost")
+CMD_SPIN = command("dynamics-spin")
+CMD_C11 = command("dynamics-interpenetration")
 #: Errors below this are rounding (RK4 integrates the parabola of free
 #: flight exactly; refsim's wall response is then exact too): the cost chart
 #: draws them at this floor so that a log axis can show them.
@@ -35,41 +42,6 @@ ERROR_FLOOR = 1e-16
 
 STYLES = {"euler": "o-", "averaged-euler": "s--", "backwards-euler": "^-", "midpoint": "x:",
           "rk4": "D-", "rk4, seed wall speed": "D--", "pybullet": "*-"}
-
-
-def _pybullet_available():
-    """``(engine, "")``: the pybullet oracle, or ``(None, why)`` without it.
-    One client serves every scene (each ``simulate`` resets it)."""
-    from refsim.oracles import OracleUnavailable
-
-    try:
-        from refsim.oracles.pybullet_adapter import PybulletOracle
-
-        return PybulletOracle(), ""
-    except OracleUnavailable as exc:
-        return None, str(exc)
-
-
-def _pybullet_variants():
-    """pybullet with the oracle's settings, then with one setting at a time
-    back at (or near) pybullet's default: ``(label, engine)`` pairs."""
-    from dataclasses import replace
-
-    from refsim.oracles.pybullet_adapter import PybulletOracle, PybulletSettings
-
-    base = PybulletSettings()
-    changes = (
-        ("none (the oracle's settings)", base),
-        ("useMaximalCoordinates=False (multibody)", replace(base, use_maximal_coordinates=False)),
-        ("contactProcessingThreshold=1e30 (Bullet's default: all)",
-         replace(base, contact_processing_threshold=1e30)),
-        ("useSplitImpulse=0", replace(base, use_split_impulse=0)),
-        ("restitutionVelocityThreshold=0.2 (Bullet's default)",
-         replace(base, restitution_velocity_threshold=0.2)),
-        ("linear/angular damping 0.04 (pybullet's default)",
-         replace(base, linear_damping=0.04, angular_damping=0.04)),
-    )
-    return [(label, PybulletOracle(settings)) for label, settings in changes]
 
 
 def _f(x, digits: int = 5) -> str:
@@ -82,78 +54,25 @@ def _pct(x) -> str:
     return "n/a" if not math.isfinite(x) else f"{100 * x:.3g}%"
 
 
-def _jsonable(obj):
-    """Dataclasses with numpy arrays as plain data for results.json."""
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, float) and not math.isfinite(obj):
-        return None
-    if isinstance(obj, dict):
-        return {k: _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [_jsonable(v) for v in obj]
-    if hasattr(obj, "__dataclass_fields__"):
-        return _jsonable(asdict(obj))
-    return obj
-
-
 def build(ctx) -> Section:
     from refsim.dynamics.choices import choices
     from refsim.studies import bounce
     from refsim.studies import dynamics as dyn_measure
 
     quick = ctx.quick
-    say = ctx.progress.announce
-    pb, missing = _pybullet_available()
-
-    # -- measurements ------------------------------------------------------------------
-    say("dynamics: apex ratios")
-    if quick:
-        apex_rows = bounce.measure_apexes(models=(bounce.SPHERE,), oracle=pb)
-        apex_rows.append(bounce.measure_apex_row(bounce.CUBE, 0.8, rotation="seed",
-                                                 oracle=pb))
-    else:
-        apex_rows = bounce.measure_apexes(oracle=pb)
-    say("dynamics: oblique bounces")
-    oblique_rows = bounce.measure_oblique(oracle=pb)
-    say("dynamics: time to rest")
-    rest_rows = bounce.measure_rest(restitutions=(0.5,) if quick else (0.5, 0.8),
-                                    oracle=pb)
-    say("dynamics: energy over time")
-    series = bounce.measure_energy(oracle=pb)
-    say("dynamics: error against cost")
-    cost = bounce.measure_cost(bounce.COST_STEPS_QUICK if quick else bounce.COST_STEPS,
-                               bounce.COST_SOLVERS_QUICK if quick else bounce.COST_SOLVERS,
-                               oracle=pb)
-    settings_rows = []
-    if pb and not quick:
-        say("dynamics: pybullet's settings")
-        settings_rows = bounce.measure_engine_variants(_pybullet_variants())
-    say("dynamics: step cost against pybullet")
-    step_rows = bounce.measure_step_cost(steps=50 if quick else 200, warmup=10 if quick else 20,
-                                         repeats=3 if quick else 5, oracle=pb)
-    if not quick:
-        step_rows += bounce.measure_step_cost(counts=(bounce.BENCH_COUNTS[-1],),
-                                              warmup=bounce.LATE_WARMUP, repeats=3,
-                                              oracle=pb)
-    say("dynamics: C12 spin")
-    # C12 runs its full 6 s in the quick report too: a shorter run stops
-    # before the corrected model comes to rest and would change the verdict.
-    if pb:
-        from refsim.dynamics.simulation import default_every
-        from refsim.oracles.pybullet_adapter import PybulletOracle
-
-        spin_scene = dyn_measure._scene("spinning-cube.toml")
-        with PybulletOracle() as oracle:
-            external = oracle.simulate(
-                spin_scene, every=default_every(spin_scene.integration.n_steps))
-        spin_rows = dyn_measure.measure_spin(spin_scene, external=external)
-    else:
-        spin_rows = dyn_measure.measure_spin()
-    say("dynamics: C11 interpenetration")
-    c11_rows = dyn_measure.measure_interpenetration(duration=1.0 if quick else 2.0)
+    run = ctx.run
+    apex_rows = run.get("dynamics-apex")
+    oblique_rows = run.get("dynamics-oblique")
+    rest_rows = run.get("dynamics-rest")
+    series = run.get("dynamics-energy")
+    cost_run = run.get("dynamics-cost")
+    cost = cost_run.study
+    settings_rows = run.get("dynamics-pybullet-settings")
+    step_rows = run.get("dynamics-step-cost")
+    spin_rows = run.get("dynamics-spin")
+    c11_rows = run.get("dynamics-interpenetration")
+    pb = "pybullet" not in run.missing
+    missing = run.missing.get("pybullet", "")
 
     # -- figures and tables --------------------------------------------------------------
     figures, tables = [], []
@@ -173,7 +92,7 @@ def build(ctx) -> Section:
             size=CHART_SIZE),
         caption=f"{series.body}, e = {series.e}, dropped from {bounce.DROP_HEIGHT} m, "
                 f"h = {bounce.STEP} s, rotation off. {_height_gaps(series, apex_rows)}"
-                f"{pb_note} Reproduce: {CMD_BOUNCE}"))
+                f"{pb_note} Reproduce: {CMD_ENERGY}; {CMD_APEX}"))
     figures.append(Figure(
         id="dynamics-energy", title="Mechanical energy over time",
         svg=line_chart([
@@ -185,7 +104,7 @@ def build(ctx) -> Section:
         caption="Potential energy above the touching height plus kinetic, per unit weight. "
                 "Between bounces it is constant (RK4 is exact for free flight; Bullet's "
                 "symplectic Euler nearly so); each bounce multiplies it by e^2. "
-                f"Reproduce: {CMD_BOUNCE}"))
+                f"Reproduce: {CMD_ENERGY}"))
 
     apex_table_rows = tuple(
         (r.body, r.rotation, r.e, _f(r.analytic_ratio), _f(r.refsim_ratio),
@@ -201,13 +120,14 @@ def build(ctx) -> Section:
         rows=apex_table_rows,
         caption=f"Geometric mean of the first {bounce.BOUNCES} apex ratios, h = {bounce.STEP} "
                 f"s, RK4, drop height {bounce.DROP_HEIGHT} m. "
-                + _apex_findings(apex_rows, bounce.APEX_RATIO_TARGET, bounce.ROUNDING_ERROR)
+                + _apex_findings(judged.apex_findings(apex_rows, bounce.APEX_RATIO_TARGET,
+                                                      bounce.ROUNDING_ERROR))
                 + " pybullet detects a contact only once the hull overlaps the wall and "
                 "restitutes that velocity (split impulse removes the overlap without "
                 "energy)."
                 + (" Quick run: the cube only at e = 0.8 with the seed's rotation." if quick
                    else "")
-                + pb_note + f" Reproduce: {CMD_BOUNCE}"))
+                + pb_note + f" Reproduce: {CMD_APEX}"))
 
     tables.append(Table(
         id="dynamics-oblique", title="Lateral velocity after an oblique bounce",
@@ -226,7 +146,7 @@ def build(ctx) -> Section:
                 "pybullet's cube tips on the friction at its leading edge, so its centre "
                 "keeps less. refsim's cube with the seed's rotation hits the floor again "
                 "as it turns (its box grows), and each hit damps v_t by another 0.7."
-                + pb_note + f" Reproduce: {CMD_BOUNCE}"))
+                + pb_note + f" Reproduce: {CMD_OBLIQUE}"))
 
     tables.append(Table(
         id="dynamics-rest", title="Time to rest",
@@ -239,7 +159,7 @@ def build(ctx) -> Section:
                 f"Measured: the time of the bounce after which every apex stays below "
                 f"{bounce.REST_FRACTION} of the drop height. " + _rest_findings(rest_rows)
                 + (" Quick run: e = 0.5 only." if quick else "") + pb_note
-                + f" Reproduce: {CMD_BOUNCE}"))
+                + f" Reproduce: {CMD_REST}"))
 
     cost_steps = sorted(dict.fromkeys(p.step for p in cost.points), reverse=True)
     cost_solvers = [x for x in dict.fromkeys(p.solver for p in cost.points)
@@ -258,14 +178,15 @@ def build(ctx) -> Section:
         caption=f"{cost.body}, e = {cost.e}, {cost.bounces} bounces; each point one step "
                 f"size from 1/{1 / max(cost_steps):.0f} to 1/{1 / min(cost_steps):.0f} s, in "
                 f"the manner of Erez, Tassa and Todorov "
-                f"(ICRA 2015). " + _order_findings(cost, bounce.fit_error_orders(cost),
-                                                   bounce.ROUNDING_ERROR)
+                f"(ICRA 2015). " + _order_findings(
+                    judged.rounding_series(cost, bounce.ROUNDING_ERROR), cost_run.orders,
+                    bounce.ROUNDING_ERROR)
                 + " refsim's time is the whole simulate call; pybullet's the "
                 "stepSimulation calls alone. Timings vary from run to run."
                 + (f" Quick run: {len(cost_steps)} step sizes ("
                    + ", ".join(f"1/{1 / h:.0f}" for h in cost_steps) + f" s), "
                    f"{len(cost_solvers)} solvers." if quick else "") + pb_note
-                + f" Reproduce: {CMD_BOUNCE}"))
+                + f" Reproduce: {CMD_COST}"))
 
     if settings_rows:
         tables.append(Table(
@@ -281,7 +202,7 @@ def build(ctx) -> Section:
                     "oracles/pybullet_adapter.py back to (or near) pybullet's default; the "
                     "module docstring says why each is set as it is. The restitution "
                     "threshold changes only the micro-bounces after settling (fewer "
-                    f"bounces in all). Reproduce: {CMD_BOUNCE}"))
+                    f"bounces in all). Reproduce: {CMD_SETTINGS}"))
     tables.append(Table(
         id="dynamics-step-cost", title="Time per step against pybullet", timing=True,
         columns=("cubes", "rotation", "timed after step", "refsim (us/step)",
@@ -295,11 +216,10 @@ def build(ctx) -> Section:
                 + "; ".join(f"{rep} runs of {n} steps after a warm-up of {w}"
                             for w, n, rep in dict.fromkeys((r.warmup, r.steps, r.repeats)
                                                            for r in step_rows))
-                + ". " + _step_cost_findings(step_rows) + " Timings vary from run to run. "
-                "Reproduce: "
-                "make bench (tests/benchmarks/test_bench_dynamics.py) or " + CMD_BOUNCE))
+                + ". " + _step_cost_findings(step_rows, judged.step_cost_findings(step_rows))
+                + " Timings vary from run to run. Reproduce: "
+                "make bench (tests/benchmarks/test_bench_dynamics.py) or " + CMD_STEP_COST))
 
-    by_model = {s.model: s for s in spin_rows}
     spin_series = [Series(s.model, s.t, s.spin, "-") for s in spin_rows]
     energy_series = [Series(s.model, s.t, s.rotational_energy, "-") for s in spin_rows]
     figures.append(Figure(
@@ -309,13 +229,13 @@ def build(ctx) -> Section:
                 "e = 0.5, friction 0.3. \"seed\": the seed's rotation model (S9); "
                 "\"impulse\": the corrected model (impulses with the real inertia and "
                 "Coulomb friction at every contact vertex); pybullet: the same scene."
-                + f" Reproduce: {CMD_MEASURE}"))
+                + f" Reproduce: {CMD_SPIN}"))
     figures.append(Figure(
         id="dynamics-c12-energy", title="C12: rotational energy over time",
         svg=line_chart(energy_series, xlabel="time (s)", ylabel="w . I w / 2 (J)",
                        size=CHART_SIZE),
         caption="Rotational energy with each body's inertia tensor, for the same runs. "
-                f"Reproduce: {CMD_MEASURE}"))
+                f"Reproduce: {CMD_SPIN}"))
     tables.append(Table(
         id="dynamics-c12", title="C12: spin at the end of the run",
         columns=("model", "mean |w| over the last second (rad/s)",
@@ -323,7 +243,7 @@ def build(ctx) -> Section:
         rows=tuple((s.model, _f(s.final_spin, 4), _f(s.final_speed, 4),
                     "yes" if s.at_rest else "no") for s in spin_rows),
         caption=f"At rest: |w| < {dyn_measure.REST_SPIN} rad/s and |v| < "
-                f"{dyn_measure.REST_SPEED} m/s. Reproduce: {CMD_MEASURE}"))
+                f"{dyn_measure.REST_SPEED} m/s. Reproduce: {CMD_SPIN}"))
     tables.append(Table(
         id="dynamics-c11", title="C11: interpenetrating frames",
         columns=("case", "body response", "frames", "interpenetrating", "longest run",
@@ -336,7 +256,7 @@ def build(ctx) -> Section:
                 "pass. \"seed\": the seed's velocity exchange along the centroid line "
                 "(S8); \"impulse\": the corrected response with positional separation."
                 + (" Quick run: 1 s per case." if quick else "")
-                + f" Reproduce: {CMD_MEASURE}"))
+                + f" Reproduce: {CMD_C11}"))
     choice_rows = tuple((tag, "AMBIGUITY" if tag.startswith("A") else "DEVIATION", text)
                         for tag, text in choices())
     tables.append(Table(
@@ -346,40 +266,15 @@ def build(ctx) -> Section:
                 "the choice."))
 
     # -- verdicts ---------------------------------------------------------------------------
-    seed_spin = by_model.get("seed")
-    corrected = by_model.get("impulse")
-    theirs = by_model.get("pybullet")
-    c12_measured = (
-        f"With the seed's rotation model the dropped cube still turns at "
-        f"{seed_spin.final_spin:.3g} rad/s (mean |w| over the last second; at rest: "
-        f"{'yes' if seed_spin.at_rest else 'no'}), its spin about the vertical at "
-        f"{seed_spin.spin_normal[-1]:.3g} rad/s against {seed_spin.spin_normal[0]:.3g} "
-        f"at the start: the seed's impulse I lies along the floor's normal, so the torque "
-        f"Pi x I has no vertical component and no floor contact can slow that spin, and "
-        f"nothing in S9 damps w between contacts; the corrected model ends at "
-        f"{corrected.final_spin:.3g} rad/s (at rest: {'yes' if corrected.at_rest else 'no'})"
-        + (f" and pybullet at {theirs.final_spin:.3g} rad/s" if theirs else "") + ".")
-    if not seed_spin.at_rest and corrected.at_rest:
-        c12 = "confirmed"
-    elif not seed_spin.at_rest:
-        c12 = "partly"
-    else:
-        c12 = "refuted"
-    c11_measured, c11 = _c11(c11_rows)
-    verdicts = [
-        Verdict("C11", measured=c11_measured, verdict=c11, evidence="dynamics-c11",
-                command=CMD_MEASURE),
-        Verdict("C12", measured=c12_measured, verdict=c12, evidence="dynamics-c12-spin",
-                command=CMD_MEASURE),
-    ]
+    verdicts = [_c11(run.claim("C11")), _c12(run.claim("C12"))]
 
     # -- results -------------------------------------------------------------------------------
     spin_results = [{"model": s.model, "final_spin": s.final_spin,
                      "final_speed": s.final_speed, "at_rest": s.at_rest, "t": s.t,
                      "spin": s.spin, "rotational_energy": s.rotational_energy}
                     for s in spin_rows]
-    results = _jsonable({
-        "pybullet": pb is not None,
+    results = {
+        "pybullet": pb,
         "apex_ratios": apex_rows,
         "oblique": oblique_rows,
         "rest": rest_rows,
@@ -393,7 +288,7 @@ def build(ctx) -> Section:
         "settings": {"step": bounce.STEP, "solver": bounce.SOLVER,
                      "drop_height": bounce.DROP_HEIGHT, "bounces": bounce.BOUNCES,
                      "apex_ratio_target": bounce.APEX_RATIO_TARGET},
-    })
+    }
     intro = ("A body dropped onto the floor of the world cube is the seed's wall response "
              "(S7) in its simplest form: Newton's restitution law says each apex is e^2 "
              "of the one before, the bounces end at a finite (Zeno) time, and friction "
@@ -405,18 +300,11 @@ def build(ctx) -> Section:
              "interpenetrate (C11), each against the corrected model.")
     return Section(key="dynamics", title="Rigid-body dynamics", intro=intro, figures=figures,
                    tables=tables, verdicts=verdicts, results=results,
-                   divergences=_divergences(apex_rows, oblique_rows),
+                   divergences=_divergences(apex_rows, oblique_rows,
+                                            judged.tipping_spin(apex_rows)),
                    agreements=_agreements(apex_rows, oblique_rows))
 
 
-#: The issue's step-cost target: refsim at most this many times pybullet's
-#: time per step at the largest body count.
-STEP_COST_TARGET = 2.0
-#: The C11 cases where bodies meet slowly or moving the same way (the claim's
-#: "slow or same-direction"; refsim.studies.dynamics.c11_scene): the chase,
-#: the slow head-on approach and the body dropped onto another. "glancing"
-#: (an offset pass at 1 m/s) is neither.
-C11_CLAIM_CASES = ("chase", "slow", "stack")
 #: What each C11 case is, for the verdict sentence (the scene, not a finding).
 C11_CASE_NOTES = {
     "chase": "same direction, 2 and 0.5 m/s",
@@ -454,47 +342,41 @@ def _height_gaps(series, apex_rows) -> str:
     return text + "."
 
 
-def _apex_findings(apex_rows, target: float, rounding: float) -> str:
-    """The apex table's findings, from its rows."""
+def _apex_findings(found: dict) -> str:
+    """The apex table's findings (:func:`refsim.claims.dynamics.apex_findings`)."""
     parts = []
-    off = [r for r in apex_rows if r.rotation == "off"]
-    if off:
-        worst = max(r.refsim_error for r in off)
-        literal = max(r.seed_speed_error for r in off)
+    target = found["target"]
+    if "off_worst" in found:
         parts.append(
             "With rotation off, refsim's default wall response (it flips the speed the "
-            f"body had at the wall, DEVIATION D1) is at most {_pct(worst)} from e^2 ("
-            + ("rounding" if worst <= rounding else
-               ("inside" if worst <= target else "outside") + f" the issue's {_pct(target)} "
-               "target")
+            f"body had at the wall, DEVIATION D1) is at most {_pct(found['off_worst'])} from "
+            "e^2 ("
+            + ("rounding" if found["off_at_rounding"] else
+               ("inside" if found["off_within_target"] else "outside")
+               + f" the issue's {_pct(target)} target")
             + f"); the seed's literal flip (the deeper, faster speed one step past the wall) "
-            f"is at most {_pct(literal)} off, "
-            + ("inside" if literal <= target else "outside")
+            f"is at most {_pct(found['literal_worst'])} off, "
+            + ("inside" if found["literal_within_target"] else "outside")
             + f" the issue's {_pct(target)} target.")
-    cubes_off = [r for r in off if r.body == "cube.ac"]
-    if cubes_off:
-        worst = max(r.refsim_error for r in cubes_off)
-        parts.append(f"The cube's face-down bounce with rotation off: at most {_pct(worst)} "
-                     "from e^2.")
-    seeded = [r for r in apex_rows if r.body == "cube.ac" and r.rotation == "seed"]
-    if seeded:
-        high = [r for r in seeded if r.refsim_ratio > r.analytic_ratio]
-        spin = max(r.refsim_max_spin for r in seeded)
+    if "cube_off_worst" in found:
+        parts.append(f"The cube's face-down bounce with rotation off: at most "
+                     f"{_pct(found['cube_off_worst'])} from e^2.")
+    if "seeded_drops" in found:
         text = (f"With the seed's rotation model (which picks one of the four tied bottom "
-                f"vertices, AMBIGUITY A4) the cube turns at up to {_f(spin, 3)} rad/s and "
-                f"its apex ratio is off by up to {_pct(max(r.refsim_error for r in seeded))}")
-        if high:
-            text += (f", above e^2 in {len(high)} of {len(seeded)} drops (w += Pi x I "
-                     "takes nothing from the linear motion, so the spin is added energy)")
+                f"vertices, AMBIGUITY A4) the cube turns at up to "
+                f"{_f(found['seeded_max_spin'], 3)} rad/s and its apex ratio is off by up to "
+                f"{_pct(found['seeded_worst'])}")
+        if found["seeded_above_e2"]:
+            text += (f", above e^2 in {found['seeded_above_e2']} of {found['seeded_drops']} "
+                     "drops (w += Pi x I takes nothing from the linear motion, so the spin is "
+                     "added energy)")
         parts.append(text + ".")
-    cubes_pb = _finite(r.pybullet_max_spin for r in apex_rows if r.body == "cube.ac")
-    if cubes_pb:
-        spin = max(cubes_pb)
+    if "pybullet_cube_spin" in found:
         parts.append(
-            f"pybullet's cube reaches max |w| {_f(spin, 3)} rad/s"
+            f"pybullet's cube reaches max |w| {_f(found['pybullet_cube_spin'], 3)} rad/s"
             + (": it meets the floor at four points solved one after another, which can "
-               "break the symmetry and tip it." if spin > NOTICEABLE_SPIN else
-               f", below {NOTICEABLE_SPIN} rad/s: it does not tip."))
+               "break the symmetry and tip it." if found["pybullet_cube_tips"] else
+               f", below {found['noticeable_spin']} rad/s: it does not tip."))
     return " ".join(parts)
 
 
@@ -517,12 +399,10 @@ def _rest_findings(rest_rows) -> str:
     return ("; ".join(parts) + ".") if parts else ""
 
 
-def _order_findings(cost, orders: dict, rounding: float) -> str:
-    """The cost chart's finding: which series stay at rounding, and the
-    fitted order in h of the others."""
-    at_rounding = [solver for solver in dict.fromkeys(p.solver for p in cost.points)
-                   if all(p.error <= rounding for p in cost.points
-                          if p.solver == solver and math.isfinite(p.error))]
+def _order_findings(at_rounding: list, orders: dict, rounding: float) -> str:
+    """The cost chart's finding: which series stay at rounding
+    (:func:`refsim.claims.dynamics.rounding_series`), and the fitted order in
+    h of the others."""
     parts = []
     if at_rounding:
         parts.append(f"Errors at every step size below {rounding:g} (rounding, drawn at "
@@ -534,8 +414,9 @@ def _order_findings(cost, orders: dict, rounding: float) -> str:
     return " ".join(parts)
 
 
-def _step_cost_findings(step_rows) -> str:
-    """The step-cost table's findings: refsim's 1-body time and the ratios."""
+def _step_cost_findings(step_rows, found: dict) -> str:
+    """The step-cost table's findings: refsim's 1-body time and the ratios
+    (:func:`refsim.claims.dynamics.step_cost_findings`)."""
     early = [r for r in step_rows if r.warmup == min(x.warmup for x in step_rows)]
     parts = []
     single = [r for r in early if r.bodies == min(x.bodies for x in early)]
@@ -553,24 +434,19 @@ def _step_cost_findings(step_rows) -> str:
                 parts.append(f"Its largest stage (rotation {r.rotation}): {top}, "
                              f"{_pct(stages[top] / r.refsim_seconds)} of the step.")
                 break
-    counts = sorted(dict.fromkeys(r.bodies for r in early))
-    ratios = {c: [r.ratio for r in early if r.bodies == c] for c in counts}
+    ratios = found["ratios"]
     parts.append("refsim / pybullet by body count: "
                  + "; ".join(f"{c}: " + ", ".join(f"{x:.2g}x" for x in ratios[c])
-                             for c in counts) + ".")
-    means = [float(np.mean(ratios[c])) for c in counts]
-    if len(means) > 1 and all(math.isfinite(m) for m in means):
-        falling = all(b < a for a, b in zip(means, means[1:], strict=False))
+                             for c in ratios) + ".")
+    if found["ratio_falls"] is not None:
         parts.append("The ratio falls as bodies are added: refsim's time per step grows far "
-                     "less with the body count than pybullet's." if falling else
+                     "less with the body count than pybullet's." if found["ratio_falls"] else
                      "The ratio does not fall steadily as bodies are added.")
-    biggest = max(r.bodies for r in step_rows)
-    at_max = [r for r in step_rows if r.bodies == biggest]
-    parts.append(f"The issue's target is refsim at most {STEP_COST_TARGET:g}x pybullet at "
-                 f"{biggest} bodies; this run measured "
-                 + ", ".join(f"{r.ratio:.2g}x (rotation {r.rotation}, after step {r.warmup}"
-                             f"{', within' if r.ratio <= STEP_COST_TARGET else ', above'} it)"
-                             for r in at_max) + ".")
+    parts.append(f"The issue's target is refsim at most {found['target']:g}x pybullet at "
+                 f"{found['largest_bodies']} bodies; this run measured "
+                 + ", ".join(f"{r['ratio']:.2g}x (rotation {r['rotation']}, after step "
+                             f"{r['warmup']}{', within' if r['within_target'] else ', above'} it)"
+                             for r in found["at_largest"]) + ".")
     late = [r for r in step_rows if r.warmup > min(x.warmup for x in step_rows)]
     if late:
         parts.append(f"Once the cubes have settled on the floor (timed after step "
@@ -582,50 +458,51 @@ def _step_cost_findings(step_rows) -> str:
     return " ".join(parts)
 
 
-def _c11(c11_rows) -> tuple[str, str]:
-    """C11's sentence and verdict from the measured frames.
+def _named(cases) -> str:
+    return ", ".join(f"{c} ({C11_CASE_NOTES[c]})" if c in C11_CASE_NOTES else c for c in cases)
 
-    A frame of overlap is what any discrete detection sees first (the contact
-    is found after the step that made it); the claim is about overlap that
-    persists, so a case counts when its longest run of interpenetrating
-    frames exceeds one step. Confirmed when the seed's response lets every
-    slow or same-direction case (C11_CLAIM_CASES) persist, partly when some,
-    refuted when none."""
-    seed_c11 = {r.case: r for r in c11_rows if r.response == "seed"}
-    imp_c11 = {r.case: r for r in c11_rows if r.response == "impulse"}
-    persistent = [c for c, r in seed_c11.items() if r.longest_run > 1]
-    single = [c for c, r in seed_c11.items() if r.longest_run == 1]
-    never = [c for c, r in seed_c11.items() if r.longest_run == 0]
-    imp_persistent = [c for c, r in imp_c11.items() if r.longest_run > 1]
 
-    def named(cases):
-        return ", ".join(f"{c} ({C11_CASE_NOTES[c]})" if c in C11_CASE_NOTES else c
-                         for c in cases)
-
+def _c11(result) -> Verdict:
+    """C11's sentence from :func:`refsim.claims.dynamics.c11`'s facts."""
+    f = result.facts
     text = ("With the seed's velocity exchange, interpenetrating frames (longest run): "
-            + ", ".join(f"{c} {r.interpenetrating} of {r.frames} ({r.longest_run})"
-                        for c, r in seed_c11.items())
+            + ", ".join(f"{c} {r['interpenetrating']} of {r['frames']} ({r['longest_run']})"
+                        for c, r in f["seed"].items())
             + "; with the corrected response: "
-            + ", ".join(f"{c} {r.interpenetrating} ({r.longest_run})"
-                        for c, r in imp_c11.items()) + ".")
+            + ", ".join(f"{c} {r['interpenetrating']} ({r['longest_run']})"
+                        for c, r in f["impulse"].items()) + ".")
     text += (" With the seed's response, overlap persists for more than a frame in: "
-             + (named(persistent) if persistent else "no case") + ".")
-    if single:
+             + (_named(f["persistent"]) if f["persistent"] else "no case") + ".")
+    if f["detection_only"]:
         text += (" Overlap in single frames only (the frame in which the contact is "
-                 "detected) in: " + named(single) + ".")
-    if never:
-        text += " No overlap at all in: " + named(never) + "."
+                 "detected) in: " + _named(f["detection_only"]) + ".")
+    if f["never"]:
+        text += " No overlap at all in: " + _named(f["never"]) + "."
     text += (" The corrected response lets overlap persist in: "
-             + (", ".join(imp_persistent) if imp_persistent else "no case") + ".")
-    claim_cases = [c for c in C11_CLAIM_CASES if c in seed_c11]
-    hit = [c for c in claim_cases if c in persistent]
-    if claim_cases and len(hit) == len(claim_cases):
-        verdict = "confirmed"
-    elif hit:
-        verdict = "partly"
-    else:
-        verdict = "refuted"
-    return text, verdict
+             + (", ".join(f["impulse_persistent"]) if f["impulse_persistent"] else "no case")
+             + ".")
+    return Verdict("C11", measured=text, verdict=result.verdict, evidence="dynamics-c11",
+                   command=CMD_C11, timing=result.timing)
+
+
+def _c12(result) -> Verdict:
+    """C12's sentence from :func:`refsim.claims.dynamics.c12`'s facts."""
+    f = result.facts
+    measured = (
+        f"With the seed's rotation model the dropped cube still turns at "
+        f"{f['seed_final_spin']:.3g} rad/s (mean |w| over the last second; at rest: "
+        f"{'yes' if f['seed_at_rest'] else 'no'}), its spin about the vertical at "
+        f"{f['seed_vertical_spin_end']:.3g} rad/s against "
+        f"{f['seed_vertical_spin_start']:.3g} "
+        f"at the start: the seed's impulse I lies along the floor's normal, so the torque "
+        f"Pi x I has no vertical component and no floor contact can slow that spin, and "
+        f"nothing in S9 damps w between contacts; the corrected model ends at "
+        f"{f['corrected_final_spin']:.3g} rad/s (at rest: "
+        f"{'yes' if f['corrected_at_rest'] else 'no'})"
+        + (f" and pybullet at {f['pybullet_final_spin']:.3g} rad/s"
+           if f["pybullet_final_spin"] is not None else "") + ".")
+    return Verdict("C12", measured=measured, verdict=result.verdict,
+                   evidence="dynamics-c12-spin", command=CMD_SPIN, timing=result.timing)
 
 
 def _agreements(apex_rows, oblique_rows) -> list[Agreement]:
@@ -637,29 +514,28 @@ def _agreements(apex_rows, oblique_rows) -> list[Agreement]:
         rows.append(Agreement(
             "analytic", f"apex ratio against e^2 (e = {es}), refsim's seed model, RK4, "
             "h = 1e-3", f"largest error {_pct(max(r.refsim_error for r in rounds))} over "
-            f"{len(rounds)} drops (target 0.5%)", CMD_BOUNCE))
+            f"{len(rounds)} drops (target 0.5%)", CMD_APEX))
         measured = [r for r in rounds if r.pybullet_error is not None]
         if measured:
             rows.append(Agreement(
                 "pybullet", f"apex ratio against e^2 (e = {es}), same scenes",
                 f"largest error {_pct(max(r.pybullet_error for r in measured))} over "
-                f"{len(measured)} drops", CMD_BOUNCE))
+                f"{len(measured)} drops", CMD_APEX))
     sliding = [r for r in oblique_rows if r.body.startswith("sphere") and r.pybullet is not None]
     if sliding:
         worst = max(abs(r.pybullet - r.coulomb_ball) / r.coulomb_ball for r in sliding)
         rows.append(Agreement(
             "pybullet", "lateral speed after an oblique bounce against Coulomb's law",
             f"within {100 * worst:.2g}% on {len(sliding)} bounces (refsim's seed model keeps "
-            "(1 - friction) v_t instead: see the divergence catalogue)", CMD_BOUNCE))
+            "(1 - friction) v_t instead: see the divergence catalogue)", CMD_OBLIQUE))
     return rows
 
-#: A spin the catalogue reports as the cube tipping (rad/s): a face-down drop
-#: starts with none, and rounding alone leaves pybullet's cube below 1e-4.
-NOTICEABLE_SPIN = 0.01
 
 
-def _divergences(apex_rows, oblique_rows) -> list[Divergence]:
-    """Where pybullet and refsim's seed model part, with the figures."""
+def _divergences(apex_rows, oblique_rows, tipping_spin) -> list[Divergence]:
+    """Where pybullet and refsim's seed model part, with the figures;
+    ``tipping_spin``: pybullet's cube's largest spin where it tips, or None
+    (:func:`refsim.claims.dynamics.tipping_spin`)."""
     entries = []
     rounds = [r for r in apex_rows if r.rotation == "off" and r.pybullet_error is not None]
     if rounds:
@@ -688,12 +564,10 @@ def _divergences(apex_rows, oblique_rows) -> list[Divergence]:
                       for r in slides)
             + ": the seed keeps (1 - friction) v_t whatever the normal speed",
             "dynamics-oblique"))
-    cubes = [r for r in apex_rows if r.body.startswith("cube") and r.pybullet_max_spin
-             and r.pybullet_max_spin > NOTICEABLE_SPIN]
-    if cubes:
+    if tipping_spin is not None:
         entries.append(Divergence(
             "pybullet's falling cube tips and spins", "oracle: contact model",
-            f"max |w| {max(r.pybullet_max_spin for r in cubes):.3g} rad/s after face-down "
+            f"max |w| {tipping_spin:.3g} rad/s after face-down "
             "bounces that start with no spin: pybullet solves the four floor contacts one "
             "after another, which breaks the symmetry", "dynamics-apex-ratios"))
     return entries

@@ -1,10 +1,13 @@
-"""Report section: the bundled models (seed S1)."""
+"""Report section: the bundled models (seed S1).
+
+Arranges the plan's ``models-facts`` (refsim's own facts of each bundled
+model) and ``models-agreement`` (the same facts by trimesh).
+"""
 
 from __future__ import annotations
 
-from refsim.bundled import bundled_models
-from refsim.models.facts import describe
 from refsim.report.charts import bar_chart
+from refsim.report.plan import command
 from refsim.report.section import Agreement, Figure, Section, Table
 
 #: Coordinates below this are rounding noise of models about 1 unit in size
@@ -12,10 +15,7 @@ from refsim.report.section import Agreement, Figure, Section, Table
 #: values are in results.json.
 SHOWN_AS_ZERO = 1e-12
 
-AGREEMENT_COMMAND = ("python -c \"from refsim.bundled import bundled_models; "
-                     "from refsim.oracles.trimesh_adapter import TrimeshOracle; "
-                     "from refsim.studies.models import measure_mesh_facts_agreement as m; "
-                     "[print(r) for r in m(TrimeshOracle(), bundled_models())]\"")
+AGREEMENT_COMMAND = command("models-agreement")
 
 
 def _point(p) -> str:
@@ -23,9 +23,7 @@ def _point(p) -> str:
 
 
 def build(ctx) -> Section:
-    from refsim.models.loading import load_model
-
-    facts = [describe(load_model(path), name=path.name) for path in bundled_models()]
+    facts = ctx.run.get("models-facts")
     rows = tuple(
         (f.name, f.triangles, f.vertices, "yes" if f.convex else "no",
          "yes" if f.closed else "no", f.degenerate_triangles,
@@ -40,11 +38,8 @@ def build(ctx) -> Section:
                  "volume", "centroid (vertex average)", "centroid (volume)", "max neighbours"),
         rows=rows,
         caption="Read by refsim's own AC3D reader, welded to shared-vertex form. "
-                "Reproduce one row: refsim info models/NAME.ac")
-    from refsim.oracles.trimesh_adapter import TrimeshOracle
-    from refsim.studies.models import measure_mesh_facts_agreement
-
-    agreement = measure_mesh_facts_agreement(TrimeshOracle(), bundled_models())
+                f"Reproduce: {command('models-facts')} (one row: refsim info models/NAME.ac)")
+    agreement = ctx.run.get("models-agreement")
     agree_table = Table(
         id="models-trimesh", title="Agreement with trimesh",
         columns=("model", "convex agrees", "closed agrees", "volume |difference| / volume",
@@ -86,4 +81,4 @@ def build(ctx) -> Section:
         figures=[figure],
         agreements=agreements,
         results={"models": [f.as_dict() for f in facts],
-                 "trimesh_agreement": [a.__dict__ for a in agreement]})
+                 "trimesh_agreement": agreement})

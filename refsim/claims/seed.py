@@ -1,8 +1,8 @@
 """The seed's claims C1-C12 and its terminology, as the report lists them.
 
-The wording follows DESIGN.md's summary of the seed. A claim gets its verdict
-from the section that measures it (a :class:`~refsim.report.section.Verdict`);
-a claim nobody has measured yet is shown as "not measured yet", never guessed.
+The wording follows DESIGN.md's summary of the seed. Each claim is judged by
+one function of this package (``refsim.claims.<area>.c<N>``); a claim
+nobody has measured is shown as "not measured yet", never guessed.
 """
 
 from __future__ import annotations

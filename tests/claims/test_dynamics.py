@@ -1,0 +1,160 @@
+"""C11, C12 and the bounce findings (refsim.claims.dynamics) at their edges.
+
+C11 counts a case when its longest run of interpenetrating frames is longer
+than the one frame any discrete detection sees; C12 turns on the at-rest
+flags of the seed's and the corrected model; the findings on the issue's
+targets (apex ratio, step cost) and on pybullet's cube tipping.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from refsim.claims.dynamics import (
+    C11_CLAIM_CASES,
+    DETECTION_FRAMES,
+    NOTICEABLE_SPIN,
+    STEP_COST_TARGET,
+    apex_findings,
+    c11,
+    c12,
+    rounding_series,
+    step_cost_findings,
+    tipping_spin,
+)
+from refsim.studies.bounce import ApexRow, CostPoint, CostStudy, StepCost
+from refsim.studies.dynamics import InterpenetrationRow, SpinSeries
+
+
+def rows(seed_runs: dict, impulse_runs: dict | None = None) -> list[InterpenetrationRow]:
+    """Interpenetration rows with these longest runs per case and response."""
+    impulse_runs = impulse_runs or dict.fromkeys(seed_runs, 0)
+    return [InterpenetrationRow(case, response, 1000, 3 * run, run, 2)
+            for response, runs in (("seed", seed_runs), ("impulse", impulse_runs))
+            for case, run in runs.items()]
+
+
+PERSISTS = DETECTION_FRAMES + 1
+
+
+@pytest.mark.parametrize(("runs", "verdict"), [
+    (dict.fromkeys(C11_CLAIM_CASES, PERSISTS) | {"glancing": 0}, "confirmed"),
+    # one case overlaps for the detection frame only: partly
+    (dict.fromkeys(C11_CLAIM_CASES, PERSISTS) | {"slow": DETECTION_FRAMES}, "partly"),
+    # persistence in a case outside the claim does not count
+    (dict.fromkeys(C11_CLAIM_CASES, DETECTION_FRAMES) | {"glancing": 50}, "refuted"),
+])
+def test_c11_verdict_at_the_detection_frame(runs, verdict):
+    assert c11(rows(runs)).verdict == verdict
+
+
+def test_c11_facts():
+    facts = c11(rows({"chase": 40, "slow": 1, "stack": 0, "glancing": 3},
+                     {"chase": 2, "slow": 0, "stack": 0, "glancing": 0})).facts
+    assert facts["persistent"] == ["chase", "glancing"]
+    assert facts["detection_only"] == ["slow"] and facts["never"] == ["stack"]
+    assert facts["impulse_persistent"] == ["chase"]
+    assert facts["claim_cases_persistent"] == ["chase"]
+    assert facts["seed"]["chase"] == {"interpenetrating": 120, "frames": 1000, "longest_run": 40}
+
+
+def spin(model, at_rest, final=0.5) -> SpinSeries:
+    t = np.linspace(0.0, 6.0, 4)
+    return SpinSeries(model=model, t=t, spin=np.full(4, final), spin_normal=np.array([5., 5, 5, 4]),
+                      rotational_energy=np.ones(4), speed=np.zeros(4), final_spin=final,
+                      final_speed=0.0, at_rest=at_rest)
+
+
+@pytest.mark.parametrize(("seed_rest", "corrected_rest", "verdict"), [
+    (False, True, "confirmed"), (False, False, "partly"), (True, True, "refuted"),
+    (True, False, "refuted")])
+def test_c12_verdict(seed_rest, corrected_rest, verdict):
+    assert c12([spin("seed", seed_rest), spin("impulse", corrected_rest)]).verdict == verdict
+
+
+def test_c12_facts():
+    facts = c12([spin("seed", False, 4.2), spin("impulse", True, 1e-4),
+                 spin("pybullet", True, 2e-4)]).facts
+    assert facts["seed_final_spin"] == 4.2 and facts["corrected_final_spin"] == 1e-4
+    assert facts["seed_vertical_spin_start"] == 5.0 and facts["seed_vertical_spin_end"] == 4.0
+    assert facts["pybullet_final_spin"] == 2e-4
+    assert c12([spin("seed", False), spin("impulse", True)]).facts["pybullet_final_spin"] is None
+
+
+def apex(body="sphere-2k.ac", rotation="off", error=1e-3, literal=0.02, ratio=0.64,
+         pybullet_spin=math.nan, refsim_spin=0.0) -> ApexRow:
+    return ApexRow(body=body, rotation=rotation, e=0.8, step=1e-3, solver="rk4",
+                   analytic_heights=[], analytic_times=[], refsim_heights=[], refsim_times=[],
+                   pybullet_heights=[], pybullet_times=[], analytic_ratio=0.64,
+                   refsim_ratio=ratio, pybullet_ratio=0.63, refsim_first_ratio=0.64,
+                   pybullet_first_ratio=0.63, refsim_error=error, pybullet_error=0.01,
+                   seed_speed_heights=[], seed_speed_ratio=0.65, seed_speed_first_ratio=0.65,
+                   seed_speed_error=literal, refsim_max_spin=refsim_spin,
+                   pybullet_max_spin=pybullet_spin)
+
+
+TARGET, ROUNDING = 0.005, 1e-9
+
+
+@pytest.mark.parametrize(("error", "at_rounding", "within"), [
+    (ROUNDING, True, True), (ROUNDING * 1.001, False, True),
+    (TARGET, False, True), (TARGET * 1.001, False, False)])
+def test_apex_findings_targets(error, at_rounding, within):
+    found = apex_findings([apex(error=error, literal=TARGET * 1.001)], TARGET, ROUNDING)
+    assert found["off_at_rounding"] is at_rounding
+    assert found["off_within_target"] is within
+    assert found["literal_within_target"] is False
+
+
+def test_apex_findings_cube_and_pybullet():
+    found = apex_findings([apex(), apex("cube.ac", error=2e-3, pybullet_spin=NOTICEABLE_SPIN),
+                           apex("cube.ac", "seed", error=0.05, ratio=0.7, refsim_spin=3.0),
+                           apex("cube.ac", "seed", error=0.02, ratio=0.6, refsim_spin=1.0)],
+                          TARGET, ROUNDING)
+    assert found["cube_off_worst"] == 2e-3
+    assert (found["seeded_drops"], found["seeded_above_e2"]) == (2, 1)
+    assert found["seeded_max_spin"] == 3.0 and found["seeded_worst"] == 0.05
+    assert found["pybullet_cube_spin"] == NOTICEABLE_SPIN
+    assert found["pybullet_cube_tips"] is False         # exactly the threshold: no tipping
+
+
+@pytest.mark.parametrize(("spin_", "tips"), [(NOTICEABLE_SPIN, None),
+                                             (NOTICEABLE_SPIN * 1.001, NOTICEABLE_SPIN * 1.001)])
+def test_tipping_spin(spin_, tips):
+    assert tipping_spin([apex("cube.ac", pybullet_spin=spin_), apex()]) == tips
+
+
+def test_rounding_series():
+    points = [CostPoint("refsim", "rk4", h, 0.64, ROUNDING, 1.0) for h in (1e-2, 1e-3)]
+    points += [CostPoint("refsim", "euler", h, 0.6, err, 1.0)
+               for h, err in ((1e-2, 0.1), (1e-3, ROUNDING))]
+    points += [CostPoint("pybullet", "pybullet", 1e-2, math.nan, math.nan, 1.0)]
+    assert rounding_series(CostStudy(0.8, "sphere-2k.ac", 3, points), ROUNDING) == \
+        ["rk4", "pybullet"]      # a series with no finite error has none above rounding
+
+
+def step(bodies, ratio, warmup=20, rotation="off") -> StepCost:
+    return StepCost(bodies=bodies, rotation=rotation, warmup=warmup, refsim_seconds=ratio * 1e-5,
+                    pybullet_seconds=1e-5, ratio=ratio, refsim_stage_seconds={}, steps=50,
+                    repeats=3)
+
+
+@pytest.mark.parametrize(("ratio", "within"), [(STEP_COST_TARGET, True),
+                                                (STEP_COST_TARGET * 1.001, False)])
+def test_step_cost_target(ratio, within):
+    found = step_cost_findings([step(1, 30.0), step(10, 6.0), step(40, ratio)])
+    assert found["at_largest"] == [{"rotation": "off", "warmup": 20, "ratio": ratio,
+                                    "within_target": within}]
+    assert found["ratio_falls"] is True
+    assert found["ratios"] == {1: [30.0], 10: [6.0], 40: [ratio]}
+
+
+def test_step_cost_ratio_must_fall_at_every_count():
+    found = step_cost_findings([step(1, 30.0), step(10, 6.0), step(40, 6.0),
+                                step(40, 1.0, warmup=3000)])
+    assert found["ratio_falls"] is False            # 6.0 then 6.0: not falling
+    assert [r["warmup"] for r in found["at_largest"]] == [20, 3000]
+    assert step_cost_findings([step(1, 30.0)])["ratio_falls"] is None
