@@ -100,3 +100,39 @@ def adaptive_run(f, y0, t0: float, t1: float, method: str, tol: float) -> Adapti
     if not sol.success:
         raise OracleFailure(f"{method} at tol {tol:g} failed: {sol.message}")
     return AdaptiveRun(method, tol, sol.y[:, -1].copy(), int(sol.nfev), wall_time)
+
+
+def solve_with_events(f, y0, t0: float, t1: float, events, tol: float = REFERENCE_TOL):
+    """DOP853 at ``rtol = atol = tol`` from ``t0`` until ``t1`` or the first
+    terminal event (scipy's event functions: ``terminal``, ``direction``).
+    Returns scipy's result (``status`` 1 when an event stopped it,
+    ``t_events``, ``y_events``, ``t``, ``y`` as (d, n))."""
+    y0 = np.atleast_1d(np.asarray(y0, dtype=np.float64))
+    sol = solve_ivp(f, (t0, t1), y0, method="DOP853", rtol=tol, atol=tol, events=events)
+    if sol.status < 0:
+        raise OracleFailure(f"DOP853 with events failed: {sol.message}")
+    return sol
+
+
+class ScipyReference:
+    """scipy's ``solve_ivp`` as a reference solver for the studies: a DOP853
+    reference (``solution``, ``solve_with_events``) and adaptive runs to
+    compare against (``adaptive_run``); :class:`refsim.engines.ReferenceSolver`."""
+
+    name = "scipy"
+    tolerance = REFERENCE_TOL
+
+    def solution(self, f, y0, t0: float, t1: float, t_eval=None) -> ReferenceSolution:
+        return reference_solution(f, y0, t0, t1, t_eval=t_eval)
+
+    def solve_with_events(self, f, y0, t0: float, t1: float, events):
+        return solve_with_events(f, y0, t0, t1, events)
+
+    def adaptive_run(self, f, y0, t0: float, t1: float, method: str,
+                     tol: float) -> AdaptiveRun:
+        return adaptive_run(f, y0, t0, t1, method, tol)
+
+
+def engine() -> ScipyReference:
+    """The reference solver (``refsim.oracles.scipy_ivp:engine``)."""
+    return ScipyReference()

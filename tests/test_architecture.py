@@ -29,7 +29,7 @@ SOURCES = ((ROOT / "refsim", "refsim"), (ROOT / "oracles", "refsim.oracles"))
 #: the shared modules of plain types, errors, limits and input/output.
 ALGORITHMS = tuple(f"refsim.{name}" for name in (
     "models", "bounds", "collision", "solvers", "dynamics", "particles", "scenes",
-    "types", "errors", "limits", "files", "io", "npz", "frames", "jit", "bundled", "signals"))
+    "types", "errors", "limits", "files", "io", "npz", "frames", "kernels", "bundled", "signals"))
 
 #: Everything to the right of the algorithms.
 ABOVE_ALGORITHMS = ("refsim.engines", "refsim.oracles", "refsim.studies", "refsim.claims",
@@ -53,17 +53,7 @@ RULES: tuple[tuple[str, tuple[str, ...], tuple[str, ...], tuple[str, ...]], ...]
 
 #: Imports that break a rule today, each with the reason and whose work
 #: removes it: (importing module, imported module) -> why.
-ALLOWANCES: dict[tuple[str, str], str] = {
-    # The studies take scipy's reference solutions and adaptive runs from the
-    # oracle module directly: refsim.engines has no capability for a
-    # reference ODE solution yet, and the solvers' tests call these studies
-    # without one. To be removed when the kernel/algorithm work adds that
-    # capability and the plan passes the reference in.
-    ("refsim.studies.solvers", "refsim.oracles.scipy_ivp"):
-        "reference ODE solutions (no engine capability yet)",
-    ("refsim.studies.particles", "refsim.oracles.scipy_ivp"):
-        "reference ODE solutions (no engine capability yet)",
-}
+ALLOWANCES: dict[tuple[str, str], str] = {}
 
 
 def _is(name: str, prefix: str) -> bool:

@@ -97,6 +97,26 @@ class RigidBodyWorld(Protocol):
     def simulate(self, scene) -> Any: ...
 
 
+@runtime_checkable
+class ReferenceSolver(Protocol):
+    """Not a checked capability but the role the solver studies give an ODE
+    oracle: a tight reference solution of ``y' = f(t, y)`` (``solution``
+    returning ``t`` (n,) and ``y`` (n, d) at ``t_eval``, default ``[t1]``),
+    the same with terminal events (``solve_with_events``, scipy's result
+    conventions), and adaptive runs at a tolerance to compare the fixed-step
+    solvers with (``adaptive_run``, returning ``y1``, ``nfev``,
+    ``wall_time``). ``refsim.oracles.scipy_ivp.ScipyReference`` is one."""
+
+    name: str
+    tolerance: float
+
+    def solution(self, f, y0, t0: float, t1: float, t_eval=None) -> Any: ...
+
+    def solve_with_events(self, f, y0, t0: float, t1: float, events) -> Any: ...
+
+    def adaptive_run(self, f, y0, t0: float, t1: float, method: str, tol: float) -> Any: ...
+
+
 #: Each capability, the method that provides it and its protocol.
 CAPABILITIES: dict[str, tuple[str, type]] = {
     "triangles": ("triangles_intersect", TriangleTest),

@@ -63,6 +63,12 @@ def _pybullet():
     return PybulletOracle()
 
 
+def _scipy():
+    from refsim.oracles.scipy_ivp import ScipyReference
+
+    return ScipyReference()
+
+
 #: The oracle engines the report uses, by name: a factory each. One engine of
 #: each is made per run and shared by the entries (one pybullet client serves
 #: every bounce scene; each ``simulate`` resets it).
@@ -71,6 +77,7 @@ ENGINES: dict[str, Callable[[], Any]] = {
     "fcl": _fcl,
     "trimesh-collision": _trimesh_collision,
     "pybullet": _pybullet,
+    "scipy": _scipy,
 }
 
 
@@ -502,12 +509,12 @@ def _solvers_orders(run: Run):
         for name, problem in problems.items():
             lo, hi = sm.STEP_RANGE[name]
             steps = [lo * 2**k for k in range(int(math.log2(hi // lo)) - 1)]
-            y_ref = sm.reference_at_t1(problem)
+            y_ref = sm.reference_at_t1(problem, run.engine("scipy"))
             for method in SOLVERS:
                 convergence[(name, method)] = sm.measure_convergence(problem, method, steps,
                                                                      y_ref=y_ref)
     else:
-        convergence = sm.measure_orders(problems)
+        convergence = sm.measure_orders(problems, oracle=run.engine("scipy"))
     return OrderRun(convergence, {k: s.order for k, s in SOLVERS.items()},
                     {k: s.seed_order for k, s in SOLVERS.items()},
                     {k: _failing_conditions(s) for k, s in SOLVERS.items()})
@@ -519,7 +526,8 @@ def _solvers_seed_literal(run: Run):
 
     problems = ([harmonic_oscillator()] if run.quick
                 else [exponential_decay(), harmonic_oscillator(), kepler_orbit()])
-    return [SeedLiteral(p.name, sm.measure_seed_literal_rk4(p)) for p in problems]
+    return [SeedLiteral(p.name, sm.measure_seed_literal_rk4(p, oracle=run.engine("scipy")))
+            for p in problems]
 
 
 def _solvers_stability(run: Run):
@@ -560,9 +568,10 @@ def _solvers_work_precision(run: Run):
     if run.quick:
         lo, _ = sm.STEP_RANGE["kepler"]
         points = sm.measure_work_precision(steps=[lo * 2**k for k in range(8)],
-                                           tolerances=sm.SCIPY_TOLERANCES[:8], repeats=repeats)
+                                           tolerances=sm.SCIPY_TOLERANCES[:8], repeats=repeats,
+                                           oracle=run.engine("scipy"))
     else:
-        points = sm.measure_work_precision(repeats=repeats)
+        points = sm.measure_work_precision(repeats=repeats, oracle=run.engine("scipy"))
     return WorkPrecisionRun(points, repeats)
 
 
@@ -576,7 +585,8 @@ def _particles_work_precision(run: Run):
     from refsim.studies import particles as pm
 
     points = pm.measure_particle_work_precision(_particle_config(run, False),
-                                                repeats=_repeats(run))
+                                                repeats=_repeats(run),
+                                                oracle=run.engine("scipy"))
     return WorkPrecisionRun(points, _repeats(run), run.size(*PARTICLE_COUNT),
                             pm.observed_orders(points))
 
@@ -586,7 +596,8 @@ def _particles_work_precision_walls(run: Run):
 
     steps = pm.PARTICLE_STEPS if run.quick else pm.PARTICLE_STEPS + (2048, 4096)
     points = pm.measure_particle_work_precision(_particle_config(run, True), steps=steps,
-                                                repeats=_repeats(run))
+                                                repeats=_repeats(run),
+                                                oracle=run.engine("scipy"))
     return WorkPrecisionRun(points, _repeats(run), run.size(*PARTICLE_COUNT),
                             pm.observed_orders(points))
 
@@ -606,15 +617,17 @@ def _particles_jitter(run: Run):
 def _particles_drag(run: Run):
     from refsim.studies import particles as pm
 
-    return pm.measure_drag_models(count=20_000, repeats=3) if run.quick \
-        else pm.measure_drag_models()
+    scipy = run.engine("scipy")
+    return pm.measure_drag_models(scipy, count=20_000, repeats=3) if run.quick \
+        else pm.measure_drag_models(scipy)
 
 
 def _particles_frame(run: Run):
     from refsim.studies import particles as pm
 
-    return FrameRun(pm.measure_frame_step_difference(_particle_config(run, False)),
-                    pm.measure_frame_step_difference(_particle_config(run, True)))
+    scipy = run.engine("scipy")
+    return FrameRun(pm.measure_frame_step_difference(_particle_config(run, False), oracle=scipy),
+                    pm.measure_frame_step_difference(_particle_config(run, True), oracle=scipy))
 
 
 def _quick_choice(run: Run) -> list:
@@ -646,7 +659,7 @@ def _particles_choice(run: Run):
         return ChoiceRun(_quick_choice(run), run.size(*PARTICLE_COUNT), max(pm.PARTICLE_STEPS),
                          TARGET_FREE, BUDGET_WALLS)
     return ChoiceRun(pm.measure_solver_choice(target_free=TARGET_FREE, budget_walls=BUDGET_WALLS,
-                                              count=CHOICE_COUNT),
+                                              count=CHOICE_COUNT, oracle=run.engine("scipy")),
                      CHOICE_COUNT, CHOICE_MAX_STEPS, TARGET_FREE, BUDGET_WALLS)
 
 

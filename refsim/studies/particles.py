@@ -189,16 +189,14 @@ class DragComparison:
     cost_ratio: float = timing_field()
 
 
-def _trajectory(config: ParticleConfig, x0, v0, t_eval):
-    from refsim.oracles.scipy_ivp import reference_solution
-
+def _trajectory(config: ParticleConfig, x0, v0, t_eval, oracle):
     y0 = np.concatenate([x0, v0])
-    ref = reference_solution(particle_rhs(config, count=1), y0, 0.0, float(t_eval[-1]),
-                             t_eval=t_eval)
+    ref = oracle.solution(particle_rhs(config, count=1), y0, 0.0, float(t_eval[-1]),
+                          t_eval=t_eval)
     return ref.y[:, :3]
 
 
-def measure_drag_models(terminal_speed: float = 10.0, launch_speed: float = 15.0,
+def measure_drag_models(oracle, terminal_speed: float = 10.0, launch_speed: float = 15.0,
                         duration: float = 2.0, gravity: float = 9.81, count: int = 100_000,
                         repeats: int = 5) -> DragComparison:
     """Trajectory difference and cost of quadratic against linear drag.
@@ -214,10 +212,12 @@ def measure_drag_models(terminal_speed: float = 10.0, launch_speed: float = 15.0
     v0 = launch_speed * np.array([math.sqrt(0.5), math.sqrt(0.5), 0.0])
     t_eval = np.linspace(0.0, duration, 401)
     base = ParticleConfig(count=1, gravity=gravity, mass=mass, walls=False)
-    linear = _trajectory(replace(base, drag=k_linear, drag_model="linear"), x0, v0, t_eval)
-    quad = _trajectory(replace(base, drag=k_quadratic, drag_model="quadratic"), x0, v0, t_eval)
+    linear = _trajectory(replace(base, drag=k_linear, drag_model="linear"), x0, v0, t_eval,
+                         oracle)
+    quad = _trajectory(replace(base, drag=k_quadratic, drag_model="quadratic"), x0, v0, t_eval,
+                       oracle)
     quad_same_k = _trajectory(replace(base, drag=k_linear, drag_model="quadratic"), x0, v0,
-                              t_eval)
+                              t_eval, oracle)
     distance = float(np.linalg.norm(np.diff(linear, axis=0), axis=1).sum())
 
     times = {}
@@ -247,11 +247,11 @@ MAX_CONTACTS = 200
 
 
 def wall_reference(config: ParticleConfig, x0: np.ndarray, v0: np.ndarray,
-                   t1: float) -> np.ndarray:
+                   t1: float, oracle) -> np.ndarray:
     """Positions and velocities at ``t1`` with each wall contact located exactly.
 
-    Each particle is integrated by DOP853 (tolerance
-    :data:`refsim.oracles.scipy_ivp.REFERENCE_TOL`) until an event function
+    Each particle is integrated by the reference solver ``oracle``
+    (:class:`refsim.engines.ReferenceSolver`: scipy's DOP853) until an event function
     ``x_a -+ half_size`` crosses zero outward; there the seed's response is
     applied (normal component times ``-e``, lateral times ``1 - friction``)
     and integration restarts. Returns (2, N, 3).
@@ -262,10 +262,6 @@ def wall_reference(config: ParticleConfig, x0: np.ndarray, v0: np.ndarray,
         A particle needs more than MAX_CONTACTS contacts (choose a shorter
         ``t1``: it is coming to rest on a wall).
     """
-    from scipy.integrate import solve_ivp
-
-    from refsim.oracles.scipy_ivp import REFERENCE_TOL
-
     f = particle_rhs(config, count=1)
     L = config.half_size
     events = []
@@ -281,8 +277,7 @@ def wall_reference(config: ParticleConfig, x0: np.ndarray, v0: np.ndarray,
     for i in range(len(x0)):
         t, y = 0.0, np.concatenate([x0[i], v0[i]])
         for _ in range(MAX_CONTACTS):
-            sol = solve_ivp(f, (t, t1), y, method="DOP853", rtol=REFERENCE_TOL,
-                            atol=REFERENCE_TOL, events=events)
+            sol = oracle.solve_with_events(f, y, t, t1, events)
             y = sol.y[:, -1].copy()
             t = float(sol.t[-1])
             if sol.status != 1:
@@ -315,15 +310,14 @@ def particle_test_config(count: int = 200, walls: bool = False, seed: int = 3) -
                           walls=walls, wall_speed=SEED_WALLS)
 
 
-def particle_reference(config: ParticleConfig, t1: float) -> np.ndarray:
-    """(2, N, 3) state at ``t1`` from ``config.initial_state()``: DOP853 on the
-    whole system without walls, :func:`wall_reference` with."""
-    from refsim.oracles.scipy_ivp import reference_solution
-
+def particle_reference(config: ParticleConfig, t1: float, oracle) -> np.ndarray:
+    """(2, N, 3) state at ``t1`` from ``config.initial_state()``: the
+    reference solver ``oracle`` on the whole system without walls,
+    :func:`wall_reference` with."""
     x0, v0 = config.initial_state()
     if config.walls:
-        return wall_reference(config, x0, v0, t1)
-    y = reference_solution(particle_rhs(config), np.stack([x0, v0]).reshape(-1), 0.0, t1).y[-1]
+        return wall_reference(config, x0, v0, t1, oracle)
+    y = oracle.solution(particle_rhs(config), np.stack([x0, v0]).reshape(-1), 0.0, t1).y[-1]
     return y.reshape(2, config.count, 3)
 
 
@@ -339,16 +333,14 @@ PARTICLE_STEPS = (8, 16, 32, 64, 128, 256, 512, 1024)
 def measure_particle_work_precision(config: ParticleConfig | None = None, t1: float = 1.0,
                                     methods=tuple(SOLVERS), steps=PARTICLE_STEPS,
                                     scipy_tolerances=(1e-3, 1e-5, 1e-7, 1e-9),
-                                    repeats: int = 1) -> list[WorkPoint]:
+                                    repeats: int = 1, *, oracle) -> list[WorkPoint]:
     """Position error at ``t1`` (m, max over particles) against wall time and
     ``nfev`` (force evaluations of the whole system) for each solver at
     ``steps`` steps (the particle system's fast path), and for scipy RK45 /
     DOP853 on the same system (only without walls: scipy would step through
     the walls). Default system: :func:`particle_test_config`."""
-    from refsim.oracles.scipy_ivp import adaptive_run
-
     config = particle_test_config() if config is None else config
-    Y_ref = particle_reference(config, t1)
+    Y_ref = particle_reference(config, t1, oracle)
     x0, v0 = config.initial_state()
     out = []
     for method in methods:
@@ -366,7 +358,8 @@ def measure_particle_work_precision(config: ParticleConfig | None = None, t1: fl
         y0 = np.stack([x0, v0]).reshape(-1)
         for scipy_method in ("RK45", "DOP853"):
             for tol in scipy_tolerances:
-                runs = [adaptive_run(particle_rhs(config), y0, 0.0, t1, scipy_method, tol)
+                runs = [oracle.adaptive_run(particle_rhs(config), y0, 0.0, t1, scipy_method,
+                                            tol)
                         for _ in range(repeats)]
                 Y = runs[0].y1.reshape(2, config.count, 3)
                 out.append(WorkPoint(f"scipy-{scipy_method}", tol, _state_error(Y, Y_ref),
@@ -411,11 +404,12 @@ class FrameStepDifference:
 
 
 def measure_frame_step_difference(config: ParticleConfig | None = None, h: float = 1 / 60,
-                                  t1: float = 1.0) -> FrameStepDifference:
-    """C8's "no noticeable difference": each solver against rk4 at step ``h``."""
+                                  t1: float = 1.0, *, oracle) -> FrameStepDifference:
+    """C8's "no noticeable difference": each solver against rk4 at step ``h``
+    (and against the reference of the solver ``oracle``)."""
     config = particle_test_config() if config is None else config
     n = round(t1 / h)
-    Y_ref = particle_reference(config, n * h)
+    Y_ref = particle_reference(config, n * h, oracle)
     states = {}
     for method in SOLVERS:
         system = ParticleSystem(replace(config, solver=method, step=h))
@@ -604,7 +598,7 @@ class SolverChoice:
 
 
 def measure_solver_choice(target_free: float = 1e-4, budget_walls: float = 512,
-                          count: int = 50) -> list[SolverChoice]:
+                          count: int = 50, *, oracle) -> list[SolverChoice]:
     """One :class:`SolverChoice` per solver, from the particle work-precision
     runs (``count`` particles, 1 s, with and without walls), the stability
     polynomials and the resting-contact jitter."""
@@ -613,9 +607,10 @@ def measure_solver_choice(target_free: float = 1e-4, budget_walls: float = 512,
 
     free = measure_particle_work_precision(particle_test_config(count=count), methods=SOLVERS,
                                            steps=tuple(8 * 2**k for k in range(12)),
-                                           scipy_tolerances=())
+                                           scipy_tolerances=(), oracle=oracle)
     walls = measure_particle_work_precision(particle_test_config(count=count, walls=True),
-                                            methods=SOLVERS, steps=(64, 128, 256, 512, 1024))
+                                            methods=SOLVERS, steps=(64, 128, 256, 512, 1024),
+                                            oracle=oracle)
     out = []
     for name, method in SOLVERS.items():
         out.append(SolverChoice(

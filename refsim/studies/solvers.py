@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from refsim.errors import OptionError
 from refsim.solvers.explicit_rk import ExplicitRungeKutta
 from refsim.solvers.integrate import resolve_method, solve_fixed_step
 from refsim.solvers.methods import SOLVERS
@@ -164,16 +165,22 @@ def standard_problems() -> dict[str, Problem]:
     return {p.name: p for p in problems}
 
 
-def reference_at_t1(problem: Problem, reference: str = "dop853") -> np.ndarray:
-    """``y(t1)`` by DOP853 (``reference="dop853"``) or the closed form
-    (``"exact"``)."""
-    if reference == "exact":
-        return problem.exact(problem.t1)
-    if reference != "dop853":
-        raise ValueError(f"reference must be 'dop853' or 'exact', got {reference!r}")
-    from refsim.oracles.scipy_ivp import reference_solution
+def reference_at_t1(problem: Problem, oracle=None) -> np.ndarray:
+    """``y(t1)``: by ``oracle``, a reference solver
+    (:class:`refsim.engines.ReferenceSolver`, e.g. scipy's DOP853), or, with
+    ``oracle=None``, the problem's closed form.
 
-    return reference_solution(problem.f, problem.y0, problem.t0, problem.t1).y[-1]
+    Raises
+    ------
+    OptionError
+        ``oracle=None`` for a problem without a closed form.
+    """
+    if oracle is None:
+        if problem.exact is None:
+            raise OptionError(f"problem {problem.name!r} has no closed form: give a "
+                              "reference solver (refsim.oracles.scipy_ivp:engine)")
+        return problem.exact(problem.t1)
+    return oracle.solution(problem.f, problem.y0, problem.t0, problem.t1).y[-1]
 
 
 # --------------------------------------------------------------------------
@@ -181,16 +188,17 @@ def reference_at_t1(problem: Problem, reference: str = "dop853") -> np.ndarray:
 # --------------------------------------------------------------------------
 
 def measure_convergence(problem: Problem, method, steps=None, y_ref=None,
-                        stop_at_floor: bool = True) -> Convergence:
+                        stop_at_floor: bool = True, oracle=None) -> Convergence:
     """Error at ``t1`` for step counts ``steps`` (default: doubling through
-    ``STEP_RANGE[problem.name]``), and the observed order.
+    ``STEP_RANGE[problem.name]``), and the observed order. The reference is
+    ``y_ref``, or :func:`reference_at_t1` with ``oracle``.
 
     With ``stop_at_floor`` the doubling stops after the second error below
     ERROR_FLOOR_REL (more steps only measure rounding).
     """
     solver = resolve_method(method)
     if y_ref is None:
-        y_ref = reference_at_t1(problem)
+        y_ref = reference_at_t1(problem, oracle)
     if steps is None:
         lo, hi = STEP_RANGE[problem.name]
         steps = [lo * 2**k for k in range(int(math.log2(hi // lo)) + 1)]
@@ -212,13 +220,14 @@ def measure_convergence(problem: Problem, method, steps=None, y_ref=None,
 
 
 def measure_orders(problems: dict[str, Problem] | None = None,
-                   methods=tuple(SOLVERS)) -> dict[tuple[str, str], Convergence]:
+                   methods=tuple(SOLVERS), oracle=None) -> dict[tuple[str, str], Convergence]:
     """:func:`measure_convergence` for every (problem, method); keys are
-    ``(problem name, method name)``. One DOP853 reference per problem."""
+    ``(problem name, method name)``. One reference per problem, by ``oracle``
+    (a reference solver; None: closed forms only)."""
     problems = standard_problems() if problems is None else problems
     out = {}
     for name, problem in problems.items():
-        y_ref = reference_at_t1(problem)
+        y_ref = reference_at_t1(problem, oracle)
         for method in methods:
             out[(name, resolve_method(method).name)] = measure_convergence(problem, method,
                                                                           y_ref=y_ref)
@@ -246,15 +255,17 @@ class SeedLiteralRK4:
     limit_error: float
 
 
-def measure_seed_literal_rk4(problem: Problem | None = None) -> SeedLiteralRK4:
-    """Show that the literal RK4 reading converges to ``y' = (5/3) f``."""
+def measure_seed_literal_rk4(problem: Problem | None = None, oracle=None) -> SeedLiteralRK4:
+    """Show that the literal RK4 reading converges to ``y' = (5/3) f``
+    (references by ``oracle``, a reference solver: the scaled problem has no
+    closed form)."""
     from refsim.solvers.methods import RK4_SEED_LITERAL
 
     problem = harmonic_oscillator() if problem is None else problem
     scaled = Problem(problem.name, lambda t, y: (5.0 / 3.0) * problem.f(t, y), problem.y0,
                      problem.t0, problem.t1, None, problem.scale)
-    y_true = reference_at_t1(problem)
-    y_scaled = reference_at_t1(scaled)
+    y_true = reference_at_t1(problem, oracle)
+    y_scaled = reference_at_t1(scaled, oracle)
     against_true = measure_convergence(problem, RK4_SEED_LITERAL, y_ref=y_true)
     against_scaled = measure_convergence(problem, RK4_SEED_LITERAL, y_ref=y_scaled)
     return SeedLiteralRK4(against_true, against_scaled,
@@ -469,17 +480,16 @@ SCIPY_TOLERANCES = tuple(10.0 ** -k for k in range(3, 13))
 
 def measure_work_precision(problem: Problem | None = None, methods=tuple(SOLVERS),
                            steps=None, tolerances=SCIPY_TOLERANCES,
-                           repeats: int = 1) -> list[WorkPoint]:
+                           repeats: int = 1, oracle=None) -> list[WorkPoint]:
     """Error against cost on one problem (default: Kepler, e = 0.5).
 
     Fixed-step solvers at the step counts ``steps`` (default: doubling
-    through STEP_RANGE, capped at 2^14 to bound the time), scipy RK45 and
-    DOP853 at ``tolerances``.
+    through STEP_RANGE, capped at 2^14 to bound the time), and, with
+    ``oracle`` (a reference solver), its adaptive RK45 and DOP853 at
+    ``tolerances`` and its reference; without, the closed-form reference only.
     """
-    from refsim.oracles.scipy_ivp import adaptive_run
-
     problem = kepler_orbit() if problem is None else problem
-    y_ref = reference_at_t1(problem)
+    y_ref = reference_at_t1(problem, oracle)
     if steps is None:
         lo, hi = STEP_RANGE[problem.name]
         steps = [lo * 2**k for k in range(int(math.log2(min(hi, 2**14) // lo)) + 1)]
@@ -496,10 +506,10 @@ def measure_work_precision(problem: Problem | None = None, methods=tuple(SOLVERS
                 best = min(best, time.perf_counter() - start)
             error = float(np.abs(result.y[-1] - y_ref).max()) / problem.scale
             out.append(WorkPoint(solver.name, h, error, result.nfev, best))
-    for scipy_method in ("RK45", "DOP853"):
+    for scipy_method in ("RK45", "DOP853") if oracle is not None else ():
         for tol in tolerances:
-            runs = [adaptive_run(problem.f, problem.y0, problem.t0, problem.t1, scipy_method,
-                                 tol) for _ in range(repeats)]
+            runs = [oracle.adaptive_run(problem.f, problem.y0, problem.t0, problem.t1,
+                                        scipy_method, tol) for _ in range(repeats)]
             error = float(np.abs(runs[0].y1 - y_ref).max()) / problem.scale
             out.append(WorkPoint(f"scipy-{scipy_method}", tol, error, runs[0].nfev,
                                  min(r.wall_time for r in runs)))

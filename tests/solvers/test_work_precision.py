@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import pytest
+from refsim.oracles.scipy_ivp import ScipyReference
 
 from refsim.solvers.problems import kepler_orbit
 from refsim.studies.solvers import (
@@ -18,7 +19,7 @@ from refsim.studies.solvers import (
 @pytest.fixture(scope="module")
 def points():
     return measure_work_precision(kepler_orbit(), steps=[64, 128, 256, 512, 1024],
-                                  tolerances=(1e-4, 1e-6, 1e-8))
+                                  tolerances=(1e-4, 1e-6, 1e-8), oracle=ScipyReference())
 
 
 def test_every_run_is_recorded(points):

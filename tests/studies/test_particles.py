@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from refsim.oracles.scipy_ivp import ScipyReference
 
 from refsim.particles.config import ParticleConfig
 from refsim.solvers.methods import SOLVERS
@@ -20,6 +21,9 @@ from refsim.studies.particles import (
     wall_reference,
 )
 from refsim.studies.solvers import error_at_cost
+
+#: The reference solver of the studies (scipy's DOP853).
+SCIPY = ScipyReference()
 
 # -- C6, C7: resting contact ---------------------------------------------------
 
@@ -89,7 +93,7 @@ def test_drag_damps_euler_jitter():
 
 def test_quadratic_and_linear_drag_differ_visibly():
     # (their cost ratio is a timing: measured and reported, never asserted)
-    c = measure_drag_models(count=20_000, repeats=3)
+    c = measure_drag_models(SCIPY, count=20_000, repeats=3)
     print(c)
     assert c.k_linear == pytest.approx(0.981) and c.k_quadratic == pytest.approx(0.0981)
     # Same terminal speed: ~1.5 m apart after 2 s of a ~14 m flight (10%).
@@ -106,13 +110,13 @@ ORDER_TOL = 0.15
 @pytest.fixture(scope="module")
 def free_points():
     return measure_particle_work_precision(particle_test_config(count=50),
-                                           scipy_tolerances=(1e-4, 1e-8))
+                                           scipy_tolerances=(1e-4, 1e-8), oracle=SCIPY)
 
 
 @pytest.fixture(scope="module")
 def wall_points():
     return measure_particle_work_precision(particle_test_config(count=30, walls=True),
-                                           steps=(128, 256, 512, 1024, 2048))
+                                           steps=(128, 256, 512, 1024, 2048), oracle=SCIPY)
 
 
 def test_free_particle_orders(free_points):
@@ -164,7 +168,7 @@ def test_rk4_wins_at_equal_evaluations_without_walls(free_points):
 
 
 def test_frame_step_difference_rk4_vs_second_order_is_sub_millimetre():
-    d = measure_frame_step_difference(particle_test_config(count=30))
+    d = measure_frame_step_difference(particle_test_config(count=30), oracle=SCIPY)
     print(d)
     assert d.difference["midpoint"] < 1e-3 and d.difference["averaged-euler"] < 1e-3
     assert d.difference["euler"] > 1e-2 and d.difference["backwards-euler"] > 1e-2
@@ -175,7 +179,8 @@ def test_wall_reference_single_bounce():
     # contact at t = 0.5, then back at 2 e m/s for 0.5 s.
     config = ParticleConfig(count=1, gravity=0.0, half_size=2.0, restitution=0.5,
                             friction=0.0)
-    Y = wall_reference(config, np.array([[1.0, 0.0, 0.0]]), np.array([[2.0, 0.0, 0.0]]), 1.0)
+    Y = wall_reference(config, np.array([[1.0, 0.0, 0.0]]), np.array([[2.0, 0.0, 0.0]]), 1.0,
+                       SCIPY)
     np.testing.assert_allclose(Y[0, 0], [2.0 - 0.5 * 1.0, 0.0, 0.0], atol=1e-12)
     np.testing.assert_allclose(Y[1, 0], [-1.0, 0.0, 0.0], atol=1e-12)
 
