@@ -58,3 +58,10 @@ def rk4_seed_literal() -> SeedLiteralRK4:
 
 def box_ignores_translation() -> BoxIgnoresTranslation:
     return BoxIgnoresTranslation()
+
+
+def missing():
+    """An engine whose package is not installed (as an adapter reports it)."""
+    from refsim.oracles import OracleUnavailable
+
+    raise OracleUnavailable("oracle engine 'nothing-here' is not installed")
