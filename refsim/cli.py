@@ -271,8 +271,9 @@ def _conform(args) -> int:
                           expected_failures=args.expected_failures, spec=args.engine)
     print(summary_table(result))
     json_path, page = write_engine_pages(result, out)
-    verdict = "every check passed" if result.ok else \
-        f"failed: {', '.join(result.failed_checks())}"
+    expected = sum(c.status == "xfailed" for c in result.checks)
+    verdict = (f"failed: {', '.join(result.failed_checks())}" if not result.ok
+               else "no check failed") + (f" ({expected} expected failures)" if expected else "")
     print(f"{result.engine}: {verdict}; wrote {json_path} and {page}")
     return 0 if result.ok else EXIT_CHECK_FAILED
 

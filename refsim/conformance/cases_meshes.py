@@ -47,7 +47,7 @@ from refsim.conformance.draw import (
     unit_quaternion_rotation,
 )
 
-MODELS = ("tetrahedron.ac", "cube.ac", "icosahedron.ac", "l-beam.ac", "star.ac")
+MODELS = ("tetrahedron.ac", "cube.ac", "icosahedron.ac", "l-beam.ac", "star.ac", "sphere-2k.ac")
 FAMILIES = ("separated", "deep", "touching", "grazing")
 
 

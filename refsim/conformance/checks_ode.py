@@ -13,7 +13,8 @@
   Runge-Kutta method of the declared order needs (Butcher's bounds:
   :data:`MIN_STAGES`). The count is reported either way.
 
-A failure within twice its tolerance is "tolerance"; beyond, "bug". The
+A failure within twice its tolerance is "tolerance"; beyond, "bug"
+(:data:`refsim.conformance.results.MARGINAL_FACTOR`). The
 RK4 with the seed's literal weights (1/6, 2/3, 2/3, 1/6; they sum to 5/3)
 declared as order 4 fails ``ode.order`` on every problem: its error does not
 fall with h at all (observed order ~0).
@@ -36,7 +37,7 @@ import time
 import numpy as np
 
 from refsim.conformance.cases_ode import end_error, fitted_order
-from refsim.conformance.results import CheckResult, not_applicable, tally
+from refsim.conformance.results import CheckResult, classify_miss, not_applicable, tally
 
 #: Observed and declared order may differ by this much. The fits of refsim's
 #: five methods on these problems land within 0.15 of their orders (the
@@ -57,12 +58,6 @@ STABILITY_RTOL = 1e-12
 MIN_STAGES = {1: 1, 2: 2, 3: 3, 4: 4, 5: 6, 6: 7, 7: 9, 8: 11}
 
 
-def _outcome(miss: float, tol: float) -> str | None:
-    if miss <= tol:
-        return None
-    return "tolerance" if miss <= 2 * tol else "bug"
-
-
 def check_ode_order(engine, cases) -> CheckResult:
     """``ode.order``: observed order within ORDER_TOL of ``ode_order`` on
     every problem (module docstring). A problem solved to rounding at every
@@ -78,7 +73,7 @@ def check_ode_order(engine, cases) -> CheckResult:
         orders[problem.name] = observed
         miss = 0.0 if observed is None else (math.inf if math.isnan(observed)
                                              else abs(observed - declared))
-        outcome = _outcome(miss, ORDER_TOL)
+        outcome = classify_miss(miss, ORDER_TOL)
         outcomes.append(outcome)
         if outcome is not None:
             examples.append({"class": outcome, "problem": problem.name,
@@ -117,7 +112,7 @@ def check_ode_stability(engine, cases) -> CheckResult:
         got = _amplification(engine, z)
         declared = complex(engine.ode_stability(z))
         miss = abs(got - declared) / max(1.0, abs(declared)) if math.isfinite(got) else math.inf
-        outcome = _outcome(miss, STABILITY_RTOL)
+        outcome = classify_miss(miss, STABILITY_RTOL)
         outcomes.append(outcome)
         measured.append(got)
         if outcome is not None and len(examples) < 5:

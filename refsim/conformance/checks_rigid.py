@@ -67,7 +67,7 @@ import time
 import numpy as np
 
 from refsim.conformance import cases_rigid as R
-from refsim.conformance.results import CheckResult, tally
+from refsim.conformance.results import CheckResult, classify_miss, tally
 from refsim.dynamics import analytic
 
 #: Steps over which an engine may find and resolve one contact (module docstring).
@@ -94,12 +94,6 @@ NO_SPIN_FRACTION = 1e-3
 REST_PENETRATION_STEPS = 10
 
 
-def _miss(miss: float, tol: float) -> str | None:
-    if miss <= tol:
-        return None
-    return "tolerance" if miss <= 2 * tol else "bug"
-
-
 def apex_tolerance(scene) -> float:
     """Relative apex-ratio tolerance of a drop (module docstring)."""
     h_K = scene.height * scene.e ** (2 * R.BOUNCES)
@@ -117,7 +111,7 @@ def check_rigid_apex_ratio(engine, cases) -> CheckResult:
         error = (ratio - ideal) / ideal if math.isfinite(ratio) else math.nan
         tol = apex_tolerance(scene)
         measured[scene.name] = {"ratio": ratio, "relative_error": error, "tolerance": tol}
-        outcome = _miss(abs(error), tol) if math.isfinite(error) else "bug"
+        outcome = classify_miss(abs(error), tol) if math.isfinite(error) else "bug"
         outcomes.append(outcome)
         if outcome is not None:
             examples.append({"class": outcome, "apex_ratio": ratio, "ideal": ideal,
@@ -144,7 +138,7 @@ def check_rigid_no_spin(engine, cases) -> CheckResult:
         impact = analytic.impact_speed(scene.height, R.GRAVITY)
         fraction = spin * reach / impact
         measured[scene.name] = {"largest_spin": spin, "surface_speed_fraction": fraction}
-        outcome = _miss(fraction, NO_SPIN_FRACTION) if math.isfinite(fraction) else "bug"
+        outcome = classify_miss(fraction, NO_SPIN_FRACTION) if math.isfinite(fraction) else "bug"
         outcomes.append(outcome)
         if outcome is not None:
             examples.append({"class": outcome, "largest_spin": spin,
@@ -167,7 +161,7 @@ def check_rigid_oblique_bounce(engine, cases) -> CheckResult:
         coulomb = analytic.lateral_velocity_coulomb(v_t, v_n, scene.friction, scene.e)
         seed_law = analytic.lateral_velocity_seed(v_t, scene.friction)
         tol = scene.friction * CONTACT_STEPS * R.GRAVITY * scene.scene.integration.step
-        outcome = _miss(abs(got - coulomb), tol)
+        outcome = classify_miss(abs(got - coulomb), tol)
         if outcome is not None and abs(got - seed_law) <= tol:
             outcome = "known-divergence"
         measured[scene.name] = {"lateral_velocity": got, "coulomb": coulomb,
@@ -211,7 +205,7 @@ def check_rigid_spin_to_rest(engine, cases) -> CheckResult:
         measured[scene.name] = {"rest_time_limit": limit,
                                 "first_time_below": float(t[below[0]]) if len(below) else None,
                                 "largest_spin_after_limit": left * w0}
-        outcome = _miss(left, SPIN_REST_FRACTION)
+        outcome = classify_miss(left, SPIN_REST_FRACTION)
         outcomes.append(outcome)
         if outcome is not None:
             examples.append({"class": outcome, "rest_time_limit": limit,
@@ -251,7 +245,7 @@ def check_rigid_energy(engine, cases) -> CheckResult:
         tol = energy_tolerance(scene)
         measured[scene.name] = {"largest_rise": rise, "tolerance": tol,
                                 "initial": float(energy[0])}
-        outcome = _miss(rise, tol) if math.isfinite(rise) else "bug"
+        outcome = classify_miss(rise, tol) if math.isfinite(rise) else "bug"
         outcomes.append(outcome)
         if outcome is not None:
             k = int(np.nanargmax(energy))
@@ -277,7 +271,7 @@ def check_rigid_resting_contact(engine, cases) -> CheckResult:
         h = scene.scene.integration.step
         tol = REST_PENETRATION_STEPS * R.GRAVITY * h * h
         measured[scene.name] = {"deepest": depth, "tolerance": tol, "from_time": since}
-        outcome = _miss(depth, tol)
+        outcome = classify_miss(depth, tol)
         outcomes.append(outcome)
         if outcome is not None:
             examples.append({"class": outcome, "deepest_penetration": depth, "tolerance": tol,

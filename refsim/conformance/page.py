@@ -39,9 +39,14 @@ def _e(text) -> str:
 
 
 def _json(value) -> str:
+    """A record as JSON, one top-level key a line (its value on that line)."""
     from refsim.conformance.results import _jsonable
 
-    text = json.dumps(value, indent=1, default=_jsonable)
+    if isinstance(value, dict):
+        text = "{\n" + ",\n".join(f" {json.dumps(k)}: {json.dumps(v, default=_jsonable)}"
+                                  for k, v in value.items()) + "\n}"
+    else:
+        text = json.dumps(value, default=_jsonable)
     if len(text) > EXAMPLE_CHARS:
         text = text[:EXAMPLE_CHARS] + "\n... (cut; conformance.json has it all)"
     return _e(text)
@@ -58,7 +63,9 @@ def engine_page(result) -> str:
     from refsim.conformance.registry import CHECKS
 
     docs = {c.key: c.doc for c in CHECKS}
-    verdict = "every check passed" if result.ok else "a check failed"
+    expected = sum(c.status == "xfailed" for c in result.checks)
+    verdict = ("no check failed" if result.ok else "a check failed") + \
+        (f" ({expected} expected failures)" if expected else "")
     parts = [f"<h1>Conformance of {_e(result.engine)}</h1>",
              f"<p class=\"meta\">refsim {_e(result.refsim)} &middot; engine "
              f"{_e(result.spec or result.engine)} &middot; seed {result.seed} &middot; "

@@ -32,6 +32,10 @@ rigid.determinism      rigid       two runs, the same bits
 
 ``--cases N`` sizes the generated sets (triangles, poses, boxes); the ODE
 problems and the rigid scenes are fixed sets.
+
+Cost: building a case set is the cost its module states (the exact answers:
+about 1 ms per triangle pair, 1 ms per pose, 20 us per box vertex; about
+12,000 rigid-body steps per engine); the registry itself is O(checks).
 """
 
 from __future__ import annotations
@@ -64,8 +68,10 @@ class Check:
 
     @property
     def doc(self) -> str:
-        """The first line of the check function's docstring."""
-        return (self.run.__doc__ or "").strip().splitlines()[0]
+        """The first paragraph of the check function's docstring, on one
+        line, without reStructuredText's double backquotes."""
+        paragraph = (self.run.__doc__ or "").strip().split("\n\n")[0]
+        return " ".join(paragraph.split()).replace("``", "")
 
 
 CHECKS: tuple[Check, ...] = (

@@ -47,6 +47,21 @@ CLASSES = ("bug", "known-divergence", "tolerance", "touching", "coplanar")
 
 STATUSES = ("passed", "failed", "xfailed", "xpassed", "n/a")
 
+#: A measured quantity that misses its tolerance by no more than this factor
+#: is classed "tolerance" (the engine does the right thing, less accurately
+#: than the bound asks); beyond it, "bug". Two: a tolerance is a bound on the
+#: error of a correct method, and a correct method's constant can be a few
+#: times another's; an error ten times the bound is no longer "less accurate".
+MARGINAL_FACTOR = 2.0
+
+
+def classify_miss(miss: float, tolerance: float) -> str | None:
+    """None when ``miss <= tolerance``; "tolerance" within
+    :data:`MARGINAL_FACTOR` of it; else "bug" (nan: "bug")."""
+    if miss <= tolerance:
+        return None
+    return "tolerance" if miss <= MARGINAL_FACTOR * tolerance else "bug"
+
 
 def worst_class(classes) -> str:
     """The most serious of ``classes`` (in :data:`CLASSES` order)."""

@@ -20,6 +20,8 @@ one engine so that the matrix has one trimesh column.
 
 Each shipped engine's declared divergences are in
 ``refsim/conformance/expected/<name>.txt`` (:mod:`refsim.conformance.expected`).
+
+Cost: building an engine is its adapter's (imports, a client); O(1) here.
 """
 
 from __future__ import annotations
