@@ -94,3 +94,25 @@ def test_console_script_in_a_fresh_interpreter(tmp_path):
                              "-o", str(tmp_path / "x")], capture_output=True, text=True)
     assert result.returncode == EXIT_USER_ERROR
     assert result.stderr.count("\n") == 1 and "Traceback" not in result.stderr
+
+
+def test_same_inputs_give_the_same_record_but_timings(tmp_path, capsys):
+    records = []
+    for run in ("a", "b"):
+        assert main(["conform", BOX, "--cases", "12", "-o", str(tmp_path / run)]) == 1
+        records.append(json.loads((tmp_path / run / "conformance.json").read_text()))
+    capsys.readouterr()
+
+    def without_timings(value):
+        if isinstance(value, dict):
+            return {k: without_timings(v) for k, v in value.items()
+                    if k not in ("seconds", "case_seconds")}
+        if isinstance(value, list):
+            return [without_timings(v) for v in value]
+        return value
+
+    first, second = map(without_timings, records)
+    assert first == second                      # the Hypothesis search is seeded too
+    assert first["checks"][0]["examples"][0]["shrunk"] is True
+    assert (tmp_path / "a" / "index.html").read_text() == \
+        (tmp_path / "b" / "index.html").read_text()
