@@ -7,11 +7,6 @@
     refsim view SCENE [--port N]       the scene in the browser, re-run from its controls
     refsim replay RUN.npz ... -o OUT.html
                                        recorded runs as one standalone replay page
-    refsim conform MODULE:FACTORY [-o DIR] [--cases N] [--seed S] [--only CAPABILITY]
-                   [--expected-failures FILE]
-    refsim conform --all [-o DIR] [--cases N] [--seed S] [--only CAPABILITY]
-                                       check an engine (or the six shipped ones)
-                                       against refsim's ground truth
 
 A user's mistake (a missing or malformed file, a bad scene) prints one line
 naming the file and the line or key, and exits with status 2; ``--debug``

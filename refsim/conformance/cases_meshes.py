@@ -36,12 +36,15 @@ millisecond per case for these models.
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from refsim.conformance.draw import (
     NumpyDraw,
+    dot3,
+    matmul3,
     signed_permutations,
     strategy,
     unit_quaternion_rotation,
@@ -98,7 +101,7 @@ def _pose_case(draw, family: str, model_a: str, model_b: str):
         t_a = np.array(draw.uniform(-2.0, 2.0, 3))
         if family == "separated":
             d = np.array(draw.uniform(-1.0, 1.0, 3))
-            norm = float(np.sqrt(d @ d))
+            norm = math.sqrt(dot3(d, d))
             d = d / norm if norm > 1e-3 else np.array([1.0, 0.0, 0.0])
             reach = (_radius(mesh_a) + _radius(mesh_b)) * draw.uniform(1.02, 2.0)[0]
             t_b = t_a + reach * d
@@ -112,7 +115,8 @@ def _pose_case(draw, family: str, model_a: str, model_b: str):
             t_b[axis] += side * gap                     # > 0 apart, < 0 into A
             tilt_axis = np.array(draw.uniform(-1.0, 1.0, 3))
             if np.abs(tilt_axis).max() > 1e-3:
-                r_b = rotation_about_axis(tilt_axis, draw.log_uniform(-12.0, -6.0)) @ r_b
+                tilt = rotation_about_axis(tilt_axis, draw.log_uniform(-12.0, -6.0))
+                r_b = matmul3(tilt, r_b)
     return PoseCase(model_a=model_a, model_b=model_b, pose_a=(r_a, t_a), pose_b=(r_b, t_b),
                     family=family, gap=gap, truth=_exact_pairs(model_a, (r_a, t_a),
                                                                model_b, (r_b, t_b)))

@@ -42,12 +42,13 @@ Cost: O(1) per pair to build; the truth is about a millisecond per pair
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from refsim.collision.sat_exact import triangles_intersect_sat
-from refsim.conformance.draw import NumpyDraw, signed_permutations, strategy
+from refsim.conformance.draw import NumpyDraw, dot3, signed_permutations, strategy
 
 FAMILIES = ("random", "vertex-on-face", "edge-on-edge", "near-parallel", "touching-exact",
             "coplanar-exact")
@@ -87,7 +88,7 @@ def _near_parallel(draw):
     a = np.array(draw.uniform(-1.0, 1.0, 9)).reshape(3, 3)
     e1, e2 = a[1] - a[0], a[2] - a[0]
     n = np.cross(e1, e2)
-    length = float(np.sqrt(n @ n))
+    length = math.sqrt(dot3(n, n))
     n = n / length if length > 0 else n
     b = np.empty((3, 3))
     for j in range(3):
@@ -119,9 +120,9 @@ def _touching_exact(draw):
     b[0] = p
     for m in (1, 2):
         d = np.array(draw.integers(-3, 3, 3), dtype=np.float64)
-        side = float(n @ d)
+        side = dot3(n, d)                        # integers: exact
         if side == 0.0:
-            d, side = n, float(n @ n)            # in the plane: go along the normal
+            d, side = n, dot3(n, n)              # in the plane: go along the normal
         b[m] = p + (d if side > 0 else -d)
     return a, b
 
@@ -135,7 +136,7 @@ def _coplanar_exact(draw):
     else:
         xyz = np.column_stack([pts, c - pts[:, 0] - pts[:, 1]])
     rotation = draw.choice(signed_permutations())
-    xyz = xyz @ rotation.T                      # exact: entries 0, +-1
+    xyz = np.array([[dot3(rotation[i], p) for i in range(3)] for p in xyz])  # exact: 0, +-1
     return xyz[:3].copy(), xyz[3:].copy()
 
 

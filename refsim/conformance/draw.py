@@ -106,6 +106,17 @@ def strategy(builder, *args):
     return build()
 
 
+def dot3(u, v) -> float:
+    """``u . v`` of two 3-vectors, summed left to right (no BLAS: the same
+    bits on every machine, so a seed gives the same cases everywhere)."""
+    return float((u[0] * v[0] + u[1] * v[1]) + u[2] * v[2])
+
+
+def matmul3(a, b) -> np.ndarray:
+    """The (3, 3) product ``a b``, each entry by :func:`dot3` (no BLAS)."""
+    return np.array([[dot3(a[i], b[:, j]) for j in range(3)] for i in range(3)])
+
+
 def unit_quaternion_rotation(draw) -> np.ndarray:
     """A rotation from four drawn numbers (normalized as a quaternion;
     the identity when all four are 0, which is where Hypothesis shrinks)."""
