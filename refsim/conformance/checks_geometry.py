@@ -65,18 +65,19 @@ IDENTITY_TOLERANCE = 1e-8
 FLOAT32_ROUNDOFF = 2.0 ** -24
 
 
+def _keep(found: list, example: dict) -> None:
+    """Keep ``example`` if its class has fewer than EXAMPLES_PER_CLASS so far
+    (every class that occurs gets its examples, however rare)."""
+    if sum(e["class"] == example["class"] for e in found) < EXAMPLES_PER_CLASS:
+        found.append(example)
+
+
 def _examples(found, shrunk) -> list[dict]:
-    """The shrunk case first, then up to EXAMPLES_PER_CLASS seeded ones per class."""
-    out = []
-    if shrunk is not None:
-        out.append(shrunk)
-    per: dict[str, int] = {}
-    for example in found:
-        kind = example["class"]
-        if per.get(kind, 0) < EXAMPLES_PER_CLASS:
-            per[kind] = per.get(kind, 0) + 1
-            out.append(example)
-    return out
+    """The shrunk case first, then the kept seeded ones, by class order."""
+    from refsim.conformance.results import CLASSES
+
+    return ([shrunk] if shrunk is not None else []) + sorted(
+        found, key=lambda e: CLASSES.index(e["class"]))
 
 
 def _shrunk(cases, fails, classify, describe):
@@ -106,8 +107,7 @@ def _triangle_check(name: str, answer, cases) -> CheckResult:
             continue
         kind = classify_triangles(pair.a, pair.b)
         outcomes.append(kind)
-        if len(found) < 10 * EXAMPLES_PER_CLASS:
-            found.append({"case": index, "class": kind, "answer": got, **pair.to_dict()})
+        _keep(found, {"case": index, "class": kind, "answer": got, **pair.to_dict()})
     shrunk = None
     if any(outcomes):
         def fails(p):
@@ -277,10 +277,9 @@ def check_pairs_agreement(engine, cases) -> CheckResult:
         missing += len(truth - answer)
         kind = classify_pairs(case, got)
         outcomes.append(kind)
-        if len(found) < 10 * EXAMPLES_PER_CLASS:
-            found.append({"case": index, "class": kind,
-                          "extra_pairs": sorted(answer - truth)[:10],
-                          "missing_pairs": sorted(truth - answer)[:10], **case.to_dict()})
+        _keep(found, {"case": index, "class": kind,
+                      "extra_pairs": sorted(answer - truth)[:10],
+                      "missing_pairs": sorted(truth - answer)[:10], **case.to_dict()})
     shrunk = None
     if any(outcomes):
         def fails(c):
@@ -306,8 +305,7 @@ def check_collide_agreement(engine, cases) -> CheckResult:
             continue
         kind = classify_collide(case, got)
         outcomes.append(kind)
-        if len(found) < 10 * EXAMPLES_PER_CLASS:
-            found.append({"case": index, "class": kind, "answer": got, **case.to_dict()})
+        _keep(found, {"case": index, "class": kind, "answer": got, **case.to_dict()})
     shrunk = None
     if any(outcomes):
         def fails(c):
@@ -376,9 +374,8 @@ def _box_check(name: str, engine, cases, side: int) -> CheckResult:
             continue
         kind = _classify_box(case, excess, lo, hi)
         outcomes.append(kind)
-        if len(found) < 10 * EXAMPLES_PER_CLASS:
-            found.append({"case": index, "class": kind, "excess_in_bounds": excess,
-                          "lo": lo.tolist(), "hi": hi.tolist(), **case.to_dict()})
+        _keep(found, {"case": index, "class": kind, "excess_in_bounds": excess,
+                      "lo": lo.tolist(), "hi": hi.tolist(), **case.to_dict()})
     shrunk = None
     if any(outcomes):
         def excess_of(c):
