@@ -47,7 +47,8 @@ velocity and ``w . I w / 2`` with the uniform solid's inertia.
 A run of each scene is kept per engine (:meth:`RigidCases.run`), so the
 checks share it; ``rerun`` runs a scene again for the determinism check.
 
-Cost: about 12,000 steps per engine in all (the drops are 1.8 to 3.3 s).
+Cost: about 15,300 steps per engine in all (the drops are 1.8 to 3.0 s of
+simulated time), and 1,700 more for the determinism check's reruns.
 """
 
 from __future__ import annotations

@@ -35,7 +35,7 @@ problems and the rigid scenes are fixed sets.
 
 Cost: building a case set is the cost its module states (the exact answers:
 about 1 ms per triangle pair, 1 ms per pose, 20 us per box vertex; about
-12,000 rigid-body steps per engine); the registry itself is O(checks).
+17,000 rigid-body steps per engine); the registry itself is O(checks).
 """
 
 from __future__ import annotations
