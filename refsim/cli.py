@@ -262,6 +262,96 @@ def _add_study_command(commands) -> None:
     study.set_defaults(run=_study)
 
 
+EXIT_CHECK_FAILED = 1
+
+
+def _conform(args) -> int:
+    """``refsim conform``: one engine through the conformance kit, or the
+    shipped six side by side (``--all``). Exit 0 when every check passed
+    (declared expected failures aside), 1 when one failed; user errors
+    (a bad spec, a missing engine, a malformed expected-failures file) are
+    RefsimErrors and exit 2 (``main``)."""
+    from refsim.conformance.expected import read_expected
+    from refsim.conformance.matrix import make_directory, run_matrix, write_engine_pages
+    from refsim.conformance.results import summary_table
+    from refsim.conformance.runner import DEFAULT_CASES, check_engine, select_capabilities
+    from refsim.engines import CAPABILITIES, load_engine
+    from refsim.errors import OptionError, check_count
+    from refsim.oracles import OracleUnavailable
+
+    if (args.engine is None) == (not args.all):
+        raise OptionError("give one engine as MODULE:FACTORY, or --all for the shipped ones")
+    if args.all and args.expected_failures:
+        raise OptionError("--expected-failures is for one engine; --all uses each shipped "
+                          "engine's own file (refsim/conformance/expected/)")
+    cases = check_count("--cases", DEFAULT_CASES if args.cases is None else args.cases, 1)
+    seed = check_count("--seed", args.seed, minimum=0)
+    out = Path(args.output)
+    if args.only is not None and args.only not in CAPABILITIES:
+        raise OptionError(f"--only {args.only!r}: not a capability (capabilities: "
+                          f"{', '.join(CAPABILITIES)})")
+    if args.all:
+        make_directory(out)
+        matrix, results = run_matrix(cases=cases, seed=seed, out_dir=out, only=args.only)
+        print(matrix.table())
+        for name, reason in matrix.unavailable.items():
+            print(f"refsim: warning: {name} not run: {reason}", file=sys.stderr)
+        for d in matrix.divergences:
+            print(f"  {d.engine:17} {d.check:22} {d.status:8} {d.reason}")
+        print(f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine")
+        return 0 if matrix.ok else EXIT_CHECK_FAILED
+    try:
+        engine = load_engine(args.engine)
+    except (OracleUnavailable, ImportError) as exc:
+        raise OptionError(f"engine {args.engine!r}: {exc}") from None
+    # every user error is found before any work or any output
+    select_capabilities(engine, args.only)
+    if args.expected_failures:
+        read_expected(args.expected_failures)
+    make_directory(out)
+    result = check_engine(engine, cases=cases, seed=seed, only=args.only,
+                          expected_failures=args.expected_failures, spec=args.engine)
+    print(summary_table(result))
+    json_path, page = write_engine_pages(result, out)
+    expected = sum(c.status == "xfailed" for c in result.checks)
+    verdict = (f"failed: {', '.join(result.failed_checks())}" if not result.ok
+               else "no check failed") + (f" ({expected} expected failures)" if expected else "")
+    print(f"{result.engine}: {verdict}; wrote {json_path} and {page}")
+    return 0 if result.ok else EXIT_CHECK_FAILED
+
+
+def _add_conform_command(commands) -> None:
+    """``refsim conform`` (refsim.conformance)."""
+    conform = commands.add_parser(
+        "conform", help="check an engine against refsim's ground truth",
+        description="Run an engine (MODULE:FACTORY, a callable returning it; see "
+                    "refsim.engines) through every check its capabilities call for, "
+                    "against answers that depend on no float engine. Writes "
+                    "DIR/conformance.json and a self-contained DIR/index.html, prints a "
+                    "table. --all runs the six shipped engines and writes their matrix. "
+                    "Exit status 0: every check passed (declared expected failures "
+                    "aside); 1: a check failed; 2: a usage error.")
+    conform.add_argument("engine", nargs="?", metavar="MODULE:FACTORY",
+                         help="the engine, e.g. refsim.engines.refsim_engines:corrected")
+    conform.add_argument("--all", action="store_true",
+                         help="the six shipped engines side by side (each with its own "
+                              "expected failures)")
+    conform.add_argument("-o", "--output", default="conformance", metavar="DIR",
+                         help="output directory (default: conformance)")
+    conform.add_argument("--cases", type=int, metavar="N",
+                         help="cases in each generated set: triangle pairs, mesh poses, "
+                              "boxes (default 200)")
+    conform.add_argument("--seed", type=int, default=0, metavar="S",
+                         help="seed of the cases and of the Hypothesis searches (default 0)")
+    conform.add_argument("--only", metavar="CAPABILITY",
+                         help="check one capability: triangles, pairs, collide, aabb, ode "
+                              "or rigid")
+    conform.add_argument("--expected-failures", metavar="FILE",
+                         help="declared divergences, one a line: "
+                              "'capability.check[class,...]  reason'")
+    conform.set_defaults(run=_conform)
+
+
 def _add_viewer_commands(commands) -> None:
     """``refsim view`` and ``refsim replay`` (refsim.viewer; the ``viewer`` extra)."""
     from refsim.viewer import REPLAY_MAX_BYTES as DEFAULT_MAX_BYTES
@@ -349,6 +439,7 @@ def build_parser() -> argparse.ArgumentParser:
     report.set_defaults(run=_report)
     _add_study_command(commands)
     _add_viewer_commands(commands)
+    _add_conform_command(commands)
     return parser
 
 

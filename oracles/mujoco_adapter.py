@@ -1,0 +1,322 @@
+"""MuJoCo as a second rigid-body oracle: the same scene, run by MuJoCo.
+
+MuJoCo (E. Todorov, T. Erez, Y. Tassa, "MuJoCo: A physics engine for
+model-based control", IROS 2012; E. Todorov, "Convex and analytically-invertible
+dynamics with contacts and constraints", ICRA 2014) solves contacts as soft
+constraints in one convex optimisation per step. Here it runs a refsim
+:class:`~refsim.scenes.schema.Scene`: the world cube's six walls as planes,
+each body as the convex hull of its mesh with its true mass properties on a
+free joint, gravity along -y, the scene's step. The result is a
+:class:`~refsim.dynamics.trajectory.Trajectory`, frame for frame comparable
+with ``refsim.simulate`` and the pybullet oracle.
+
+The adapter is an engine (:mod:`refsim.engines`) with the capability
+``rigid``: ``refsim.oracles.mujoco_adapter:engine``.
+
+Conventions converted here and nowhere else
+-------------------------------------------
+
+- Frames. Each body's MuJoCo frame is the mesh's own frame (refsim's
+  reference point and axes); its centre of mass and principal axes go into
+  ``<inertial pos quat>``. MuJoCo's free joint holds the frame's position and
+  its orientation as a quaternion ``(w, x, y, z)`` (scalar first, unlike
+  pybullet and scipy); its velocity ``qvel[0:3]`` is the frame origin's, in
+  world coordinates, and its angular velocity ``qvel[3:6]`` is in the
+  **body** frame: ``w_world = R w_body`` when reading, ``w_body = R^T
+  w_world`` when setting the initial state (measured here: a body spinning
+  about its tilted axis).
+- Meshes. ``<mesh vertex="...">`` without faces: MuJoCo collides a mesh as
+  the convex hull of its vertices (qhull), so the l-beam, the star and the
+  torus collide as their hulls, as in pybullet. The scene's ``scale`` is
+  the mesh's ``scale``.
+- Mass properties. Given explicitly (``<inertial>``, ``inertiafromgeom``
+  off): the uniform solid of the body's mass, from trimesh's integrals, as
+  the pybullet oracle computes them
+  (:func:`refsim.oracles.pybullet_adapter.mass_properties`).
+- Units and gravity: SI, ``gravity="0 -g 0"`` (y up, as refsim).
+
+Every setting, and why (:class:`MujocoSettings` holds them)
+------------------------------------------------------------
+
+- Walls: six ``plane`` geoms at ``+-half_size`` with ``zaxis`` pointing into
+  the cube (a MuJoCo plane is the infinite half-space below its z axis).
+- Contacts only between explicit ``<pair>`` elements (every geom has
+  ``contype = conaffinity = 0``): body-wall and body-body. A pair carries its
+  own ``solref``, ``solreffriction``, ``solimp``, ``friction`` and
+  ``margin``, which is what lets normal and friction rows differ (below).
+- Restitution. MuJoCo's default soft contact (``solref="0.02 1"``, a
+  critically damped spring) does not bounce. A bounce of restitution ``e``
+  needs the normal row's reference acceleration to reverse the approach
+  speed in one step: ``solref="0 -b"`` with ``b = (1 + e) / h`` (the
+  "direct" form ``-stiffness -damping``: stiffness 0, damping ``b``, so
+  ``a_ref = -b v`` and one step of it turns ``v`` into ``-e v``), rebuilt
+  for each scene's ``h``, with ``solimp="0.9999 0.9999 0.001 0.5 2"`` (the
+  impedance ``d ~ 1``: the reference acceleration is nearly all applied, a
+  near-hard constraint). Measured here (sphere, e = 0.8, Euler): apex
+  ratios within 0.64 % of e^2 at h = 1e-3 and 0.08 % at h = 1e-4.
+- Friction. With the same damper on the friction rows a sticking contact's
+  tangential speed is *reversed* (by ``e``); so the friction rows get their
+  own one-step damper ``solreffriction="0 -1/h"`` (tangential speed brought
+  to 0 in one step, within the friction cone) and ``cone="elliptic"``
+  (``solreffriction`` applies to elliptic cones only). ``friction`` is
+  ``mu mu 0 0 0``: sliding friction ``mu = scene.world.friction`` in both
+  tangent directions, no torsional or rolling friction, ``condim=3``. It is
+  still MuJoCo's law, not Coulomb's impact law: an oblique bounce leaves
+  with MuJoCo's own tangential speed (measured: 3.738 m/s where Coulomb
+  gives 3.795). The stiff friction reference is a trade-off, measured on a
+  cube spinning flat on the floor at 5 rad/s: through the elliptic cone it
+  lifts the cube (hops up to 6 cm) while stopping the spin (below 1 % by
+  0.69 s); a soft reference (``"0.02 1"``) keeps the cube down but barely
+  acts within a one-step impact (4.857 m/s). docs/decisions/conformance.md
+  has the table.
+- ``integrator="Euler"`` (semi-implicit Euler, as Bullet's); ``margin=0``
+  and ``gap=0`` on every pair (no contact before the shapes touch).
+- Drag: the scene's drag as a force at the centre of mass each step
+  (``xfrc_applied``, world frame), ``F = -k v`` or ``-k |v| v`` with the
+  centre of mass's velocity at the start of the step (first order, as in
+  the pybullet oracle).
+
+A missing MuJoCo raises :class:`refsim.oracles.OracleUnavailable`.
+
+Cost: building compiles the model (a convex hull per mesh, O(n log n)); a
+step is MuJoCo's collision (hull against plane or hull, per pair) plus its
+constraint solver (Newton, a few iterations over the active contacts).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+from refsim.oracles import import_engine
+
+#: Wall names in the order of refsim's events (x-, x+, y-, y+, z-, z+).
+WALL_NAMES = ("x-", "x+", "y-", "y+", "z-", "z+")
+
+
+@dataclass(frozen=True)
+class MujocoSettings:
+    """The MuJoCo settings the oracle uses (module docstring: why each)."""
+
+    integrator: str = "Euler"
+    cone: str = "elliptic"
+    solimp: tuple = (0.9999, 0.9999, 0.001, 0.5, 2.0)
+    margin: float = 0.0
+    #: Newton solver iterations and tolerance: MuJoCo's defaults (100, 1e-8)
+    #: kept explicit.
+    iterations: int = 100
+    tolerance: float = 1e-8
+
+
+def _floats(values) -> str:
+    return " ".join(repr(float(v)) for v in np.ravel(values))
+
+
+def _quat_wxyz(rotation) -> np.ndarray:
+    """The unit quaternion ``(w, x, y, z)`` of a rotation matrix."""
+    from scipy.spatial.transform import Rotation
+
+    x, y, z, w = Rotation.from_matrix(np.asarray(rotation, dtype=np.float64)).as_quat()
+    return np.array([w, x, y, z])
+
+
+def _matrix(quat_wxyz) -> np.ndarray:
+    from refsim.types import quaternion_to_rotation
+
+    q = np.asarray(quat_wxyz, dtype=np.float64)
+    return quaternion_to_rotation(q / np.sqrt(q @ q))
+
+
+class MujocoOracle:
+    """MuJoCo behind the engine contract's ``rigid`` capability (lazy import)."""
+
+    name = "mujoco"
+
+    def __init__(self, settings: MujocoSettings | None = None):
+        self.mujoco = import_engine("mujoco", "mujoco")
+        self.settings = settings or MujocoSettings()
+        self.model = None
+        self.data = None
+        self.properties: list = []
+        self._scene = None
+
+    # -- building -----------------------------------------------------------------
+
+    def mjcf(self, scene) -> str:
+        """The MJCF document of ``scene`` (module docstring: every setting)."""
+        from refsim.oracles.pybullet_adapter import mass_properties
+
+        s = self.settings
+        h = scene.integration.step
+        e = scene.world.restitution
+        mu = scene.world.friction
+        H = scene.world.half_size
+        solref = f"0 {-(1.0 + e) / h!r}"
+        solreffriction = f"0 {-1.0 / h!r}"
+        solimp = _floats(s.solimp)
+        friction = _floats([mu, mu, 0.0, 0.0, 0.0])
+        assets, bodies, pairs = [], [], []
+        self.properties = []
+        meshes = {}
+        for i, body in enumerate(scene.bodies):
+            mesh = scene.mesh(body)
+            key = (id(mesh), body.scale)
+            if key not in meshes:
+                meshes[key] = f"mesh{len(meshes)}"
+                assets.append(f'<mesh name="{meshes[key]}" vertex="{_floats(mesh.vertices)}" '
+                              f'scale="{_floats([body.scale] * 3)}"/>')
+            props = mass_properties(mesh.vertices, mesh.faces, body.mass, body.scale)
+            self.properties.append(props)
+            r = np.asarray(body.orientation, dtype=np.float64)
+            bodies.append(
+                f'<body name="b{i}" pos="{_floats(body.position)}" quat="{_floats(_quat_wxyz(r))}">'
+                f'<freejoint name="j{i}"/>'
+                f'<inertial pos="{_floats(props.center)}" quat="{_floats(_quat_wxyz(props.axes))}" '
+                f'mass="{float(body.mass)!r}" diaginertia="{_floats(props.inertia)}"/>'
+                f'<geom name="g{i}" type="mesh" mesh="{meshes[key]}" contype="0" '
+                f'conaffinity="0"/></body>')
+        walls = []
+        for k, wall in enumerate(WALL_NAMES):
+            axis, sign = k // 2, (-1.0 if wall.endswith("-") else 1.0)
+            pos = [0.0, 0.0, 0.0]
+            pos[axis] = sign * H
+            zaxis = [0.0, 0.0, 0.0]
+            zaxis[axis] = -sign                          # into the cube
+            walls.append(f'<geom name="w{k}" type="plane" size="{H!r} {H!r} 0.1" '
+                         f'pos="{_floats(pos)}" zaxis="{_floats(zaxis)}" contype="0" '
+                         f'conaffinity="0"/>')
+        common = (f'condim="3" friction="{friction}" solref="{solref}" '
+                  f'solreffriction="{solreffriction}" solimp="{solimp}" '
+                  f'margin="{s.margin!r}" gap="0"')
+        n = len(scene.bodies)
+        for i in range(n):
+            for k in range(len(WALL_NAMES)):
+                pairs.append(f'<pair geom1="g{i}" geom2="w{k}" {common}/>')
+            for j in range(i + 1, n):
+                pairs.append(f'<pair geom1="g{i}" geom2="g{j}" {common}/>')
+        g = scene.world.gravity
+        return (
+            '<mujoco model="refsim">'
+            '<compiler angle="radian" inertiafromgeom="false"/>'
+            f'<option timestep="{h!r}" gravity="0 {-g!r} 0" integrator={quoteattr(s.integrator)} '
+            f'cone={quoteattr(s.cone)} iterations="{s.iterations}" '
+            f'tolerance="{s.tolerance!r}"/>'
+            f'<asset>{"".join(assets)}</asset>'
+            f'<worldbody>{"".join(walls)}{"".join(bodies)}</worldbody>'
+            f'<contact>{"".join(pairs)}</contact>'
+            '</mujoco>')
+
+    def load(self, scene) -> None:
+        """Compile ``scene`` and set its initial state."""
+        mj = self.mujoco
+        self.model = mj.MjModel.from_xml_string(self.mjcf(scene))
+        self.data = mj.MjData(self.model)
+        for i, body in enumerate(scene.bodies):
+            r = np.asarray(body.orientation, dtype=np.float64)
+            w_world = np.asarray(body.angular_velocity, dtype=np.float64)
+            self.data.qvel[6 * i:6 * i + 3] = np.asarray(body.velocity, dtype=np.float64)
+            self.data.qvel[6 * i + 3:6 * i + 6] = r.T @ w_world
+        mj.mj_forward(self.model, self.data)
+        self._scene = scene
+
+    # -- stepping and reading ------------------------------------------------------
+
+    def _apply_drag(self) -> None:
+        world = self._scene.world
+        if world.drag == 0.0:
+            return
+        d = self.data
+        for i, props in enumerate(self.properties):
+            x, v, w, r = self._body_state(i)
+            v_com = v + np.cross(w, r @ props.center)
+            k = world.drag * (np.linalg.norm(v_com) if world.drag_model == "quadratic" else 1.0)
+            d.xfrc_applied[i + 1, :3] = -k * v_com           # body 0 is the world
+
+    def step(self) -> None:
+        """One MuJoCo step of the loaded scene (drag applied first)."""
+        self._apply_drag()
+        self.mujoco.mj_step(self.model, self.data)
+
+    def _body_state(self, i: int):
+        qpos, qvel = self.data.qpos, self.data.qvel
+        r = _matrix(qpos[7 * i + 3:7 * i + 7])
+        x = np.array(qpos[7 * i:7 * i + 3])
+        v = np.array(qvel[6 * i:6 * i + 3])
+        w = r @ np.array(qvel[6 * i + 3:6 * i + 6])
+        return x, v, w, r
+
+    def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(B, 3) positions and velocities of the mesh origins, (B, 3) angular
+        velocities (world frame), (B, 3, 3) orientations (columns: body axes)."""
+        parts = [self._body_state(i) for i in range(len(self._scene.bodies))]
+        return tuple(np.array([p[k] for p in parts]) for k in range(4))
+
+    def _wall_contacts(self) -> set[tuple[int, int]]:
+        d = self.data
+        touching = set()
+        n = len(self._scene.bodies)
+        for c in range(d.ncon):
+            contact = d.contact[c]
+            if contact.dist > 0.0:
+                continue
+            a, b = sorted((int(contact.geom1), int(contact.geom2)))
+            # geoms: the six walls first (ids 0..5), then one per body
+            if a < len(WALL_NAMES) <= b < len(WALL_NAMES) + n:
+                touching.add((b - len(WALL_NAMES), a))
+        return touching
+
+    def simulate(self, scene, *, every: int = 1):
+        """Run ``scene`` for its duration; a frame every ``every`` steps (and
+        the first and the last). Returns a
+        :class:`~refsim.dynamics.trajectory.Trajectory` whose events are the
+        wall contacts that began in a step; ``stage_seconds`` splits the
+        wall time into "step" (``mj_step`` and the drag forces) and "record"."""
+        from refsim.dynamics.trajectory import Event, Trajectory
+
+        self.load(scene)
+        h = scene.integration.step
+        n = scene.integration.n_steps
+        names = tuple(b.name for b in scene.bodies)
+        frames = [self.state()]
+        times = [0.0]
+        events = []
+        touching: set[tuple[int, int]] = set()
+        stepping = 0.0
+        start = time.perf_counter()
+        for k in range(1, n + 1):
+            before = time.perf_counter()
+            self.step()
+            stepping += time.perf_counter() - before
+            now = self._wall_contacts()
+            for i, j in sorted(now - touching):
+                events.append(Event("wall", k, k * h, names[i], WALL_NAMES[j]))
+            touching = now
+            if k % every == 0 or k == n:
+                frames.append(self.state())
+                times.append(k * h)
+        elapsed = time.perf_counter() - start
+        x, v, w, r = (np.stack([f[i] for f in frames]) for i in range(4))
+        return Trajectory(t=np.asarray(times), position=x, velocity=v, angular_velocity=w,
+                          orientation=r, names=names, events=events, stages=("step", "record"),
+                          stage_seconds={"step": stepping, "record": elapsed - stepping},
+                          settings={"engine": "mujoco", "version": self.mujoco.__version__,
+                                    **asdict(self.settings)})
+
+    def step_time(self, scene, steps: int, warmup: int = 0) -> float:
+        """Seconds per step of ``scene`` (mean over ``steps`` steps after
+        loading and ``warmup`` untimed steps; reading no state)."""
+        self.load(scene)
+        for _ in range(warmup):
+            self.step()
+        start = time.perf_counter()
+        for _ in range(steps):
+            self.step()
+        return (time.perf_counter() - start) / steps
+
+
+def engine(**settings) -> MujocoOracle:
+    """The engine factory (``refsim.oracles.mujoco_adapter:engine``); keyword
+    arguments set fields of :class:`MujocoSettings`."""
+    return MujocoOracle(MujocoSettings(**settings))

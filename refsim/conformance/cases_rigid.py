@@ -1,0 +1,265 @@
+"""Rigid-body scenes with analytic answers (seeds S5, S7, S9; capability ``rigid``).
+
+What: a fixed set of one-body scenes in the world cube (half size 5 m,
+g = 9.81, step 1e-3 s, RK4 where the engine uses the scene's solver, no
+drag), each with the answer :mod:`refsim.dynamics.analytic` gives for it:
+
+=====================  =====================================================
+scene                  what happens, and the answer
+=====================  =====================================================
+drop-sphere-e0.5/0.8   the sphere-2k model dropped from rest, its lowest
+drop-cube-e0.5/0.8     point 2 m above the floor (the cube face down, the
+drop-icosahedron-e0.8  icosahedron on an edge): apex heights e^(2k) h0,
+                       apex ratio e^2; each lands on a vertex, face or edge
+                       straight below its centre of mass, so no impulse has
+                       a moment about it and the body does not turn
+oblique-sphere         the sphere 5 cm above the floor moving at (5, -2, 0)
+                       m/s, Coulomb friction mu = 0.3, e = 0.8: a uniform
+                       ball sliding throughout the impact leaves with
+                       ``v_t - mu (1 + e) |v_n|`` (it slides throughout:
+                       ``mu (1 + e) |v_n| <= 2/7 v_t``)
+spin-cube              the cube resting face down, spinning at 5 rad/s about
+                       the vertical, mu = 0.5: friction brings it to rest
+rest-cube              the cube resting face down, mu = 0.5: it stays on
+                       the floor
+=====================  =====================================================
+
+Two choices keep the answers exact for every reasonable engine:
+
+- the drop height is 2 m, so that the first impact (6.3 m/s) moves the
+  sphere-2k model at most 6.3 mm in a step of 1e-3 s, less than the 7.4 mm
+  between its lowest vertex and the next ring of vertices: the first contact
+  is one vertex straight below the centre (no torque); from 4 m a step can
+  carry the ring into the floor too, and a contact solver that treats the
+  ring's vertices one after another spins the sphere;
+- the cube and the sphere have their centre of mass at their mesh origin, so
+  the reference point's velocity is the centre of mass's in every engine's
+  convention.
+
+Reading a trajectory (:func:`lowest_height`, :func:`energy`): the height of
+the body's lowest vertex above the floor in every frame (from the frame's
+orientation, so a turning body is read correctly); apexes as
+:func:`refsim.studies.bounce.read_bounces` reads them (bounce where the
+vertical velocity turns upward, apex refined by the parabola through its
+frame and the neighbours); the energy from the centre of mass's height and
+velocity and ``w . I w / 2`` with the uniform solid's inertia.
+
+A run of each scene is kept per engine (:meth:`RigidCases.run`), so the
+checks share it; ``rerun`` runs a scene again for the determinism check.
+
+Cost: about 15,300 steps per engine in all (the drops are 1.8 to 3.0 s of
+simulated time), and 1,700 more for the determinism check's reruns.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from refsim.dynamics import analytic
+
+HALF_SIZE = 5.0
+GRAVITY = 9.81
+STEP = 1e-3
+SOLVER = "rk4"
+SPHERE = "sphere-2k.ac"
+CUBE = "cube.ac"
+ICOSAHEDRON = "icosahedron.ac"
+#: Drop height of the lowest point above the floor, metres (module docstring).
+DROP_HEIGHT = 2.0
+#: Bounces whose apex ratio is read (geometric mean over them).
+BOUNCES = 3
+RESTITUTIONS = (0.5, 0.8)
+#: The oblique bounce (refsim.studies.bounce's first case, from 5 cm).
+OBLIQUE_VELOCITY = (5.0, -2.0, 0.0)
+OBLIQUE_HEIGHT = 0.05
+OBLIQUE_FRICTION = 0.3
+OBLIQUE_E = 0.8
+#: The spinning cube: angular speed about the vertical (rad/s), friction.
+SPIN = 5.0
+SPIN_FRICTION = 0.5
+SPIN_E = 0.5
+SPIN_DURATION = 1.5
+REST_DURATION = 1.0
+
+
+@dataclass(frozen=True)
+class RigidScene:
+    """One scene of the set: its name, kind ("drop", "oblique", "spin",
+    "rest"), the scene, and the parameters its answer needs."""
+
+    name: str
+    kind: str
+    scene: object
+    e: float
+    friction: float = 0.0
+    height: float = 0.0
+
+    def to_dict(self) -> dict:
+        body = self.scene.bodies[0]
+        return {"scene": self.name, "kind": self.kind, "model": body.model.name,
+                "restitution": self.e, "friction": self.friction,
+                "position": list(body.position), "velocity": list(body.velocity),
+                "angular_velocity": list(body.angular_velocity),
+                "step": self.scene.integration.step,
+                "duration": self.scene.integration.duration}
+
+
+def _touch_y(model: str) -> float:
+    """``y`` of the mesh origin when its lowest vertex is on the floor."""
+    from refsim.conformance.cases_meshes import bundled_mesh
+
+    return -HALF_SIZE - float(bundled_mesh(model).vertices[:, 1].min())
+
+
+def _scene(model: str, e: float, friction: float, height: float, duration: float,
+           velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0)):
+    from refsim.scenes.loader import scene_from_dict
+    from refsim.solvers.integrate import covering_duration
+
+    return scene_from_dict({
+        "world": {"half_size": HALF_SIZE, "gravity": GRAVITY, "drag": 0.0,
+                  "restitution": e, "friction": friction},
+        "integration": {"solver": SOLVER, "step": STEP,
+                        "duration": covering_duration(duration, STEP)},
+        "collision": {"level": "aabb"},
+        "body": [{"name": "body", "model": model,
+                  "position": [0.0, _touch_y(model) + height, 0.0],
+                  "velocity": [float(c) for c in velocity],
+                  "angular_velocity": [float(c) for c in angular_velocity]}],
+    })
+
+
+def oblique_impact_speed() -> float:
+    """Normal speed at the oblique scene's impact (it falls 5 cm first)."""
+    v_n = -OBLIQUE_VELOCITY[1]
+    return math.sqrt(v_n * v_n + 2.0 * GRAVITY * OBLIQUE_HEIGHT)
+
+
+def rigid_scenes() -> tuple[RigidScene, ...]:
+    """The scenes of the module docstring, in order."""
+    scenes = []
+    drops = [(SPHERE, "sphere", e) for e in RESTITUTIONS]
+    drops += [(CUBE, "cube", e) for e in RESTITUTIONS] + [(ICOSAHEDRON, "icosahedron", 0.8)]
+    for model, label, e in drops:
+        duration = (analytic.apex_times(DROP_HEIGHT, GRAVITY, e, BOUNCES)[-1]
+                    + 0.5 * analytic.fall_time(DROP_HEIGHT * e ** (2 * BOUNCES), GRAVITY)
+                    + 0.05)
+        scenes.append(RigidScene(f"drop-{label}-e{e}", "drop",
+                                 _scene(model, e, 0.0, DROP_HEIGHT, duration), e,
+                                 height=DROP_HEIGHT))
+    v_imp = oblique_impact_speed()
+    v_n = -OBLIQUE_VELOCITY[1]
+    # to the middle of the flight after the first bounce
+    duration = (v_imp - v_n) / GRAVITY + OBLIQUE_E * v_imp / GRAVITY
+    scenes.append(RigidScene("oblique-sphere", "oblique",
+                             _scene(SPHERE, OBLIQUE_E, OBLIQUE_FRICTION, OBLIQUE_HEIGHT,
+                                    duration, velocity=OBLIQUE_VELOCITY),
+                             OBLIQUE_E, OBLIQUE_FRICTION, OBLIQUE_HEIGHT))
+    scenes.append(RigidScene("spin-cube", "spin",
+                             _scene(CUBE, SPIN_E, SPIN_FRICTION, 0.0, SPIN_DURATION,
+                                    angular_velocity=(0.0, SPIN, 0.0)),
+                             SPIN_E, SPIN_FRICTION))
+    scenes.append(RigidScene("rest-cube", "rest",
+                             _scene(CUBE, SPIN_E, SPIN_FRICTION, 0.0, REST_DURATION),
+                             SPIN_E, SPIN_FRICTION))
+    return tuple(scenes)
+
+
+@dataclass(frozen=True)
+class RigidCases:
+    """The scene set and, per engine, one run of each scene (kept so that the
+    checks share it; keyed by the engine object's identity, the engine kept
+    alive alongside so the identity is not reused)."""
+
+    scenes: tuple
+    seed: int = 0
+    _runs: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def __len__(self) -> int:
+        return len(self.scenes)
+
+    def of_kind(self, *kinds: str) -> list[RigidScene]:
+        return [s for s in self.scenes if s.kind in kinds]
+
+    def run(self, engine, scene: RigidScene):
+        """``engine.simulate(scene.scene)``, once per engine and scene."""
+        key = (id(engine), scene.name)
+        if key not in self._runs:
+            self._runs[key] = (engine, engine.simulate(scene.scene))
+        return self._runs[key][1]
+
+    def rerun(self, engine, scene: RigidScene):
+        """A fresh run (not kept)."""
+        return engine.simulate(scene.scene)
+
+
+def rigid_cases(seed: int = 0) -> RigidCases:
+    return RigidCases(scenes=rigid_scenes(), seed=seed)
+
+
+# -- reading a trajectory ----------------------------------------------------------------
+
+
+@functools.cache
+def _body(model: str):
+    """(vertices, centre of mass, body-frame inertia) of a bundled model of mass 1."""
+    from refsim.conformance.cases_meshes import bundled_mesh
+    from refsim.dynamics.mass_properties import body_mass_properties
+
+    mesh = bundled_mesh(model)
+    props = body_mass_properties(mesh, 1.0)
+    return np.array(mesh.vertices), np.array(props.center), np.array(props.inertia)
+
+
+def _model(scene: RigidScene) -> str:
+    return scene.scene.bodies[0].model.name
+
+
+def lowest_height(scene: RigidScene, trajectory) -> np.ndarray:
+    """(F,) height of the body's lowest vertex above the floor, per frame."""
+    vertices, _, _ = _body(_model(scene))
+    R = np.asarray(trajectory.orientation)[:, 0]
+    y = (R[:, 1, 0:1] * vertices[:, 0] + R[:, 1, 1:2] * vertices[:, 1]
+         + R[:, 1, 2:3] * vertices[:, 2])
+    return np.asarray(trajectory.position)[:, 0, 1] + y.min(axis=1) + HALF_SIZE
+
+
+def energy(scene: RigidScene, trajectory) -> np.ndarray:
+    """(F,) mechanical energy: ``m g y_c + m |v_c|^2 / 2 + w . I_world w / 2``,
+    with ``y_c`` the centre of mass's height above the floor and ``I_world =
+    R I R^T`` (joules, for the scene's mass)."""
+    _, center, inertia = _body(_model(scene))
+    mass = scene.scene.bodies[0].mass
+    R = np.asarray(trajectory.orientation)[:, 0]
+    x = np.asarray(trajectory.position)[:, 0]
+    v = np.asarray(trajectory.velocity)[:, 0]
+    w = np.asarray(trajectory.angular_velocity)[:, 0]
+    rc = np.einsum("fij,j->fi", R, center)
+    y_c = x[:, 1] + rc[:, 1] + HALF_SIZE
+    v_c = v + np.cross(w, rc)
+    body_w = np.einsum("fji,fj->fi", R, w)                       # R^T w
+    rotational = 0.5 * np.einsum("fi,ij,fj->f", body_w, inertia * mass, body_w)
+    return mass * GRAVITY * y_c + 0.5 * mass * np.einsum("fi,fi->f", v_c, v_c) + rotational
+
+
+def apex_ratio(scene: RigidScene, trajectory) -> tuple[float, list[float]]:
+    """Geometric-mean apex ratio over :data:`BOUNCES` bounces and the apex
+    heights read (release first); nan when fewer bounces are found."""
+    from refsim.studies.bounce import apex_ratio as mean_ratio
+    from refsim.studies.bounce import read_bounces
+
+    heights = lowest_height(scene, trajectory)
+    bounces = read_bounces(trajectory.t, heights,
+                           np.asarray(trajectory.velocity)[:, 0, 1], 0.0)
+    return mean_ratio(bounces.apex_heights, BOUNCES), [float(h) for h in
+                                                      bounces.apex_heights[:BOUNCES + 1]]
+
+
+def with_body(scene: RigidScene, **changes) -> RigidScene:
+    """``scene`` with fields of its body changed (for tests)."""
+    s = scene.scene
+    return replace(scene, scene=replace(s, bodies=(replace(s.bodies[0], **changes),)))

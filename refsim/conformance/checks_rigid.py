@@ -1,0 +1,304 @@
+"""Checks of the ``rigid`` capability against analytic answers.
+
+Every tolerance below follows from one fact about time-stepped contact: an
+engine finds a contact only at a step, so a bounce can happen up to a step
+late and be resolved over a step or two. With :data:`CONTACT_STEPS` = 2
+steps of size ``h`` at impact speed ``v`` the bounce point can move by up to
+``2 v h``, and a friction impulse spread over those steps can include
+gravity's ``m g h`` per step. refsim's corrected model meets the answers to
+rounding; first-order engines (Bullet, MuJoCo: semi-implicit Euler) must
+meet them within these bounds.
+
+- ``rigid.apex_ratio`` (drops of the sphere and the cube, e = 0.5 and 0.8,
+  and of the icosahedron, e = 0.8):
+  the apex ratio over K = 3 bounces is ``e^2`` within
+  ``CONTACT_STEPS h sqrt(2 g / h_K) / K`` relative, ``h_K = e^(2K) h0`` the
+  last apex (an error of ``2 v_K h`` in that apex's height, shared by the
+  K ratios of the geometric mean): 1.7 % at e = 0.5, 0.41 % at e = 0.8.
+- ``rigid.no_spin`` (the same drops, frictionless, each landing on a
+  vertex, face or edge straight below the centre of mass): no contact
+  impulse has a moment about the centre, so the body must not turn; its
+  largest angular speed times its reach stays below
+  :data:`NO_SPIN_FRACTION` of the impact speed.
+- ``rigid.oblique_bounce`` (the sphere sliding through an impact): the
+  lateral velocity after it is Coulomb's ``v_t - mu (1 + e) |v_n|``
+  (:func:`refsim.dynamics.analytic.lateral_velocity_coulomb`) within
+  ``mu CONTACT_STEPS g h`` (6e-3 m/s). One that matches the seed's law
+  ``(1 - friction) v_t`` instead (S5, S7) is "known-divergence".
+- ``rigid.spin_to_rest`` (the cube spinning flat on the floor): by
+  :func:`spin_rest_time` its angular speed is below
+  :data:`SPIN_REST_FRACTION` of the initial one. Coulomb friction at the
+  face brings it to rest in ``w0 I / (mu m g r)``, ``r`` the mean lever arm
+  of the contact pressure: the face's corners, ``r = s / sqrt(2)``, for
+  contact at the vertices; a uniform pressure over the face, ``r = 0.3826
+  s``, is the slowest plausible distribution; the limit is twice that
+  (0.89 s here).
+- ``rigid.energy`` (every scene): the mechanical energy never exceeds its
+  initial value by more than ``CONTACT_STEPS m g v_max h`` (a contact
+  resolved a step late may leave the body ``2 v h`` higher), ``v_max`` the
+  scene's largest speed.
+- ``rigid.resting_contact`` (the resting cube; the spinning cube after it
+  should have stopped): the lowest vertex is never deeper than
+  :data:`REST_PENETRATION_STEPS` ``g h^2`` below the floor (gravity moves a
+  resting body ``g h^2`` into the floor per step before a contact acts; a
+  soft-contact engine holds a steady penetration of that order).
+- ``rigid.determinism`` (the oblique and the spinning scene): a second run
+  of the same scene in the same engine gives the same trajectory, bit for bit.
+
+A failure within twice its tolerance is "tolerance"; beyond, "bug" (unless
+recognised as above).
+
+References: the analytic answers of :mod:`refsim.dynamics.analytic`
+(Mirtich 1996, ch. 3; Stronge, *Impact Mechanics*, 2000); the spin-down of
+a flat face under Coulomb friction, e.g. K. L. Johnson, *Contact
+Mechanics*, Cambridge 1985, section 7.4 (torsion of a contact), with the
+mean distance of a square's points from its centre, ``s (sqrt 2 + ln(1 +
+sqrt 2)) / 6``.
+
+Cost: the runs of :mod:`refsim.conformance.cases_rigid` (shared between the
+checks) plus two reruns for ``rigid.determinism``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from refsim.conformance import cases_rigid as R
+from refsim.conformance.results import CheckResult, classify_miss, tally
+from refsim.dynamics import analytic
+
+#: Steps over which an engine may find and resolve one contact (module docstring).
+CONTACT_STEPS = 2
+
+#: The spinning cube counts as at rest below this fraction of its initial
+#: angular speed (0.05 rad/s of 5): a hundredth of the motion is left, far
+#: below what a reader of the trajectory would call spinning.
+SPIN_REST_FRACTION = 0.01
+
+#: The mean distance of a square's points from its centre, per unit side.
+SQUARE_MEAN_RADIUS = (math.sqrt(2.0) + math.log(1.0 + math.sqrt(2.0))) / 6.0
+
+#: The spin-down time limit is this many times the slowest plausible one.
+SPIN_TIME_FACTOR = 2.0
+
+#: A frictionless symmetric landing may leave the body turning only this
+#: fast: its surface speed (|w| times its reach) a thousandth of the impact
+#: speed, far above rounding (1e-12 and below in refsim and MuJoCo), far
+#: below a spin that changes a bounce visibly.
+NO_SPIN_FRACTION = 1e-3
+
+#: Resting penetration allowed, in units of ``g h^2`` (one step's fall from rest).
+REST_PENETRATION_STEPS = 10
+
+
+def apex_tolerance(scene) -> float:
+    """Relative apex-ratio tolerance of a drop (module docstring)."""
+    h_K = scene.height * scene.e ** (2 * R.BOUNCES)
+    h = scene.scene.integration.step
+    return CONTACT_STEPS * h * math.sqrt(2.0 * R.GRAVITY / h_K) / R.BOUNCES
+
+
+def check_rigid_apex_ratio(engine, cases) -> CheckResult:
+    """``rigid.apex_ratio``: apex ratio e^2 in every drop (module docstring)."""
+    start = time.perf_counter()
+    outcomes, examples, measured = [], [], {}
+    for scene in cases.of_kind("drop"):
+        ratio, heights = R.apex_ratio(scene, cases.run(engine, scene))
+        ideal = analytic.apex_ratio(scene.e)
+        error = (ratio - ideal) / ideal if math.isfinite(ratio) else math.nan
+        tol = apex_tolerance(scene)
+        measured[scene.name] = {"ratio": ratio, "relative_error": error, "tolerance": tol}
+        outcome = classify_miss(abs(error), tol) if math.isfinite(error) else "bug"
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, "apex_ratio": ratio, "ideal": ideal,
+                             "relative_error": error, "tolerance": tol,
+                             "apex_heights": heights,
+                             "analytic_heights": analytic.apex_heights(
+                                 scene.height, scene.e, R.BOUNCES).tolist(),
+                             **scene.to_dict()})
+    return tally("rigid", "apex_ratio", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
+def check_rigid_no_spin(engine, cases) -> CheckResult:
+    """``rigid.no_spin``: a frictionless drop landing straight below the
+    centre of mass does not start the body turning (module docstring)."""
+    start = time.perf_counter()
+    outcomes, examples, measured = [], [], {}
+    for scene in cases.of_kind("drop"):
+        trajectory = cases.run(engine, scene)
+        vertices, _, _ = R._body(R._model(scene))
+        reach = float(np.sqrt((vertices ** 2).sum(axis=1)).max())
+        spin = float(np.sqrt((np.asarray(trajectory.angular_velocity)[:, 0] ** 2)
+                             .sum(axis=1)).max())
+        impact = analytic.impact_speed(scene.height, R.GRAVITY)
+        fraction = spin * reach / impact
+        measured[scene.name] = {"largest_spin": spin, "surface_speed_fraction": fraction}
+        outcome = classify_miss(fraction, NO_SPIN_FRACTION) if math.isfinite(fraction) else "bug"
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, "largest_spin": spin,
+                             "surface_speed_over_impact_speed": fraction,
+                             "limit": NO_SPIN_FRACTION, **scene.to_dict()})
+    return tally("rigid", "no_spin", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
+def check_rigid_oblique_bounce(engine, cases) -> CheckResult:
+    """``rigid.oblique_bounce``: Coulomb's lateral velocity after a sliding
+    impact (module docstring)."""
+    start = time.perf_counter()
+    outcomes, examples, measured = [], [], {}
+    v_n = R.oblique_impact_speed()
+    for scene in cases.of_kind("oblique"):
+        trajectory = cases.run(engine, scene)
+        v_t = R.OBLIQUE_VELOCITY[0]
+        got = float(np.asarray(trajectory.velocity)[-1, 0, 0])
+        coulomb = analytic.lateral_velocity_coulomb(v_t, v_n, scene.friction, scene.e)
+        seed_law = analytic.lateral_velocity_seed(v_t, scene.friction)
+        tol = scene.friction * CONTACT_STEPS * R.GRAVITY * scene.scene.integration.step
+        outcome = classify_miss(abs(got - coulomb), tol)
+        if outcome is not None and abs(got - seed_law) <= tol:
+            outcome = "known-divergence"
+        measured[scene.name] = {"lateral_velocity": got, "coulomb": coulomb,
+                                "seed_law": seed_law, "tolerance": tol}
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, "lateral_velocity": got, "coulomb": coulomb,
+                             "seed_law": seed_law, "impact_normal_speed": v_n,
+                             "tolerance": tol, **scene.to_dict()})
+    return tally("rigid", "oblique_bounce", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
+def spin_rest_time(scene) -> float:
+    """The time by which the spinning cube must be at rest (module docstring):
+    ``SPIN_TIME_FACTOR w0 I_yy / (mu m g r)`` with ``r`` the uniform face
+    pressure's mean lever arm."""
+    vertices, _, inertia = R._body(R._model(scene))
+    side = float(vertices[:, 0].max() - vertices[:, 0].min())
+    body = scene.scene.bodies[0]
+    w0 = float(np.abs(body.angular_velocity).max())
+    # torque mu m g r over inertia I_yy m: the mass cancels
+    deceleration = scene.friction * R.GRAVITY * SQUARE_MEAN_RADIUS * side / inertia[1, 1]
+    return float(SPIN_TIME_FACTOR * w0 / deceleration)
+
+
+def check_rigid_spin_to_rest(engine, cases) -> CheckResult:
+    """``rigid.spin_to_rest``: the spinning cube is at rest by
+    :func:`spin_rest_time` (module docstring)."""
+    start = time.perf_counter()
+    outcomes, examples, measured = [], [], {}
+    for scene in cases.of_kind("spin"):
+        trajectory = cases.run(engine, scene)
+        t = np.asarray(trajectory.t)
+        speed = np.sqrt((np.asarray(trajectory.angular_velocity)[:, 0] ** 2).sum(axis=1))
+        w0 = float(np.abs(scene.scene.bodies[0].angular_velocity).max())
+        limit = spin_rest_time(scene)
+        late = speed[t >= limit]
+        left = float(late.max()) / w0 if len(late) else math.inf
+        below = np.flatnonzero(speed < SPIN_REST_FRACTION * w0)
+        measured[scene.name] = {"rest_time_limit": limit,
+                                "first_time_below": float(t[below[0]]) if len(below) else None,
+                                "largest_spin_after_limit": left * w0}
+        outcome = classify_miss(left, SPIN_REST_FRACTION)
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, "rest_time_limit": limit,
+                             "spin_after_limit": left * w0, "initial_spin": w0,
+                             "final_angular_velocity":
+                                 np.asarray(trajectory.angular_velocity)[-1, 0].tolist(),
+                             **scene.to_dict()})
+    return tally("rigid", "spin_to_rest", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
+def _max_speed(scene) -> float:
+    body = scene.scene.bodies[0]
+    vertices, _, _ = R._body(R._model(scene))
+    reach = float(np.sqrt((vertices ** 2).sum(axis=1)).max())
+    fall = math.sqrt(float(np.dot(body.velocity, body.velocity))
+                     + 2.0 * R.GRAVITY * max(scene.height, 0.0))
+    spin = float(np.sqrt(np.dot(body.angular_velocity, body.angular_velocity))) * reach
+    return max(fall + spin, R.GRAVITY * scene.scene.integration.step)
+
+
+def energy_tolerance(scene) -> float:
+    """Joules the energy may rise by in ``scene`` (module docstring)."""
+    mass = scene.scene.bodies[0].mass
+    return CONTACT_STEPS * mass * R.GRAVITY * _max_speed(scene) * scene.scene.integration.step
+
+
+def check_rigid_energy(engine, cases) -> CheckResult:
+    """``rigid.energy``: with restitution <= 1 and no driving force the
+    mechanical energy never rises beyond :func:`energy_tolerance`."""
+    start = time.perf_counter()
+    outcomes, examples, measured = [], [], {}
+    for scene in cases.scenes:
+        trajectory = cases.run(engine, scene)
+        energy = R.energy(scene, trajectory)
+        rise = float((energy - energy[0]).max())
+        tol = energy_tolerance(scene)
+        measured[scene.name] = {"largest_rise": rise, "tolerance": tol,
+                                "initial": float(energy[0])}
+        outcome = classify_miss(rise, tol) if math.isfinite(rise) else "bug"
+        outcomes.append(outcome)
+        if outcome is not None:
+            k = int(np.nanargmax(energy))
+            examples.append({"class": outcome, "largest_rise": rise, "tolerance": tol,
+                             "at_time": float(np.asarray(trajectory.t)[k]),
+                             "initial_energy": float(energy[0]), **scene.to_dict()})
+    return tally("rigid", "energy", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
+def check_rigid_resting_contact(engine, cases) -> CheckResult:
+    """``rigid.resting_contact``: a body resting on the floor stays above it
+    within ``REST_PENETRATION_STEPS g h^2`` (the spinning cube from its
+    rest-time limit on)."""
+    start = time.perf_counter()
+    outcomes, examples, measured = [], [], {}
+    for scene in cases.of_kind("rest", "spin"):
+        trajectory = cases.run(engine, scene)
+        t = np.asarray(trajectory.t)
+        heights = R.lowest_height(scene, trajectory)
+        since = spin_rest_time(scene) if scene.kind == "spin" else 0.0
+        depth = float(max(0.0, -heights[t >= since].min()))
+        h = scene.scene.integration.step
+        tol = REST_PENETRATION_STEPS * R.GRAVITY * h * h
+        measured[scene.name] = {"deepest": depth, "tolerance": tol, "from_time": since}
+        outcome = classify_miss(depth, tol)
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, "deepest_penetration": depth, "tolerance": tol,
+                             "from_time": since, **scene.to_dict()})
+    return tally("rigid", "resting_contact", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
+def _same(a, b) -> bool:
+    names = ("t", "position", "velocity", "angular_velocity", "orientation")
+    return all(np.array_equal(np.asarray(getattr(a, n)), np.asarray(getattr(b, n)),
+                              equal_nan=True) for n in names)
+
+
+def check_rigid_determinism(engine, cases) -> CheckResult:
+    """``rigid.determinism``: a second run gives the same frames, bit for bit."""
+    start = time.perf_counter()
+    outcomes, examples = [], []
+    for scene in cases.of_kind("oblique", "spin"):
+        first = cases.run(engine, scene)
+        second = cases.rerun(engine, scene)
+        same = _same(first, second)
+        outcomes.append(None if same else "bug")
+        if not same:
+            a, b = np.asarray(first.position), np.asarray(second.position)
+            diff = float(np.nanmax(np.abs(a - b))) if a.shape == b.shape else math.inf
+            examples.append({"class": "bug", "largest_position_difference": diff,
+                             **scene.to_dict()})
+    return tally("rigid", "determinism", outcomes, examples=examples,
+                 seconds=time.perf_counter() - start)

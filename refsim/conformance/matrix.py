@@ -1,0 +1,236 @@
+"""Engines side by side: the data of one table (engines as columns, checks as
+rows) and the divergences as records the report can list.
+
+:func:`conformance_matrix` arranges results that exist; :func:`run_matrix`
+produces them: it builds each case set once (the exact answers are shared by
+every engine), runs each engine through its checks with its declared
+expected failures, and writes each engine's pages (``DIR/<engine>/
+conformance.json`` and ``index.html``), the matrix (``DIR/matrix.json``) and
+its page (``DIR/index.html``). ``refsim conform --all -o DIR`` calls it for
+the six shipped engines (:data:`refsim.conformance.shipped.SHIPPED_ENGINES`).
+
+A :class:`Divergence` is one engine's failing or expected-failing check:
+its classes, its declared reason (or none, for a failure nobody declared)
+and its first example. The report lists them; it computes nothing.
+
+Cost: the sum of the engines' runs, with each case set built once.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One check of one engine: status and counts."""
+
+    status: str
+    cases: int
+    passed: int
+    failed: int
+    classes: dict
+
+
+@dataclass(frozen=True)
+class Divergence:
+    """A failing (``failed``) or declared (``xfailed``) check of one engine."""
+
+    engine: str
+    check: str
+    status: str
+    classes: dict
+    reason: str
+    example: dict | None
+
+
+@dataclass(frozen=True)
+class Matrix:
+    """The table: ``engines`` (columns), ``checks`` (rows, in the registry's
+    order), ``cells[(check, engine)]``, each engine's page (relative path),
+    the divergences, and the engines that could not be loaded (name ->
+    reason)."""
+
+    engines: tuple
+    checks: tuple
+    cells: dict
+    pages: dict
+    divergences: tuple
+    refsim: str
+    seed: int
+    cases: int
+    unavailable: dict = field(default_factory=dict)
+    seconds: dict = field(default_factory=dict)
+
+    def cell(self, check: str, engine: str) -> Cell | None:
+        return self.cells.get((check, engine))
+
+    @property
+    def ok(self) -> bool:
+        """No check of any engine failed (expected failures aside)."""
+        return not any(c.status == "failed" for c in self.cells.values())
+
+    def to_dict(self) -> dict:
+        return {"refsim": self.refsim, "seed": self.seed, "cases": self.cases,
+                "engines": list(self.engines), "checks": list(self.checks),
+                "cells": {check: {engine: asdict(self.cells[(check, engine)])
+                                  for engine in self.engines if (check, engine) in self.cells}
+                          for check in self.checks},
+                "pages": dict(self.pages), "unavailable": dict(self.unavailable),
+                "divergences": [asdict(d) for d in self.divergences],
+                "seconds": dict(self.seconds)}
+
+    def to_json(self) -> str:
+        from refsim.conformance.results import _jsonable
+
+        return json.dumps(self.to_dict(), indent=1, default=_jsonable) + "\n"
+
+    def table(self) -> str:
+        """Plain text: a row per check, a column per engine, each cell
+        ``status passed/cases`` (blank where the engine lacks the capability)."""
+        rows = [("check", *self.engines)]
+        for check in self.checks:
+            row = [check]
+            for engine in self.engines:
+                c = self.cell(check, engine)
+                row.append("" if c is None else ("n/a" if c.status == "n/a"
+                                                 else f"{c.status} {c.passed}/{c.cases}"))
+            rows.append(tuple(row))
+        widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+        lines = ["  ".join(cell.ljust(w) for cell, w in zip(r, widths, strict=True)).rstrip()
+                 for r in rows]
+        lines.insert(1, "  ".join("-" * w for w in widths))
+        return "\n".join(lines)
+
+
+def conformance_matrix(results, pages: dict | None = None, unavailable: dict | None = None,
+                       seconds: dict | None = None) -> Matrix:
+    """The matrix of ``results`` (ConformanceResults, or a dict name ->
+    result), with each engine's page path from ``pages``."""
+    from refsim.conformance.registry import CHECK_KEYS
+
+    results = list(results.values()) if isinstance(results, dict) else list(results)
+    if not results:
+        raise ValueError("a matrix needs at least one engine's results")
+    cells, divergences = {}, []
+    for result in results:
+        for c in result.checks:
+            cells[(c.key, result.engine)] = Cell(c.status, c.cases, c.passed, c.failed,
+                                                 dict(c.classes))
+            if c.status in ("failed", "xfailed"):
+                divergences.append(Divergence(
+                    engine=result.engine, check=c.key, status=c.status, classes=dict(c.classes),
+                    reason=c.reason or "not declared",
+                    example=c.examples[0] if c.examples else None))
+    present = {key for key, _ in cells}
+    first = results[0]
+    return Matrix(engines=tuple(r.engine for r in results),
+                  checks=tuple(k for k in CHECK_KEYS if k in present), cells=cells,
+                  pages=dict(pages or {}), divergences=tuple(divergences),
+                  refsim=first.refsim, seed=first.seed, cases=first.cases,
+                  unavailable=dict(unavailable or {}), seconds=dict(seconds or {}))
+
+
+def write_engine_pages(result, out_dir) -> tuple[Path, Path]:
+    """``out_dir/conformance.json`` and ``out_dir/index.html`` of one engine's
+    result, each written whole or not at all (:mod:`refsim.io`); ``out_dir``
+    is created if missing."""
+    from refsim.conformance.page import engine_page
+    from refsim.io import write_text_atomic
+
+    out_dir = make_directory(out_dir)
+    return (write_text_atomic(out_dir / "conformance.json", result.to_json()),
+            write_text_atomic(out_dir / "index.html", engine_page(result)))
+
+
+def make_directory(path) -> Path:
+    """``path`` as a directory, created with its parents if missing;
+    :class:`~refsim.errors.OutputError` naming it when that fails (a file in
+    the way, no permission)."""
+    from refsim.io import output_error
+
+    path = Path(path)
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise output_error(path, exc.strerror or str(exc)) from None
+    return path
+
+
+def load_shipped(name: str, spec: str):
+    """The engine of ``spec``, or the one-line reason it cannot be loaded
+    (a missing package: :class:`refsim.oracles.OracleUnavailable`, or a
+    spec that does not resolve)."""
+    from refsim.engines import load_engine
+    from refsim.errors import RefsimError
+    from refsim.oracles import OracleUnavailable
+
+    try:
+        return load_engine(spec), None
+    except (OracleUnavailable, RefsimError, ImportError) as exc:
+        return None, f"{name}: {exc}"
+
+
+def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=None,
+               only=None, expected: dict | None = None) -> tuple[Matrix, dict]:
+    """Run every engine of ``specs`` (name -> ``module:factory``; default the
+    shipped six) with shared case sets, and write the pages under ``out_dir``
+    when given (module docstring).
+
+    ``expected`` maps a name to its expected-failures file (None for none);
+    by default each shipped engine's bundled file. ``only`` limits the run to
+    one capability; an engine without it is left out of the matrix. An
+    engine that cannot be loaded is left out and named in
+    ``Matrix.unavailable``.
+
+    Returns the matrix and the results by engine name.
+    """
+    from refsim.conformance.expected import shipped_expected_failures
+    from refsim.conformance.registry import build_cases
+    from refsim.conformance.runner import check_engine, needed_case_sets
+    from refsim.conformance.shipped import SHIPPED_ENGINES
+    from refsim.engines import capabilities
+
+    specs = dict(SHIPPED_ENGINES if specs is None else specs)
+    engines, unavailable = {}, {}
+    for name, spec in specs.items():
+        engine, reason = load_shipped(name, spec)
+        if engine is None:
+            unavailable[name] = reason
+        elif only is None or only in capabilities(engine):
+            engines[name] = engine
+    if not engines:
+        from refsim.errors import OptionError
+
+        raise OptionError("no engine to run: " + ("; ".join(unavailable.values())
+                                                  or f"none has the capability {only!r}"))
+    needed = set()
+    for engine in engines.values():
+        caps = capabilities(engine) if only is None else (only,)
+        needed.update(needed_case_sets(caps))
+    start = time.perf_counter()
+    shared = build_cases(needed, cases, seed)
+    seconds = {"cases": time.perf_counter() - start}
+    results, pages = {}, {}
+    for name, engine in engines.items():
+        file = expected.get(name) if expected is not None else \
+            shipped_expected_failures(engine.name)
+        result = check_engine(engine, cases=cases, seed=seed, only=only,
+                              expected_failures=file, case_sets=shared, spec=specs[name])
+        results[name] = result
+        seconds[name] = result.seconds
+        if out_dir is not None:
+            write_engine_pages(result, Path(out_dir) / name)
+            pages[result.engine] = f"{name}/index.html"
+    matrix = conformance_matrix(results, pages, unavailable, seconds)
+    if out_dir is not None:
+        from refsim.conformance.page import matrix_page
+        from refsim.io import write_text_atomic
+
+        make_directory(out_dir)
+        write_text_atomic(Path(out_dir) / "matrix.json", matrix.to_json())
+        write_text_atomic(Path(out_dir) / "index.html", matrix_page(matrix))
+    return matrix, results

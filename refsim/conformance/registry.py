@@ -1,0 +1,119 @@
+"""The checks, one per property, and the case sets they run on.
+
+Each :class:`Check` names its capability (:data:`refsim.engines.CAPABILITIES`),
+the case set it needs and the function that runs it. The case sets are
+built once per run and shared by every check and every engine that uses
+them (:func:`build_cases`): a run of several engines computes each exact
+answer once.
+
+=====================  ==========  =========================================
+check                  cases       property
+=====================  ==========  =========================================
+triangles.reference    triangles   refsim's edge-triangle test agrees with
+                                   the rational separating-axis test (the
+                                   ground truth, checked twice)
+triangles.agreement    triangles   the engine's answer is the exact one
+pairs.agreement        poses       the exact set of intersecting face pairs
+collide.agreement      poses       true exactly when the surfaces meet
+aabb.encloses          boxes       contains every exactly transformed vertex
+aabb.tight             boxes       no larger than the exact box
+ode.order              ode         observed order is the declared one
+ode.stability          ode         realises its declared R(z)
+ode.evaluations        ode         evaluations of f per step
+rigid.apex_ratio       rigid       apex ratio e^2
+rigid.no_spin          rigid       a symmetric frictionless landing does
+                                   not turn the body
+rigid.oblique_bounce   rigid       Coulomb's lateral velocity
+rigid.spin_to_rest     rigid       friction stops a spin
+rigid.energy           rigid       energy never rises
+rigid.resting_contact  rigid       no interpenetration at rest
+rigid.determinism      rigid       two runs, the same bits
+=====================  ==========  =========================================
+
+``--cases N`` sizes the generated sets (triangles, poses, boxes); the ODE
+problems and the rigid scenes are fixed sets.
+
+Cost: building a case set is the cost its module states (the exact answers:
+about 1 ms per triangle pair, 1 ms per pose, 20 us per box vertex; about
+17,000 rigid-body steps per engine); the registry itself is O(checks).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from refsim.conformance import checks_geometry as G
+from refsim.conformance import checks_ode as O
+from refsim.conformance import checks_rigid as RB
+
+CASE_SETS = ("triangles", "poses", "boxes", "ode", "rigid")
+
+
+@dataclass(frozen=True)
+class Check:
+    """A check: its capability and name, the case set it runs on, its
+    function, and an engine attribute it needs beyond the capability
+    (``requires``; without it the check reports ``n/a``)."""
+
+    capability: str
+    name: str
+    cases: str
+    run: Callable
+    requires: str | None = None
+
+    @property
+    def key(self) -> str:
+        return f"{self.capability}.{self.name}"
+
+    @property
+    def doc(self) -> str:
+        """The first paragraph of the check function's docstring, on one
+        line, without reStructuredText's double backquotes."""
+        paragraph = (self.run.__doc__ or "").strip().split("\n\n")[0]
+        return " ".join(paragraph.split()).replace("``", "")
+
+
+CHECKS: tuple[Check, ...] = (
+    Check("triangles", "reference", "triangles", G.check_triangles_reference),
+    Check("triangles", "agreement", "triangles", G.check_triangles_agreement),
+    Check("pairs", "agreement", "poses", G.check_pairs_agreement),
+    Check("collide", "agreement", "poses", G.check_collide_agreement),
+    Check("aabb", "encloses", "boxes", G.check_aabb_encloses),
+    Check("aabb", "tight", "boxes", G.check_aabb_tight),
+    Check("ode", "order", "ode", O.check_ode_order),
+    Check("ode", "stability", "ode", O.check_ode_stability, requires="ode_stability"),
+    Check("ode", "evaluations", "ode", O.check_ode_evaluations),
+    Check("rigid", "apex_ratio", "rigid", RB.check_rigid_apex_ratio),
+    Check("rigid", "no_spin", "rigid", RB.check_rigid_no_spin),
+    Check("rigid", "oblique_bounce", "rigid", RB.check_rigid_oblique_bounce),
+    Check("rigid", "spin_to_rest", "rigid", RB.check_rigid_spin_to_rest),
+    Check("rigid", "energy", "rigid", RB.check_rigid_energy),
+    Check("rigid", "resting_contact", "rigid", RB.check_rigid_resting_contact),
+    Check("rigid", "determinism", "rigid", RB.check_rigid_determinism),
+)
+
+CHECK_KEYS = tuple(c.key for c in CHECKS)
+
+
+def checks_for(capabilities) -> tuple[Check, ...]:
+    """The checks of the given capabilities, in :data:`CHECKS` order."""
+    wanted = set(capabilities)
+    return tuple(c for c in CHECKS if c.capability in wanted)
+
+
+def build_cases(needed, n: int, seed: int) -> dict:
+    """The case sets named in ``needed`` (a subset of :data:`CASE_SETS`),
+    ``n`` cases in each generated set, from ``seed``."""
+    from refsim.conformance.cases_boxes import box_cases
+    from refsim.conformance.cases_meshes import pose_cases
+    from refsim.conformance.cases_ode import ode_cases
+    from refsim.conformance.cases_rigid import rigid_cases
+    from refsim.conformance.cases_triangles import triangle_cases
+
+    builders = {"triangles": lambda: triangle_cases(n, seed),
+                "poses": lambda: pose_cases(n, seed),
+                "boxes": lambda: box_cases(n, seed),
+                "ode": lambda: ode_cases(seed),
+                "rigid": lambda: rigid_cases(seed)}
+    return {name: builders[name]() for name in CASE_SETS if name in set(needed)}

@@ -1,0 +1,64 @@
+"""The engines refsim ships, as ``module:factory`` specs (a composition root:
+the kit itself never chooses an engine).
+
+=================  ==============================================  ==================
+engine             spec                                            capabilities
+=================  ==============================================  ==================
+refsim-seed        refsim.engines.refsim_engines:seed              all six
+refsim-corrected   refsim.engines.refsim_engines:corrected         all six
+fcl                refsim.oracles.fcl_adapter:engine               triangles, pairs,
+                                                                   collide
+trimesh            refsim.conformance.shipped:trimesh              collide, aabb
+pybullet           refsim.oracles.pybullet_adapter:engine          rigid
+mujoco             refsim.oracles.mujoco_adapter:engine            rigid
+=================  ==============================================  ==================
+
+trimesh has two adapters, one per question it answers (its boxes,
+:mod:`refsim.oracles.trimesh_adapter`; its CollisionManager,
+:mod:`refsim.oracles.trimesh_collision`); :func:`trimesh` puts them behind
+one engine so that the matrix has one trimesh column.
+
+Each shipped engine's declared divergences are in
+``refsim/conformance/expected/<name>.txt`` (:mod:`refsim.conformance.expected`).
+
+Cost: building an engine is its adapter's (imports, a client); O(1) here.
+"""
+
+from __future__ import annotations
+
+SHIPPED_ENGINES: dict[str, str] = {
+    "refsim-seed": "refsim.engines.refsim_engines:seed",
+    "refsim-corrected": "refsim.engines.refsim_engines:corrected",
+    "fcl": "refsim.oracles.fcl_adapter:engine",
+    "trimesh": "refsim.conformance.shipped:trimesh",
+    "pybullet": "refsim.oracles.pybullet_adapter:engine",
+    "mujoco": "refsim.oracles.mujoco_adapter:engine",
+}
+
+
+class TrimeshEngine:
+    """trimesh's boxes (``aabb``) and its CollisionManager (``collide``) as
+    one engine named "trimesh"; both adapters load lazily and raise
+    :class:`refsim.oracles.OracleUnavailable` when trimesh (or python-fcl,
+    for the CollisionManager) is missing."""
+
+    name = "trimesh"
+
+    def __init__(self):
+        from refsim.oracles.trimesh_adapter import TrimeshOracle
+        from refsim.oracles.trimesh_collision import TrimeshCollisionOracle
+
+        self._boxes = TrimeshOracle()
+        self._collision = TrimeshCollisionOracle()
+
+    def aabb(self, vertices, pose):
+        return self._boxes.aabb(vertices, pose)
+
+    def bodies_collide(self, vertices_a, faces_a, pose_a, vertices_b, faces_b, pose_b) -> bool:
+        return self._collision.bodies_collide(vertices_a, faces_a, pose_a, vertices_b, faces_b,
+                                              pose_b)
+
+
+def trimesh() -> TrimeshEngine:
+    """The engine factory (``refsim.conformance.shipped:trimesh``)."""
+    return TrimeshEngine()

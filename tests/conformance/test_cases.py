@@ -1,0 +1,188 @@
+"""The case sets: seeded, sized, and their answers exact and independent of
+any float engine."""
+
+from __future__ import annotations
+
+import math
+from fractions import Fraction
+
+import numpy as np
+import pytest
+
+from refsim.collision.bodies import intersecting_pairs
+from refsim.collision.predicates import orient3d
+from refsim.collision.sat_exact import triangles_intersect_sat
+from refsim.conformance import cases_rigid as R
+from refsim.conformance.cases_boxes import GAMMA_4, box_cases, exact_box, rounding_bound
+from refsim.conformance.cases_meshes import FAMILIES as POSE_FAMILIES
+from refsim.conformance.cases_meshes import pose_cases
+from refsim.conformance.cases_ode import (
+    ERROR_FLOOR,
+    STABILITY_POINTS,
+    fitted_order,
+    logistic,
+    order_problems,
+    time_dependent,
+)
+from refsim.conformance.cases_triangles import FAMILIES, triangle_cases
+from refsim.conformance.checks_rigid import apex_tolerance, energy_tolerance, spin_rest_time
+from refsim.conformance.draw import signed_permutations
+from refsim.types import transform_points
+
+
+@pytest.fixture(scope="module")
+def triangles():
+    return triangle_cases(120, seed=3)
+
+
+def test_triangle_cases_are_seeded_and_sized(triangles):
+    again = triangle_cases(120, seed=3)
+    other = triangle_cases(120, seed=4)
+    assert len(triangles) == 120
+    assert all(np.array_equal(p.a, q.a) and np.array_equal(p.b, q.b)
+               for p, q in zip(triangles.pairs, again.pairs, strict=True))
+    assert not all(np.array_equal(p.a, q.a) for p, q in zip(triangles.pairs, other.pairs,
+                                                             strict=True))
+    assert [p.family for p in triangles.pairs[:6]] == list(FAMILIES)
+    # every family has both answers somewhere in 120 pairs
+    for family in FAMILIES:
+        assert {p.truth for p in triangles.pairs if p.family == family} == {True, False}
+
+
+def test_triangle_truth_is_the_rational_sat(triangles):
+    for p in triangles.pairs:
+        assert triangles_intersect_sat(p.a, p.b) is p.truth      # never None: no degenerate
+
+
+def _t(points):
+    return [tuple(map(float, row)) for row in points]
+
+
+def test_exact_families_touch_and_lie_in_one_plane_exactly(triangles):
+    for p in triangles.pairs:
+        a, b = _t(p.a), _t(p.b)
+        if p.family == "touching-exact":
+            assert orient3d(*a, b[0]) == 0                       # on A's plane
+            sides = {orient3d(*a, b[1]), orient3d(*a, b[2])}
+            assert sides in ({1}, {-1})                          # the rest strictly off it
+        elif p.family == "coplanar-exact":
+            assert all(orient3d(*a, q) == 0 for q in b)
+
+
+def test_pose_truth_is_refsims_exact_path_and_families_cycle():
+    cases = pose_cases(24, seed=5)
+    assert [c.family for c in cases.cases[:4]] == list(POSE_FAMILIES)
+    for c in cases.cases:
+        again = intersecting_pairs(c.mesh_a, c.pose_a, c.mesh_b, c.pose_b, level="exact",
+                                   method="seed")
+        assert again.tolist() == c.truth.tolist()                 # both of refsim's paths
+        if c.family == "separated":
+            assert len(c.truth) == 0
+        if c.family == "touching" and {c.model_a, c.model_b} == {"cube.ac"}:
+            assert len(c.truth) > 0                               # faces meet exactly
+
+
+def test_exact_box_of_a_hand_example():
+    vertices = np.array([[1.0, 0.0, 0.0], [0.0, 2.0, -1.0]])
+    rotation = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    lo, hi = exact_box(vertices, (rotation, np.array([0.5, 0.0, 0.1])))
+    assert lo == (Fraction(-3, 2), Fraction(0), Fraction(-1) + Fraction(0.1))   # 0.1 as stored
+    assert hi == (Fraction(1, 2), Fraction(1), Fraction(0.1))
+
+
+def test_box_truth_and_bound():
+    cases = box_cases(60, seed=2)
+    for c in cases.cases:
+        world = transform_points(c.vertices, c.pose)
+        lo = np.array([float(x) for x in c.exact[0]])
+        hi = np.array([float(x) for x in c.exact[1]])
+        # refsim's own float arithmetic is within the bound of the exact box
+        assert (np.abs(world.min(axis=0) - lo) <= c.bound).all()
+        assert (np.abs(world.max(axis=0) - hi) <= c.bound).all()
+        if c.family == "exact":
+            assert (world.min(axis=0) == lo).all() and (world.max(axis=0) == hi).all()
+    one = np.array([[3.0, -4.0, 0.0]])
+    bound = rounding_bound(one, (np.eye(3), np.array([1.0, 0.0, 0.0])))
+    assert bound[0] == pytest.approx(GAMMA_4 * 4.0, rel=1e-14)
+    assert bound[1] == pytest.approx(GAMMA_4 * 4.0, rel=1e-14)
+
+
+def test_signed_permutations_are_the_24_exact_rotations():
+    rotations = signed_permutations()
+    assert len(rotations) == 24
+    assert len({r.tobytes() for r in rotations}) == 24
+    for r in rotations:
+        assert np.array_equal(r.T @ r, np.eye(3)) and round(np.linalg.det(r)) == 1
+
+
+def test_ode_problems_satisfy_their_equations():
+    for problem in order_problems():
+        for t in (0.3, 1.1):
+            d = 1e-5
+            slope = (problem.exact(t + d) - problem.exact(t - d)) / (2 * d)
+            np.testing.assert_allclose(slope, problem.f(t, problem.exact(t)), rtol=1e-8,
+                                       atol=1e-8)
+        np.testing.assert_allclose(problem.exact(problem.t0), problem.y0, rtol=1e-15)
+    assert logistic().exact(2.0)[0] == pytest.approx(1 / (1 + 9 * math.exp(-2)), rel=1e-15)
+    assert time_dependent().exact(2.0)[0] == pytest.approx(math.exp(math.sin(2.0)), rel=1e-15)
+    assert STABILITY_POINTS[0] == 0.0 and STABILITY_POINTS[-1] == -5.0
+
+
+def test_fitted_order_recovers_a_power_law():
+    steps = [0.1, 0.05, 0.025, 0.0125]
+    assert fitted_order(steps, [3 * h ** 2 for h in steps]) == pytest.approx(2.0, abs=1e-12)
+    # points at the rounding floor are left out; fewer than two: no order
+    assert fitted_order(steps, [1e-3, 1e-12, 1e-13, 1e-14]) is None
+    assert fitted_order(steps, [h ** 4 for h in steps]) == pytest.approx(4.0, abs=1e-12)
+    assert 1e-4 ** 4 < ERROR_FLOOR
+    assert math.isnan(fitted_order(steps, [1.0, math.inf, 1.0, 1.0]))
+
+
+def test_rigid_scenes_and_their_tolerances():
+    cases = R.rigid_cases()
+    names = [s.name for s in cases.scenes]
+    assert names == ["drop-sphere-e0.5", "drop-sphere-e0.8", "drop-cube-e0.5", "drop-cube-e0.8",
+                     "drop-icosahedron-e0.8", "oblique-sphere", "spin-cube", "rest-cube"]
+    for scene in cases.of_kind("drop"):
+        body = scene.scene.bodies[0]
+        vertices = R._body(body.model.name)[0]
+        assert body.position[1] + vertices[:, 1].min() + R.HALF_SIZE == pytest.approx(2.0)
+        assert scene.scene.integration.step == 1e-3
+    drops = {s.name: s for s in cases.of_kind("drop")}
+    # CONTACT_STEPS h sqrt(2 g / h_K) / K with h_K = e^6 h0
+    assert apex_tolerance(drops["drop-sphere-e0.5"]) == pytest.approx(
+        2e-3 * math.sqrt(2 * 9.81 / (2.0 / 64)) / 3)
+    assert apex_tolerance(drops["drop-cube-e0.8"]) == pytest.approx(0.00408, abs=1e-5)
+    spin = cases.of_kind("spin")[0]
+    # 2 w0 I / (mu m g r): I = 1/6, r = 0.3826 for the unit cube
+    assert spin_rest_time(spin) == pytest.approx(2 * 5.0 / 6 / (0.5 * 9.81 * 0.382597858),
+                                                 rel=1e-6)
+    rest = cases.of_kind("rest")[0]
+    assert energy_tolerance(rest) == pytest.approx(2 * 9.81 * 9.81e-3 * 1e-3)
+
+
+class _Still:
+    """An engine whose bodies never move (to test the trajectory readers)."""
+
+    name = "still"
+
+    def simulate(self, scene):
+        from refsim.dynamics.trajectory import Trajectory
+
+        body = scene.bodies[0]
+        n = 5
+        return Trajectory(t=np.arange(n) * 0.1,
+                          position=np.tile(np.array(body.position), (n, 1, 1)),
+                          velocity=np.zeros((n, 1, 3)), angular_velocity=np.zeros((n, 1, 3)),
+                          orientation=np.tile(np.eye(3), (n, 1, 1, 1)), names=("body",))
+
+
+def test_trajectory_readers_on_a_body_at_rest():
+    cases = R.rigid_cases()
+    rest = cases.of_kind("rest")[0]
+    trajectory = cases.run(_Still(), rest)
+    np.testing.assert_allclose(R.lowest_height(rest, trajectory), 0.0, atol=1e-15)
+    # the cube's centre is 0.5 above the floor: E = m g 0.5
+    np.testing.assert_allclose(R.energy(rest, trajectory), 9.81 * 0.5, rtol=1e-14)
+    engine = _Still()
+    assert cases.run(engine, rest) is cases.run(engine, rest)       # one run per engine

@@ -1,0 +1,118 @@
+"""``refsim conform``: files written, the table, exit status 0 / 1 / 2, one
+line for a user's mistake and nothing written."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from refsim.cli import EXIT_USER_ERROR, main
+
+CORRECTED = "refsim.engines.refsim_engines:corrected"
+BOX = "tests.conformance.broken_engines:box_ignores_translation"
+
+
+def test_passing_engine_exits_0_and_writes_json_and_page(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["conform", CORRECTED, "--only", "ode", "-o", str(out), "--seed", "3"]) == 0
+    printed = capsys.readouterr().out
+    assert printed.splitlines()[0].split() == ["check", "cases", "passed", "failed", "classes",
+                                               "status"]
+    assert "ode.order" in printed and "refsim-corrected: no check failed; wrote" in printed
+    record = json.loads((out / "conformance.json").read_text())
+    assert record["engine"] == "refsim-corrected" and record["seed"] == 3
+    assert record["spec"] == CORRECTED and record["capabilities"] == ["ode"]
+    assert [c["check"] for c in record["checks"]] == ["order", "stability", "evaluations"]
+    assert all(c["status"] == "passed" for c in record["checks"])
+    assert (out / "index.html").read_text().startswith("<!DOCTYPE html>")
+    assert sorted(p.name for p in out.iterdir()) == ["conformance.json", "index.html"]
+
+
+def test_failing_engine_exits_1_unless_declared(tmp_path, capsys):
+    assert main(["conform", BOX, "--cases", "12", "-o", str(tmp_path / "a")]) == 1
+    printed = capsys.readouterr().out
+    assert "failed: aabb.encloses, aabb.tight" in printed
+    declared = tmp_path / "expected.txt"
+    declared.write_text("# the box forgets t\naabb.encloses  forgets the translation\n"
+                        "aabb.tight  forgets the translation\n")
+    assert main(["conform", BOX, "--cases", "12", "-o", str(tmp_path / "b"),
+                 "--expected-failures", str(declared)]) == 0
+    record = json.loads((tmp_path / "b" / "conformance.json").read_text())
+    assert [c["status"] for c in record["checks"]] == ["xfailed", "xfailed"]
+    assert record["checks"][0]["reason"] == "forgets the translation"
+
+
+@pytest.mark.parametrize("args, phrase", [
+    (["conform", "nope:thing"], "cannot import 'nope'"),
+    (["conform", "refsim.engines.refsim_engines"], "expected 'module:factory'"),
+    (["conform", "refsim.engines.refsim_engines:nothing"], "has no callable 'nothing'"),
+    (["conform", "tests.conformance.broken_engines:missing"], "'nothing-here' is not installed"),
+    (["conform", CORRECTED, "--only", "wings"], "--only 'wings': not a capability"),
+    (["conform", "refsim.oracles.fcl_adapter:engine", "--only", "rigid"],
+     "has no 'rigid' capability (it has: triangles, pairs, collide)"),
+    (["conform", CORRECTED, "--cases", "0"], "--cases must be at least 1"),
+    (["conform"], "give one engine as MODULE:FACTORY, or --all"),
+    (["conform", CORRECTED, "--all"], "give one engine as MODULE:FACTORY, or --all"),
+])
+def test_user_errors_exit_2_with_one_line_and_write_nothing(tmp_path, capsys, args, phrase):
+    out = tmp_path / "out"
+    assert main([*args, "-o", str(out)]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith("refsim: error: ") and err.count("\n") == 1, err
+    assert phrase in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_malformed_expected_failures_names_its_line(tmp_path, capsys):
+    bad = tmp_path / "expected.txt"
+    bad.write_text("# fine\naabb.tight  fine\naabb.wide  oops\n")
+    assert main(["conform", BOX, "-o", str(tmp_path / "out"),
+                 "--expected-failures", str(bad)]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert f"{bad}:3: unknown check 'aabb.wide'" in err and err.count("\n") == 1
+    assert not (tmp_path / "out").exists()
+
+
+def test_all_runs_the_shipped_engines_with_a_capability(tmp_path, capsys):
+    out = tmp_path / "all"
+    assert main(["conform", "--all", "--only", "ode", "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    header = printed.splitlines()[0].split()
+    assert header == ["check", "refsim-seed", "refsim-corrected"]    # the two with "ode"
+    matrix = json.loads((out / "matrix.json").read_text())
+    assert matrix["engines"] == ["refsim-seed", "refsim-corrected"]
+    assert matrix["cells"]["ode.order"]["refsim-seed"]["status"] == "passed"
+    assert (out / "refsim-seed" / "conformance.json").is_file()
+    assert 'href="refsim-corrected/index.html"' in (out / "index.html").read_text()
+
+
+def test_console_script_in_a_fresh_interpreter(tmp_path):
+    result = subprocess.run([sys.executable, "-m", "refsim.cli", "conform", "nope:thing",
+                             "-o", str(tmp_path / "x")], capture_output=True, text=True)
+    assert result.returncode == EXIT_USER_ERROR
+    assert result.stderr.count("\n") == 1 and "Traceback" not in result.stderr
+
+
+def test_same_inputs_give_the_same_record_but_timings(tmp_path, capsys):
+    records = []
+    for run in ("a", "b"):
+        assert main(["conform", BOX, "--cases", "12", "-o", str(tmp_path / run)]) == 1
+        records.append(json.loads((tmp_path / run / "conformance.json").read_text()))
+    capsys.readouterr()
+
+    def without_timings(value):
+        if isinstance(value, dict):
+            return {k: without_timings(v) for k, v in value.items()
+                    if k not in ("seconds", "case_seconds")}
+        if isinstance(value, list):
+            return [without_timings(v) for v in value]
+        return value
+
+    first, second = map(without_timings, records)
+    assert first == second                      # the Hypothesis search is seeded too
+    assert first["checks"][0]["examples"][0]["shrunk"] is True
+    assert (tmp_path / "a" / "index.html").read_text() == \
+        (tmp_path / "b" / "index.html").read_text()

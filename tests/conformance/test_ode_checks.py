@@ -1,0 +1,54 @@
+"""The ``ode`` checks on refsim's five solvers (each passes with the order
+its tableau has) and on the seed's stated orders (claim C10)."""
+
+from __future__ import annotations
+
+import pytest
+
+from refsim.conformance import check_engine
+from refsim.conformance.checks_ode import ORDER_TOL, real_axis_limit
+from refsim.engines.refsim_engines import RefsimEngine
+from refsim.solvers.methods import SOLVERS
+
+#: Real-axis stability limits on the grid z = -k/8 (the exact ones: 2, 2, 1,
+#: 2, 2.785 for RK4, whose grid point below is 2.75).
+REAL_LIMITS = {"euler": 2.0, "averaged-euler": 2.0, "backwards-euler": 1.0, "midpoint": 2.0,
+               "rk4": 2.75}
+
+
+@pytest.mark.parametrize("solver", list(SOLVERS))
+def test_each_refsim_solver_passes_with_its_tableau_order(solver):
+    engine = RefsimEngine("corrected", solver)
+    result = check_engine(engine, only="ode")
+    assert result.failed_checks() == []
+    order = result.check("ode.order")
+    assert order.cases == 5 and order.passed == 5
+    for observed in order.measured["observed_orders"].values():
+        assert abs(observed - SOLVERS[solver].order) <= ORDER_TOL / 2     # within 0.15
+    evaluations = result.check("ode.evaluations").measured["evaluations_per_step"]
+    assert evaluations == SOLVERS[solver].stages
+    assert result.check("ode.stability").measured["real_axis_limit"] == REAL_LIMITS[solver]
+
+
+def test_backwards_euler_is_not_the_second_order_the_seed_states():
+    # claim C10: the seed gives "backwards Euler" order h^2; its tableau has order 1
+    engine = RefsimEngine("corrected", "backwards-euler")
+    engine.ode_order = SOLVERS["backwards-euler"].seed_order
+    result = check_engine(engine, only="ode")
+    assert result.failed_checks() == ["ode.order"]
+    assert result.check("ode.order").classes == {"bug": 5}
+
+
+def test_a_declared_evaluation_count_is_compared():
+    engine = RefsimEngine("corrected", "midpoint")
+    engine.ode_evaluations = 3
+    result = check_engine(engine, only="ode")
+    assert result.failed_checks() == ["ode.evaluations"]
+    example = result.check("ode.evaluations").examples[0]
+    assert example["evaluations"] == 2 and example["expected"] == 3
+
+
+def test_real_axis_limit_reads_the_grid():
+    points = (0.0, -0.5, -1.0, -1.5)
+    assert real_axis_limit([1.0, 0.5, 1.0, 1.2], points) == 1.0
+    assert real_axis_limit([1.0, 1.1, 0.5, 0.5], points) == 0.0
