@@ -6,7 +6,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: test report bench lint models clean
+.PHONY: test typecheck report bench lint models clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -16,6 +16,10 @@ $(STAMP): pyproject.toml
 
 test: $(STAMP)
 	$(BIN)/python -m pytest tests properties --benchmark-disable -n auto
+
+# mypy over the package; pyproject.toml's [tool.mypy] lists what is not yet clean.
+typecheck: $(STAMP)
+	$(BIN)/mypy refsim
 
 report: $(STAMP)
 	$(BIN)/refsim report

@@ -49,7 +49,7 @@ from __future__ import annotations
 import os
 from collections.abc import Iterator, Mapping
 from pathlib import Path
-from typing import Protocol
+from typing import BinaryIO, Protocol, TypeAlias
 
 import numpy as np
 
@@ -80,7 +80,7 @@ class FrameSink(Protocol):
 
     def append(self, frame: Mapping[str, object]) -> None: ...
 
-    def arrays(self) -> dict[str, object]: ...
+    def arrays(self) -> Mapping[str, FrameArray]: ...
 
 
 def _c_order(value, dtype) -> np.ndarray:
@@ -224,6 +224,11 @@ class SpilledArray:
                 yield view[:got]
 
 
+#: A frame array as a sink gives it back: a numpy array (:class:`MemorySink`)
+#: or a view of a spill file (:class:`SpillSink`).
+FrameArray: TypeAlias = np.ndarray | SpilledArray
+
+
 class SpillSink:
     """Frames appended to one raw file per name beside ``out`` (see the
     module docstring). A context manager: leaving it removes the files.
@@ -241,11 +246,11 @@ class SpillSink:
         the disk is full.
     """
 
-    def __init__(self, out):
+    def __init__(self, out: str | os.PathLike):
         self.out = Path(out)
         self.n_frames = 0
         self._layout: _Layout | None = None
-        self._files: dict[str, tuple[object, Path]] = {}
+        self._files: dict[str, tuple[BinaryIO, Path]] = {}
         self._clean_up: list[Path] = []
 
     def __enter__(self) -> SpillSink:
@@ -254,20 +259,20 @@ class SpillSink:
     def __exit__(self, *exc) -> None:
         self.close()
 
-    def _open(self, frame: Mapping[str, object]) -> None:
-        self._layout = _Layout(frame)
+    def _open(self, frame: Mapping[str, object]) -> _Layout:
+        self._layout = layout = _Layout(frame)
         target = output_target(self.out)
-        for name in self._layout.shapes:
+        for name in layout.shapes:
             fd, path = hidden_temporary(target, f".{name}.spill", self._clean_up)
             self._files[name] = (os.fdopen(fd, "wb", buffering=SPILL_BUFFER_BYTES), path)
+        return layout
 
     def append(self, frame: Mapping[str, object]) -> None:
-        if self._layout is None:
-            self._open(frame)
-        values = self._layout.check(frame)
+        layout = self._open(frame) if self._layout is None else self._layout
+        values = layout.check(frame)
         try:
             for name, value in values:
-                self._files[name][0].write(value)     # its bytes, C order (buffer protocol)
+                self._files[name][0].write(value.data)    # its bytes, C order
         except OSError as exc:
             raise output_error(self.out, exc.strerror or str(exc)) from None
         self.n_frames += 1
@@ -280,8 +285,11 @@ class SpillSink:
                 handle.flush()
         except OSError as exc:
             raise output_error(self.out, exc.strerror or str(exc)) from None
-        return {name: SpilledArray(path, self.n_frames, self._layout.shapes[name],
-                                   self._layout.dtypes[name])
+        layout = self._layout
+        if layout is None:                       # no frame yet: no files
+            return {}
+        return {name: SpilledArray(path, self.n_frames, layout.shapes[name],
+                                   layout.dtypes[name])
                 for name, (_, path) in self._files.items()}
 
     def close(self) -> None:

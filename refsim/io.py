@@ -45,6 +45,7 @@ import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
+from typing import IO
 
 from refsim.errors import OutputError
 
@@ -155,7 +156,7 @@ def remove_quietly(paths: list) -> None:
 
 
 @contextmanager
-def atomic_output(path, *, binary: bool = True) -> Iterator:
+def atomic_output(path, *, binary: bool = True) -> Iterator[IO]:
     """Yield a handle on a hidden temporary file beside ``path``'s target
     (:func:`output_target`); when the body finishes, flush it to disk and
     move it over the target. Any exception removes it instead.
@@ -180,7 +181,7 @@ def atomic_output(path, *, binary: bool = True) -> Iterator:
     try:
         fd, tmp = hidden_temporary(target, ".tmp", clean_up)
         with os.fdopen(fd, "wb" if binary else "w",
-                       **({} if binary else {"encoding": "utf-8"})) as handle:
+                       encoding=None if binary else "utf-8") as handle:
             yield handle
             handle.flush()
             os.fsync(handle.fileno())

@@ -69,7 +69,7 @@ def _array_chunks(array: np.ndarray, size: int) -> Iterator[memoryview]:
     """The bytes of C-contiguous ``array`` in slices of ``size`` (views, no copy)."""
     flat = array.reshape(-1).view(np.uint8)
     for start in range(0, flat.size, size):
-        yield memoryview(flat[start:start + size])
+        yield flat[start:start + size].data
 
 
 def _entry(name: str, value) -> tuple[tuple, np.dtype, Iterator]:

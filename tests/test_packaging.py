@@ -4,6 +4,7 @@ found by the import system, the oracle adapters under refsim's namespace."""
 from __future__ import annotations
 
 import tomllib
+from importlib.resources import files
 from pathlib import Path
 
 import refsim.oracles
@@ -53,3 +54,11 @@ def test_package_data_patterns_cover_every_bundled_file():
                  and p.suffix != ".py"]
         missed = [p.name for p in files if "".join(p.suffixes[-1:]) not in suffixes[package]]
         assert not missed, (package, missed)
+
+
+def test_the_type_marker_ships_as_package_data():
+    # PEP 561: type checkers use an installed package's annotations only when
+    # the package holds a py.typed file (.ci/check-wheel looks in the wheel).
+    assert (ROOT / "refsim" / "py.typed").is_file()
+    assert "py.typed" in _pyproject()["tool"]["setuptools"]["package-data"]["refsim"]
+    assert files("refsim").joinpath("py.typed").is_file()

@@ -252,7 +252,8 @@ class IncrementalAABB:
         rotation, translation = as_pose(pose)
         return self.update_unchecked(rotation, translation)
 
-    def update_unchecked(self, rotation: np.ndarray, translation: np.ndarray):
+    def update_unchecked(self, rotation: np.ndarray, translation: np.ndarray
+                         ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`update` without the pose check, for a loop whose poses are
         known to be finite float64 (3, 3) orthonormal and (3,) (the check
         costs more than the compiled update itself)."""
@@ -262,7 +263,8 @@ class IncrementalAABB:
 
     # -- the readable kernel -------------------------------------------------------
 
-    def _update_python(self, rotation, translation):
+    def _update_python(self, rotation: np.ndarray, translation: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
         if self._extremes[0, 0] < 0:
             return self._initialize_by_scan(rotation, translation)
         xyz, R = self._xyz, rotation.tolist()
@@ -290,7 +292,8 @@ class IncrementalAABB:
         self._counts[:] = len(set().union(*examined)), sum(len(m) for m in examined)
         return lo, hi
 
-    def _initialize_by_scan(self, rotation, translation):
+    def _initialize_by_scan(self, rotation: np.ndarray, translation: np.ndarray
+                            ) -> tuple[np.ndarray, np.ndarray]:
         # The first update: the linear scan, remembering where the extremes are
         # (np.argmin/argmax return the lowest index among ties).
         r = rotated_coordinates(rotation, self.mesh.vertices.T)
@@ -302,7 +305,8 @@ class IncrementalAABB:
 
     # -- the compiled kernel ---------------------------------------------------------
 
-    def _update_numba(self, rotation, translation):
+    def _update_numba(self, rotation: np.ndarray, translation: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
         box = np.empty((2, 3))
         self._kernel_numba(
             self._xyz, self.mesh.neighbor_offsets, self.mesh.neighbor_indices, rotation,

@@ -154,7 +154,8 @@ class LinearAABB:
         rotation, translation = as_pose(pose)
         return self.update_unchecked(rotation, translation)
 
-    def update_unchecked(self, rotation, translation):
+    def update_unchecked(self, rotation: np.ndarray, translation: np.ndarray
+                         ) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`update` without the pose check, for a loop whose poses are
         known to be finite float64 (3, 3) orthonormal and (3,) (the check
         costs more than the compiled update itself)."""

@@ -23,11 +23,17 @@ AABB_MODES = ("linear", "incremental", "auto")
 
 
 class AABBTracker(Protocol):
-    """What the simulation loop needs from a box update."""
+    """What the simulation loop needs from a box update (the counters are
+    read-only: a plain attribute or a property)."""
 
-    method: str        # "linear" or "incremental"
-    visits: int        # vertices examined by the last update
-    evaluations: int   # rotated coordinates computed by the last update
+    @property
+    def method(self) -> str: ...        # "linear" or "incremental"
+
+    @property
+    def visits(self) -> int: ...        # vertices examined by the last update
+
+    @property
+    def evaluations(self) -> int: ...   # rotated coordinates computed by the last update
 
     def update(self, pose: Pose) -> tuple[np.ndarray, np.ndarray]: ...
 

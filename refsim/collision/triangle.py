@@ -79,6 +79,7 @@ from refsim.errors import StateError
 
 Point = tuple[float, float, float]
 Point2 = tuple[float, float]
+Triangle = tuple[Point, Point, Point]
 
 
 # --------------------------------------------------------------------------
@@ -120,7 +121,7 @@ def triangles_intersect_float(a, b) -> bool:
     return intersect_point_sets(as_triangle(a, "a"), as_triangle(b, "b"), FLOAT)
 
 
-def as_triangle(t, what: str = "triangle") -> tuple[Point, Point, Point]:
+def as_triangle(t, what: str = "triangle") -> Triangle:
     """Check a (3, 3) vertex array and return it as three tuples of floats."""
     array = np.asarray(t, dtype=np.float64)
     if array.shape != (3, 3):
@@ -317,7 +318,7 @@ def _drop(p, axis: int) -> Point2:
     return (p[0], p[1])
 
 
-def projection_axis_of_triangle(t, predicates: Predicates = FILTERED) -> int:
+def projection_axis_of_triangle(t: Triangle, predicates: Predicates = FILTERED) -> int:
     """An axis along which t's exact normal is non-zero (t non-degenerate).
 
     Of the admissible axes we drop the one with the largest float normal

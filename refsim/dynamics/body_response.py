@@ -107,6 +107,9 @@ def contact_geometry(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a,
     exact one would add every face normal and edge-pair cross product). The
     point is the midpoint of the centroids of the two bodies' vertices lying
     in the overlap slab (for a face on a face, the middle of the shared part).
+
+    Raises ValueError when no candidate has a direction: coincident
+    centroids and zero orientation axes on both bodies.
     """
     d = np.asarray(c_a, dtype=np.float64) - c_b
     candidates = [d] + [axes_a[:, k] for k in range(3)] + [axes_b[:, k] for k in range(3)]
@@ -122,6 +125,11 @@ def contact_geometry(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a,
         depth = pb.max() - pa.min()                  # A lies above B along n
         if best is None or depth < best[1]:
             best = (n, depth, pa, pb)
+    if best is None:
+        # Only when the centroids coincide and both bodies' axes are zero
+        # vectors (a degenerate orientation): no direction to separate along.
+        raise ValueError("contact_geometry: every candidate axis has zero length (coincident "
+                         "centroids and zero orientation axes); no contact normal")
     n, depth, pa, pb = best
     if depth < 0.0:
         # a separating axis: the bodies do not touch (their boxes, or spheres,

@@ -88,7 +88,8 @@ try:
     # compiled inline when called from a numba-compiled function.
     from numba.extending import register_jitable as _jitable
 except Exception:  # numba missing or unusable: the plain path only
-    def _jitable(f):
+    # The same name for the identity decorator, the usual optional import.
+    def _jitable(f):                                # type: ignore[no-redef]
         return f
 
 

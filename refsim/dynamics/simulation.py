@@ -53,12 +53,12 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass, replace
-from typing import NamedTuple
+from typing import NamedTuple, cast
 
 import numpy as np
 
 from refsim.bounds.aabb_linear import transform_vertices
-from refsim.bounds.tracker import make_aabb_tracker
+from refsim.bounds.tracker import AABBTracker, make_aabb_tracker
 from refsim.bounds.world_cube import world_cube_test
 from refsim.collision.bodies import bodies_collide
 from refsim.collision.broad_phase import overlapping_pairs
@@ -161,7 +161,7 @@ class Body:
 
     name: str
     mesh: Mesh
-    tracker: object
+    tracker: AABBTracker
     mass: float
     center: np.ndarray          # body-space centroid the body rotates about
     inertia: np.ndarray         # (3, 3) body-space, about the solid's centre of mass
@@ -407,10 +407,11 @@ class Simulation:
         self._walls(touching)
         timer.lap("walls")
         if self.body_body:
-            pairs = self._broad_phase()
+            candidates = self._broad_phase()
             timer.lap("broad-phase")
+            pairs: np.ndarray | list = candidates
             if self.level != "aabb":
-                pairs = self._narrow_phase(pairs)
+                pairs = self._narrow_phase(candidates)
                 timer.lap("narrow-phase")
             self._body_response(pairs, touching)
             timer.lap("body-response")
@@ -468,12 +469,12 @@ class Simulation:
     def _walls(self, touching: set) -> None:
         H = self.scene.world.half_size
         beyond = np.flatnonzero(((self.lo < -H) | (self.hi > H)).any(axis=1))
-        for i in beyond:
+        for i in beyond.tolist():
             correction = world_cube_test(self.lo[i], self.hi[i], H).correction
             self._wall(i, correction)
             self.lo[i] += correction
             self.hi[i] += correction
-            for k in np.flatnonzero(correction):
+            for k in np.flatnonzero(correction).tolist():
                 touching.add(Contact("wall", self.names[i], wall_name(k, correction[k])))
 
     def _wall_seed(self, i: int, correction: np.ndarray) -> None:
@@ -490,7 +491,7 @@ class Simulation:
         """S9 at each crossed wall: the contact vertex, then w += Pi x I."""
         world = self.scene.world
         W = self.world_vertices(i)
-        for k in np.flatnonzero(correction):
+        for k in np.flatnonzero(correction).tolist():
             low = correction[k] > 0.0
             N = np.zeros(3)
             N[k] = 1.0 if low else -1.0                     # into the body
@@ -504,7 +505,7 @@ class Simulation:
         world = self.scene.world
         H = world.half_size
         I_inv = world_inertia(self.R[i:i + 1], self.I_body_inv[i:i + 1])[0]
-        for k in np.flatnonzero(correction):
+        for k in np.flatnonzero(correction).tolist():
             low = correction[k] > 0.0
             W = self.world_vertices(i)
             r_a = W[wall_contacts(W, k, -H if low else H, low)] - self.x[i]
@@ -627,7 +628,10 @@ class Simulation:
         B = len(self.bodies)
         if self._frames.n_frames:
             frames = self._frames.arrays()
-            t, x, v, w, R = (frames[name] for name in FRAME_ENTRIES)
+            # Trajectory's frame fields are typed for numpy arrays, what the
+            # default memory sink gives; a spill sink's SpilledArray views
+            # stand in for them (see refsim.dynamics.trajectory), enough to save.
+            t, x, v, w, R = (cast(np.ndarray, frames[name]) for name in FRAME_ENTRIES)
         else:
             t = np.empty(0)
             x, v, w = (np.empty((0, B, 3)) for _ in range(3))

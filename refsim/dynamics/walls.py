@@ -186,6 +186,9 @@ def wall_response_points_inplace(x: np.ndarray, v: np.ndarray, half_size: float,
             if speed == "wall":
                 # wall_speed, masked: copysign(sqrt(max(v^2 + (2 a) (wall - x), 0)), v),
                 # the push-back (wall - x) taking x's column until x is set to the wall
+                if scratch is None:
+                    raise ValueError('wall_response_points_inplace: speed="wall" needs the '
+                                     '(N,) float scratch array, got None')
                 s, c = scratch, x[:, axis]
                 np.multiply(v_k, v_k, out=s, where=beyond)
                 np.subtract(wall, c, out=c, where=beyond)

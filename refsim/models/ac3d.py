@@ -157,7 +157,8 @@ def _tokenize(line: str) -> list[str] | str:
 
 def _tokenize_with_ends(line: str) -> list[tuple[str, int]] | str:
     """The tokens of ``line``, each with the offset just past it."""
-    tokens, pos, n = [], 0, len(line)
+    tokens: list[tuple[str, int]] = []
+    pos, n = 0, len(line)
     while True:
         while pos < n and line[pos] in _SPACE:
             pos += 1
@@ -171,6 +172,8 @@ def _tokenize_with_ends(line: str) -> list[tuple[str, int]] | str:
             pos = close + 1
         else:
             match = _BARE.match(line, pos)
+            if match is None:                    # line[pos] is neither a space nor a quote
+                raise ValueError(f"_tokenize_with_ends: no token at offset {pos} of {line!r}")
             tokens.append((match.group(), match.end()))
             pos = match.end()
         if pos < n and line[pos] not in _SPACE:
@@ -234,7 +237,7 @@ class _Parser:
         self.count_encoding = count_encoding
         self.lines = self.text.split("\n")
         self.i = 0  # index of the next line to read
-        self._starts = None
+        self._starts: list[int] | None = None     # offset of each line in text, when needed
         self.materials: list[Material] = []
         self.objects: list[str] = []
         self.vertex_blocks: list[np.ndarray] = []
@@ -330,7 +333,10 @@ class _Parser:
         if problem:
             raise self.error(problem, lineno)
         line = self.lines[lineno - 1]
-        rest = line[_tokenize_with_ends(line)[5][1]:].strip(_SPACE)
+        ends = _tokenize_with_ends(line)
+        if isinstance(ends, str):                # cannot be: the line was tokenized
+            raise self.error(ends, lineno)
+        rest = line[ends[5][1]:].strip(_SPACE)
         self.materials.append(Material(name=str(tokens[1]), rgb=tuple(rgb.tolist()),
                                        rest=rest))
 
@@ -342,8 +348,8 @@ class _Parser:
         or a link ``(rot, loc, parent_chain)``: extending it is O(1), so deep
         trees cost O(depth), not O(depth^2).
         """
-        stack = [[None, 1]]
-        first = (tokens, lineno)
+        stack: list[list] = [[None, 1]]          # [chain, kids still to read] per parent
+        first: tuple[list[str], int] | None = (tokens, lineno)
         while stack:
             chain, left = stack[-1]
             if left == 0:
@@ -459,11 +465,13 @@ class _Parser:
     def skip_data(self, n: int, lineno: int):
         """Skip the ``n``-byte blob that starts on the line after ``lineno``."""
         if self._starts is None:
-            self._starts, offset = [], 0
+            starts, offset = [], 0
             for line in self.lines:
-                self._starts.append(offset)
+                starts.append(offset)
                 offset += len(line) + 1
-        start = self._starts[self.i] if self.i < len(self.lines) else len(self.text)
+            self._starts = starts
+        starts = self._starts
+        start = starts[self.i] if self.i < len(self.lines) else len(self.text)
         chunk = self.text[start:start + n]
         if chunk.isascii():
             end = start + n if len(chunk) == n else None
@@ -478,11 +486,11 @@ class _Parser:
                     break
         if end is None:
             raise self.error(f"data count {n} runs past the end of the file", lineno)
-        k = bisect.bisect_right(self._starts, end) - 1
-        if self._starts[k] == end:
+        k = bisect.bisect_right(starts, end) - 1
+        if starts[k] == end:
             self.i = k
         else:
-            tail = self.text[end:self._starts[k] + len(self.lines[k])]
+            tail = self.text[end:starts[k] + len(self.lines[k])]
             if tail.strip(_SPACE):
                 raise self.error(f"text after the {n} data bytes: {_show(tail.strip(_SPACE))}",
                                  k + 1)

@@ -181,7 +181,9 @@ class CornerTree(NamedTuple):
     xmax: np.ndarray
     ymin: np.ndarray
     ymax: np.ndarray
-    count: np.ndarray
+    # The field shadows tuple.count, which a NamedTuple allows at run time; the
+    # name is the one used by the compiled kernels and the tests.
+    count: np.ndarray                             # type: ignore[assignment]
 
 
 class Ring(NamedTuple):

@@ -34,7 +34,8 @@ class ModelFacts:
 
 
 def _triple(a) -> tuple[float, float, float]:
-    return tuple(float(x) for x in a)
+    x, y, z = a
+    return float(x), float(y), float(z)
 
 
 def describe(mesh: Mesh, name: str | None = None) -> ModelFacts:

@@ -89,7 +89,7 @@ def _load_with_trimesh(path: Path, data: bytes, weld_tolerance: float) -> Mesh:
             text = data.decode("utf-8")
         except UnicodeDecodeError:
             text = data.decode("latin-1")
-        source = io.StringIO(text)
+        source: io.StringIO | io.BytesIO = io.StringIO(text)
     else:
         source = io.BytesIO(data)
     try:

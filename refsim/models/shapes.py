@@ -113,7 +113,13 @@ def geodesic_sphere(frequency: int, radius: float = 1.0) -> Mesh:
 
 def torus(major: float = 1.0, minor: float = 0.35, n_major: int = 40,
           n_minor: int = 25) -> Mesh:
-    """Torus about the y axis: ``2 * n_major * n_minor`` triangles."""
+    """Torus about the y axis: ``2 * n_major * n_minor`` triangles.
+
+    ``n_major`` and ``n_minor`` (segments around and across the tube) must be
+    at least 3: with fewer, faces repeat and the surface is not closed.
+    """
+    if n_major < 3 or n_minor < 3:
+        raise ValueError(f"torus: n_major and n_minor must be >= 3, got {n_major}, {n_minor}")
     u = 2.0 * np.pi * np.arange(n_major) / n_major
     w = 2.0 * np.pi * np.arange(n_minor) / n_minor
     uu, ww = np.meshgrid(u, w, indexing="ij")
@@ -126,7 +132,11 @@ def torus(major: float = 1.0, minor: float = 0.35, n_major: int = 40,
     faces = np.concatenate([np.stack([a, d, c], -1).reshape(-1, 3),
                             np.stack([a, c, b], -1).reshape(-1, 3)])
     mesh = Mesh(v.reshape(-1, 3), faces, name="torus")
-    if mesh.volume < 0:  # wind outward whatever the parametrisation's handedness
+    volume = mesh.volume
+    if volume is None:
+        raise ValueError(f"torus: the surface is not closed (n_major={n_major}, "
+                         f"n_minor={n_minor})")
+    if volume < 0:  # wind outward whatever the parametrisation's handedness
         mesh = Mesh(mesh.vertices, mesh.faces[:, ::-1], name="torus")
     return mesh
 

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import logging
 import queue
+from typing import TYPE_CHECKING
 
 from refsim.errors import OptionError, SweepError
 from refsim.sweep.execute import LOST, RAISED, Outcome, execute, one_line
@@ -55,6 +56,9 @@ CLOSE_SECONDS = 20.0
 #: that a worker does not idle for a scheduler round trip between two tasks.
 #: More would put more calls on a worker that may die with them.
 CALLS_PER_THREAD = 2
+
+if TYPE_CHECKING:                                # imported when used: see _distributed
+    from distributed import Future
 
 #: The local scheduler's HTTP server (health checks; no dashboard is shown)
 #: listens on a free port of the loopback interface, never on the dashboard's
@@ -85,8 +89,8 @@ class DaskCluster:
         distributed = _distributed()
         self._killed_worker = distributed.KilledWorker
         self._cluster = None
-        self._finished = queue.SimpleQueue()     # (index, future), from callbacks
-        self._in_flight = {}                     # index -> future
+        self._finished: queue.SimpleQueue[tuple[int, Future]] = queue.SimpleQueue()
+        self._in_flight: dict[int, Future] = {}  # index -> future
         if scheduler is None:
             self._cluster = distributed.LocalCluster(
                 n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
@@ -126,7 +130,7 @@ class DaskCluster:
         finally:
             future.release()
 
-    def _outcome(self, future) -> Outcome:
+    def _outcome(self, future: Future) -> Outcome:
         if future.status == "finished":
             try:
                 return future.result(timeout=GATHER_SECONDS)
@@ -134,12 +138,12 @@ class DaskCluster:
                 return Outcome(LOST, f"result lost with its worker: {one_line(error)}")
         if future.status != "error":             # cancelled or lost by the scheduler
             return Outcome(LOST, f"the scheduler reports the task {future.status}")
-        error = future.exception(timeout=GATHER_SECONDS)
-        if isinstance(error, self._killed_worker):
+        exception = future.exception(timeout=GATHER_SECONDS)
+        if isinstance(exception, self._killed_worker):
             return Outcome(LOST, f"worker process died while running the task "
-                                 f"({error.allowed_failures + 1} time(s) on the scheduler)",
-                           attempts_used=error.allowed_failures + 1)
-        return Outcome(RAISED, one_line(error))       # raised outside execute's handler
+                                 f"({exception.allowed_failures + 1} time(s) on the scheduler)",
+                           attempts_used=exception.allowed_failures + 1)
+        return Outcome(RAISED, one_line(exception))   # raised outside execute's handler
 
     def close(self, *, abort: bool = False) -> None:
         try:

@@ -12,6 +12,7 @@ Cost: the tasks' own, one after the other.
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Callable
 
 from refsim.sweep.execute import Outcome, execute
 
@@ -22,8 +23,8 @@ class InProcess:
     name = "inprocess"
     slots = 1
 
-    def __init__(self):
-        self._queue = deque()
+    def __init__(self) -> None:
+        self._queue: deque[tuple[int, Callable, dict, int]] = deque()   # submitted calls
 
     def submit(self, index: int, function, kwargs: dict, seed: int) -> None:
         self._queue.append((index, function, kwargs, seed))

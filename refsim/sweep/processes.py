@@ -30,7 +30,7 @@ from __future__ import annotations
 import multiprocessing
 import queue
 import signal
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from concurrent.futures.process import BrokenProcessPool
 
 from refsim.sweep.execute import LOST, RAISED, Outcome, execute, one_line
@@ -50,9 +50,10 @@ class Processes:
     def __init__(self, workers: int):
         self.slots = workers
         self._workers = workers
-        self._pool = None
+        self._pool: ProcessPoolExecutor | None = None
         self._generation = 0                     # which pool a future belongs to
-        self._finished = queue.SimpleQueue()     # (index, generation, future), from callbacks
+        # (index, generation, future), from callbacks
+        self._finished: queue.SimpleQueue[tuple[int, int, Future[Outcome]]] = queue.SimpleQueue()
 
     def submit(self, index: int, function, kwargs: dict, seed: int) -> None:
         for _ in range(2):                       # a pool found broken is renewed once

@@ -93,7 +93,8 @@ class SweepResult:
     @property
     def failures(self) -> dict[str, str]:
         """Key -> one-line reason, for each failed task, in task order."""
-        return {r.key: r.error for r in self.results if r.status == FAILED_STATUS}
+        return {r.key: r.error or "no reason given" for r in self.results
+                if r.status == FAILED_STATUS}
 
     @property
     def ok(self) -> bool:
@@ -181,7 +182,7 @@ def run_sweep(tasks: Iterable[Task], *, backend: str = "inprocess", workers: int
             runner.close()
     finally:
         shown.close()
-    return SweepResult(tuple(results), backend, time.perf_counter() - start)
+    return SweepResult(_filled(results, tasks), backend, time.perf_counter() - start)
 
 
 def _run(runner, tasks, seeds, waiting: deque, results: list, saved: Store | None,
@@ -234,6 +235,14 @@ def _run(runner, tasks, seeds, waiting: deque, results: list, saved: Store | Non
         finished += 1
         failed += results[index].status == FAILED_STATUS
         shown.update(finished, failed, force=finished == len(tasks))
+
+
+def _filled(results: list[TaskResult | None], tasks: list[Task]) -> tuple[TaskResult, ...]:
+    """``results`` once every task has one (``_run`` fills each index it is given)."""
+    missing = [task.key for task, result in zip(tasks, results, strict=True) if result is None]
+    if missing:
+        raise SweepError(f"internal error: the sweep ended without a result for {missing}")
+    return tuple(result for result in results if result is not None)
 
 
 def _checked(tasks) -> list[Task]:

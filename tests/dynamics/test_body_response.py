@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from refsim.dynamics.body_response import (
     SEPARATION_SLOP,
@@ -56,3 +57,20 @@ def test_face_contact_normal_depth_and_separation():
     assert np.allclose(dx_a, -dx_b)
     gap = ((a + dx_a) @ g.n).min() - ((b + dx_b) @ g.n).max()
     assert gap > 0.0                                          # disjoint: no interpenetration
+
+
+def test_coincident_centroids_take_the_normal_from_the_bodies_axes():
+    # The centroid line has zero length and is skipped; the body axes remain.
+    a, b = _cube([0.0, 0.0, 0.0]), 0.5 * _cube([0.0, 0.0, 0.0])
+    g = contact_geometry(a, b, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], np.eye(3), np.eye(3))
+    assert np.array_equal(g.n, [1.0, 0.0, 0.0])     # the first of the tied axes: A's x
+    assert g.depth == 0.75                                     # 0.25 + 0.5, exact in binary
+
+
+def test_no_candidate_axis_raises_a_clear_error():
+    # Coincident centroids and zero orientation axes: every candidate has
+    # zero length. This used to fail with "cannot unpack non-iterable NoneType".
+    a, b = _cube([0.0, 0.0, 0.0]), _cube([0.0, 0.0, 0.0])
+    zero = np.zeros((3, 3))
+    with pytest.raises(ValueError, match="every candidate axis has zero length"):
+        contact_geometry(a, b, [0.0, 0.0, 0.0], [0.0, 0.0, 0.0], zero, zero)

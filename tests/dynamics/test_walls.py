@@ -5,7 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.dynamics.walls import wall_name, wall_response_seed, wall_speed
+from refsim.dynamics.walls import (
+    wall_name,
+    wall_response_points_inplace,
+    wall_response_seed,
+    wall_speed,
+)
 
 E, FRICTION, G = 0.8, 0.25, 9.81
 
@@ -52,3 +57,16 @@ def test_ceiling_and_side_walls_flip_with_their_sign():
 def test_unknown_speed_option_raises():
     with pytest.raises(ValueError):
         wall_response_seed(np.zeros(3), np.zeros(3), np.zeros(3), E, 0.0, G, speed="x")
+
+
+def test_inplace_response_needs_its_scratch_for_the_speed_at_the_wall():
+    # Found by the type checker: without the scratch array, speed="wall"
+    # failed with "unsupported operand type(s) for +: 'NoneType' and 'float'".
+    x, v = np.array([[1.5, 0.0, 0.0]]), np.array([[1.0, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="needs the \\(N,\\) float scratch"):
+        wall_response_points_inplace(x, v, 1.0, 0.7, 0.2, np.empty(1, dtype=bool),
+                                     speed="wall", scratch=None)
+    # the seed's speed needs no scratch
+    n = wall_response_points_inplace(x, v, 1.0, 0.5, 0.2, np.empty(1, dtype=bool),
+                                     speed="seed", scratch=None)
+    assert n == 1 and x[0, 0] == 1.0 and v[0, 0] == -0.5

@@ -55,6 +55,19 @@ def test_torus_volume_closed_form_and_nonconvex():
     assert 0.97 * exact < mesh.volume < exact          # a polyhedral torus is smaller
 
 
+def test_smallest_torus_is_closed():
+    mesh = shapes.torus(1.0, 0.35, 3, 3)
+    assert mesh.n_faces == 18 and mesh.is_closed and mesh.volume > 0.0
+
+
+@pytest.mark.parametrize("n_major, n_minor", [(2, 3), (3, 2), (1, 1)])
+def test_torus_with_fewer_than_three_segments_raises(n_major, n_minor):
+    # Found by the type checker: the surface is open, its volume None, and
+    # the winding check used to fail with "'<' not supported ... NoneType".
+    with pytest.raises(ValueError, match="must be >= 3"):
+        shapes.torus(1.0, 0.35, n_major, n_minor)
+
+
 @pytest.mark.parametrize("build, volume", [
     (shapes.l_beam, 2 * 2.0 * 0.5 * 0.5 - 0.5 * 0.5 * 0.5),
     (shapes.star_prism, None),

@@ -90,3 +90,20 @@ def test_the_step_into_buffers_is_the_step_bit_for_bit(name):
     K, stage, scratch = np.empty((method.stages, 6)), np.empty(6), np.empty(6)
     rk_step_into(method, f_into, 0.2, Y, 0.05, K, stage, scratch)
     assert Y.tobytes() == expected.tobytes()
+
+
+def test_step_into_without_the_stage_buffer_it_needs_raises():
+    # Euler's stage is evaluated at y itself (stage may be None); rk4's are not.
+    from refsim.solvers.explicit_rk import rk_step_into
+
+    def f_into(t, y, out):
+        np.copyto(out, -y)
+
+    Y = np.ones(3)
+    rk_step_into(refsim.SOLVERS["euler"], f_into, 0.0, Y, 0.5, np.empty((1, 3)), None,
+                 np.empty(3))
+    assert Y.tolist() == [0.5, 0.5, 0.5]                # y + h (-y), exact in binary
+    method = refsim.SOLVERS["rk4"]
+    with pytest.raises(ValueError, match="stage 1 of 'rk4' needs the stage buffer"):
+        rk_step_into(method, f_into, 0.0, Y, 0.5, np.empty((method.stages, 3)), None,
+                     np.empty(3))

@@ -28,6 +28,13 @@ def test_results_come_in_task_order_with_failures_carrying_their_message():
     assert result.results[0].wall_seconds > 0 and result.backend == "inprocess"
 
 
+def test_a_failed_result_without_a_message_is_still_a_failure():
+    from refsim.sweep.run import SweepResult, TaskResult
+
+    result = SweepResult((TaskResult("a", "failed"),), "inprocess", 0.0)
+    assert result.failures == {"a": "no reason given"} and not result.ok
+
+
 def test_the_progress_line_never_goes_to_stdout(capsys):
     run_sweep([Task("a", tasks.draws)], progress=True)
     assert capsys.readouterr() == ("", "")          # and stderr is no terminal here
