@@ -42,7 +42,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from tests.fuzz.judge import Failure, innermost_frame
-from tests.fuzz.runner import DUMP_GRACE, ENV, ROOT
+from tests.fuzz.runner import DUMP_GRACE, ENV, ROOT, die_with_parent
 
 #: Bytes a probe may map beyond what the worker maps after its prelude:
 #: more than any honest call with the fixtures needs, far less than "GB".
@@ -188,6 +188,7 @@ def serve() -> None:
     Results go to the original stdout; anything a probe prints goes to
     stderr, with faulthandler's dumps (a crash, or SIGUSR1 at a timeout).
     """
+    die_with_parent()
     results = os.dup(1)
     os.dup2(2, 1)
     faulthandler.enable(sys.stderr, all_threads=True)

@@ -145,7 +145,7 @@ def _names_location(message: str, case: Case, places: dict) -> bool:
         escaped = spelled.encode("utf-8", "backslashreplace").decode("utf-8")
         p = "(?:" + re.escape(spelled) + "|" + re.escape(escaped) + ")"
         patterns = {
-            "line": [rf"^{p}:\d+: ", rf"^{p}: (?:{'|'.join(WHOLE_FILE_MODEL)})"],
+            "line": [rf"^{p}:\d+: ", rf"^{p}: .*(?:{'|'.join(WHOLE_FILE_MODEL)})"],
             "file": [rf"^{p}(?::\d+)?: "],
             "key": [rf"^{p}: {_KEY}: ", rf"^{p}:\d+: ",
                     rf"^{p}: invalid TOML: .*\(at (?:line \d+|end of document)"],
@@ -153,7 +153,7 @@ def _names_location(message: str, case: Case, places: dict) -> bool:
             # the file (trimesh formats), but not "unknown model format":
             # then the scene's key names a file that is no model, and only
             # the scene's file and key say where to look.
-            "model": [rf"^{p}:\d+: ", rf"^{p}: (?:{_WHOLE_FILE_KNOWN_FORMAT})"],
+            "model": [rf"^{p}:\d+: ", rf"^{p}: .*(?:{_WHOLE_FILE_KNOWN_FORMAT})"],
             "model-file": [rf"^{p}: (?!unknown model format)"],
         }[what]
         if any(re.search(pattern, message) for pattern in patterns):

@@ -56,15 +56,33 @@ ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
            MKL_NUM_THREADS="1", NUMBA_NUM_THREADS="1")
 ENV.pop("REFSIM_MODELS", None)          # the bundled models, always
 
-#: The console script (``refsim = refsim.cli:main``) with a memory limit and a
-#: stack dump on SIGUSR1. ``sys.argv[1]`` is the limit in bytes (0: none).
-SHIM = ("import sys, resource, signal, faulthandler\n"
+#: The console script (``refsim = refsim.cli:main``) with a memory limit, no
+#: core file, a stack dump on SIGUSR1, and death with its parent (a killed
+#: campaign leaves no hanging command behind). ``sys.argv[1]`` is the limit
+#: in bytes (0: none).
+SHIM = ("import ctypes, sys, resource, signal, faulthandler\n"
+        "try:\n"
+        "    ctypes.CDLL(None).prctl(1, signal.SIGKILL)   # as die_with_parent()\n"
+        "except (OSError, AttributeError):\n"
+        "    pass\n"
         "limit = int(sys.argv.pop(1))\n"
         "if limit: resource.setrlimit(resource.RLIMIT_AS, (limit, limit))\n"
         "resource.setrlimit(resource.RLIMIT_CORE, (0, 0))\n"
         "faulthandler.register(signal.SIGUSR1, all_threads=True)\n"
         "from refsim.cli import main\n"
         "sys.exit(main())\n")
+
+
+def die_with_parent() -> None:
+    """Have the kernel SIGKILL this process when its parent dies (Linux
+    ``prctl(PR_SET_PDEATHSIG)``; elsewhere nothing): a campaign stopped by
+    Ctrl-C or a crash leaves no fork server, worker or hanging command."""
+    import ctypes
+
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)   # PR_SET_PDEATHSIG = 1
+    except (OSError, AttributeError):
+        pass
 
 
 @dataclass(frozen=True)

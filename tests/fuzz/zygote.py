@@ -36,6 +36,8 @@ import tempfile
 import traceback
 import warnings
 
+from tests.fuzz.runner import die_with_parent
+
 #: The warning state of a fresh interpreter, saved before anything warns.
 _FILTERS = list(warnings.filters)
 _SHOWWARNING = warnings.showwarning
@@ -88,6 +90,7 @@ def _child(request: dict) -> None:
     """Become ``refsim ARGV`` and exit with its status (never returns)."""
     code = 1
     try:
+        die_with_parent()                      # the server's death ends a hanging command
         devnull = os.open(os.devnull, os.O_RDONLY)
         os.dup2(devnull, 0)
         out = os.open(request["stdout"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
@@ -149,6 +152,7 @@ def serve() -> None:
 
 
 if __name__ == "__main__":
+    die_with_parent()
     warm_up()
     print(json.dumps({"ready": os.getpid()}), flush=True)
     serve()
