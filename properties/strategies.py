@@ -564,8 +564,8 @@ def _probe(function, template, args, check=None, law=""):
     """The probe of ``template`` (a format string) filled with ``args``
     (name -> (spelling, class)); ``check`` is filled the same way."""
     spellings = {name: spelling for name, (spelling, _) in args.items()}
-    bad = [f"{name}={spelling.lstrip(', ')}" for name, (spelling, kind) in args.items()
-           if kind == _BAD]
+    bad = [f"{name}={spelling.lstrip(', ').removeprefix(name + '=')}"
+           for name, (spelling, kind) in args.items() if kind == _BAD]
     return _Probe(function, template.format(**spellings), must_refuse=bool(bad),
                   why=", ".join(bad),
                   check=None if check is None or bad else check.format(**spellings), law=law,
@@ -608,21 +608,21 @@ def _mesh_probe(draw):
     scales = ("1e155", "1e154", "-1e155", "1e150", "1e62", "1e308", "1e300", "1e-300",
               "5e-324", "0.0")
     specs = {
-        "v": _arg((f"{base}.vertices",), tuple(f"{base}.vertices * {k}" for k in scales)
+        "vertices": _arg((f"{base}.vertices",), tuple(f"{base}.vertices * {k}" for k in scales)
                   + (f"{base}.vertices.astype(complex)",),
                   ("None", "'abc'", f"np.full_like({base}.vertices, np.nan)",
                    f"{base}.vertices[:, :2]", "np.zeros((0, 3))", "[[0, 0], [1]]")),
-        "f": _arg((f"{base}.faces",), (f"{base}.faces[::-1]", "np.array([[0, 0, 0]])"),
+        "faces": _arg((f"{base}.faces",), (f"{base}.faces[::-1]", "np.array([[0, 0, 0]])"),
                   ("None", "np.array([[0, 1, 99999]])", "np.array([[0, 1, -1]])",
                    "np.array([[0.0, 1.0, 2.0]])", "np.zeros((0, 3), int)",
                    f"{base}.faces[:, :2]", "[[0, 1, 2], [3]]", "np.array([[0, 1, 2**62]])",
                    "'faces'")),
-        "w": _keyword("weld_tolerance", ("0.0", "1e-9"), ("1e308", "5e-324"),
+        "weld_tolerance": _keyword("weld_tolerance", ("0.0", "1e-9"), ("1e308", "5e-324"),
                       ("-1.0", "float('nan')", "float('inf')", "'0'", "None"))}
     args = _draw_args(draw, specs)
     if draw(_st.booleans()):          # a uniform scale that keeps the shape, and its laws
-        args["v"] = (f"{base}.vertices" + draw(_st.sampled_from(_SHAPE_KEEPING)), _GOOD)
-        args["f"], args["w"] = (f"{base}.faces", _GOOD), ("", _GOOD)
+        args["vertices"] = (f"{base}.vertices" + draw(_st.sampled_from(_SHAPE_KEEPING)), _GOOD)
+        args["faces"], args["weld_tolerance"] = (f"{base}.faces", _GOOD), ("", _GOOD)
     attribute = draw(_st.sampled_from(("", ".is_convex", ".volume", ".is_closed",
                                        ".centroid_volume", ".neighbors", ".degenerate_faces",
                                        ".bounds", ".face_areas")))
@@ -633,45 +633,49 @@ def _mesh_probe(draw):
               ".volume": ("_result is None or math.isfinite(_result)", "volume is not finite"),
               ".centroid_volume": ("_result is None or bool(np.isfinite(_result).all())",
                                    "volume centroid is not finite")}
-    keeps_shape = (args["f"][0] == f"{base}.faces" and args["w"][0] == ""
-                   and args["v"][0] in tuple(f"{base}.vertices" + k for k in _SHAPE_KEEPING))
+    keeps_shape = (args["faces"][0] == f"{base}.faces" and args["weld_tolerance"][0] == ""
+                   and args["vertices"][0] in tuple(f"{base}.vertices" + k for k in _SHAPE_KEEPING))
     check, law = checks.get(attribute, (None, "")) if keeps_shape else (None, "")
-    return _probe("Mesh", "Mesh({v}, {f}{w})" + attribute, args, check, law)
+    return _probe("Mesh", "Mesh({vertices}, {faces}{weld_tolerance})" + attribute, args, check,
+                  law)
 
 
 @_st.composite
 def _load_model_probe(draw):
     specs = {
-        "p": _arg(("'cube.ac'", "pathlib.Path('cube.ac')", "CUBE_AC", "'tetrahedron.ac'",
+        "path": _arg(("'cube.ac'", "pathlib.Path('cube.ac')", "CUBE_AC", "'tetrahedron.ac'",
                    "LATIN1_OBJ"),
                   ("COLLINEAR_AC", "'CUBE.AC'"),
                   ("None", "42", "b'cube.ac'", "''", "'/'", "DIR_AC", "FIFO_AC", "LOOP_AC",
                    "'/dev/null'", "'missing.ac'", "NOTES", "JUNK_AC", "EMPTY_AC",
                    "'x' * 5000 + '.ac'", "'cube.ac\\x00'", "['cube.ac']")),
-        "w": _keyword("weld_tolerance", ("1e-9",), ("1e308",), ("-1.0", "float('nan')"))}
-    return _probe("load_model", "load_model({p}{w})", _draw_args(draw, specs))
+        "weld_tolerance": _keyword("weld_tolerance", ("1e-9",), ("1e308",),
+                                   ("-1.0", "float('nan')"))}
+    return _probe("load_model", "load_model({path}{weld_tolerance})", _draw_args(draw, specs))
 
 
 @_st.composite
 def _aabb_linear_probe(draw):
-    specs = {"m": _MESH, "p": _POSE,
-             "k": _keyword("kernel", ("'numpy'", "'numba'"), (), _KERNEL_BAD + ("None",))}
-    return _probe("aabb_linear", "aabb_linear({m}, {p}{k})", _draw_args(draw, specs),
+    specs = {"mesh": _MESH, "pose": _POSE,
+             "kernel": _keyword("kernel", ("'numpy'", "'numba'"), (), _KERNEL_BAD + ("None",))}
+    return _probe("aabb_linear", "aabb_linear({mesh}, {pose}{kernel})", _draw_args(draw, specs),
                   "bool(np.all(_result[0] <= _result[1]))", "lo <= hi fails")
 
 
 @_st.composite
 def _incremental_probe(draw):
-    specs = {"m": _arg(_CONVEX, ("TORUS",) + _HOSTILE_MESHES, _NOT_MESHES), "p": _POSE,
-             "k": _keyword("kernel", ("None", "'numba'", "'python'"), (),
-                           _KERNEL_BAD + ("'numpy'",)),
-             "a": _keyword("allow_nonconvex", ("False",), ("True", "'yes'"), ())}
+    specs = {"mesh": _arg(_CONVEX, ("TORUS",) + _HOSTILE_MESHES, _NOT_MESHES), "pose": _POSE,
+             "kernel": _keyword("kernel", ("None", "'numba'", "'python'"), (),
+                                _KERNEL_BAD + ("'numpy'",)),
+             "allow_nonconvex": _keyword("allow_nonconvex", ("False",), ("True", "'yes'"), ())}
     args = _draw_args(draw, specs)
     check = None
-    if args["m"][0] in _CONVEX and args["a"][0] in ("", ", allow_nonconvex=False"):
-        check = ("bool(np.array_equal(_result[0], aabb_linear({m}, {p})[0]) and "
-                 "np.array_equal(_result[1], aabb_linear({m}, {p})[1]))")
-    return _probe("IncrementalAABB.update", "IncrementalAABB({m}{k}{a}).update({p})", args,
+    if args["mesh"][0] in _CONVEX and args["allow_nonconvex"][0] in (
+            "", ", allow_nonconvex=False"):
+        check = ("bool(np.array_equal(_result[0], aabb_linear({mesh}, {pose})[0]) and "
+                 "np.array_equal(_result[1], aabb_linear({mesh}, {pose})[1]))")
+    return _probe("IncrementalAABB.update",
+                  "IncrementalAABB({mesh}{kernel}{allow_nonconvex}).update({pose})", args,
                   check, "the incremental box differs from the linear scan")
 
 
@@ -704,13 +708,12 @@ def _triangles_probe(draw):
 
 
 def _options(levels, bad_levels=("'bogus'", "'EXACT'", "None", "3", "'none'")):
-    return {"l": _keyword("level", levels, (), bad_levels),
-            "me": _keyword("method", ("'bvh'", "'seed'"), (), ("'bogus'", "None", "'BVH'")),
-            "k": _keyword("kernel", ("None", "'numba'", "'python'"), (), _KERNEL_BAD)}
+    return {"level": _keyword("level", levels, (), bad_levels),
+            "method": _keyword("method", ("'bvh'", "'seed'"), (), ("'bogus'", "None", "'BVH'")),
+            "kernel": _keyword("kernel", ("None", "'numba'", "'python'"), (), _KERNEL_BAD)}
 
 
-_BODY_PAIR = {"A": _MESH, "PA": _POSE, "B": _MESH, "PB": _POSE}
-
+_BODY_PAIR = {"mesh_a": _MESH, "pose_a": _POSE, "mesh_b": _MESH, "pose_b": _POSE}
 
 #: Offsets of two copies of one mesh placed at +t and -t on every axis: the
 #: copies overlap when the mesh is larger than t, at coordinates up to 1e308.
@@ -724,43 +727,46 @@ def _bodies_collide_probe(draw):
         # (module docstring of refsim.collision.bodies), it never says apart where
         # "exact" says touching; half the time two copies of one mesh mirrored
         # about the origin, which overlap at any scale
-        levels = ("{{l: bodies_collide({A}, {PA}, {B}, {PB}, level=l, method='seed') "
-                  "for l in LEVELS}}")
+        levels = ("{{l: bodies_collide({mesh_a}, {pose_a}, {mesh_b}, {pose_b}, level=l, "
+                  "method='seed') for l in LEVELS}}")
         if draw(_st.booleans()):
             mesh = draw(_st.sampled_from(_MODELS + _HOSTILE_MESHES))
             t = draw(_st.sampled_from(_MIRROR_OFFSETS))
             kind, offset = (_GOOD if mesh in _MODELS else _EDGE), (_GOOD if t == "0.25"
                                                                    else _EDGE)
-            args = {"A": (mesh, kind), "B": (mesh, kind),
-                    "PA": (f"(np.eye(3), np.full(3, {t}))", offset),
-                    "PB": (f"(np.eye(3), np.full(3, -{t}))", offset)}
+            args = {"mesh_a": (mesh, kind), "mesh_b": (mesh, kind),
+                    "pose_a": (f"(np.eye(3), np.full(3, {t}))", offset),
+                    "pose_b": (f"(np.eye(3), np.full(3, -{t}))", offset)}
         else:
             args = _draw_args(draw, _BODY_PAIR)
         return _probe("bodies_collide", levels, args,
                       "not _result['exact'] or all(_result.values())",
                       "a coarser level says apart where exact says touching")
     specs = _BODY_PAIR | _options(("'sphere'", "'aabb'", "'triangle-aabb'", "'exact'"))
-    return _probe("bodies_collide", "bodies_collide({A}, {PA}, {B}, {PB}{l}{me}{k})",
+    return _probe("bodies_collide",
+                  "bodies_collide({mesh_a}, {pose_a}, {mesh_b}, {pose_b}{level}{method}{kernel})",
                   _draw_args(draw, specs),
-                  "_result == bodies_collide({B}, {PB}, {A}, {PA}{l}{me}{k})",
-                  "not symmetric in its bodies")
+                  "_result == bodies_collide({mesh_b}, {pose_b}, {mesh_a}, {pose_a}"
+                  "{level}{method}{kernel})", "not symmetric in its bodies")
 
 
 @_st.composite
 def _intersecting_pairs_probe(draw):
     specs = _BODY_PAIR | _options(("'exact'", "'triangle-aabb'"),
                                   ("'sphere'", "'aabb'", "'bogus'", "None"))
-    return _probe("intersecting_pairs", "intersecting_pairs({A}, {PA}, {B}, {PB}{l}{me}{k})",
+    pair = "{mesh_a}, {pose_a}, {mesh_b}, {pose_b}"
+    return _probe("intersecting_pairs", "intersecting_pairs(" + pair + "{level}{method}{kernel})",
                   _draw_args(draw, specs),
-                  "bool(np.array_equal(intersecting_pairs({A}, {PA}, {B}, {PB}{l}, "
-                  "method='seed'), intersecting_pairs({A}, {PA}, {B}, {PB}{l}, method='bvh')))",
+                  "bool(np.array_equal(intersecting_pairs(" + pair + "{level}, method='seed'), "
+                  "intersecting_pairs(" + pair + "{level}, method='bvh')))",
                   "methods 'seed' and 'bvh' disagree")
 
 
 @_st.composite
 def _step_probe(draw):
     specs = {
-        "s": _arg(("'euler'", "'averaged-euler'", "'backwards-euler'", "'midpoint'", "'rk4'")),
+        "solver": _arg(("'euler'", "'averaged-euler'", "'backwards-euler'", "'midpoint'",
+                        "'rk4'")),
         "f": _arg(("decay",), ("lambda t, y: np.full_like(y, np.nan)", "lambda t, y: y * 1e308"),
                   ("None", "42", "lambda t, y: None", "lambda t, y: 'x'",
                    "lambda t, y: np.zeros(7)")),
@@ -771,7 +777,7 @@ def _step_probe(draw):
                   ("None", "'abc'", "np.zeros((2, 2))")),
         "h": _arg(("0.1",), ("5e-324", "1e308", "0.0", "-0.1", "float('nan')", "float('inf')"),
                   ("None", "'0.1'"))}
-    return _probe("SOLVERS[name].step", "SOLVERS[{s}].step({f}, {t}, {y}, {h})",
+    return _probe("SOLVERS[name].step", "SOLVERS[{solver}].step({f}, {t}, {y}, {h})",
                   _draw_args(draw, specs), "np.shape(_result) == np.shape({y})",
                   "the state changes shape")
 
@@ -780,28 +786,29 @@ def _step_probe(draw):
 def _integrate_probe(draw):
     specs = {
         "f": _arg(("decay",), (), ("None", "lambda t, y: None", "lambda t, y: np.zeros(7)")),
-        "y": _arg(("[1.0]", "np.array([1.0, 0.5])"), ("np.array([1e308])", "1.0", "[]"),
-                  ("None", "np.array([np.nan])", "np.zeros((2, 2))", "'abc'")),
+        "y0": _arg(("[1.0]", "np.array([1.0, 0.5])"), ("np.array([1e308])", "1.0", "[]"),
+                   ("None", "np.array([np.nan])", "np.zeros((2, 2))", "'abc'")),
         "t0": _arg(("0.0",), ("-1e308",), ("float('nan')", "None")),
         "t1": _arg(("1.0", "0.5"), ("1e9", "1e308"), ("float('inf')", "-1.0", "None")),
         "h": _arg(("0.1", "0.25"), ("5e-324", "1e-9", "1.0", "0.3", "1e308"),
                   ("0.0", "-0.1", "float('nan')", "None", "'0.1'")),
-        "m": _keyword("method", ("'rk4'", "'euler'", "'midpoint'"), (), ("'bogus'", "None", "3")),
-        "ls": _keyword("last_step", ("'error'", "'short'"), (), ("'bogus'", "None"))}
-    return _probe("integrate", "integrate({f}, {y}, {t0}, {t1}, {h}{m}{ls})",
+        "method": _keyword("method", ("'rk4'", "'euler'", "'midpoint'"), (),
+                           ("'bogus'", "None", "3")),
+        "last_step": _keyword("last_step", ("'error'", "'short'"), (), ("'bogus'", "None"))}
+    return _probe("integrate", "integrate({f}, {y0}, {t0}, {t1}, {h}{method}{last_step})",
                   _draw_args(draw, specs),
-                  "_result[1].shape == (len(_result[0]), np.atleast_1d({y}).size)",
+                  "_result[1].shape == (len(_result[0]), np.atleast_1d({y0}).size)",
                   "y does not have shape (steps + 1, d)")
 
 
 @_st.composite
 def _load_scene_probe(draw):
-    specs = {"p": _arg(
+    specs = {"path": _arg(
         ("'bounce.toml'", "SCENE_FILE", "pathlib.Path(SCENE_FILE)", "'particles.toml'"), (),
         ("None", "42", "DIR_TOML", "FIFO_TOML", "ZERO_TOML", "LOOP_TOML", "DEEP_TOML",
          "LATIN1_TOML", "'missing.toml'", "''", "'x' * 5000 + '.toml'", "b'bounce.toml'",
          "'bounce.toml\\x00'", "'/dev/null'"))}
-    return _probe("load_scene", "load_scene({p})", _draw_args(draw, specs),
+    return _probe("load_scene", "load_scene({path})", _draw_args(draw, specs),
                   "scene_absurdity(_result) is None", "accepts a physically absurd scene")
 
 
@@ -859,25 +866,27 @@ _SCENE = _arg(("BOUNCE", "HEADON", "SPIN"),
 
 @_st.composite
 def _simulate_probe(draw):
-    specs = {"s": _SCENE,
-             "d": _arg((", duration=0.01", ", duration=0.004"), (),
-                       (", duration=-1.0", ", duration=0.0", ", duration=float('nan')",
-                        ", duration=float('inf')", ", duration='0.1'", ", duration=1e9",
-                        ", duration=5e-324", ", duration=1e-9")),
-             "e": _keyword("every", ("1", "3"), ("10**30",),
-                           ("0", "-1", "2.5", "'2'", "float('nan')"))}
-    return _probe("simulate", "simulate({s}{d}{e})", _draw_args(draw, specs),
+    specs = {"scene": _SCENE,
+             "duration": _arg((", duration=0.01", ", duration=0.004"), (),
+                              (", duration=-1.0", ", duration=0.0", ", duration=float('nan')",
+                               ", duration=float('inf')", ", duration='0.1'", ", duration=1e9",
+                               ", duration=5e-324", ", duration=1e-9")),
+             "every": _keyword("every", ("1", "3"), ("10**30",),
+                               ("0", "-1", "2.5", "'2'", "float('nan')"))}
+    return _probe("simulate", "simulate({scene}{duration}{every})", _draw_args(draw, specs),
                   "_result.n_frames >= 2 and bool(np.isfinite(_result.position).all())",
                   "returns fewer than two frames or non-finite positions")
 
 
 @_st.composite
 def _simulation_probe(draw):
-    specs = {"s": _SCENE,
-             "w": _keyword("wall_speed", ("'wall'", "'seed'"), (), ("'bogus'", "None")),
-             "b": _keyword("boxes", ("'auto'", "'trackers'", "'batched'"), (), ("'bogus'", "3")),
-             "n": _arg(("1", "3"), ("0",), ("-1", "2.5", "None", "'3'", "10**9"))}
-    return _probe("Simulation", "Simulation({s}{w}{b}).run({n})", _draw_args(draw, specs))
+    specs = {"scene": _SCENE,
+             "wall_speed": _keyword("wall_speed", ("'wall'", "'seed'"), (), ("'bogus'", "None")),
+             "boxes": _keyword("boxes", ("'auto'", "'trackers'", "'batched'"), (),
+                               ("'bogus'", "3")),
+             "n_steps": _arg(("1", "3"), ("0",), ("-1", "2.5", "None", "'3'", "10**9"))}
+    return _probe("Simulation", "Simulation({scene}{wall_speed}{boxes}).run({n_steps})",
+                  _draw_args(draw, specs))
 
 
 _PARTICLE_FIELDS = {
@@ -903,48 +912,54 @@ _PARTICLE_FIELDS = {
 
 
 @_st.composite
-def _particle_kwargs(draw, count=None):
-    """``ParticleConfig`` keyword arguments: up to four fields, at most two of
-    them hostile; with ``count``, that count."""
+def _particle_fields(draw, count=None):
+    """``ParticleConfig`` keyword arguments as probe arguments (name ->
+    (``name=spelling``, class)): up to four fields, at most two hostile;
+    with ``count``, that count."""
     names = draw(_st.lists(_st.sampled_from(sorted(_PARTICLE_FIELDS)), max_size=4,
                            unique=True))
-    fields = {name: _PARTICLE_FIELDS[name] for name in names if name != "count" or
-              count is None}
-    args = _draw_args(draw, fields) if fields else {}
+    specs = {name: _PARTICLE_FIELDS[name] for name in names if name != "count" or count is None}
+    args = _draw_args(draw, specs) if specs else {}
     if count is not None:
         args["count"] = count
-    text = ", ".join(f"{name}={spelling}" for name, (spelling, _) in args.items())
-    kinds = [kind for _, kind in args.values()]
-    return text, _BAD if _BAD in kinds else _EDGE if _EDGE in kinds else _GOOD
+    return {name: (f"{name}={spelling}", kind) for name, (spelling, kind) in args.items()}
+
+
+def _call(name: str, args: dict) -> str:
+    """``name({a}, {b}, ...)``: a template calling ``name`` with every argument."""
+    return name + "(" + ", ".join("{" + key + "}" for key in args) + ")"
 
 
 @_st.composite
 def _particle_config_probe(draw):
-    return _probe("ParticleConfig", "ParticleConfig({k})", {"k": draw(_particle_kwargs())})
+    args = draw(_particle_fields())
+    return _probe("ParticleConfig", _call("ParticleConfig", args), args)
 
 
 @_st.composite
 def _particle_system_probe(draw):
-    specs = {"x": _arg(("",), (), (", positions=np.zeros((10, 3))",
-                                   ", positions=np.zeros((10, 2)), velocities=np.zeros((10, 2))",
-                                   ", positions=np.full((10, 3), np.nan), "
-                                   "velocities=np.zeros((10, 3))",
-                                   ", positions='abc', velocities='abc'")),
-             "k": _keyword("kernel", ("'numpy'",), ("'fused'",), ("'bogus'", "3")),
-             "n": _arg(("1", "5"), ("0",), ("-5", "2.5", "None", "'3'", "10**9")),
+    specs = {"state": _arg(("",), (), (", positions=np.zeros((10, 3))",
+                                       ", positions=np.zeros((10, 2)), "
+                                       "velocities=np.zeros((10, 2))",
+                                       ", positions=np.full((10, 3), np.nan), "
+                                       "velocities=np.zeros((10, 3))",
+                                       ", positions='abc', velocities='abc'")),
+             "kernel": _keyword("kernel", ("'numpy'",), ("'fused'",), ("'bogus'", "3")),
+             "steps": _arg(("1", "5"), ("0",), ("-5", "2.5", "None", "'3'", "10**9")),
              "count": _arg(("10",), ("10**8",), ("10**10",))}
     args = _draw_args(draw, specs)
-    args["c"] = draw(_particle_kwargs(count=args.pop("count")))
-    return _probe("ParticleSystem.run", "ParticleSystem(ParticleConfig({c}){x}{k}).run({n})",
-                  args)
+    fields = draw(_particle_fields(count=args.pop("count")))
+    args |= fields
+    return _probe("ParticleSystem.run", "ParticleSystem(" + _call("ParticleConfig", fields)
+                  + "{state}{kernel}).run({steps})", args)
 
 
 @_st.composite
 def _trajectory_probe(draw):
-    specs = {"p": _arg(("GOOD_NPZ", "pathlib.Path(GOOD_NPZ)"), (),
-                       ("None", "'missing.npz'", "DIR_AC", "JUNK_NPZ", "PARTIAL_NPZ",
-                        "PICKLE_NPZ", "FIFO_NPZ", "'/dev/null'", "42", "SCENE_FILE"))}
-    return _probe("Trajectory.load", "Trajectory.load({p})", _draw_args(draw, specs),
+    specs = {"path": _arg(("GOOD_NPZ", "pathlib.Path(GOOD_NPZ)"), (),
+                          ("None", "'missing.npz'", "DIR_AC", "JUNK_NPZ", "PARTIAL_NPZ",
+                           "PICKLE_NPZ", "FIFO_NPZ", "'/dev/null'", "42", "SCENE_FILE"))}
+    return _probe("Trajectory.load", "Trajectory.load({path})", _draw_args(draw, specs),
                   "_result.n_frames >= 1", "loads no frames")
 
 

@@ -46,10 +46,10 @@ KNOWN = {
                               "(refsim/bounds/aabb_incremental.py __init__)",
     "triangles_intersect": "ValueError from np.asarray for a string triangle (as_triangle in "
                            "refsim/collision/triangle.py)",
-    "bodies_collide": "UnboundLocalError 'best' in build_tree (refsim/collision/bvh.py) for "
-                      "coordinates >= 1e154",
-    "intersecting_pairs": "UnboundLocalError 'best' in build_tree (refsim/collision/bvh.py) "
-                          "for coordinates >= 1e154",
+    "bodies_collide": "ValueError, not OptionError, for an unknown kernel (check_kernel in "
+                      "refsim/collision/bvh.py)",
+    "intersecting_pairs": "ValueError, not OptionError, for an unknown kernel (check_kernel "
+                          "in refsim/collision/bvh.py)",
     "SOLVERS[name].step": "TypeError for a right-hand side that is not callable (rk_step in "
                           "refsim/solvers/explicit_rk.py)",
     "integrate": "TypeError for f=None (counted_f in refsim/solvers/integrate.py)",

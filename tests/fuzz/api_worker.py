@@ -41,7 +41,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-from tests.fuzz.judge import Failure, innermost_frame
+from tests.fuzz.judge import Failure, exception_name, innermost_frame
 from tests.fuzz.runner import DUMP_GRACE, ENV, ROOT, die_with_parent
 
 #: Bytes a probe may map beyond what the worker maps after its prelude:
@@ -360,7 +360,7 @@ def judge_probe(probe: Probe, outcome: ProbeOutcome) -> list[Failure]:
     if facts["status"] == "raised":
         where = facts["frame"]
         if not facts["refsim"]:
-            return [Failure("traceback", f"{facts['type']} in {where}",
+            return [Failure("traceback", f"{exception_name(facts['type'])} in {where}",
                             f"{facts['type']}: {facts['message']}"[:300])]
         if not (facts["value_error"] or facts["type_error"] or facts["allowed_other"]):
             return [Failure("bad message", f"plain {facts['type']} (neither ValueError nor "
@@ -371,8 +371,10 @@ def judge_probe(probe: Probe, outcome: ProbeOutcome) -> list[Failure]:
         return []
     found = []
     if probe.must_refuse:
-        found.append(Failure("bad output", f"{probe.function} accepts {probe.why}",
-                             f"returned {facts['repr']}"[:300]))
+        names = sorted({part.split("=", 1)[0] for part in probe.why.split(", ") if part})
+        found.append(Failure("bad output",
+                             f"{probe.function} accepts a forbidden {', '.join(names)}",
+                             f"{probe.why}: returned {facts['repr']}"[:300]))
     if probe.check is not None and facts["check"] is False:
         found.append(Failure("bad output", f"{probe.function}: {probe.law}",
                              facts.get("check_error", f"returned {facts['repr']}")[:300]))

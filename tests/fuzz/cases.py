@@ -30,7 +30,6 @@ mutator from ``random.Random("family/mutator/seed/index")``, so a case id
 
 from __future__ import annotations
 
-import pwd
 import random
 import signal
 from collections.abc import Iterator
@@ -49,9 +48,6 @@ RUN_ARGS = ("-o", "out.npz", "--duration", "0.02")
 #: Scenes that reference a mutant model (scene+model), with their bodies: every
 #: body of these scenes gets the mutant except in mixed.toml, where one does.
 MODEL_HOSTS = ("bounce.toml", "head-on.toml", "spinning-cube.toml", "mixed.toml")
-
-#: The user a permission case runs as (root reads every file).
-NOBODY = pwd.getpwnam("nobody").pw_uid
 
 #: Seconds a long polygon may take (the ear clipper must be fast: a 20 000
 #: corner polygon is a fraction of a second of work for an O(n log n) or a
@@ -94,6 +90,8 @@ class Case:
     output: the file the command writes when it succeeds (or diverges).
     facts: ``refsim info`` lines an accepted model must print.
     must_refuse: accepting the input is a failure.
+    unprivileged: run without root's file-permission override (a permission
+    case: root reads every file otherwise).
     """
 
     id: str
@@ -109,7 +107,7 @@ class Case:
     output: str | None = None
     facts: tuple[tuple[str, str], ...] = ()
     must_refuse: bool = False
-    uid: int | None = None
+    unprivileged: bool = False
     interrupt: tuple[int, str, float] | None = None
     timeout: float = TIMEOUT
 
@@ -245,17 +243,19 @@ def special_cases() -> list[Case]:
     scene_with = lambda model: _bounce().replace(b'"sphere-2k.ac"', f'"{model}"'.encode())  # noqa: E731
     cases = []
 
-    def model(name, path, *, specials=(), files=(), forbid=not_missing, uid=None,
+    def model(name, path, *, specials=(), files=(), forbid=not_missing, unprivileged=False,
               names=None, must_refuse=True, timeout=TIMEOUT):
         cases.append(_fixed("special", "model-" + name, argv=("info", path),
-                            specials=specials, files=files, forbid=forbid, uid=uid,
+                            specials=specials, files=files, forbid=forbid,
+                            unprivileged=unprivileged,
                             names=((path, "file"),) if names is None else names,
                             must_refuse=must_refuse, timeout=timeout))
 
-    def scene(name, path, *, specials=(), files=(), forbid=not_missing, uid=None,
+    def scene(name, path, *, specials=(), files=(), forbid=not_missing, unprivileged=False,
               names=None, must_refuse=True, timeout=TIMEOUT):
         cases.append(_fixed("special", "scene-" + name, argv=("run", path, *RUN_ARGS),
-                            specials=specials, files=files, forbid=forbid, uid=uid,
+                            specials=specials, files=files, forbid=forbid,
+                            unprivileged=unprivileged,
                             names=((path, "file"),) if names is None else names,
                             output="{out}/out.npz", must_refuse=must_refuse,
                             timeout=timeout))
@@ -269,11 +269,11 @@ def special_cases() -> list[Case]:
         add("symlink-loop", p, specials=(Special("symlink", p, p),))
         add("dangling-symlink", p, specials=(Special("symlink", p, "{in}/gone" + suffix),),
             forbid=())
-        add("unreadable", p, uid=NOBODY,
+        add("unreadable", p, unprivileged=True,
             specials=(Special("unreadable", p, content=_cube() if role == "model"
                               else _bounce()),))
         add("missing-directory", "{in}/no/x" + suffix, forbid=())
-        add("in-locked-directory", "{in}/locked/x" + suffix, uid=NOBODY, forbid=(),
+        add("in-locked-directory", "{in}/locked/x" + suffix, unprivileged=True, forbid=(),
             specials=(Special("locked-dir", "{in}/locked", "x" + suffix,
                               _cube() if role == "model" else _bounce()),))
         add("name-too-long", "{in}/" + "x" * 300 + suffix, forbid=())
@@ -339,7 +339,7 @@ def output_cases() -> list[Case]:
     cases.append(_fixed("output", "read-only-directory", argv=(
         "run", scene, "-o", "{out}/ro/out.npz", "--duration", "0.02"), files=files,
         specials=(Special("readonly-dir", "{out}/ro"),), output="{out}/ro/out.npz",
-        uid=NOBODY, must_refuse=True))
+        unprivileged=True, must_refuse=True))
     return cases
 
 

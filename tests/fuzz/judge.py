@@ -64,10 +64,6 @@ _KEY = r"[A-Za-z_][\w-]*(?:\[\d+\])*(?:\.[A-Za-z_][\w-]*(?:\[\d+\])*)*"
 
 _WHOLE_FILE_KNOWN_FORMAT = "|".join(w for w in WHOLE_FILE_MODEL if "unknown" not in w)
 
-#: numpy's RuntimeWarning texts ("overflow encountered in multiply"): shown as
-#: ``refsim: warning:`` lines they say nothing a user can act on.
-_NUMPY_WARNING = re.compile(r"encountered in \w+")
-
 
 @dataclass(frozen=True)
 class Failure:
@@ -114,22 +110,42 @@ def innermost_frame(stderr: str, dump: bool) -> str:
     return f"{_short(chosen[0])}:{chosen[2]}"
 
 
+def exception_name(name: str) -> str:
+    """An exception's name without its module (``numpy.linalg.LinAlgError``
+    and ``LinAlgError`` are one cause), numpy's ``_ArrayMemoryError`` as the
+    MemoryError it is."""
+    name = name.rsplit(".", 1)[-1]
+    return "MemoryError" if name.endswith("MemoryError") else name
+
+
 def exception_type(stderr: str) -> str:
     """The type of the last exception of a traceback, e.g. ``RecursionError``."""
     block = stderr.rsplit("Traceback (most recent call last):", 1)[-1]
     for line in block.splitlines()[1:]:
         if line and not line.startswith((" ", "\t")):
-            return line.split(":", 1)[0].strip()
+            return exception_name(line.split(":", 1)[0].strip())
     return "?"
 
 
+#: numpy's RuntimeWarning texts ("overflow encountered in multiply"): shown as
+#: ``refsim: warning:`` lines they say nothing a user can act on.
+_NUMPY_WARNING = re.compile(r"(?:overflow|invalid value|divide by zero|underflow) "
+                            r"encountered in \w+")
+
+
 def normalize(message: str, places: dict) -> str:
-    """``message`` with the case's directories, numbers and quoted names
-    blanked, so that one root cause gives one signature."""
+    """``message`` with what varies between cases of one root cause blanked:
+    the case's files (``<file>``), other absolute paths, quoted names,
+    numbers, the bytes of a decoding error and numpy's warning texts."""
     for key, value in places.items():
         message = message.replace(value, key.strip("{}").join("<>"))
+    message = re.sub(r"<(?:in|out)>/[^\s:,'\"()]*", "<file>", message)
+    message = re.sub(r"(?<![\w<.])/(?:[\w.+\-]+/)*[\w.+\-]+", "<path>", message)
+    message = _NUMPY_WARNING.sub("<numpy warning>", message)
+    message = re.sub(r"can't decode byte .*", "can't decode byte …", message)
     message = re.sub(r"'[^']*'", "'…'", message)
     message = re.sub(r'"[^"]*"', '"…"', message)
+    message = re.sub(r"0x[0-9a-fA-F]+", "N", message)
     message = re.sub(r"(?<![\w<])[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?", "N", message)
     return message[:160]
 
@@ -170,7 +186,7 @@ def _refusal(case: Case, record: Record, lines: list[str]) -> list[Failure]:
                      else "")
         what = ("argparse usage and error" if first.startswith("usage:")
                 else "no error line" if not lines else normalize(first, places))
-        found.append(Failure("bad message", f"refusal prints {len(lines)} stderr lines: {what}",
+        found.append(Failure("bad message", f"refusal prints more than one line: {what}",
                              " | ".join(lines)[:300]))
         if len(errors) != 1 or first.startswith("usage:"):
             return found
@@ -190,16 +206,15 @@ def _refusal(case: Case, record: Record, lines: list[str]) -> list[Failure]:
                              message[:300]))
     for pattern in case.forbid:
         if re.search(pattern, message):
-            found.append(Failure("bad message",
-                                 f"wrong reason for {case.mutator}: {normalize(message, places)}",
-                                 message[:300]))
+            found.append(Failure("bad message", f"wrong reason: {normalize(message, places)}",
+                                 f"{case.mutator}: {message[:300]}"))
     return found
 
 
 def _accepted(case: Case, record: Record) -> list[Failure]:
     found = []
     if case.must_refuse:
-        found.append(Failure("bad output", f"accepted {case.family} {case.mutator}",
+        found.append(Failure("bad output", f"accepted what must be refused: {case.mutator}",
                              record.outcome.stdout[:300]))
     if record.output_problem:
         found.append(Failure("bad output", f"accepted: {record.output_problem}",
@@ -262,8 +277,8 @@ def judge(case: Case, record: Record) -> Verdict:
             leaked = [line for line in lines
                       if line.startswith(WARNING) and _NUMPY_WARNING.search(line)]
             if leaked:
-                failures.append(Failure("bad message", "numpy RuntimeWarning shown as a "
-                                        f"refsim warning: {normalize(leaked[0], places)}",
+                failures.append(Failure("bad message",
+                                        "numpy RuntimeWarning shown as a refsim warning",
                                         " | ".join(leaked)[:300]))
             failures += _accepted(case, record)
             accepted = True

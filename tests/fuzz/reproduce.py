@@ -4,7 +4,8 @@
 mutant and any other input file, byte for byte) and ``repro.sh``, which makes
 a fresh temporary directory, copies ``in/`` there, makes the special nodes
 (FIFOs, symlinks, a device node, an unreadable file), changes to ``out/`` and
-runs the command the campaign ran, with its timeout, as its user. It then
+runs the command the campaign ran, with its timeout (and, for a permission
+case, without root's file-permission override, through ``setpriv``). It then
 prints the exit status and what is left in ``out/``. The command is
 ``${REFSIM:-refsim}``: put the project's ``.venv/bin`` on PATH, or set
 ``REFSIM=.venv/bin/refsim``.
@@ -20,7 +21,8 @@ import re
 import shlex
 from pathlib import Path
 
-from tests.fuzz.cases import NOBODY, Case
+from tests.fuzz.cases import Case
+from tests.fuzz.runner import UNPRIVILEGED
 
 
 def shell_word(text: str) -> str:
@@ -73,8 +75,7 @@ def write_reproducer(case: Case, dest: Path, signature: str = "") -> Path:
             _local(special.path, dest).write_bytes(special.content)
             if special.kind == "unreadable":
                 make.append(f"chmod 000 {where}")
-    user = (f"setpriv --reuid={NOBODY} --regid={NOBODY} --clear-groups "
-            if case.uid is not None else "")
+    user = " ".join(UNPRIVILEGED) + " " if case.unprivileged else ""
     command = (f"timeout -s KILL {case.timeout:g} {user}\"${{REFSIM:-refsim}}\" "
                + " ".join(shell_word(a) for a in case.argv))
     if case.interrupt is None:
@@ -94,9 +95,8 @@ def write_reproducer(case: Case, dest: Path, signature: str = "") -> Path:
         "set -u",
         'here=$(cd "$(dirname "$0")" && pwd)',
         "work=$(mktemp -d)",
-        'chmod 755 "$work"',
         'cp -R "$here/in" "$work/in"',
-        'mkdir -m 777 "$work/out"',
+        'mkdir "$work/out"',
         *make,
         'cd "$work/out"',
         *run,

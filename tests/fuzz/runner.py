@@ -73,6 +73,44 @@ SHIM = ("import ctypes, sys, resource, signal, faulthandler\n"
         "sys.exit(main())\n")
 
 
+#: ``setpriv`` (util-linux) dropping root's file-permission override from the
+#: command it runs (the bounding set caps what the new program may hold).
+UNPRIVILEGED = ("setpriv", "--bounding-set", "-dac_override,-dac_read_search")
+
+#: Linux capability numbers (linux/capability.h).
+CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH = 1, 2
+
+
+def drop_file_capabilities() -> None:
+    """Drop CAP_DAC_OVERRIDE and CAP_DAC_READ_SEARCH from this process (and
+    from what it may exec): root then obeys file permissions like any user.
+
+    ``capget``/``capset`` with the version-3 header (two 32-bit words per
+    set); both capabilities are in the first word.
+    """
+    import ctypes
+
+    class Header(ctypes.Structure):
+        _fields_ = [("version", ctypes.c_uint32), ("pid", ctypes.c_int)]
+
+    class Data(ctypes.Structure):
+        _fields_ = [("effective", ctypes.c_uint32), ("permitted", ctypes.c_uint32),
+                    ("inheritable", ctypes.c_uint32)]
+
+    libc = ctypes.CDLL(None, use_errno=True)
+    header, data = Header(0x20080522, 0), (Data * 2)()
+    if libc.capget(ctypes.byref(header), data) != 0:
+        raise OSError(ctypes.get_errno(), "capget failed")
+    keep = ~((1 << CAP_DAC_OVERRIDE) | (1 << CAP_DAC_READ_SEARCH)) & 0xFFFFFFFF
+    data[0].effective &= keep
+    data[0].permitted &= keep
+    data[0].inheritable &= keep
+    for cap in (CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH):
+        libc.prctl(24, cap)                                  # PR_CAPBSET_DROP
+    if libc.capset(ctypes.byref(header), data) != 0:
+        raise OSError(ctypes.get_errno(), "capset failed")
+
+
 def die_with_parent() -> None:
     """Have the kernel SIGKILL this process when its parent dies (Linux
     ``prctl(PR_SET_PDEATHSIG)``; elsewhere nothing): a campaign stopped by
@@ -91,8 +129,10 @@ class Command:
 
     ``interrupt = (signum, pattern, delay)`` sends ``signum`` ``delay``
     seconds after a file matching the glob ``pattern`` appears in ``cwd``.
-    ``uid`` runs the command as that user (root reads any file, so a
-    permission case runs as ``nobody``).
+    ``unprivileged`` runs it without the capabilities that let root read
+    and search any file (CAP_DAC_OVERRIDE, CAP_DAC_READ_SEARCH): file
+    permissions then apply to it as to any user, while it can still run the
+    interpreter (which may live in root's private home).
     """
 
     argv: tuple[str, ...]
@@ -100,7 +140,7 @@ class Command:
     stdout: Path
     stderr: Path
     timeout: float = TIMEOUT
-    uid: int | None = None
+    unprivileged: bool = False
     interrupt: tuple[int, str, float] | None = None
     memory: int = MEMORY_LIMIT
 
@@ -186,16 +226,15 @@ class ExecRunner:
         self.python = python
 
     def argv(self, command: Command) -> list[str]:
-        return [self.python, "-X", "faulthandler", "-c", SHIM, str(command.memory),
-                *command.argv]
+        return [*(UNPRIVILEGED if command.unprivileged else ()), self.python, "-X",
+                "faulthandler", "-c", SHIM, str(command.memory), *command.argv]
 
     def run(self, command: Command) -> Outcome:
         start = time.monotonic()
         with open(command.stdout, "wb") as out, open(command.stderr, "wb") as err:
             process = subprocess.Popen(
                 self.argv(command), cwd=command.cwd, stdin=subprocess.DEVNULL, stdout=out,
-                stderr=err, env=ENV, user=command.uid, group=command.uid,
-                extra_groups=[] if command.uid is not None else None)
+                stderr=err, env=ENV)
 
             def poll(seconds):
                 try:
@@ -258,7 +297,7 @@ class ForkServer:
         start = time.monotonic()
         request = {"argv": list(command.argv), "cwd": str(command.cwd),
                    "stdout": str(command.stdout), "stderr": str(command.stderr),
-                   "uid": command.uid, "memory": command.memory}
+                   "unprivileged": command.unprivileged, "memory": command.memory}
         self._process.stdin.write((json.dumps(request) + "\n").encode())
         self._process.stdin.flush()
         pid = self._message(60.0)["pid"]

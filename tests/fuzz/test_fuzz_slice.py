@@ -19,10 +19,6 @@ Every failure message ends with the case's reproducer:
 
 from __future__ import annotations
 
-import shutil
-import tempfile
-from pathlib import Path
-
 import pytest
 
 from tests.fuzz.api_worker import Probe, judge_probe, shared_runner
@@ -144,15 +140,6 @@ CASES = [
 
 
 @pytest.fixture(scope="module")
-def workdir():
-    """Where the cases run: world-searchable, since some run as ``nobody``
-    (pytest's own temporary directories are private to root)."""
-    path = Path(tempfile.mkdtemp(prefix="refsim-fuzz-slice-"))
-    yield path
-    shutil.rmtree(path, ignore_errors=True)
-
-
-@pytest.fixture(scope="module")
 def fork_server(tmp_path_factory):
     server = ForkServer(log=tmp_path_factory.mktemp("zygote") / "zygote.log")
     yield server
@@ -176,10 +163,10 @@ def _case_report(case, record, verdict) -> str:
 
 
 @pytest.mark.parametrize(("case_id", "expected"), CASES)
-def test_command_line_keeps_the_error_laws(case_id, expected, fork_server, workdir):
+def test_command_line_keeps_the_error_laws(case_id, expected, fork_server, tmp_path):
     case = case_from_id(case_id)
     case = with_timeout(case, min(case.timeout, CASE_TIMEOUT.get(case_id, SLICE_TIMEOUT)))
-    record = execute(case, fork_server, workdir)
+    record = execute(case, fork_server, tmp_path)
     verdict = judge(case, record)
     report = _case_report(case, record, verdict)
     assert [f.signature for f in verdict.failures] == [], report

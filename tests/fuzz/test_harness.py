@@ -117,22 +117,25 @@ def test_one_line_naming_the_file_and_line_or_key_is_a_good_refusal(stderr, name
 
 def test_a_refusal_without_the_line_is_a_bad_message():
     assert _signatures("refsim: error: /tmp/case/in/m.ac: bad\n") == [
-        "names no file with line or key: <in>/m.ac: bad"]
+        "names no file with line or key: <file>: bad"]
 
 
 def test_a_model_of_unknown_format_in_a_scene_must_name_the_scene_key():
     names = (("{in}/s.toml", "key"), ("{in}/m.txt", "model"))
     assert _signatures("refsim: error: /tmp/case/in/m.txt: unknown model format '.txt'\n",
                        names=names) == [
-        "names no file with line or key: <in>/m.txt: unknown model format '…'"]
+        "names no file with line or key: <file>: unknown model format '…'"]
 
 
 def test_argparse_usage_lines_and_numpy_warnings_are_bad_messages():
     assert _signatures("usage: refsim run\nrefsim run: error: bad\n") == [
-        "refusal prints 2 stderr lines: argparse usage and error"]
+        "refusal prints more than one line: argparse usage and error"]
     assert _signatures("refsim: warning: overflow encountered in multiply\n", 0) == [
-        "numpy RuntimeWarning shown as a refsim warning: "
-        "refsim: warning: overflow encountered in multiply"]
+        "numpy RuntimeWarning shown as a refsim warning"]
+    two = ("refsim: warning: invalid value encountered in divide\n"
+           "refsim: error: /tmp/case/in/m.ac:2: bad\n")
+    assert _signatures(two) == [
+        "refusal prints more than one line: refsim: warning: <numpy warning>"]
 
 
 def test_a_divergence_naming_its_body_twice_is_a_bad_message():
@@ -173,9 +176,13 @@ def test_a_signal_refsim_was_sent_is_no_crash_but_a_left_temp_file_is_a_failure(
         ("files left", "temporary file left after SIGTERM")]
 
 
-def test_normalize_blanks_directories_numbers_and_names():
+def test_normalize_blanks_files_paths_numbers_and_names():
     assert normalize("/tmp/case/in/m.ac:12: vertex 'x' at 1e+308", PLACES) == \
-        "<in>/m.ac:N: vertex '…' at N"
+        "<file>:N: vertex '…' at N"
+    assert normalize("model 'm.ac' not found (looked in /tmp/case/in/m.ac, /work/models/m.ac)",
+                     PLACES) == "model '…' not found (looked in <file>, <path>)"
+    assert normalize("can't decode byte 0xe9 in position 3: invalid start byte", PLACES) == \
+        normalize("can't decode byte 0xff in position 9: invalid continuation byte", PLACES)
 
 
 # -- reproducers ------------------------------------------------------------------------

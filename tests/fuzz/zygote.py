@@ -7,7 +7,8 @@ This process pays that once (imports, then one short run of every bundled
 scene and one ``refsim info`` per model format), then serves requests: for
 each it forks a child that becomes the command line, ``refsim.cli.main(argv)``
 with stdin from /dev/null, stdout and stderr to the given files, the given
-working directory, user and address-space limit. The child does what the
+working directory and address-space limit, and, for a permission case, without
+root's file-permission override. The child does what the
 console script does (``sys.exit(main())``); an exception that escapes is
 printed as the interpreter would print it (``Traceback ...``, status 1).
 
@@ -20,7 +21,7 @@ this server are confirmed in a fresh process (:class:`runner.ExecRunner`)
 before they are reported.
 
 Protocol (JSON lines): a request ``{"argv", "cwd", "stdout", "stderr",
-"uid", "memory"}`` on stdin; the replies ``{"pid": n}`` once the child runs
+"unprivileged", "memory"}`` on stdin; the replies ``{"pid": n}`` once the child runs
 and ``{"status": s}`` (the raw ``waitpid`` status) when it ends.
 """
 
@@ -36,7 +37,7 @@ import tempfile
 import traceback
 import warnings
 
-from tests.fuzz.runner import die_with_parent
+from tests.fuzz.runner import die_with_parent, drop_file_capabilities
 
 #: The warning state of a fresh interpreter, saved before anything warns.
 _FILTERS = list(warnings.filters)
@@ -102,10 +103,8 @@ def _child(request: dict) -> None:
         faulthandler.enable(sys.stderr, all_threads=True)
         faulthandler.register(signal.SIGUSR1, file=sys.stderr, all_threads=True)
         os.chdir(request["cwd"])
-        if request.get("uid") is not None:
-            os.setgroups([])
-            os.setgid(request["uid"])
-            os.setuid(request["uid"])
+        if request.get("unprivileged"):
+            drop_file_capabilities()
         if request.get("memory"):
             resource.setrlimit(resource.RLIMIT_AS, (request["memory"], request["memory"]))
         resource.setrlimit(resource.RLIMIT_CORE, (0, 0))   # a crash leaves no core file
