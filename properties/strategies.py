@@ -569,7 +569,8 @@ def _probe(function, template, args, check=None, law=""):
     return _Probe(function, template.format(**spellings), must_refuse=bool(bad),
                   why=", ".join(bad),
                   check=None if check is None or bad else check.format(**spellings), law=law,
-                  must_accept=all(kind == _GOOD for _, kind in args.values()))
+                  must_accept=all(kind == _GOOD for _, kind in args.values()),
+                  bad=tuple(sorted(name for name, (_, kind) in args.items() if kind == _BAD)))
 
 
 _MODELS = ("CUBE", "SPHERE", "TETRA", "TORUS")
@@ -836,20 +837,39 @@ def _table(keys):
     return _st.dictionaries(_st.sampled_from(keys + ("bogus",)), _SCENE_VALUE, max_size=3)
 
 
+#: A valid scene as a dict: one cube dropped in the default world.
+_BASE_SCENE = {"integration": {"step": 0.001, "duration": 0.01},
+               "body": [{"model": "cube.ac", "position": [0.0, 2.0, 0.0]}]}
+
+
 @_st.composite
 def _scene_from_dict_probe(draw):
+    """A valid scene with zero to two hostile changes: a key of any table
+    (or ``[[body]]``, or an unknown table) set to a hostile value, or a
+    table replaced whole; mostly refused, sometimes accepted, and then the
+    scene must not be physically absurd."""
     from refsim.scenes.schema import BODY_FIELDS, PARTICLE_KEYS, TABLES
 
-    body = _st.fixed_dictionaries(
-        {"model": _st.sampled_from(("cube.ac", "sphere-2k.ac", "tetrahedron.ac",
-                                    "missing.ac", "", None, 42, "notes.txt"))},
-        optional={f.name: _SCENE_VALUE for f in BODY_FIELDS if f.name != "model"})
-    tables = {name: _table(tuple(f.name for f in fields))
-              for name, (_, fields) in TABLES.items()}
-    tables["particles"] = _table(PARTICLE_KEYS)
-    tables["body"] = _st.lists(body, max_size=2)
-    tables["bogus"] = _SCENE_VALUE
-    data = draw(_st.fixed_dictionaries({}, optional=tables))
+    keys = {name: tuple(f.name for f in fields) + ("bogus",)
+            for name, (_, fields) in TABLES.items()}
+    keys["body"] = tuple(f.name for f in BODY_FIELDS) + ("bogus",)
+    keys["particles"] = PARTICLE_KEYS + ("bogus",)
+    data = {"integration": dict(_BASE_SCENE["integration"]),
+            "body": [dict(_BASE_SCENE["body"][0])]}
+    for _ in range(draw(_st.sampled_from((1, 1, 2, 0)))):
+        table = draw(_st.sampled_from(sorted(keys) + ["bogus"]))
+        if table == "bogus" or draw(_st.integers(0, 9)) == 0:       # a whole table
+            data[table] = draw(_SCENE_VALUE)
+            continue
+        key = draw(_st.sampled_from(keys[table]))
+        value = draw(_st.one_of(_SCENE_VALUE, _st.sampled_from(
+            ("cube.ac", "missing.ac", "sphere-2k.ac", "rk5", "exact", "impulse"))))
+        if table == "body":
+            if isinstance(data["body"], list) and data["body"] and isinstance(
+                    data["body"][0], dict):
+                data["body"][0][key] = value
+        elif isinstance(data.setdefault(table, {}), dict):
+            data[table][key] = value
     return _Probe("scene_from_dict", f"scene_from_dict({_py(data)})",
                   check="scene_absurdity(_result) is None",
                   law="accepts a physically absurd scene")

@@ -41,7 +41,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
-from tests.fuzz.judge import Failure, exception_name, innermost_frame
+from tests.fuzz.judge import Failure, exception_name, hang_site, innermost_frame
 from tests.fuzz.runner import DUMP_GRACE, ENV, ROOT, die_with_parent
 
 #: Bytes a probe may map beyond what the worker maps after its prelude:
@@ -217,7 +217,8 @@ class Probe:
     contract forbids its arguments (``must_refuse``, with ``why``), and a
     law about a successful result (``check``, an expression over
     ``_result``; ``law`` says it in words). ``must_accept``: every argument
-    is one the contract allows, so refusing is a failure too."""
+    is one the contract allows, so refusing is a failure too. ``bad``: the
+    names of the forbidden arguments."""
 
     function: str
     code: str
@@ -226,6 +227,7 @@ class Probe:
     check: str | None = None
     law: str = ""
     must_accept: bool = False
+    bad: tuple[str, ...] = ()
 
     def reproducer(self) -> str:
         return f"python -m tests.fuzz.api_worker --probe {_shell_quote(self.code)}"
@@ -350,8 +352,9 @@ def judge_probe(probe: Probe, outcome: ProbeOutcome) -> list[Failure]:
     TypeError, OSError or DivergenceError), "bad output" (returned where it
     must refuse, refused where it must accept, or broke its law)."""
     if outcome.timed_out:
-        return [Failure("hang", f"hang in {innermost_frame(outcome.stack, dump=True)}",
-                        f"{probe.function}: killed after {outcome.seconds:.1f} s")]
+        return [Failure("hang", f"hang in {hang_site(outcome.stack)}",
+                        f"{probe.function}: killed after {outcome.seconds:.1f} s in "
+                        f"{innermost_frame(outcome.stack, dump=True)}")]
     if outcome.signal is not None:
         name = signal.Signals(outcome.signal).name if outcome.signal > 0 else "exit"
         return [Failure("signal", f"{name} in {innermost_frame(outcome.stack, dump=True)}",
@@ -371,9 +374,8 @@ def judge_probe(probe: Probe, outcome: ProbeOutcome) -> list[Failure]:
         return []
     found = []
     if probe.must_refuse:
-        names = sorted({part.split("=", 1)[0] for part in probe.why.split(", ") if part})
-        found.append(Failure("bad output",
-                             f"{probe.function} accepts a forbidden {', '.join(names)}",
+        names = ", ".join(sorted(probe.bad)) or "argument"
+        found.append(Failure("bad output", f"{probe.function} accepts a forbidden {names}",
                              f"{probe.why}: returned {facts['repr']}"[:300]))
     if probe.check is not None and facts["check"] is False:
         found.append(Failure("bad output", f"{probe.function}: {probe.law}",

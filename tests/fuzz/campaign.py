@@ -249,6 +249,7 @@ def tabulate(case_results, probe_results) -> list[dict]:
         counts["cases"] += 1
         counts["accepted"] += result.verdict.accepted
         counts["refused ok"] += result.verdict.refused_ok
+        counts["inconclusive"] += result.verdict.inconclusive
         for column in result.verdict.columns():
             counts[column] += 1
     for result in probe_results:
@@ -262,6 +263,7 @@ def tabulate(case_results, probe_results) -> list[dict]:
              "signal": 5, "args": 6, "known": 7, "api": 8}
     names = {c: h for c, h in zip(("cases", "accepted", "refused ok") + COLUMNS, HEADER,
                                   strict=True)}
+    names["inconclusive"] = "inconclusive"
     return [{"group": group, "row": row, **{names[k]: counts[k] for k in names}}
             for (group, row), counts in sorted(rows.items(), key=lambda kv: (
                 order[kv[0][0]], kv[0][1]))]
@@ -288,6 +290,10 @@ def format_table(rows: list[dict]) -> str:
         lines.append("")
         total.update(subtotal)
     lines.append(line("total", total))
+    inconclusive = sum(r.get("inconclusive", 0) for r in rows)
+    if inconclusive:
+        lines.append(f"({inconclusive} signal case(s) inconclusive: the command ended before "
+                     "its signal was sent)")
     return "\n".join(lines)
 
 

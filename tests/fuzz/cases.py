@@ -344,21 +344,23 @@ def output_cases() -> list[Case]:
 
 
 #: Seconds between the temporary file's appearance and the signal: well
-#: inside the write of the particle scene's frames (about 50 MB, 0.2 s).
+#: inside the write of the signal scene's frames (about 150 MB, 0.5 s).
 INTO_THE_WRITE = 0.03
 
 
 def signal_cases() -> list[Case]:
     """A signal while the output is being written: no temporary file may stay.
 
-    The particle scene writes about 50 MB of frames, so its temporary file
-    exists long enough to be seen; the signal is sent 30 ms after it
-    appears (inside the write), or, for ``SIGINT-at-mkstemp``, the moment it
+    The particle scene with 30 000 particles writes about 150 MB of frames,
+    so its temporary file exists for about half a second (long enough to be
+    seen by a poll starved on a loaded machine); the signal is sent 30 ms
+    after it appears (inside the write), or, for ``SIGINT-at-mkstemp``, the moment it
     appears (racing the start of ``write_atomic``'s ``try``: the outcome
     depends on timing, so that case is in the campaign, not the slice).
     """
     scene = "{in}/particles.toml"
-    files = ((scene, corpus.scenes()["particles.toml"]),)
+    particles = corpus.scenes()["particles.toml"].replace(b"count = 10000", b"count = 30000")
+    files = ((scene, particles),)
     argv = ("run", scene, "-o", "out.npz", "--duration", "0.4")
     cases = [_fixed("signal", signal.Signals(signum).name, files=files, argv=argv,
                     output="{out}/out.npz", timeout=60.0,

@@ -76,9 +76,15 @@ class Failure:
 
 @dataclass(frozen=True)
 class Verdict:
+    """``inconclusive``: a signal case whose command ended before its signal
+    could be sent (its file never appeared, or the write was too quick);
+    it says nothing about the signal and counts as neither accepted nor
+    refused."""
+
     accepted: bool
     refused_ok: bool
     failures: tuple[Failure, ...]
+    inconclusive: bool = False
 
     def columns(self) -> set[str]:
         return {f.column for f in self.failures}
@@ -110,6 +116,13 @@ def innermost_frame(stderr: str, dump: bool) -> str:
     return f"{_short(chosen[0])}:{chosen[2]}"
 
 
+def hang_site(stack: str) -> str:
+    """Where a hang is: the module of the innermost refsim frame of the
+    dump (a slow loop is caught in whichever of its helpers it is in at the
+    timeout, so the function would split one cause into several)."""
+    return innermost_frame(stack, dump=True).rsplit(":", 1)[0]
+
+
 def exception_name(name: str) -> str:
     """An exception's name without its module (``numpy.linalg.LinAlgError``
     and ``LinAlgError`` are one cause), numpy's ``_ArrayMemoryError`` as the
@@ -130,16 +143,16 @@ def exception_type(stderr: str) -> str:
 #: numpy's RuntimeWarning texts ("overflow encountered in multiply"): shown as
 #: ``refsim: warning:`` lines they say nothing a user can act on.
 _NUMPY_WARNING = re.compile(r"(?:overflow|invalid value|divide by zero|underflow) "
-                            r"encountered in \w+")
+                            r"encountered in (?:scalar )?\w+")
 
 
 def normalize(message: str, places: dict) -> str:
     """``message`` with what varies between cases of one root cause blanked:
-    the case's files (``<file>``), other absolute paths, quoted names,
+    the case's files and other absolute paths (``<path>``), quoted names,
     numbers, the bytes of a decoding error and numpy's warning texts."""
     for key, value in places.items():
         message = message.replace(value, key.strip("{}").join("<>"))
-    message = re.sub(r"<(?:in|out)>/[^\s:,'\"()]*", "<file>", message)
+    message = re.sub(r"<(?:in|out)>/[^\s:,'\"()]*", "<path>", message)
     message = re.sub(r"(?<![\w<.])/(?:[\w.+\-]+/)*[\w.+\-]+", "<path>", message)
     message = _NUMPY_WARNING.sub("<numpy warning>", message)
     message = re.sub(r"can't decode byte .*", "can't decode byte …", message)
@@ -244,8 +257,9 @@ def judge(case: Case, record: Record) -> Verdict:
     sent = case.interrupt[0] if case.interrupt and o.interrupted else None
     accepted = refused_ok = False
     if o.timed_out:
-        failures.append(Failure("hang", f"hang in {innermost_frame(o.stderr, dump=True)}",
-                                f"killed after {o.elapsed:.1f} s"))
+        failures.append(Failure("hang", f"hang in {hang_site(o.stderr)}",
+                                f"killed after {o.elapsed:.1f} s in "
+                                f"{innermost_frame(o.stderr, dump=True)}"))
     elif o.signal is not None and o.signal != sent:
         name = signal.Signals(o.signal).name
         failures.append(Failure("signal", f"{name} in {innermost_frame(o.stderr, dump=True)}",
@@ -293,4 +307,6 @@ def judge(case: Case, record: Record) -> Verdict:
     for change in record.replaced:
         failures.append(Failure("files replaced", "-o replaced " + change.split(": ", 1)[1]
                                 .replace(" -> ", " by "), change))
+    if case.interrupt is not None and not o.interrupted and not failures:
+        return Verdict(False, False, (), inconclusive=True)
     return Verdict(accepted, refused_ok, tuple(failures))

@@ -117,14 +117,14 @@ def test_one_line_naming_the_file_and_line_or_key_is_a_good_refusal(stderr, name
 
 def test_a_refusal_without_the_line_is_a_bad_message():
     assert _signatures("refsim: error: /tmp/case/in/m.ac: bad\n") == [
-        "names no file with line or key: <file>: bad"]
+        "names no file with line or key: <path>: bad"]
 
 
 def test_a_model_of_unknown_format_in_a_scene_must_name_the_scene_key():
     names = (("{in}/s.toml", "key"), ("{in}/m.txt", "model"))
     assert _signatures("refsim: error: /tmp/case/in/m.txt: unknown model format '.txt'\n",
                        names=names) == [
-        "names no file with line or key: <file>: unknown model format '…'"]
+        "names no file with line or key: <path>: unknown model format '…'"]
 
 
 def test_argparse_usage_lines_and_numpy_warnings_are_bad_messages():
@@ -178,9 +178,9 @@ def test_a_signal_refsim_was_sent_is_no_crash_but_a_left_temp_file_is_a_failure(
 
 def test_normalize_blanks_files_paths_numbers_and_names():
     assert normalize("/tmp/case/in/m.ac:12: vertex 'x' at 1e+308", PLACES) == \
-        "<file>:N: vertex '…' at N"
+        "<path>:N: vertex '…' at N"
     assert normalize("model 'm.ac' not found (looked in /tmp/case/in/m.ac, /work/models/m.ac)",
-                     PLACES) == "model '…' not found (looked in <file>, <path>)"
+                     PLACES) == "model '…' not found (looked in <path>, <path>)"
     assert normalize("can't decode byte 0xe9 in position 3: invalid start byte", PLACES) == \
         normalize("can't decode byte 0xff in position 9: invalid continuation byte", PLACES)
 
