@@ -327,6 +327,51 @@ class ProbeRunner:
         self._err.close()
 
 
+_BIG_CUBE = "Mesh(CUBE.vertices * 1e308, CUBE.faces)"
+
+#: The API findings of the earlier manual campaign, one probe each: the
+#: campaign runs them before its random probes (so every campaign confirms or
+#: clears each), and the slice (tests/fuzz/test_fuzz_slice.py) marks them.
+KNOWN_PROBES = {
+    "qhull-1e155": Probe("Mesh", "Mesh(SPHERE.vertices * 1e155, SPHERE.faces).is_convex"),
+    "bvh-best-1e155": Probe("bodies_collide", "bodies_collide(Mesh(SPHERE.vertices * 1e155, "
+                                              "SPHERE.faces), ID, CUBE, ID)"),
+    "sphere-overflow": Probe(
+        "bodies_collide", f"bodies_collide({_BIG_CUBE}, (np.eye(3), np.full(3, 2.5e307)), "
+                          f"{_BIG_CUBE}, (np.eye(3), np.full(3, -2.5e307)), level='sphere')",
+        check="_result is True", law="says apart for overlapping cubes"),
+    "level-bogus": Probe("bodies_collide", "bodies_collide(CUBE, ID, CUBE, ID, level='bogus')",
+                         must_refuse=True, bad=("level",)),
+    "kernel-bogus": Probe("intersecting_pairs", "intersecting_pairs(CUBE, ID, CUBE, ID, "
+                                                "kernel='bogus')", must_refuse=True,
+                          bad=("kernel",)),
+    "none-mesh": Probe("bodies_collide", "bodies_collide(None, ID, CUBE, ID)", must_refuse=True,
+                       bad=("mesh_a",)),
+    "particles-1e10": Probe("ParticleSystem.run", "ParticleSystem(ParticleConfig(count=10**10))",
+                            must_refuse=True, bad=("count",)),
+    "integrate-1e9-steps": Probe("integrate", "integrate(decay, [1.0], 0.0, 1e9, 1.0)"),
+    "trajectory-missing": Probe("Trajectory.load", "Trajectory.load('missing.npz')",
+                                must_refuse=True, bad=("path",)),
+    "trajectory-partial": Probe("Trajectory.load", "Trajectory.load(PARTIAL_NPZ)",
+                                must_refuse=True, bad=("path",)),
+    "aabb-kernel-bogus": Probe("aabb_linear", "aabb_linear(CUBE, ID, kernel='bogus')",
+                               must_refuse=True, bad=("kernel",)),
+    "run-negative": Probe("ParticleSystem.run", "ParticleSystem(ParticleConfig(count=5)).run(-5)",
+                          must_refuse=True, why="run(-5)", bad=("steps",)),
+    "duration-negative": Probe("simulate", "simulate(BOUNCE, duration=-1.0)", must_refuse=True,
+                               why="duration=-1.0", bad=("duration",)),
+    "every-fraction": Probe("simulate", "simulate(BOUNCE, duration=0.01, every=2.5)",
+                            must_refuse=True, why="every=2.5", bad=("every",)),
+    "toml-nested-500": Probe("load_scene", "load_scene(DEEP_TOML)", must_refuse=True,
+                             bad=("path",)),
+    "step-y-none": Probe("SOLVERS[name].step", "SOLVERS['rk4'].step(decay, 0.0, None, 0.1)",
+                         must_refuse=True, bad=("y",)),
+    "obj-latin1": Probe("load_model", "load_model(LATIN1_OBJ)", must_accept=True),
+    "collinear-body": Probe("simulate", "simulate(body_scene(model=COLLINEAR_AC), "
+                                        "duration=0.01)"),
+}
+
+
 _SHARED: dict[float, ProbeRunner] = {}
 
 

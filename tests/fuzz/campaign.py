@@ -7,11 +7,14 @@
 Run it from the repository root (``tests`` is a namespace package found from
 the working directory). Phases:
 
-1. mutants: every fixed case (special files, ``-o`` targets, signals,
-   arguments), then random cases in the order of
+1. mutants: the signal cases alone, then every other fixed case (special
+   files, ``-o`` targets, arguments, the manual campaign's findings), then
+   random cases in the order of
    :func:`tests.fuzz.cases.schedule`, on ``--workers`` fork servers (one
    thread each), until ``(1 - api_share)`` of the time or ``--cases``;
-2. API probes: for each public function in turn, Hypothesis (profile
+2. API probes: the manual campaign's findings
+   (``tests.fuzz.api_worker.KNOWN_PROBES``), then for each public function
+   in turn, Hypothesis (profile
    ``fuzz``, seeded from ``--seed``, the round and the function) draws
    probes from ``properties/strategies.py``; distinct probes run in one
    worker until the time or ``--probes`` is used up;
@@ -42,7 +45,7 @@ from collections import Counter, defaultdict
 from dataclasses import dataclass
 from pathlib import Path
 
-from tests.fuzz.api_worker import Probe, ProbeOutcome, ProbeRunner, judge_probe
+from tests.fuzz.api_worker import KNOWN_PROBES, Probe, ProbeOutcome, ProbeRunner, judge_probe
 from tests.fuzz.cases import Case, case_from_id, fixed_cases, make_case, schedule
 from tests.fuzz.execute import Record, execute
 from tests.fuzz.judge import COLUMNS, Failure, Verdict, judge
@@ -98,11 +101,21 @@ def run_mutants(seed, deadline: float, max_cases: int | None, workers: int,
                 workdir: Path, logs: Path, progress=None) -> list[CaseResult]:
     """Run cases from :func:`case_stream` on ``workers`` fork servers until
     ``deadline`` (monotonic seconds) or ``max_cases``; results in case order.
-    The servers' own stderr goes to ``logs``."""
-    stream = iter(enumerate(case_stream(seed)))
+    The servers' own stderr goes to ``logs``.
+
+    The signal cases run first, one at a time: their signal must arrive while
+    the output is being written, and a poll starved by a busy second thread
+    can see the temporary file too late.
+    """
     lock = threading.Lock()
     results: dict[int, CaseResult] = {}
     busy = [0]                                         # cases handed out, not yet done
+    servers = [ForkServer(log=logs / f"zygote-{n}.log") for n in range(workers)]
+    stream = ((i, c) for i, c in enumerate(case_stream(seed)) if c.family != "signal")
+    for index, case in enumerate(fixed_cases()):
+        if case.family == "signal" and (max_cases is None or len(results) < max_cases):
+            record = execute(case, servers[0], workdir)
+            results[index] = CaseResult(case, record, judge(case, record))
 
     def next_case():
         with lock:
@@ -113,8 +126,7 @@ def run_mutants(seed, deadline: float, max_cases: int | None, workers: int,
             busy[0] += 1
             return next(stream)
 
-    def work(n: int):
-        server = ForkServer(log=logs / f"zygote-{n}.log")
+    def work(server):
         try:
             while (item := next_case()) is not None:
                 index, case = item
@@ -128,7 +140,8 @@ def run_mutants(seed, deadline: float, max_cases: int | None, workers: int,
         finally:
             server.close()
 
-    threads = [threading.Thread(target=work, args=(n,), daemon=True) for n in range(workers)]
+    threads = [threading.Thread(target=work, args=(server,), daemon=True)
+               for server in servers]
     for thread in threads:
         thread.start()
     for thread in threads:
@@ -160,6 +173,11 @@ def run_probes(seed, deadline: float, max_probes: int | None, logs: Path,
     per_round = PROBES_PER_ROUND if max_probes is None else max(
         1, min(PROBES_PER_ROUND, -(-max_probes // len(API_FUNCTIONS))))   # a fair share each
     try:
+        for probe in KNOWN_PROBES.values():              # the manual campaign's findings
+            if not done():
+                seen.add(probe.code)
+                outcome = runner.run(probe)
+                results.append(ProbeResult(probe, outcome, tuple(judge_probe(probe, outcome))))
         round_ = 0
         while not done():
             before = len(results)

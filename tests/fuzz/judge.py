@@ -307,6 +307,7 @@ def judge(case: Case, record: Record) -> Verdict:
     for change in record.replaced:
         failures.append(Failure("files replaced", "-o replaced " + change.split(": ", 1)[1]
                                 .replace(" -> ", " by "), change))
-    if case.interrupt is not None and not o.interrupted and not failures:
+    # the signal was never sent, or reached a process that had already exited
+    if case.interrupt is not None and (not o.interrupted or o.returncode == 0) and not failures:
         return Verdict(False, False, (), inconclusive=True)
     return Verdict(accepted, refused_ok, tuple(failures))

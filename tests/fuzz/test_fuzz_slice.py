@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import pytest
 
-from tests.fuzz.api_worker import Probe, judge_probe, shared_runner
+from tests.fuzz.api_worker import KNOWN_PROBES, Probe, judge_probe, shared_runner
 from tests.fuzz.cases import case_from_id, with_timeout
 from tests.fuzz.execute import execute
 from tests.fuzz.judge import judge
@@ -188,68 +188,55 @@ SPHERE_OVERFLOW = ("level='sphere' says apart for overlapping cubes at +-2.5e307
                    "squared centre distance overflows (refsim/collision/spheres.py)")
 SILENT_ACCEPT = "a forbidden argument is accepted silently"
 STEP_TYPE = "TypeError from rk_step for y=None (refsim/solvers/explicit_rk.py)"
-BIG = "Mesh(CUBE.vertices * 1e308, CUBE.faces)"
+
+
+def known(name: str, expected: str, reason: str):
+    """A probe of tests.fuzz.api_worker.KNOWN_PROBES, marked with its root cause."""
+    return pytest.param(KNOWN_PROBES[name], expected, marks=xfail(reason), id=name)
+
 
 #: (probe, the outcome the law requires), with the mark of a known bug.
 PROBES = [
     pytest.param(Probe("triangles_intersect", "triangles_intersect(None, "
-                       "[[0, 0, 0], [1, 0, 0], [0, 1, 0]])", must_refuse=True), REFUSED),
+                       "[[0, 0, 0], [1, 0, 0], [0, 1, 0]])", must_refuse=True), REFUSED,
+                 id="triangle-none"),
     pytest.param(Probe("Mesh", "Mesh(np.full((3, 3), np.nan), [[0, 1, 2]])",
-                       must_refuse=True), REFUSED),
-    pytest.param(Probe("load_scene", "load_scene(DIR_TOML)", must_refuse=True), REFUSED),
+                       must_refuse=True), REFUSED, id="mesh-nan"),
+    pytest.param(Probe("load_scene", "load_scene(DIR_TOML)", must_refuse=True), REFUSED,
+                 id="scene-directory"),
     pytest.param(Probe("ParticleConfig", "ParticleConfig(count=-5)", must_refuse=True),
-                 REFUSED),
+                 REFUSED, id="particles-negative"),
     pytest.param(Probe("integrate", "integrate(decay, [1.0], 0.0, 1.0, 0.1)",
                        must_accept=True, check="_result[1].shape == (11, 1)",
-                       law="y has shape (11, 1)"), ACCEPTED),
+                       law="y has shape (11, 1)"), ACCEPTED, id="integrate-ten-steps"),
     pytest.param(Probe("simulate", "simulate(BOUNCE, duration=0.01)", must_accept=True,
-                       check="_result.n_frames == 11", law="11 frames"), ACCEPTED),
+                       check="_result.n_frames == 11", law="11 frames"), ACCEPTED,
+                 id="simulate-ten-steps"),
     pytest.param(Probe("bodies_collide", "bodies_collide(CUBE, ID, CUBE, "
                        "(np.eye(3), np.array([0.5, 0.0, 0.0])))", must_accept=True,
-                       check="_result is True", law="touching cubes collide"), ACCEPTED),
-    pytest.param(Probe("bodies_collide", "bodies_collide(Mesh(SPHERE.vertices * 1e155, "
-                       "SPHERE.faces), ID, CUBE, ID)"), ACCEPTED, marks=xfail(BVH_BEST)),
-    pytest.param(Probe("bodies_collide", f"bodies_collide({BIG}, (np.eye(3), "
-                       f"np.full(3, 2.5e307)), {BIG}, (np.eye(3), np.full(3, -2.5e307)), "
-                       "level='sphere')", check="_result is True",
-                       law="says apart for overlapping cubes"), ACCEPTED,
-                 marks=xfail(SPHERE_OVERFLOW)),
-    pytest.param(Probe("bodies_collide", "bodies_collide(CUBE, ID, CUBE, ID, level='bogus')",
-                       must_refuse=True), REFUSED, marks=xfail(OPTION_VALUE_ERROR)),
-    pytest.param(Probe("intersecting_pairs", "intersecting_pairs(CUBE, ID, CUBE, ID, "
-                       "kernel='bogus')", must_refuse=True), REFUSED,
-                 marks=xfail(OPTION_VALUE_ERROR)),
-    pytest.param(Probe("bodies_collide", "bodies_collide(None, ID, CUBE, ID)",
-                       must_refuse=True), REFUSED, marks=xfail(NONE_MESH)),
-    pytest.param(Probe("ParticleSystem.run", "ParticleSystem(ParticleConfig(count=10**10))",
-                       must_refuse=True), REFUSED, marks=xfail(ALLOCATION)),
-    pytest.param(Probe("integrate", "integrate(decay, [1.0], 0.0, 1e9, 1.0)"), REFUSED,
-                 marks=xfail(ALLOCATION)),
-    pytest.param(Probe("Trajectory.load", "Trajectory.load('missing.npz')",
-                       must_refuse=True), REFUSED, marks=xfail(TRAJECTORY_LOAD)),
-    pytest.param(Probe("Trajectory.load", "Trajectory.load(PARTIAL_NPZ)", must_refuse=True),
-                 REFUSED, marks=xfail(TRAJECTORY_LOAD)),
-    pytest.param(Probe("aabb_linear", "aabb_linear(CUBE, ID, kernel='bogus')",
-                       must_refuse=True), REFUSED, marks=xfail(PLAIN_REFSIM_ERROR)),
-    pytest.param(Probe("ParticleSystem.run", "ParticleSystem(ParticleConfig(count=5)).run(-5)",
-                       must_refuse=True, why="run(-5)"), REFUSED, marks=xfail(SILENT_ACCEPT)),
-    pytest.param(Probe("simulate", "simulate(BOUNCE, duration=-1.0)", must_refuse=True,
-                       why="duration=-1"), REFUSED, marks=xfail(SILENT_ACCEPT)),
-    pytest.param(Probe("simulate", "simulate(BOUNCE, duration=0.01, every=2.5)",
-                       must_refuse=True, why="every=2.5"), REFUSED,
-                 marks=xfail(SILENT_ACCEPT)),
-    pytest.param(Probe("load_scene", "load_scene(DEEP_TOML)", must_refuse=True), REFUSED,
-                 marks=xfail(TOML_RECURSION)),
-    pytest.param(Probe("SOLVERS[name].step", "SOLVERS['rk4'].step(decay, 0.0, None, 0.1)",
-                       must_refuse=True), REFUSED, marks=xfail(STEP_TYPE)),
-    pytest.param(Probe("load_model", "load_model(LATIN1_OBJ)", must_accept=True), ACCEPTED,
-                 marks=xfail(CHARSET)),
-    pytest.param(Probe("simulate", "simulate(body_scene(model=COLLINEAR_AC), duration=0.01)"),
-                 REFUSED, marks=xfail(SINGULAR_INERTIA)),
+                       check="_result is True", law="touching cubes collide"), ACCEPTED,
+                 id="cubes-touch"),
+    known("bvh-best-1e155", ACCEPTED, BVH_BEST),
+    known("sphere-overflow", ACCEPTED, SPHERE_OVERFLOW),
+    known("level-bogus", REFUSED, OPTION_VALUE_ERROR),
+    known("kernel-bogus", REFUSED, OPTION_VALUE_ERROR),
+    known("none-mesh", REFUSED, NONE_MESH),
+    known("particles-1e10", REFUSED, ALLOCATION),
+    known("integrate-1e9-steps", REFUSED, ALLOCATION),
+    known("trajectory-missing", REFUSED, TRAJECTORY_LOAD),
+    known("trajectory-partial", REFUSED, TRAJECTORY_LOAD),
+    known("aabb-kernel-bogus", REFUSED, PLAIN_REFSIM_ERROR),
+    known("run-negative", REFUSED, SILENT_ACCEPT),
+    known("duration-negative", REFUSED, SILENT_ACCEPT),
+    known("every-fraction", REFUSED, SILENT_ACCEPT),
+    known("toml-nested-500", REFUSED, TOML_RECURSION),
+    known("step-y-none", REFUSED, STEP_TYPE),
+    known("obj-latin1", ACCEPTED, CHARSET),
+    known("collinear-body", REFUSED, SINGULAR_INERTIA),
 ]
 
 
-@pytest.mark.parametrize(("probe", "expected"), PROBES, ids=lambda p: getattr(p, "code", p))
+@pytest.mark.parametrize(("probe", "expected"), PROBES)
 def test_public_api_keeps_the_error_law(probe, expected, probe_runner):
     outcome = probe_runner.run(probe)
     failures = judge_probe(probe, outcome)
