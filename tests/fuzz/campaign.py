@@ -370,6 +370,10 @@ def write_outputs(out: Path, args, case_results, probe_results, confirmed, secon
         d["count"] += 1
         d["where"][entry.get("family", "api") + " / " + entry.get("mutator",
                                                                    entry.get("function", ""))] += 1
+    inconclusive = [{"id": r.case.id, "exit": r.record.outcome.returncode,
+                     "signal_sent": r.record.outcome.interrupted,
+                     "seconds": round(r.record.outcome.elapsed, 3)}
+                    for r in case_results if r.verdict.inconclusive]
     summary = {
         "seed": args.seed, "minutes": args.minutes, "cases_limit": args.cases,
         "probes_limit": args.probes, "workers": args.workers, "seconds": round(seconds, 1),
@@ -377,6 +381,7 @@ def write_outputs(out: Path, args, case_results, probe_results, confirmed, secon
         "distinct": sorted(({**d, "where": dict(d["where"])} for d in distinct.values()),
                            key=lambda d: (COLUMNS.index(d["column"]), -d["count"])),
         "failures": failures,
+        "inconclusive": inconclusive,
     }
     (out / "results.json").write_text(json.dumps(summary, indent=1, default=str))
     (out / "table.txt").write_text(format_table(rows) + "\n")

@@ -352,11 +352,13 @@ def signal_cases() -> list[Case]:
     """A signal while the output is being written: no temporary file may stay.
 
     The particle scene with 30 000 particles writes about 150 MB of frames,
-    so its temporary file exists for about half a second (long enough to be
-    seen by a poll starved on a loaded machine); the signal is sent 30 ms
-    after it appears (inside the write), or, for ``SIGINT-at-mkstemp``, the moment it
-    appears (racing the start of ``write_atomic``'s ``try``: the outcome
-    depends on timing, so that case is in the campaign, not the slice).
+    so its temporary file exists for about half a second. SIGTERM and SIGHUP
+    are sent the moment it appears (nothing in the process can clean up
+    after them, so the moment does not matter, and sending at once leaves a
+    slow poll the least room to miss the write). SIGINT is sent 30 ms later,
+    inside the write, where ``write_atomic``'s cleanup runs; for
+    ``SIGINT-at-mkstemp`` at once, racing the start of that ``try`` (the
+    outcome depends on timing, so that case is in the campaign, not the slice).
     """
     scene = "{in}/particles.toml"
     particles = corpus.scenes()["particles.toml"].replace(b"count = 10000", b"count = 30000")
@@ -364,8 +366,9 @@ def signal_cases() -> list[Case]:
     argv = ("run", scene, "-o", "out.npz", "--duration", "0.4")
     cases = [_fixed("signal", signal.Signals(signum).name, files=files, argv=argv,
                     output="{out}/out.npz", timeout=60.0,
-                    interrupt=(signum, ".out.npz.*.tmp", INTO_THE_WRITE))
-             for signum in (signal.SIGTERM, signal.SIGHUP, signal.SIGINT)]
+                    interrupt=(signum, ".out.npz.*.tmp", delay))
+             for signum, delay in ((signal.SIGTERM, 0.0), (signal.SIGHUP, 0.0),
+                                   (signal.SIGINT, INTO_THE_WRITE))]
     cases.append(_fixed("signal", "SIGINT-at-mkstemp", files=files, argv=argv,
                         output="{out}/out.npz", timeout=60.0,
                         interrupt=(signal.SIGINT, ".out.npz.*.tmp", 0.0)))
