@@ -82,7 +82,9 @@ def write_reproducer(case: Case, dest: Path, signature: str = "") -> Path:
         run = [command, 'echo "exit status: $?"']
     else:
         signum, pattern, delay = case.interrupt
-        run = [f"{command} &", "pid=$!", "n=0",
+        # job control, so that the background command keeps SIGINT (a
+        # non-interactive shell ignores it in background jobs)
+        run = ["set -m", f"{command} &", "pid=$!", "n=0",
                f"while ! ls {pattern} >/dev/null 2>&1 && [ $n -lt 60000 ]; do "
                "sleep 0.001; n=$((n + 1)); done",
                *([f"sleep {delay:g}"] if delay else []),

@@ -58,14 +58,18 @@ ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
 ENV.pop("REFSIM_MODELS", None)          # the bundled models, always
 
 #: The console script (``refsim = refsim.cli:main``) with a memory limit, no
-#: core file, a stack dump on SIGUSR1, and death with its parent (a killed
-#: campaign leaves no hanging command behind). ``sys.argv[1]`` is the limit
+#: core file, a stack dump on SIGUSR1, a terminal's signal dispositions
+#: (:func:`terminal_signals`), and death with its parent (a killed campaign
+#: leaves no hanging command behind). ``sys.argv[1]`` is the limit
 #: in bytes (0: none).
 SHIM = ("import ctypes, sys, resource, signal, faulthandler\n"
         "try:\n"
         "    ctypes.CDLL(None).prctl(1, signal.SIGKILL)   # as die_with_parent()\n"
         "except (OSError, AttributeError):\n"
         "    pass\n"
+        "for s in (signal.SIGHUP, signal.SIGTERM, signal.SIGQUIT):   # as terminal_signals()\n"
+        "    signal.signal(s, signal.SIG_DFL)\n"
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         "limit = int(sys.argv.pop(1))\n"
         "if limit: resource.setrlimit(resource.RLIMIT_AS, (limit, limit))\n"
         "resource.setrlimit(resource.RLIMIT_CORE, (0, 0))\n"
@@ -110,6 +114,18 @@ def drop_file_capabilities() -> None:
         libc.prctl(24, cap)                                  # PR_CAPBSET_DROP
     if libc.capset(ctypes.byref(header), data) != 0:
         raise OSError(ctypes.get_errno(), "capset failed")
+
+
+def terminal_signals() -> None:
+    """The signal dispositions of a command typed at a terminal: SIGHUP,
+    SIGTERM and SIGQUIT at their defaults, SIGINT raising KeyboardInterrupt.
+
+    A campaign started with ``nohup`` or in the background (``&``) has
+    SIGHUP, respectively SIGINT, ignored, and every process it starts would
+    inherit that: the signal cases would then test nothing."""
+    for signum in (signal.SIGHUP, signal.SIGTERM, signal.SIGQUIT):
+        signal.signal(signum, signal.SIG_DFL)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def die_with_parent() -> None:

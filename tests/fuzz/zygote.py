@@ -37,7 +37,7 @@ import tempfile
 import traceback
 import warnings
 
-from tests.fuzz.runner import die_with_parent, drop_file_capabilities
+from tests.fuzz.runner import die_with_parent, drop_file_capabilities, terminal_signals
 
 #: The warning state of a fresh interpreter, saved before anything warns.
 _FILTERS = list(warnings.filters)
@@ -92,6 +92,7 @@ def _child(request: dict) -> None:
     code = 1
     try:
         die_with_parent()                      # the server's death ends a hanging command
+        terminal_signals()                     # not the campaign's (nohup, &)
         devnull = os.open(os.devnull, os.O_RDONLY)
         os.dup2(devnull, 0)
         out = os.open(request["stdout"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
