@@ -31,6 +31,7 @@ import json
 import os
 import resource
 import select
+import shutil
 import signal
 import subprocess
 import sys
@@ -76,7 +77,8 @@ SPIN, PARTICLES = load_scene("spinning-cube.toml"), load_scene("particles.toml")
 def decay(t, y):
     return -y
 
-TMP = tempfile.mkdtemp(prefix="refsim-api-")
+# ProbeRunner gives each worker a directory it removes; a standalone --probe makes one
+TMP = os.environ.get("REFSIM_FUZZ_FIXTURES") or tempfile.mkdtemp(prefix="refsim-api-")
 def _file(name, data):
     path = os.path.join(TMP, name)
     with open(path, "wb") as handle:
@@ -258,16 +260,18 @@ class ProbeRunner:
                  python: str = sys.executable):
         self.timeout = timeout
         self.python = python
-        self.log = Path(log) if log else Path(tempfile.mkstemp(prefix="refsim-api-",
-                                                               suffix=".log")[1])
+        self._base = Path(tempfile.mkdtemp(prefix="refsim-api-"))   # fixtures; removed by close
+        self.log = Path(log) if log else self._base / "worker.log"
         self.starts = 0
         self._process = None
         self._start()
 
     def _start(self) -> None:
         self._err = open(self.log, "ab")
+        fixtures = tempfile.mkdtemp(prefix="fixtures-", dir=self._base)
         self._process = subprocess.Popen(
-            [self.python, "-m", "tests.fuzz.api_worker", "--serve"], cwd=ROOT, env=ENV,
+            [self.python, "-m", "tests.fuzz.api_worker", "--serve"], cwd=ROOT,
+            env=dict(ENV, REFSIM_FUZZ_FIXTURES=fixtures),
             stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._err)
         self._buffer = b""
         self.starts += 1
@@ -325,6 +329,7 @@ class ProbeRunner:
                 self._process.kill()
                 self._process.wait()
         self._err.close()
+        shutil.rmtree(self._base, ignore_errors=True)
 
 
 _BIG_CUBE = "Mesh(CUBE.vertices * 1e308, CUBE.faces)"
