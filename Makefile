@@ -6,7 +6,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: test typecheck report bench lint models clean
+.PHONY: test typecheck report bench lint models fuzz clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -33,5 +33,15 @@ lint: $(STAMP)
 models: $(STAMP)
 	$(BIN)/python models/generate.py
 
+# The fuzz campaign (tests/fuzz/campaign.py): MINUTES of mutants and API
+# probes from SEED on WORKERS processes; the table, results.json and the
+# reproducers go to fuzz-out/.
+MINUTES ?= 10
+SEED    ?= 1
+WORKERS ?= 2
+fuzz: $(STAMP)
+	$(BIN)/python -m tests.fuzz.campaign --minutes $(MINUTES) --seed $(SEED) \
+		--workers $(WORKERS) --out fuzz-out
+
 clean:
-	rm -rf $(VENV) reports/out .pytest_cache .hypothesis .benchmarks
+	rm -rf $(VENV) reports/out fuzz-out .pytest_cache .hypothesis .benchmarks

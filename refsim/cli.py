@@ -392,10 +392,12 @@ def _add_viewer_commands(commands) -> None:
 
 
 class _Parser(argparse.ArgumentParser):
-    """argparse with its usage errors on one line (it prints the usage first)."""
+    """argparse with its usage errors on the one line every refsim error has,
+    ``refsim: error: ...`` (argparse prints the usage first, then
+    ``refsim run: error: ...``)."""
 
     def error(self, message: str):
-        self.exit(EXIT_USER_ERROR, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        self.exit(EXIT_USER_ERROR, f"refsim: error: {message} (see {self.prog} --help)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -65,15 +65,19 @@ class SceneError(RefsimError, ValueError):
     """A scene file that does not follow the schema.
 
     ``key`` is the dotted path of the offending key, e.g. ``world.half_size``
-    or ``body[2].position``.
+    or ``body[2].position``; ``line`` the 1-based line of a problem found
+    before the keys are known (text that is not UTF-8, nesting too deep).
     """
 
     def __init__(self, message: str, path: str | PathLike | None = None,
-                 key: str | None = None):
+                 key: str | None = None, line: int | None = None):
         self.message = message
         self.path = None if path is None else str(path)
         self.key = key
+        self.line = line
         where = self.path or "<scene>"
+        if line is not None:
+            where = f"{where}:{line}"
         if key:
             where = f"{where}: {key}"
         super().__init__(f"{where}: {message}")
@@ -156,3 +160,46 @@ def check_count(name: str, value, minimum: int = 0, maximum: int | None = None) 
         upper = "" if maximum is None else f" and at most {maximum}"
         raise StateError(f"{name} must be at least {minimum}{upper}, got {value}")
     return value
+
+
+def check_number(name: str, value) -> float:
+    """``value`` as a float when it is a real number (an int, a float, a
+    numpy scalar; not a bool, a string or None); else
+    :class:`ArgumentTypeError` naming the argument. Finiteness and range are
+    the caller's checks."""
+    import numbers
+
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ArgumentTypeError(f"{name} must be a real number, got {type(value).__name__} "
+                                f"{value!r}")
+    return float(value)
+
+
+def check_callable(name: str, value):
+    """``value`` when it can be called; else :class:`ArgumentTypeError`."""
+    if not callable(value):
+        raise ArgumentTypeError(f"{name} must be callable, got {type(value).__name__} "
+                                f"{value!r}")
+    return value
+
+
+def as_numbers(name: str, value, *, complex_ok: bool = False):
+    """``value`` as a numpy array of float64 (of complex128 too when
+    ``complex_ok`` and it holds complex numbers), any shape; else
+    :class:`ArgumentTypeError` naming the argument: None, a string, a ragged
+    or non-numeric sequence, complex numbers where they are not allowed.
+    Shape and finiteness are the caller's checks."""
+    import numpy as np
+
+    kinds = "biufc" if complex_ok else "biuf"
+    problem = ArgumentTypeError(f"{name} must be an array of {'' if complex_ok else 'real '}"
+                                f"numbers, got {type(value).__name__}")
+    if value is None or isinstance(value, str | bytes):
+        raise problem
+    try:
+        array = np.asarray(value)
+    except (TypeError, ValueError):
+        raise problem from None
+    if array.dtype.kind not in kinds:
+        raise problem
+    return array.astype(np.complex128 if array.dtype.kind == "c" else np.float64, copy=False)

@@ -14,6 +14,7 @@ import stat
 from pathlib import Path
 
 from refsim.errors import ArgumentTypeError
+from refsim.limits import MAX_MODEL_BYTES
 
 
 def as_path(value, what: str = "path") -> Path:
@@ -40,13 +41,42 @@ def require_regular_file(path, error: type) -> Path:
     return path
 
 
-def read_regular_file(path, error: type) -> bytes:
-    """The bytes of the regular file at ``path``, or ``error(message, path)``."""
+def read_regular_file(path, error: type, max_bytes: int = MAX_MODEL_BYTES) -> bytes:
+    """The bytes of the regular file at ``path``, or ``error(message, path)``;
+    a file larger than ``max_bytes`` is refused before it is read."""
     path = require_regular_file(path, error)
+    too_large = error(f"file too large: more than {max_bytes} bytes (refsim.limits)", path)
     try:
-        return path.read_bytes()
+        with path.open("rb") as file:
+            size = os.fstat(file.fileno()).st_size
+            if size > max_bytes:
+                raise too_large
+            # read() of n bytes allocates n at once: the size, not the limit,
+            # plus one byte to see a file that grew meanwhile
+            data = file.read(size + 1)
+            while len(data) <= max_bytes and (more := file.read(2**20)):
+                data += more
     except OSError as exc:
         raise error(f"cannot read: {exc.strerror or exc}", path) from None
+    if len(data) > max_bytes:
+        raise too_large
+    return data
+
+
+def bundled_if_bare(path: Path, directory: Path) -> Path:
+    """``path`` itself, or ``directory / path.name`` when ``path`` is a bare
+    file name that does not exist here and does there (a bundled model or
+    scene). A name the system cannot look up here (too long, behind an
+    unsearchable directory) is returned as given, for the reader to refuse."""
+    if path.name != str(path):
+        return path
+    try:
+        if path.exists():
+            return path
+        bundled = directory / path.name
+        return bundled if bundled.is_file() else path
+    except OSError:
+        return path
 
 
 def decode_utf8(data: bytes, path, error: type) -> str:
@@ -57,8 +87,8 @@ def decode_utf8(data: bytes, path, error: type) -> str:
     except UnicodeDecodeError as exc:
         line = data.count(b"\n", 0, exc.start) + 1
         column = exc.start - (data.rfind(b"\n", 0, exc.start) + 1) + 1
-        raise error(f"line {line}, column {column}: not UTF-8 text (byte "
-                    f"0x{data[exc.start]:02x})", path) from None
+        raise error(f"not UTF-8 text (byte 0x{data[exc.start]:02x} at column {column})",
+                    path, line=line) from None
 
 
 def file_kind(mode: int) -> str:

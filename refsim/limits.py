@@ -32,3 +32,17 @@ MAX_RESULT_BYTES = 4 * 2**30
 #: 2e7 particles are about 4 GB, the most a 2-core machine of the kind refsim
 #: is tested on (24 GB) runs comfortably beside its output.
 MAX_PARTICLES = 20_000_000
+
+#: The largest input file refsim reads, in bytes. A model's triangles are
+#: read whole into memory (a binary STL of 2 GiB holds 42 million triangles,
+#: far more than any collision scene needs); a scene is a few kilobytes of
+#: TOML, so 16 MiB leaves room for thousands of bodies while refusing at once
+#: a log or a disk image given as a scene.
+MAX_MODEL_BYTES = 2 * 2**30
+MAX_SCENE_BYTES = 16 * 2**20
+
+#: The deepest nesting of arrays and inline tables a scene may have. A scene
+#: needs three (a body's rotation is an array of arrays inside an array of
+#: tables); Python's TOML parser recurses once per level and would overflow
+#: the stack at about a thousand.
+MAX_SCENE_NESTING = 32

@@ -105,3 +105,16 @@ def test_study_without_its_oracle_is_a_user_error(capsys, monkeypatch):
     assert main(["study", "bounds-agreement", "--quick"]) == EXIT_USER_ERROR
     err = capsys.readouterr().err
     assert "bounds-agreement" in err and "trimesh" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("argv, phrase", [
+    (["run", "bounce.toml", "--every", "2.5"], "argument --every: invalid int value: '2.5' "
+                                               "(see refsim run --help)"),
+    (["frobnicate"], "argument COMMAND: invalid choice: 'frobnicate'"),
+])
+def test_a_usage_error_is_the_same_one_line_as_any_error(argv, phrase, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith("refsim: error: ") and phrase in err and err.count("\n") == 1

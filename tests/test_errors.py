@@ -85,8 +85,43 @@ def test_check_count_refuses_what_is_not_a_count(value, error):
      "steps must be at least 0"),
     (lambda: refsim.ParticleSystem(refsim.ParticleConfig(count=10)).run(2.5),
      ArgumentTypeError, "steps must be an integer"),
+    (lambda: refsim.ParticleSystem(refsim.ParticleConfig(count=10)).run(MAX_STEPS + 1),
+     StateError, f"steps must be at least 0 and at most {MAX_STEPS}"),
+    (lambda: refsim.Simulation(refsim.load_scene("bounce.toml")).run(10**9), StateError,
+     f"n_steps must be at least 0 and at most {MAX_STEPS}"),
+    (lambda: refsim.integrate(None, [1.0], 0.0, 1.0, 0.1), ArgumentTypeError,
+     "f must be callable, got NoneType"),
+    (lambda: refsim.integrate(lambda t, y: -y, "abc", 0.0, 1.0, 0.1), ArgumentTypeError,
+     "y0 must be an array of real numbers, got str"),
+    (lambda: refsim.integrate(lambda t, y: -y, [1.0], None, 1.0, 0.1), ArgumentTypeError,
+     "t0 must be a real number, got NoneType"),
+    (lambda: refsim.integrate(lambda t, y: -y, [1.0], 0.0, 1.0, "0.1"), ArgumentTypeError,
+     "h must be a real number, got str"),
+    (lambda: refsim.SOLVERS["rk4"].step(42, 0.0, np.ones(1), 0.1), ArgumentTypeError,
+     "f must be callable, got int"),
+    (lambda: refsim.SOLVERS["rk4"].step(lambda t, y: -y, 0.0, None, 0.1), ArgumentTypeError,
+     "y must be an array of numbers, got NoneType"),
+    (lambda: refsim.SOLVERS["rk4"].step(lambda t, y: -y, 0.0, np.ones((2, 2)), 0.1),
+     StateError, "y must be a vector (d,), got shape (2, 2)"),
+    (lambda: refsim.SOLVERS["euler"].step(lambda t, y: -y, True, np.ones(1), 0.1),
+     ArgumentTypeError, "t must be a real number, got bool"),
+    (lambda: refsim.triangles_intersect("abc", np.eye(3)), ArgumentTypeError,
+     "a must be an array of real numbers, got str"),
+    (lambda: refsim.triangles_intersect(np.eye(3), np.eye(3) * 1j), ArgumentTypeError,
+     "b must be an array of real numbers, got ndarray"),
+    (lambda: refsim.triangles_intersect(np.eye(3), [[0, 0], [1, 0, 0], [0, 1, 0]]),
+     ArgumentTypeError, "b must be an array of real numbers, got list"),
 ])
 def test_bad_arguments_raise_refsim_errors_naming_them(call, error, phrase):
     with pytest.raises(error) as info:
         call()
     assert phrase in str(info.value)
+
+
+def test_a_step_takes_any_sequence_of_numbers_for_the_state():
+    # The checks convert; they do not narrow what a correct call may pass.
+    from_list = refsim.SOLVERS["rk4"].step(lambda t, y: -y, 0, [1.0], 0.5)
+    from_array = refsim.SOLVERS["rk4"].step(lambda t, y: -y, 0.0, np.array([1.0]), 0.5)
+    assert from_list.tolist() == from_array.tolist()
+    assert from_array[0] == pytest.approx(1 - 0.5 + 0.5**2 / 2 - 0.5**3 / 6 + 0.5**4 / 24,
+                                          rel=1e-15)

@@ -75,7 +75,7 @@ from refsim.collision.predicates import (
     Predicates,
     in_filter_range,
 )
-from refsim.errors import StateError
+from refsim.errors import StateError, as_numbers
 
 Point = tuple[float, float, float]
 Point2 = tuple[float, float]
@@ -123,7 +123,7 @@ def triangles_intersect_float(a, b) -> bool:
 
 def as_triangle(t, what: str = "triangle") -> Triangle:
     """Check a (3, 3) vertex array and return it as three tuples of floats."""
-    array = np.asarray(t, dtype=np.float64)
+    array = as_numbers(what, t)
     if array.shape != (3, 3):
         raise StateError(f"{what}: expected shape (3, 3), got {array.shape}")
     if not np.isfinite(array).all():

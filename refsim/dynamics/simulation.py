@@ -92,8 +92,10 @@ from refsim.errors import (
 )
 from refsim.frames import FrameSink, MemorySink, frame_count
 from refsim.kernels import choose_kernel
+from refsim.limits import MAX_STEPS
 from refsim.models.mesh import Mesh
 from refsim.scenes.schema import Scene
+from refsim.solvers.explicit_rk import rk_step
 from refsim.solvers.integrate import resolve_method, whole_steps
 
 #: At most about this many frames by default (``every`` is chosen so).
@@ -426,8 +428,9 @@ class Simulation:
         Overflow on the way to a non-finite state raises DivergenceError
         from the check stage; numpy's own warnings of it are silenced here
         (they would repeat the news once per operation, unattributed).
+        ``n_steps`` above ``refsim.limits.MAX_STEPS`` is a StateError.
         """
-        n_steps = check_count("n_steps", n_steps)
+        n_steps = check_count("n_steps", n_steps, maximum=MAX_STEPS)
         every = check_count("every", every, minimum=1)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             for _ in range(n_steps):
@@ -439,7 +442,7 @@ class Simulation:
     def _integrate(self) -> None:
         B = len(self.bodies)
         y = np.concatenate([self.x.reshape(-1), self.v.reshape(-1)])
-        y = self.method.step(self._f, self.t, y, self.h)
+        y = rk_step(self.method, self._f, self.t, y, self.h)  # arguments known good
         Y = y.reshape(2, B, 3)
         self.x[...] = Y[0]
         self.v[...] = Y[1]

@@ -24,6 +24,8 @@ class ModelFacts:
     centroid_vertex_average: tuple[float, float, float]
     centroid_volume: tuple[float, float, float] | None
     volume: float | None
+    #: log10 of |volume|: finite where the volume itself overflows.
+    volume_log10: float | None
     max_neighbors: int
     #: |vertex-average centroid - volume centroid| / box diagonal; None when
     #: open. The seed takes the vertex average as the centre of mass (S9).
@@ -54,6 +56,7 @@ def describe(mesh: Mesh, name: str | None = None) -> ModelFacts:
         centroid_vertex_average=_triple(mesh.centroid_vertex_average),
         centroid_volume=None if mesh.centroid_volume is None else _triple(mesh.centroid_volume),
         volume=mesh.volume,
+        volume_log10=mesh.volume_log10,
         max_neighbors=int(degree.max()),
         centroid_offset=centroid_offset(mesh),
     )
@@ -71,6 +74,18 @@ def centroid_offset(mesh: Mesh) -> float | None:
     gap = math.hypot(*(0.5 * mesh.centroid_vertex_average - 0.5 * mesh.centroid_volume))
     diagonal = math.hypot(*(0.5 * hi - 0.5 * lo))
     return gap / diagonal
+
+
+def _volume_text(facts: ModelFacts) -> str:
+    """The volume, in decimal; beyond float64's range (inf) as a mantissa and
+    an exponent from its logarithm, since the mesh's coordinates are finite."""
+    if facts.volume is None or facts.volume_log10 is None:
+        return "n/a (open mesh)"
+    if math.isfinite(facts.volume):
+        return f"{facts.volume:.6g}"
+    exponent = math.floor(facts.volume_log10)
+    mantissa = math.copysign(10.0 ** (facts.volume_log10 - exponent), facts.volume)
+    return f"{mantissa:.6g}e+{exponent} (beyond float64's range)"
 
 
 def format_facts(facts: ModelFacts) -> str:
@@ -91,9 +106,7 @@ def format_facts(facts: ModelFacts) -> str:
         ("bounds max", vec(facts.bounds_hi)),
         ("centroid (vertex average, seed)", vec(facts.centroid_vertex_average)),
         ("centroid (volume)", vec(facts.centroid_volume)),
-        ("volume", "n/a (open mesh)" if facts.volume is None else
-         f"{facts.volume:.6g}" if math.isfinite(facts.volume) else
-         f"{facts.volume:.6g} (beyond float64's range)"),
+        ("volume", _volume_text(facts)),
         ("centroid offset / diagonal", "n/a (open mesh)" if facts.centroid_offset is None
          else f"{facts.centroid_offset:.3g}"),
         ("most neighbours of a vertex", facts.max_neighbors),

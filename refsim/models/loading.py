@@ -18,14 +18,17 @@ Cost: that of the reader, O(file size), plus the O(n log n) weld.
 
 from __future__ import annotations
 
+import contextlib
 import io
+import logging
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 from refsim.bundled import models_dir
 from refsim.errors import ModelError
-from refsim.files import as_path, read_regular_file
+from refsim.files import as_path, bundled_if_bare, read_regular_file
 from refsim.models.ac3d import read_ac3d
 from refsim.models.mesh import Mesh
 
@@ -57,19 +60,10 @@ def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
     if suffix not in SUFFIXES:
         raise ModelError(f"unknown model format {path.suffix or '(no suffix)'!r}; "
                          f"supported: {', '.join(SUFFIXES)}", path=path)
-    path = _bundled_if_bare(path)
+    path = bundled_if_bare(path, models_dir())
     if suffix == ".ac":
         return read_ac3d(path, weld_tolerance=weld_tolerance)
     return _load_with_trimesh(path, read_regular_file(path, ModelError), weld_tolerance)
-
-
-def _bundled_if_bare(path: Path) -> Path:
-    """``path`` itself, or the bundled model of that name when ``path`` is a
-    bare name that does not exist here."""
-    if path.exists() or path.name != str(path):
-        return path
-    bundled = models_dir() / path.name
-    return bundled if bundled.is_file() else path
 
 
 #: The formats trimesh reads as text (the others, binary STL and PLY, as bytes).
@@ -93,7 +87,8 @@ def _load_with_trimesh(path: Path, data: bytes, weld_tolerance: float) -> Mesh:
     else:
         source = io.BytesIO(data)
     try:
-        loaded = trimesh.load(source, file_type=suffix[1:], force="mesh", process=False)
+        with _quiet_trimesh():
+            loaded = trimesh.load(source, file_type=suffix[1:], force="mesh", process=False)
     except Exception as exc:  # trimesh raises many types for bad files
         raise ModelError(f"trimesh cannot read it: {_one_line(exc)}", path=path) from None
     faces = getattr(loaded, "faces", None)
@@ -102,6 +97,24 @@ def _load_with_trimesh(path: Path, data: bytes, weld_tolerance: float) -> Mesh:
         raise ModelError("the file holds no triangles", path=path)
     return Mesh(np.asarray(vertices, dtype=np.float64), np.asarray(faces),
                 weld_tolerance=weld_tolerance, name=path.stem, source=str(path))
+
+
+@contextlib.contextmanager
+def _quiet_trimesh():
+    """trimesh reading a file without speaking: it logs the tracebacks of
+    the attempts it recovers from (an ASCII STL tried as binary first) and
+    lets numpy warn about the non-finite numbers of a broken file. What
+    matters reaches the user otherwise: a file trimesh cannot read is its
+    exception, and a non-finite vertex is refused by :class:`Mesh`."""
+    logger = logging.getLogger("trimesh")  # its modules log through children
+    level = logger.level
+    logger.setLevel(logging.CRITICAL + 1)
+    try:
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            yield
+    finally:
+        logger.setLevel(level)
 
 
 def _one_line(exc: Exception) -> str:

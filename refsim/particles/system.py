@@ -33,8 +33,9 @@ from refsim.dynamics.forces import acceleration, acceleration_into
 from refsim.dynamics.walls import wall_response_points, wall_response_points_inplace
 from refsim.errors import DivergenceError, OptionError, StateError, check_count
 from refsim.kernels import choose_kernel
+from refsim.limits import MAX_STEPS
 from refsim.particles.config import ParticleConfig
-from refsim.solvers.explicit_rk import rk_step_into, stages_with_own_state
+from refsim.solvers.explicit_rk import rk_step, rk_step_into, stages_with_own_state
 from refsim.solvers.integrate import resolve_method
 
 
@@ -57,7 +58,7 @@ def plain_step(config: ParticleConfig, x: np.ndarray, v: np.ndarray, t: float = 
     """One step by the plain kernels: returns new ``(x, v)``, each (N, 3)."""
     n = x.shape[0]
     y = np.stack([x, v]).reshape(-1)
-    y = resolve_method(config.solver).step(particle_rhs(config, n), t, y, config.step)
+    y = rk_step(resolve_method(config.solver), particle_rhs(config, n), t, y, config.step)
     x, v = y.reshape(2, n, 3)
     if config.walls:
         x, v, _ = wall_response_points(x, v, config.half_size, config.restitution,
@@ -200,9 +201,10 @@ class ParticleSystem:
             The state became non-finite (checked once, after the steps, to
             keep the loop at one pass over memory per operation).
         StateError, ArgumentTypeError
-            ``steps`` is negative or not an integer.
+            ``steps`` is negative, more than ``refsim.limits.MAX_STEPS`` or not
+            an integer.
         """
-        steps = check_count("steps", steps)
+        steps = check_count("steps", steps, maximum=MAX_STEPS)
         # Overflow on the way to inf is what the check below reports, once;
         # numpy's warnings would print it again, per operation.
         with np.errstate(over="ignore", invalid="ignore"):

@@ -25,8 +25,8 @@ import numpy as np
 from refsim.bundled import models_dir, scenes_dir
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
 from refsim.errors import ModelError, SceneError, StateError
-from refsim.files import as_path, decode_utf8, read_regular_file
-from refsim.limits import MAX_MAGNITUDE
+from refsim.files import as_path, bundled_if_bare, decode_utf8, read_regular_file
+from refsim.limits import MAX_MAGNITUDE, MAX_SCENE_BYTES, MAX_SCENE_NESTING
 from refsim.models.loading import load_model
 from refsim.scenes.schema import (
     BODY_FIELDS,
@@ -69,17 +69,70 @@ def load_scene(path) -> Scene:
         Never: a body's broken model is reported as a SceneError naming the
         scene, the body's key and the model file's own line.
     """
-    path = as_path(path)
-    if not path.exists() and path.name == str(path) and (scenes_dir() / path.name).is_file():
-        path = scenes_dir() / path.name
-    text = decode_utf8(read_regular_file(path, SceneError), path, SceneError)
+    path = bundled_if_bare(as_path(path), scenes_dir())
+    data = read_regular_file(path, SceneError, max_bytes=MAX_SCENE_BYTES)
+    text = decode_utf8(data, path, SceneError)
+    too_deep = first_line_nested_deeper(text, MAX_SCENE_NESTING)
+    if too_deep is not None:
+        raise SceneError(f"invalid TOML: arrays and inline tables nested more than "
+                         f"{MAX_SCENE_NESTING} deep", path, line=too_deep)
     try:
-        data = tomllib.loads(text)
+        table = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"invalid TOML: {exc}", path) from None
-    except RecursionError:
-        raise SceneError("invalid TOML: values nested too deeply", path) from None
-    return scene_from_dict(data, path)
+    return scene_from_dict(table, path)
+
+
+def first_line_nested_deeper(text: str, limit: int) -> int | None:
+    """The 1-based line where TOML ``text`` first opens more than ``limit``
+    arrays and inline tables inside one another, or None.
+
+    Brackets inside strings and comments do not count; a table header
+    (``[world]``, ``[[body]]``) opens and closes on its line. The scan only
+    counts, so a malformed file passes it and ``tomllib`` reports the syntax
+    error; its purpose is to refuse the nesting ``tomllib`` would recurse into
+    until the stack overflows. Cost: O(len(text)).
+    """
+    depth, line, i, n = 0, 1, 0, len(text)
+    while i < n:
+        c = text[i]
+        if c == "\n":
+            line += 1
+        elif c == "#":
+            end = text.find("\n", i)
+            i = n if end < 0 else end
+            continue
+        elif c in "\"'":
+            i, line = _skip_string(text, i, line)
+            continue
+        elif c in "[{":
+            depth += 1
+            if depth > limit:
+                return line
+        elif c in "]}":
+            depth = max(depth - 1, 0)
+        i += 1
+    return None
+
+
+def _skip_string(text: str, i: int, line: int) -> tuple[int, int]:
+    """The index after the TOML string that opens at ``text[i]`` and the line
+    number there. A one-line string ends at its line's end if unterminated
+    (``tomllib`` then reports it); a basic string's backslash escapes the
+    next character, a line break included."""
+    quote = text[i] * 3 if text.startswith(text[i] * 3, i) else text[i]
+    i += len(quote)
+    while i < len(text):
+        if text.startswith(quote, i):
+            return i + len(quote), line
+        if text[i] == "\\" and quote[0] == '"':
+            i += 1
+        if i < len(text) and text[i] == "\n":
+            if len(quote) == 1:
+                return i, line
+            line += 1
+        i += 1
+    return i, line
 
 
 def scene_from_dict(data: dict, path: Path | None = None) -> Scene:

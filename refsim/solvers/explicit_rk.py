@@ -37,6 +37,8 @@ from fractions import Fraction
 
 import numpy as np
 
+from refsim.errors import StateError, as_numbers, check_callable, check_number
+
 #: A tableau entry as given: anything :class:`fractions.Fraction` accepts
 #: (``0``, ``"1/2"``, a Fraction). Stored as a Fraction.
 Coefficient = int | str | Fraction
@@ -188,8 +190,23 @@ class ExplicitRungeKutta:
         return order
 
     def step(self, f, t: float, y: np.ndarray, h: float) -> np.ndarray:
-        """One step of size ``h`` from ``(t, y)``; see :func:`rk_step`."""
-        return rk_step(self, f, t, y, h)
+        """One step of size ``h`` from ``(t, y)``; see :func:`rk_step`.
+
+        Raises
+        ------
+        ArgumentTypeError
+            ``f`` not callable, ``t`` or ``h`` not a real number, ``y`` not
+            an array of numbers (real or complex).
+        StateError
+            ``y`` not a vector. (Values are not checked: a step from a
+            non-finite state gives a non-finite one, as the arithmetic does.)
+        """
+        check_callable("f", f)
+        if not (isinstance(y, np.ndarray) and y.dtype in (np.float64, np.complex128)):
+            y = as_numbers("y", y, complex_ok=True)   # complex: the linear test equation
+        if y.ndim != 1:
+            raise StateError(f"y must be a vector (d,), got shape {y.shape}")
+        return rk_step(self, f, check_number("t", t), y, check_number("h", h))
 
 
 def rk_step(method: ExplicitRungeKutta, f, t: float, y: np.ndarray, h: float) -> np.ndarray:

@@ -28,9 +28,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from refsim.errors import DivergenceError, OptionError, StateError, check_option
+from refsim.errors import (
+    DivergenceError,
+    OptionError,
+    StateError,
+    as_numbers,
+    check_callable,
+    check_number,
+    check_option,
+)
 from refsim.limits import MAX_RESULT_BYTES, MAX_STEPS
-from refsim.solvers.explicit_rk import ExplicitRungeKutta
+from refsim.solvers.explicit_rk import ExplicitRungeKutta, rk_step
 from refsim.solvers.methods import SEED_LITERAL_VARIANTS, SOLVERS
 
 #: How far ``(t1 - t0) / h`` may be from an integer, relative to it, and still
@@ -117,6 +125,7 @@ def step_grid(t0: float, t1: float, h: float,
     Every step is ``h`` exactly except, with ``last_step="short"``, the last
     one (``t1 - t_{n-1}``); see the module docstring.
     """
+    t0, t1, h = check_number("t0", t0), check_number("t1", t1), check_number("h", h)
     for name, value in (("t0", t0), ("t1", t1), ("h", h)):
         if not math.isfinite(value):
             raise StateError(f"{name} is not finite: {value!r}")
@@ -165,6 +174,9 @@ def solve_fixed_step(f, y0, t0: float, t1: float, h: float, method="rk4", *,
 
     Raises
     ------
+    ArgumentTypeError
+        ``f`` not callable, ``y0`` not numbers, ``t0``/``t1``/``h`` not real
+        numbers.
     StateError
         Non-finite ``y0``, ``t0``, ``t1`` or ``h``; ``h <= 0``; ``t1 < t0``;
         ``f`` returning the wrong shape; an unknown method.
@@ -172,7 +184,8 @@ def solve_fixed_step(f, y0, t0: float, t1: float, h: float, method="rk4", *,
         The state became non-finite; ``partial`` holds the result so far.
     """
     solver = resolve_method(method)
-    y0 = np.atleast_1d(np.asarray(y0, dtype=np.float64))
+    check_callable("f", f)
+    y0 = np.atleast_1d(as_numbers("y0", y0))
     if y0.ndim != 1:
         raise StateError(f"y0 must be a vector, got shape {y0.shape}")
     if not np.isfinite(y0).all():
@@ -198,7 +211,7 @@ def solve_fixed_step(f, y0, t0: float, t1: float, h: float, method="rk4", *,
     y = np.empty((steps + 1, y0.size), dtype=np.float64)
     y[0] = y0
     for i in range(steps):
-        y[i + 1] = solver.step(counted_f, t[i], y[i], hs[i])
+        y[i + 1] = rk_step(solver, counted_f, t[i], y[i], hs[i])
         if not np.isfinite(y[i + 1]).all():
             partial = FixedStepResult(t[:i + 1], y[:i + 1], nfev, i, solver.name)
             raise DivergenceError("state is not finite", step=i + 1, time=float(t[i + 1]),
@@ -236,6 +249,9 @@ def integrate(f, y0, t0: float, t1: float, h: float, method="rk4", *,
 
     Raises
     ------
+    ArgumentTypeError
+        ``f`` not callable, ``y0`` not numbers, ``t0``/``t1``/``h`` not real
+        numbers.
     StateError
         A non-finite input, ``h <= 0``, ``t1 < t0``, too many steps or too
         large a result (``refsim.limits``), ``f`` returning the wrong shape.

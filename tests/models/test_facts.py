@@ -3,12 +3,15 @@ with trimesh."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 from refsim.oracles.trimesh_adapter import TrimeshOracle
 
 from refsim.bundled import bundled_models, models_dir
 from refsim.models.facts import describe, format_facts
 from refsim.models.loading import load_model
+from refsim.models.mesh import Mesh
 from refsim.studies.models import measure_mesh_facts_agreement
 
 #: Volumes and centroids from two summation orders agree to a few ulps times
@@ -49,3 +52,14 @@ def test_every_bundled_model_agrees_with_trimesh():
         assert row.convex_agrees and row.closed_agrees, row.name
         assert row.volume_relative_difference < ROUNDING, row.name
         assert row.centroid_difference_over_diagonal < ROUNDING, row.name
+
+
+def test_a_volume_beyond_float64_is_printed_from_its_logarithm():
+    # The unit cube scaled by 1e154 bounds 1e462: float64 rounds it to inf,
+    # but the coordinates are finite and so is the volume's logarithm.
+    cube = load_model(models_dir() / "cube.ac")
+    facts = describe(Mesh(cube.vertices * 1e154, cube.faces))
+    assert facts.volume == math.inf
+    assert facts.volume_log10 == pytest.approx(462.0, abs=1e-9)
+    line = next(row for row in format_facts(facts).splitlines() if row.startswith("volume"))
+    assert line.split()[1:] == ["1e+462", "(beyond", "float64's", "range)"]

@@ -7,6 +7,7 @@ trimesh, loaded back through :func:`refsim.load_model`, and compared.
 from __future__ import annotations
 
 import os
+import warnings
 
 import numpy as np
 import pytest
@@ -15,6 +16,7 @@ from scipy.spatial import cKDTree
 
 import refsim
 from refsim.errors import ModelError
+from refsim.limits import MAX_MODEL_BYTES
 from refsim.models.ac3d import write_ac3d
 from refsim.models.mesh import Mesh
 
@@ -169,3 +171,44 @@ def test_a_bare_name_finds_a_bundled_model(tmp_path, monkeypatch):
     assert refsim.load_model("cube.ac").n_faces == 12
     with pytest.raises(ModelError, match="no such file"):
         refsim.load_model("no-such-model.ac")
+
+
+@pytest.mark.parametrize("suffix", [".ac", ".stl"])
+def test_a_model_larger_than_its_limit_is_refused_unread(tmp_path, suffix):
+    path = tmp_path / f"big{suffix}"
+    with open(path, "wb") as file:
+        file.truncate(MAX_MODEL_BYTES + 1)          # sparse: no disk used, nothing read
+    with pytest.raises(ModelError) as info:
+        refsim.load_model(path)
+    assert str(info.value) == (f"{path}: file too large: more than {MAX_MODEL_BYTES} bytes "
+                               "(refsim.limits)")
+
+
+def test_a_name_too_long_to_look_up_is_one_model_error(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    name = "x" * 300 + ".ac"                         # beyond NAME_MAX: stat() fails
+    with pytest.raises(ModelError) as info:
+        refsim.load_model(name)
+    assert str(info.value) == f"{name}: cannot read: File name too long"
+
+
+def test_trimesh_reads_quietly_and_a_non_finite_vertex_is_one_error(tmp_path, caplog):
+    # An ASCII STL with a stray token after a normal: trimesh tries it as
+    # binary first, then as ASCII without the normals, and logs both
+    # attempts' tracebacks; refsim's load prints nothing and keeps the triangle.
+    ascii_stl = tmp_path / "t.stl"
+    ascii_stl.write_text("solid t\nfacet normal 0 0 1 junk\nouter loop\nvertex 0 0 0\n"
+                         "vertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n")
+    assert refsim.load_model(ascii_stl).n_faces == 1
+    assert [r.getMessage() for r in caplog.records] == []
+    # A binary STL with an infinite coordinate: refused by Mesh; numpy's
+    # warning about the NaN trimesh makes of it (inf * 0) stays inside.
+    header = b"\0" * 80 + np.uint32(1).tobytes()
+    triangle = np.array([0, 0, 1, np.inf, 0, 0, 1, 0, 0, 0, 1, 0], dtype="<f4").tobytes()
+    nan_stl = tmp_path / "nan.stl"
+    nan_stl.write_bytes(header + triangle + b"\0\0")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with pytest.raises(ModelError, match="non-finite"):
+            refsim.load_model(nan_stl)
+    assert [str(w.message) for w in caught] == []

@@ -9,10 +9,11 @@ import pytest
 
 from refsim.bundled import models_dir, scenes_dir
 from refsim.errors import ModelError, SceneError
+from refsim.limits import MAX_SCENE_BYTES, MAX_SCENE_NESTING
 from refsim.models.ac3d import write_ac3d
 from refsim.models.loading import load_model
 from refsim.models.mesh import Mesh
-from refsim.scenes.loader import load_scene
+from refsim.scenes.loader import first_line_nested_deeper, load_scene
 from refsim.scenes.schema import SOLVER_NAMES, IntegrationConfig, WorldConfig
 from tests.helpers import assert_scene_error
 
@@ -177,15 +178,51 @@ def test_bytes_that_are_not_utf8_are_reported_by_line_and_column(tmp_path):
     path.write_bytes(b'[world]\ngravity = 9.81\n# caf\xe9\n' + MINIMAL.encode())
     with pytest.raises(SceneError) as info:
         load_scene(path)
-    assert str(info.value) == f"{path}: line 3, column 6: not UTF-8 text (byte 0xe9)"
+    assert str(info.value) == f"{path}:3: not UTF-8 text (byte 0xe9 at column 6)"
+    assert info.value.line == 3
 
 
-@pytest.mark.parametrize("depth", [400, 500, 5000])
-def test_deep_nesting_is_one_scene_error(tmp_path, depth):
-    text = "x = " + "[" * depth + "]" * depth + "\n"
+@pytest.mark.parametrize("depth", [MAX_SCENE_NESTING + 1, 500, 5000, 10**6])
+def test_deep_nesting_is_refused_at_its_line_before_the_parser_recurses(tmp_path, depth):
+    text = MINIMAL + "\n[world]\nx = " + "[" * depth + "]" * depth + "\n"
+    path = write(tmp_path, text)
     with pytest.raises(SceneError) as info:
-        load_scene(write(tmp_path, text))
-    assert info.value.path == str(tmp_path / "scene.toml")
+        load_scene(path)
+    line = MINIMAL.count("\n") + 3
+    assert str(info.value) == (f"{path}:{line}: invalid TOML: arrays and inline tables "
+                               f"nested more than {MAX_SCENE_NESTING} deep")
+
+
+@pytest.mark.parametrize("text, line", [
+    ("a = [[1], [2]]\nb = {c = [1, {d = [2]}]}\n", None),
+    ("a = \"[[[[[[[[\"\nb = '{{{{{{'\n# [[[[[[[[[\n", None),
+    ('a = """\n[[[[[[\n"""\nb = [[[[[[[1]]]]]]]\n', 4),
+    ('a = "\\"[[[["\nb = [[[[[1]]]]]\n', 2),
+    ("a = '''x\n'''\nb = [[[[[1]]]]]\n", 3),
+])
+def test_the_nesting_scan_skips_strings_and_comments(text, line):
+    # limit 4: only the arrays outside strings and comments count
+    assert first_line_nested_deeper(text, 4) == line
+
+
+def test_a_scene_larger_than_its_limit_is_refused_unread(tmp_path):
+    path = tmp_path / "big.toml"
+    with open(path, "wb") as file:
+        file.truncate(MAX_SCENE_BYTES + 1)          # sparse: no disk used
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    assert str(info.value) == (f"{path}: file too large: more than {MAX_SCENE_BYTES} bytes "
+                               "(refsim.limits)")
+
+
+def test_a_path_the_system_cannot_look_up_is_one_scene_error(tmp_path):
+    long_name = "x" * 300 + ".toml"             # beyond NAME_MAX (255) on Linux file systems
+    with pytest.raises(SceneError) as info:
+        load_scene(tmp_path / long_name)
+    assert str(info.value) == f"{tmp_path / long_name}: cannot read: File name too long"
+    with pytest.raises(SceneError) as info:
+        load_scene(long_name)                   # a bare name: looked up here, then bundled
+    assert str(info.value) == f"{long_name}: cannot read: File name too long"
 
 
 @pytest.mark.parametrize("model, why", [
