@@ -229,9 +229,13 @@ def lowest_height(scene: RigidScene, trajectory) -> np.ndarray:
 
 
 def energy(scene: RigidScene, trajectory) -> np.ndarray:
-    """(F,) mechanical energy: ``m g y_c + m |v_c|^2 / 2 + w . I_world w / 2``,
-    with ``y_c`` the centre of mass's height above the floor and ``I_world =
-    R I R^T`` (joules, for the scene's mass)."""
+    """(F,) mechanical energy by :func:`refsim.dynamics.energy.mechanical_energy`
+    with the uniform solid's mass properties, whatever the engine's own: the
+    centre of mass at ``x + R c`` moving at ``v + w x (R c)`` (the recorded
+    velocity is the reference point's, the mesh origin's, in every engine's
+    convention), potential from the floor (joules, for the scene's mass)."""
+    from refsim.dynamics.energy import mechanical_energy
+
     _, center, inertia = _body(_model(scene))
     mass = scene.scene.bodies[0].mass
     R = np.asarray(trajectory.orientation)[:, 0]
@@ -239,11 +243,10 @@ def energy(scene: RigidScene, trajectory) -> np.ndarray:
     v = np.asarray(trajectory.velocity)[:, 0]
     w = np.asarray(trajectory.angular_velocity)[:, 0]
     rc = np.einsum("fij,j->fi", R, center)
-    y_c = x[:, 1] + rc[:, 1] + HALF_SIZE
-    v_c = v + np.cross(w, rc)
-    body_w = np.einsum("fji,fj->fi", R, w)                       # R^T w
-    rotational = 0.5 * np.einsum("fi,ij,fj->f", body_w, inertia * mass, body_w)
-    return mass * GRAVITY * y_c + 0.5 * mass * np.einsum("fi,fi->f", v_c, v_c) + rotational
+    parts = mechanical_energy([mass], [inertia * mass], GRAVITY, -HALF_SIZE,
+                              (x + rc)[:, None], R[:, None], (v + np.cross(w, rc))[:, None],
+                              w[:, None])
+    return parts.total[:, 0]
 
 
 def apex_ratio(scene: RigidScene, trajectory) -> tuple[float, list[float]]:

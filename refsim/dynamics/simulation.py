@@ -69,6 +69,7 @@ from refsim.dynamics.body_response import (
     separate_bodies,
 )
 from refsim.dynamics.boxes import boxes_kernel
+from refsim.dynamics.energy import EnergyParts, mechanical_energy
 from refsim.dynamics.forces import translational_rhs
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
 from refsim.dynamics.rotation_impulse import (
@@ -360,13 +361,15 @@ class Simulation:
 
     def energy(self) -> np.ndarray:
         """(B,) mechanical energy: ``m |v|^2 / 2 + w . I w / 2 + m g (y + H)``
-        (potential measured from the floor; rotational with the body's inertia)."""
+        (potential measured from the floor; rotational with the body's
+        inertia), by :func:`refsim.dynamics.energy.mechanical_energy`."""
+        return self.energy_parts().total
+
+    def energy_parts(self) -> EnergyParts:
+        """The (B,) kinetic, rotational and potential parts of :meth:`energy`."""
         world = self.scene.world
-        kinetic = 0.5 * self.mass * np.einsum("bi,bi->b", self.v, self.v)
-        Iw = np.einsum("bij,bj->bi", world_inertia(self.R, self.I_body), self.w)
-        rotational = 0.5 * np.einsum("bi,bi->b", self.w, Iw)
-        potential = self.mass * world.gravity * (self.x[:, 1] + world.half_size)
-        return kinetic + rotational + potential
+        return mechanical_energy(self.mass, self.I_body, world.gravity, -world.half_size,
+                                 self.x, self.R, self.v, self.w)
 
     def _energy_bound(self) -> np.ndarray:
         """(B,) the energy with the rotational part bounded by

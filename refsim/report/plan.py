@@ -725,7 +725,7 @@ def _dynamics_rest(run: Run):
 def _dynamics_energy(run: Run):
     from refsim.studies import bounce
 
-    return bounce.measure_energy(oracle=run.optional("pybullet"))
+    return bounce.measure_drop_energy(oracle=run.optional("pybullet"))
 
 
 def _dynamics_cost(run: Run):

@@ -12,7 +12,7 @@ on the same scene, and compared with the closed forms of
   (the seed's ``(1 - friction) v_t`` against Coulomb's
   ``v_t - mu (1 + e) |v_n|``);
 - :func:`measure_rest`: the time until the bounces die out (Zeno time);
-- :func:`measure_energy`: mechanical energy over time;
+- :func:`measure_drop_energy`: mechanical energy over time;
 - :func:`measure_cost`: apex-ratio error against wall time per simulated
   second over step sizes 1/30 .. 1/4000 s, for refsim's solvers and pybullet,
   in the manner of the work-precision comparisons of T. Erez, Y. Tassa and
@@ -50,6 +50,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from refsim.dynamics import analytic
+from refsim.dynamics.energy import trajectory_energy
 from refsim.solvers.methods import SOLVERS
 from refsim.studies import timing_field
 
@@ -215,17 +216,16 @@ def apex_ratio(apexes: np.ndarray, k: int = BOUNCES) -> float:
     return float((apexes[k] / apexes[0]) ** (1.0 / k))
 
 
-def mechanical_energy(trajectory, y_touch: float, gravity: float, mass: float = 1.0,
-                      inertia: float | None = None) -> np.ndarray:
-    """(F,) energy of body 0 above the touching height: ``m g (y - y_touch)
-    + m |v|^2 / 2`` plus ``I |w|^2 / 2`` when a (scalar, isotropic) inertia is given."""
-    y = trajectory.position[:, 0, 1]
-    v = trajectory.velocity[:, 0]
-    e = mass * gravity * (y - y_touch) + 0.5 * mass * np.einsum("ij,ij->i", v, v)
-    if inertia is not None:
-        w = trajectory.angular_velocity[:, 0]
-        e = e + 0.5 * inertia * np.einsum("ij,ij->i", w, w)
-    return e
+def energy_above_touch(scene, trajectory, y_touch: float) -> np.ndarray:
+    """(F,) body 0's mechanical energy per unit weight (metres), the
+    potential measured from the height ``y_touch`` at which it touches the
+    floor: :func:`refsim.dynamics.energy.trajectory_energy` less the
+    potential of that height, over ``m g``. Equal to the apex height above
+    touching when the body is at rest at an apex (what the analytic series
+    of :func:`refsim.dynamics.analytic.energy` gives per unit weight)."""
+    weight = scene.bodies[0].mass * scene.world.gravity
+    total = trajectory_energy(scene, trajectory).total[:, 0]
+    return total / weight - (y_touch + scene.world.half_size)
 
 
 # -- the studies --------------------------------------------------------------------
@@ -449,7 +449,7 @@ def measure_rest(model: str = SPHERE, restitutions=(0.5, 0.8), *, step: float = 
 
 
 @dataclass(frozen=True)
-class EnergySeries:
+class DropEnergy:
     """Height and energy over time for one drop (every ``stride``-th frame)."""
 
     body: str
@@ -463,9 +463,9 @@ class EnergySeries:
     analytic_energy: list[float]
 
 
-def measure_energy(model: str = SPHERE, e: float = 0.8, *, duration: float = 6.0,
+def measure_drop_energy(model: str = SPHERE, e: float = 0.8, *, duration: float = 6.0,
                    step: float = STEP, solver: str = SOLVER, stride: int = 10,
-                   oracle=None) -> EnergySeries:
+                        oracle=None) -> DropEnergy:
     """Height above the touching height and mechanical energy (per unit
     weight ``m g``: metres) over time."""
     scene = drop_scene(model, e, step=step, solver=solver, duration=duration)
@@ -474,14 +474,14 @@ def measure_energy(model: str = SPHERE, e: float = 0.8, *, duration: float = 6.0
     t = ours.t[::stride]
     g = GRAVITY
     r_h = ours.position[::stride, 0, 1] - y_touch
-    r_e = mechanical_energy(ours, y_touch, g)[::stride] / g
+    r_e = energy_above_touch(scene, ours, y_touch)[::stride]
     if oracle is not None:
         theirs, _ = run_engine(scene, oracle)
         p_h = theirs.position[::stride, 0, 1] - y_touch
-        p_e = mechanical_energy(theirs, y_touch, g)[::stride] / g
+        p_e = energy_above_touch(scene, theirs, y_touch)[::stride]
     else:
         p_h = p_e = np.full(len(t), math.nan)
-    return EnergySeries(
+    return DropEnergy(
         body=model, e=e, t=t.tolist(), refsim_height=r_h.tolist(),
         pybullet_height=list(map(float, p_h)),
         analytic_height=analytic.height(t, DROP_HEIGHT, g, e).tolist(),

@@ -26,6 +26,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from refsim.dynamics.energy import trajectory_energy
 from refsim.dynamics.simulation import Simulation, simulate
 from refsim.dynamics.trajectory import Trajectory
 
@@ -49,23 +50,6 @@ def _scene_from(data: dict):
     return scene_from_dict(data)
 
 
-def trajectory_energy(scene, traj: Trajectory) -> tuple[np.ndarray, np.ndarray]:
-    """Per frame, the total translational + potential energy and the
-    rotational energy ``w . I w / 2`` (with each body's inertia tensor), both
-    (F,), for a trajectory of ``scene`` (refsim's or an oracle's)."""
-    sim = Simulation(scene)
-    R = traj.orientation
-    I_world = np.einsum("fbij,bjk,fblk->fbil", R, sim.I_body, R)
-    rotational = 0.5 * np.einsum("fbi,fbij,fbj->f", traj.angular_velocity, I_world,
-                                 traj.angular_velocity)
-    centroid = traj.position + np.einsum("fbij,bj->fbi", R, sim.center)
-    world = scene.world
-    kinetic = 0.5 * np.einsum("b,fbi,fbi->f", sim.mass, traj.velocity, traj.velocity)
-    potential = world.gravity * np.einsum("b,fb->f", sim.mass,
-                                          centroid[:, :, 1] + world.half_size)
-    return kinetic + potential, rotational
-
-
 # -- C12 -------------------------------------------------------------------------------
 
 
@@ -85,7 +69,7 @@ class SpinSeries:
 
 
 def _spin_series(label: str, scene, traj: Trajectory) -> SpinSeries:
-    _, rotational = trajectory_energy(scene, traj)
+    rotational = trajectory_energy(scene, traj).rotational.sum(axis=1)
     w = traj.angular_velocity[:, 0]
     v = traj.velocity[:, 0]
     spin = np.linalg.norm(w, axis=1)
@@ -242,8 +226,8 @@ def measure_energy(scene=None, *, duration: float | None = None,
     for model in models:
         s = replace(scene, dynamics=replace(scene.dynamics, rotation=model))
         traj = simulate(s, duration=duration, every=10)
-        translational, rotational = trajectory_energy(s, traj)
-        energy = translational + rotational
+        parts = trajectory_energy(s, traj)
+        energy, rotational = parts.total.sum(axis=1), parts.rotational.sum(axis=1)
         rise = np.diff(energy)
         rows.append(EnergySeries(model=model, t=traj.t, energy=energy, rotational=rotational,
                                  increases=int((rise > ENERGY_SLACK).sum()),

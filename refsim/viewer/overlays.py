@@ -32,6 +32,7 @@ import numpy as np
 
 from refsim.bounds.aabb_linear import aabb_linear
 from refsim.collision.bodies import intersecting_pairs
+from refsim.dynamics.energy import trajectory_energy
 from refsim.dynamics.trajectory import Trajectory
 
 #: The 12 edges of a box as pairs of corner indices; corner ``c`` has bit k
@@ -215,37 +216,16 @@ class Energy:
 
 
 def energy_per_frame(scene, traj: Trajectory) -> Energy:
-    """The mechanical energy of every frame of ``traj``, a run of ``scene``.
-
-    Each frame's state is put into a :class:`refsim.Simulation` of the scene
-    and its :meth:`~refsim.Simulation.energy` evaluated, so the viewer shows
-    the loop's own formula, not a copy of it. The parts come from the same
-    formula with parts of the state set to zero: ``E(x, 0, 0)`` is the
-    potential energy, ``E(x, v, 0) - E(x, 0, 0)`` the kinetic and
-    ``E(x, v, w) - E(x, v, 0)`` the rotational.
-
-    The recorded position is the mesh origin; the simulation's state is the
-    centroid it rotates about, ``x = position + R c`` (``Simulation.center``).
-    """
-    from refsim.dynamics.simulation import Simulation
-
-    sim = Simulation(scene)
-    F = traj.n_frames
-    parts = np.empty((3, F))
-    for f in range(F):
-        R = traj.orientation[f]
-        sim.R[...] = R
-        sim.x[...] = traj.position[f] + np.einsum("bij,bj->bi", R, sim.center)
-        sim.v[...] = 0.0
-        sim.w[...] = 0.0
-        parts[0, f] = sim.energy().sum()                     # potential
-        sim.v[...] = traj.velocity[f]
-        parts[1, f] = sim.energy().sum()                     # + kinetic
-        sim.w[...] = traj.angular_velocity[f]
-        parts[2, f] = sim.energy().sum()                     # + rotational
-    return Energy(t=np.asarray(traj.t, dtype=np.float64), potential=parts[0],
-                  kinetic=parts[1] - parts[0], rotational=parts[2] - parts[1],
-                  total=parts[2])
+    """The mechanical energy of every frame of ``traj``, a run of ``scene``,
+    summed over bodies: :func:`refsim.dynamics.energy.trajectory_energy`, the
+    formula of :meth:`refsim.Simulation.energy`, so the viewer shows the
+    loop's own energy."""
+    parts = trajectory_energy(scene, traj)
+    kinetic, rotational, potential = (p.sum(axis=1) for p in
+                                      (parts.kinetic, parts.rotational, parts.potential))
+    return Energy(t=np.asarray(traj.t, dtype=np.float64), kinetic=kinetic,
+                  potential=potential, rotational=rotational,
+                  total=parts.total.sum(axis=1))
 
 
 def _options() -> dict:
