@@ -47,7 +47,8 @@ ROW_KEYS = {"solver", "step", "level", "aabb", "roles", "steps", "proxy", "force
             "energy_gap", "count_gap", "error_ratio", "meets", "diverged"}
 REFERENCE_KEYS = {"solver", "step", "check_step", "level", "aabb", "converged", "stop",
                   "horizon", "uncertainty", "position_gap", "event_gap", "resolution",
-                  "energy_gap", "count_gap", "impacts", "halvings"}
+                  "energy_gap", "count_gap", "energy_spread", "count_spread", "impacts",
+                  "halvings"}
 
 
 @pytest.fixture(scope="module")

@@ -375,6 +375,22 @@ def test_the_next_step_proposed(solver, measured, expected):
     assert advisor._propose(solver, measured) == expected
 
 
+def test_a_proposal_past_the_affordable_becomes_the_last_chance():
+    # midpoint's impacts pair only at 40 (6.2 x TOL): first order predicts 355,
+    # which costs more than the best run (rk4 at 80, say)
+    measured = [(10, math.inf, False), (20, math.inf, False), (40, 6.2, False)]
+    assert advisor._propose("midpoint", measured) == 355
+    # the last chance: the step at which another solver met TOL, when affordable
+    assert advisor._last_chance(measured, passing={80, 200}, m_max=159) == 80
+    # else the finest step that could still cost less than the best
+    assert advisor._last_chance(measured, passing={200}, m_max=159) == 159
+    assert advisor._propose("midpoint", measured, m_max=159) == 159
+    # both measured (and failed): the solver is done
+    tried = [*measured, (80, 2.0, False), (159, 1.5, False)]
+    assert advisor._last_chance(tried, passing={80}, m_max=159) is None
+    assert advisor._propose("midpoint", tried, m_max=159) is None
+
+
 def test_the_counting_simulation_is_the_loop_bit_for_bit(tmp_path):
     path = tmp_path / "head-on.toml"
     path.write_text(HEAD_ON)
