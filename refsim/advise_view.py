@@ -259,6 +259,7 @@ def chart_figure(advice):
     out); the other levels, the scene's own settings and the recommendation
     marked; TOL as a dashed line."""
     from matplotlib.figure import Figure
+    from matplotlib.ticker import NullFormatter
 
     tol = advice.tolerance
     fig = Figure(figsize=(7.0, 4.6))
@@ -288,11 +289,16 @@ def chart_figure(advice):
     if math.isfinite(chart_error(own)):
         ax.plot([max(chart_error(own), floor)], [own.proxy], "*", color="black", ms=13,
                 mfc="none", label="scene's own settings")
+    else:                                       # named, not drawn: it has no finite error
+        ax.plot([], [], "*", color="black", ms=13, mfc="none",
+                label="scene's own settings: impacts differ (off the chart)")
     ax.plot([max(chart_error(rec), floor)], [rec.proxy], "o", color="crimson", ms=15,
             mfc="none", mew=2, label="recommended")
     ax.axvline(tol, color="crimson", ls="--", lw=1)
     ax.set_xscale("log")
     ax.set_yscale("log")
+    ax.xaxis.set_minor_formatter(NullFormatter())      # decades only: no crowded labels
+    ax.yaxis.set_minor_formatter(NullFormatter())
     ax.set_xlabel("error against the reference (m): position, or event time x response speed")
     ax.set_ylabel("cost: force evaluations x bodies + narrow-phase calls")
     title = f"{advice.scene.rsplit('/', 1)[-1]}: TOL = {tol:g} m"

@@ -285,7 +285,7 @@ def _advise(args) -> int:
         raise output_error(out, f"no directory {out.parent}")
     scene = load_scene(args.scene)
     if args.duration is not None:
-        scene = _with_duration(scene, args.duration)
+        _with_duration(scene, args.duration)        # refused here, with the flag's name
     stem = Path(args.scene).stem
     store = args.store
     if store is None and out is not None:
@@ -297,8 +297,9 @@ def _advise(args) -> int:
         options["max_reference_steps"] = args.max_reference_steps
     if out is not None:
         out.mkdir(exist_ok=True)
-    advice = advise(scene, args.tolerance, backend=backend, workers=args.workers,
-                    scheduler=args.scheduler, store=store, progress=not args.json, **options)
+    advice = advise(scene, args.tolerance, duration=args.duration, backend=backend,
+                    workers=args.workers, scheduler=args.scheduler, store=store,
+                    progress=not args.json, **options)
     chart_path = None
     if out is not None:
         if svg_available():

@@ -175,6 +175,35 @@ def test_the_help_states_the_study_defaults():
     assert MAX_REFERENCE_STEPS == 2**19 and "default 2^19" in text
 
 
+def test_an_interrupted_advise_resumes_from_its_store(scene, tmp_path):
+    """Stopped (SIGTERM, which the command unwinds like Ctrl-C; SIGINT is
+    ignored by a process started in the background) after the first run is
+    stored; the next advise reads it back."""
+    import signal
+    import time
+
+    store = tmp_path / "store"
+    argv = [sys.executable, "-m", "refsim.cli", "advise", str(scene), "--repeats", "1",
+            "--duration", "3", "--store", str(store)]
+    process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                               text=True)
+    deadline = time.monotonic() + 120.0
+    while not list((store / "results").glob("*.json")) and time.monotonic() < deadline:
+        assert process.poll() is None, process.stderr.read()
+        time.sleep(0.05)
+    process.send_signal(signal.SIGTERM)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 128 + signal.SIGTERM
+    assert err.strip().splitlines()[-1] == "refsim: interrupted (SIGTERM)"
+    stored = len(list((store / "results").glob("*.json")))
+    assert stored >= 1
+    result = subprocess.run([*argv, "--json"], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    document = json.loads(result.stdout)
+    assert document["resumed"] == stored
+    assert document["computed"] == len(document["runs"]) - stored
+
+
 def test_the_console_script_exits_2_on_a_bad_tolerance(scene):
     result = subprocess.run([sys.executable, "-m", "refsim.cli", "advise", str(scene),
                              "--tolerance", "0"], capture_output=True, text=True)

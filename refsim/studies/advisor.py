@@ -80,10 +80,11 @@ count allowance. The default TOL, ``DEFAULT_TOLERANCE``, is 1 cm.
    again from the bracket's edge (the largest step that met TOL, or while
    none has, the finest step measured), inside the bracket of
    the largest step that met TOL and the smallest that did not (aiming at
-   TOL itself once a step meets it: the bracket keeps what was found),
-   until the bracket is narrower than ``BRACKET_RATIO`` or
-   ``SEARCH_ROUNDS`` rounds have run. A step is never assumed to meet TOL: only measured runs are
-   recommended.
+   TOL itself once a step meets it: the bracket keeps what was found; and
+   bisecting the bracket, on a log scale, when the model points outside
+   it, the safeguard of Brent's root finder), until the bracket is
+   narrower than ``BRACKET_RATIO`` or ``SEARCH_ROUNDS`` rounds have run.
+   A step is never assumed to meet TOL: only measured runs are recommended.
 
    *Branch and bound.* Before a run, its force evaluations are known
    exactly (steps x stages x bodies) and bound its proxy from below (its
@@ -203,8 +204,10 @@ PROBE_TARGET = 1.0
 #: smallest that does not are within this ratio (within 25 %).
 BRACKET_RATIO = 1.25
 
-#: Rounds of prediction after the first measurements.
-SEARCH_ROUNDS = 4
+#: Rounds of prediction after the first measurements: a first prediction,
+#: and enough bisections to narrow a bracket of 4 to BRACKET_RATIO
+#: (4 -> 2 -> 1.41 -> 1.19), with one to spare.
+SEARCH_ROUNDS = 5
 
 #: Wall-time repeats of each candidate run (the median is reported); the
 #: reference's halvings are timed once (they are not candidates but for
@@ -697,6 +700,9 @@ def _propose(solver: str, measured: list[tuple[int, float, bool]],
             proposal = 1                                     # exact: the longest step
         else:
             proposal = math.ceil(m_a * (r_a / target) ** (1.0 / p) * (1.0 - 1e-12))
+    if meeting and m_fail and not m_fail < proposal < m_pass:
+        # the model points outside the bracket: bisect it (on a log scale)
+        proposal = round(math.sqrt(m_fail * m_pass))
     proposal = max(min(proposal, m_max), m_fail + 1)
     if proposal >= m_pass or proposal > m_max:
         return None

@@ -32,18 +32,20 @@ One tolerance TOL, in metres, covers all three measures:
   instants are not counted (a sample that falls on one is).
 - **Event times.** A contact is found at the end of the step in which it
   began, so its time is known to one step. When two runs respond to the
-  same contact ``dt`` apart, the run that responded first moves away at the
-  changed velocity while the other still moves at the old one: they drift
-  apart at the **response speed** ``u`` (the largest change of a point's
-  velocity the response made, :mod:`refsim.studies.fidelity_runs`) until
-  the later run responds, ``u dt`` apart, and about that far apart they
-  stay. So two events "agree within TOL" when ``|t_a - t_b| * u <= TOL``:
-  a time difference is judged by the distance it puts between the runs, in
-  the same metres as the positions, and a hard impact needs a finer step
-  than a gentle one, as it should. The same product is the event error
-  reported (metres). It also covers what the positions, compared at the
-  sample times only, cannot see: the distance between two runs in the
-  instants between two responses to one contact.
+  same contact ``dt`` apart, the run that responded first moves on with the
+  changed velocity while the other still moves with the old one, until it
+  responds too: the timing difference alone can put them up to ``u dt``
+  apart, ``u`` the **response speed** (the largest change of a point's
+  velocity that the response made, :mod:`refsim.studies.fidelity_runs`).
+  So two events "agree within TOL" when ``|t_a - t_b| * u <= TOL``: a time
+  difference is judged by the largest distance it can put between the
+  runs, in the same metres as the positions, and a hard impact needs a
+  finer step than a gentle one, as it should. The same product is the
+  event error reported (metres). It is a bound: the later run's push-back
+  out of the wall takes back part of it, and what stays between the runs
+  after both responded (about ``e v dt`` for a wall bounce) is what the
+  positions measure at the next sample (docs/decisions/advisor-metrics.md
+  has both, measured).
 - **Energy.** The total mechanical energy at the end of the run
   (:meth:`refsim.Simulation.energy`, summed over bodies), as a fraction of the
   reference's largest energy. The advisor allows ``TOL / H`` (``H`` the

@@ -21,10 +21,10 @@ update; nothing else), steps a :class:`refsim.Simulation` and records
   responses made to the body, ``|dv| + r |dw|`` (``dv``, ``dw`` the changes
   of its velocity and angular velocity by the wall and body responses,
   ``r`` its radius), the larger of the two bodies' for a body contact. Two
-  runs that respond ``dt`` apart drift apart at that speed until the later
-  one responds: the advisor turns a time difference into a distance with
-  it. A resting contact's response is small (it cancels a step's gravity);
-  an impact's is about ``(1 + e)`` times the approach speed;
+  runs that respond ``dt`` apart drift apart at up to that speed until the
+  later one responds: the advisor turns a time difference into a distance
+  with it. A resting contact's response is small (it cancels a step's
+  gravity); an impact's is about ``(1 + e)`` times the approach speed;
 - the work, in counts that do not depend on the machine: force evaluations
   times bodies (``steps * stages * B``: the solver evaluates the forces of
   all ``B`` bodies ``stages`` times per step), narrow-phase calls (body

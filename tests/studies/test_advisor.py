@@ -310,6 +310,21 @@ def test_another_tolerance_reuses_the_runs_it_shares(drop):
     assert finer.recommended.step <= advice.recommended.step
 
 
+def test_the_report_hook_gives_the_advice_at_each_tolerance(tmp_path):
+    path = tmp_path / "drop.toml"
+    path.write_text(DROP)
+    (series,) = advisor.advice_by_tolerance(scenes=[path], tolerances=(2 * TOL, TOL),
+                                            store=tmp_path / "stores", repeats=1)
+    assert series.scene == str(path) and series.tolerances == (2 * TOL, TOL)
+    coarse, fine = series.advice
+    assert (coarse.tolerance, fine.tolerance) == (2 * TOL, TOL)
+    assert coarse.recommended.meets and fine.recommended.meets
+    # the tolerances share the scene's store: the finer one reuses runs
+    assert (tmp_path / "stores" / "drop").is_dir() and fine.resumed >= 2
+    # a looser tolerance never needs more work than a tighter one here
+    assert coarse.recommended.proxy <= fine.recommended.proxy
+
+
 # -- bad input ---------------------------------------------------------------------------------
 
 
@@ -370,6 +385,8 @@ def test_the_ladder_holds_the_scene_step_to_the_bit_and_divides_the_run():
     ("rk4", [(10, 0.0, True)], 1),
     # a bracket narrower than BRACKET_RATIO: done
     ("euler", [(4, 1.2, False), (5, 0.8, True)], None),
+    # the model points past the bracket's failing edge (17 < 20): bisect it
+    ("euler", [(20, 1.9, False), (59, 0.287, True)], 34),
 ])
 def test_the_next_step_proposed(solver, measured, expected):
     assert advisor._propose(solver, measured) == expected
