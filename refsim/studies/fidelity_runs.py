@@ -1,0 +1,277 @@
+"""One run of a scene at chosen fidelity settings, measured for the advisor
+(:mod:`refsim.studies.advisor`): sampled positions, orientations and
+energy, the events with their response speeds, and the work the run did.
+
+What: :func:`measure_run` is a sweep task (:mod:`refsim.sweep`): a
+module-level function of plain arguments that returns a plain record. It
+rebuilds the scene from plain data (:func:`scene_data`, so that a worker
+process or a Dask worker needs no file but the models), replaces the four
+fidelity choices (:class:`Fidelity`: solver, step, collision level, box
+update; nothing else), steps a :class:`refsim.Simulation` and records
+
+- every ``every``-th step (a common grid of sample times, so that runs at
+  different steps compare at the same instants, never interpolated): the
+  bodies' reported positions and orientations and the total mechanical
+  energy, computed by :meth:`refsim.Simulation.energy` (the loop's one
+  energy formula); and once, each body's radius about its reported
+  position (the farthest vertex of its scaled mesh from the mesh origin),
+  with which an orientation difference becomes a distance;
+- each event of :attr:`refsim.Simulation.events` with its **response
+  speed**: the largest change of a point's velocity that the step's contact
+  responses made to the body, ``|dv| + r |dw|`` (``dv``, ``dw`` the changes
+  of its velocity and angular velocity by the wall and body responses,
+  ``r`` its radius), the larger of the two bodies' for a body contact. Two
+  runs that respond ``dt`` apart drift apart at up to that speed until the
+  later one responds: the advisor turns a time difference into a distance
+  with it. A resting contact's response is small (it cancels a step's
+  gravity); an impact's is about ``(1 + e)`` times the approach speed;
+- the work, in counts that do not depend on the machine: force evaluations
+  times bodies (``steps * stages * B``: the solver evaluates the forces of
+  all ``B`` bodies ``stages`` times per step), narrow-phase calls (body
+  pairs handed to the scene's collision level), box-update vertex visits
+  (the linear scan visits every vertex, the incremental walk fewer); and
+  the wall time of the whole run, ``repeats`` times (a timing, noisy: the
+  advisor reports the median).
+
+A divergence (:class:`refsim.errors.DivergenceError`) is a result, not a
+failure: the record keeps the samples before it and says where it happened.
+
+The counts and the response speeds come from :class:`CountingSimulation`,
+a subclass that counts in two of the loop's stage methods (the narrow phase
+and the box update) and copies the velocities in a third (the divergence
+check, after the motion and before the contacts), and otherwise leaves the
+step untouched, so the trajectory is the loop's own, bit for bit (a test
+checks it against :func:`refsim.simulate`).
+
+Cost: the simulation's own (see :mod:`refsim.dynamics.simulation`) times
+``repeats``, plus O(B) per step for the velocities before the responses and
+O(B) per sample.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from refsim.bundled import models_dir
+from refsim.dynamics.simulation import BATCH_VERTICES, Simulation
+from refsim.errors import DivergenceError, StateError, check_count
+from refsim.scenes.loader import scene_from_dict
+from refsim.scenes.schema import Scene
+from refsim.solvers.integrate import whole_steps
+from refsim.solvers.methods import SOLVERS
+
+
+@dataclass(frozen=True)
+class Fidelity:
+    """The four choices the advisor varies; everything else in a scene is
+    physics and stays as the scene has it.
+
+    ``solver``: a key of :data:`refsim.SOLVERS`; ``step``: seconds;
+    ``level``: a collision level ("none" .. "exact"); ``aabb``: the box
+    update ("linear" | "incremental" | "auto").
+    """
+
+    solver: str
+    step: float
+    level: str
+    aabb: str
+
+    def label(self) -> str:
+        """``"rk4 h=0.00025 exact linear"``: one line for tables and keys."""
+        return f"{self.solver} h={self.step!r} {self.level} {self.aabb}"
+
+
+def scene_fidelity(scene: Scene) -> Fidelity:
+    """The fidelity choices a scene makes itself."""
+    return Fidelity(scene.integration.solver, scene.integration.step, scene.collision.level,
+                    scene.collision.aabb)
+
+
+def with_fidelity(scene: Scene, fidelity: Fidelity, duration: float | None = None) -> Scene:
+    """``scene`` with its solver, step, level and box update replaced (and its
+    duration, when given); ``StateError`` when the duration is not a whole
+    number of the new steps."""
+    duration = scene.integration.duration if duration is None else duration
+    whole_steps(duration, fidelity.step)
+    return replace(
+        scene,
+        integration=replace(scene.integration, solver=fidelity.solver, step=fidelity.step,
+                            duration=duration),
+        collision=replace(scene.collision, level=fidelity.level, aabb=fidelity.aabb))
+
+
+def scene_data(scene: Scene) -> dict:
+    """``scene`` as plain data that :func:`refsim.scenes.loader.scene_from_dict`
+    turns back into an equal scene: its tables as written by the schema, each
+    body's model by its bare name when it is a bundled model (a worker finds
+    it in its own installation) and by absolute path otherwise.
+
+    Raises :class:`StateError` for a scene with a ``[particles]`` table (the
+    advisor simulates rigid bodies).
+    """
+    if scene.particles is not None:
+        raise StateError("the scene has a [particles] table; refsim advise tunes "
+                         "rigid-body scenes (remove [particles], or split the scene)")
+    bundled = models_dir().resolve()
+    bodies = []
+    for body in scene.bodies:
+        values = asdict(body)
+        model = Path(body.model).resolve()
+        values["model"] = model.name if model.parent == bundled else str(model)
+        values["position"] = list(body.position)
+        values["velocity"] = list(body.velocity)
+        values["angular_velocity"] = list(body.angular_velocity)
+        values["orientation"] = [list(row) for row in body.orientation]
+        bodies.append(values)
+    return {"world": asdict(scene.world), "integration": asdict(scene.integration),
+            "collision": asdict(scene.collision), "dynamics": asdict(scene.dynamics),
+            "body": bodies}
+
+
+class CountingSimulation(Simulation):
+    """A :class:`refsim.Simulation` that counts its narrow-phase calls and
+    box-update vertex visits (attributes ``narrow_phase_calls`` and
+    ``box_visits``, totals since construction), and keeps each step's
+    velocities before the contact responses (``v_free``, ``w_free``: copies
+    taken in the check stage, after the solver and the rotation step).
+
+    Box visits: a body whose box comes from the batched linear scan (meshes
+    of at most ``BATCH_VERTICES`` vertices under the loop's default
+    ``boxes="auto"``) visits all its vertices; a body with its own tracker
+    visits what the tracker reports (``tracker.visits``: all vertices for the
+    linear scan, the walk's for the incremental update).
+    """
+
+    def __init__(self, scene: Scene):
+        super().__init__(scene)
+        self.narrow_phase_calls = 0
+        self.box_visits = 0
+        self._batched_visits = sum(b.mesh.n_vertices for b in self.bodies
+                                   if b.mesh.n_vertices <= BATCH_VERTICES)
+        self._own_trackers = [b.tracker for b in self.bodies
+                              if b.mesh.n_vertices > BATCH_VERTICES]
+
+    def _check(self) -> None:
+        super()._check()
+        self.v_free = self.v.copy()
+        self.w_free = self.w.copy()
+
+    def _narrow_phase(self, pairs):
+        self.narrow_phase_calls += len(pairs)
+        return super()._narrow_phase(pairs)
+
+    def _bounds(self) -> None:
+        super()._bounds()
+        self.box_visits += self._batched_visits + sum(t.visits for t in self._own_trackers)
+
+
+def measure_run(*, seed: int, scene: dict, solver: str, step: float, level: str, aabb: str,
+                duration: float, every: int, repeats: int = 1) -> dict:
+    """Simulate ``scene`` (plain data, :func:`scene_data`) with the given
+    fidelity for ``duration`` seconds, ``repeats`` times; return the first
+    run's record with every run's wall time.
+
+    ``seed`` is the sweep's and unused: the simulation draws nothing at
+    random. ``every``: steps between two samples (the duration must be a
+    whole number of samples).
+
+    Returns
+    -------
+    dict
+        ``t`` (S,) sample times; ``position`` (S, B, 3) reported positions;
+        ``orientation`` (S, B, 3, 3); ``radius`` (B,) m; ``energy`` (S,)
+        total mechanical energy in J; ``events``: one
+        ``[kind, body, other, step, time, speed]`` per event (the response
+        speed in m/s, see the module docstring); ``steps`` taken; ``bodies``;
+        ``force_evaluations`` (times bodies), ``narrow_phase_calls``,
+        ``box_visits``; ``diverged``: None, or ``{"step", "time",
+        "message"}``; ``wall_seconds``: one per repeat (timings).
+    """
+    del seed
+    every = check_count("every", every, minimum=1)
+    repeats = check_count("repeats", repeats, minimum=1)
+    fidelity = Fidelity(solver, float(step), level, aabb)
+    run_scene = with_fidelity(scene_from_dict(scene), fidelity, duration)
+    n_steps = run_scene.integration.n_steps
+    if n_steps % every:
+        raise StateError(f"{n_steps} steps are not a whole number of samples of {every} steps")
+    record, seconds = None, []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = _run(run_scene, n_steps, every)
+        seconds.append(time.perf_counter() - start)
+        record = record or result
+    record["wall_seconds"] = seconds
+    return record
+
+
+def _run(scene: Scene, n_steps: int, every: int) -> dict:
+    """One simulation, sampled every ``every`` steps (see :func:`measure_run`)."""
+    sim = CountingSimulation(scene)
+    B = len(sim.bodies)
+    index = {name: i for i, name in enumerate(sim.names)}
+    samples = n_steps // every + 1
+    t = np.empty(samples)
+    position = np.empty((samples, B, 3))
+    orientation = np.empty((samples, B, 3, 3))
+    energy = np.empty(samples)
+    events = []
+    # the farthest vertex from the reported position (the mesh origin), per body
+    radius = [float(np.sqrt((b.mesh.vertices ** 2).sum(axis=1)).max()) for b in sim.bodies]
+
+    def sample(j: int) -> None:
+        t[j] = sim.t
+        position[j] = sim.position
+        orientation[j] = sim.R
+        energy[j] = sim.energy().sum()
+
+    sample(0)
+    taken = 1
+    diverged = None
+    try:
+        # overflow on the way to a divergence is reported by the loop's
+        # check stage; numpy's own warnings of it are silenced (as in Simulation.run)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            for _ in range(n_steps):
+                seen = len(sim.events)
+                sim.step()
+                if len(sim.events) > seen:
+                    _note_events(sim, seen, radius, index, events)
+                if sim.steps % every == 0:
+                    sample(taken)
+                    taken += 1
+    except DivergenceError as exc:
+        diverged = {"step": exc.step, "time": exc.time, "message": exc.message}
+    stages = SOLVERS[scene.integration.solver].stages
+    return {
+        "t": t[:taken], "position": position[:taken], "orientation": orientation[:taken],
+        "radius": radius, "energy": energy[:taken],
+        "events": events, "steps": sim.steps, "bodies": B,
+        "force_evaluations": sim.steps * stages * B,
+        "narrow_phase_calls": sim.narrow_phase_calls, "box_visits": sim.box_visits,
+        "diverged": diverged,
+    }
+
+
+def _note_events(sim: CountingSimulation, seen: int, radius: list, index: dict,
+                 events: list) -> None:
+    """Append the step's new events (``sim.events[seen:]``) with their
+    response speeds: ``|dv| + r |dw|`` of each body by the step's contact
+    responses; the larger of the two bodies' for a body contact."""
+    dv, dw = sim.v - sim.v_free, sim.w - sim.w_free
+    speed = (np.sqrt((dv * dv).sum(axis=1))
+             + np.asarray(radius) * np.sqrt((dw * dw).sum(axis=1)))
+    for event in sim.events[seen:]:
+        a = index[event.body]
+        u = speed[a] if event.kind == "wall" else max(speed[a], speed[index[event.other]])
+        events.append([event.kind, event.body, event.other, event.step, event.time, float(u)])
+
+
+def median_seconds(record: dict) -> float:
+    """The median of a record's wall times (a timing)."""
+    return float(statistics.median(record["wall_seconds"]))
