@@ -297,7 +297,7 @@ def _conform(args) -> int:
         matrix, results = run_matrix(cases=cases, seed=seed, out_dir=out, only=args.only)
         print(matrix.table())
         for name, reason in matrix.unavailable.items():
-            print(f"refsim: warning: {name} not run: {reason}", file=sys.stderr)
+            print(f"refsim: warning: {name} not run: {one_line(reason)}", file=sys.stderr)
         for d in matrix.divergences:
             print(f"  {d.engine:17} {d.check:22} {d.status:8} {d.reason}")
         print(f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine")
@@ -510,7 +510,8 @@ class _Parser(argparse.ArgumentParser):
     ``refsim run: error: ...``)."""
 
     def error(self, message: str):
-        self.exit(EXIT_USER_ERROR, f"refsim: error: {message} (see {self.prog} --help)\n")
+        self.exit(EXIT_USER_ERROR,
+                  f"refsim: error: {one_line(message)} (see {self.prog} --help)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -559,8 +560,15 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def one_line(text) -> str:
+    """``text`` on one line: control characters (a newline in a file name,
+    say) written as escapes, as ``repr`` writes them, so a message is always
+    exactly one line of the terminal."""
+    return "".join(c if c.isprintable() or c == " " else repr(c)[1:-1] for c in str(text))
+
+
 def _one_line_warning(message, category, filename, lineno, file=None, line=None):
-    print(f"refsim: warning: {message}", file=sys.stderr if file is None else file)
+    print(f"refsim: warning: {one_line(message)}", file=sys.stderr if file is None else file)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -575,12 +583,12 @@ def main(argv: list[str] | None = None) -> int:
     except DivergenceError as exc:
         if args.debug:
             raise
-        print(f"refsim: error: {exc}", file=sys.stderr)
+        print(f"refsim: error: {one_line(exc)}", file=sys.stderr)
         return EXIT_DIVERGED
     except RefsimError as exc:
         if args.debug:
             raise
-        print(f"refsim: error: {exc}", file=sys.stderr)
+        print(f"refsim: error: {one_line(exc)}", file=sys.stderr)
         return EXIT_USER_ERROR
     except Interrupted as exc:
         print(f"refsim: interrupted ({exc.name})", file=sys.stderr)

@@ -36,6 +36,8 @@ def require_regular_file(path, error: type) -> Path:
         raise error("no such file", path) from None
     except OSError as exc:
         raise error(f"cannot read: {exc.strerror or exc}", path) from None
+    except ValueError:                  # the one name the system refuses to take
+        raise error("a file name cannot contain a NUL byte", path) from None
     if not stat.S_ISREG(mode):
         raise error(f"not a regular file ({file_kind(mode)})", path)
     return path
@@ -75,7 +77,7 @@ def bundled_if_bare(path: Path, directory: Path) -> Path:
             return path
         bundled = directory / path.name
         return bundled if bundled.is_file() else path
-    except OSError:
+    except (OSError, ValueError):       # ValueError: a NUL byte in the name
         return path
 
 

@@ -118,3 +118,51 @@ def test_a_usage_error_is_the_same_one_line_as_any_error(argv, phrase, capsys):
     assert info.value.code == EXIT_USER_ERROR
     err = capsys.readouterr().err
     assert err.startswith("refsim: error: ") and phrase in err and err.count("\n") == 1
+
+
+# Found by the second fuzz campaign: each refusal is one line naming its cause.
+
+def test_a_newline_in_a_file_name_is_written_as_its_escape(tmp_path, capsys):
+    bad = tmp_path / "new\nline.ac"
+    bad.write_text("junk\n")
+    assert main(["info", str(bad)]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err == (f"refsim: error: {tmp_path}/new\\nline.ac:1: not an AC3D file: the first "
+                   "line must be 'AC3D' and a hex version, e.g. 'AC3Db'\n")
+
+
+def _scene_naming(tmp_path, model: str):
+    scene = tmp_path / "s.toml"
+    scene.write_text(f'[[body]]\nmodel = "{model}"\nposition = [0.0, 0.0, 0.0]\n')
+    return scene
+
+
+def test_a_scenes_model_that_is_a_fifo_is_refused_as_such_not_reported_missing(
+        tmp_path, capsys):
+    import os
+    os.mkfifo(tmp_path / "m.ac")
+    scene = _scene_naming(tmp_path, "m.ac")
+    assert main(["run", str(scene), "-o", str(tmp_path / "out.npz")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err == (f"refsim: error: {scene}: body[0].model: {tmp_path}/m.ac: not a regular "
+                   "file (a FIFO)\n")
+    assert not (tmp_path / "out.npz").exists()
+
+
+def test_a_model_name_too_long_for_the_system_is_refused_at_its_key(tmp_path, capsys):
+    scene = _scene_naming(tmp_path, "x" * 5000 + ".ac")
+    assert main(["run", str(scene), "-o", str(tmp_path / "out.npz")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err == (f"refsim: error: {scene}: body[0].model: model '{'x' * 60}'... cannot be "
+                   "looked up: File name too long\n")
+
+
+def test_a_rotation_that_overflows_is_refused_without_a_numpy_warning(tmp_path, capsys):
+    model = tmp_path / "m.ac"
+    model.write_text("AC3Db\nOBJECT world\nkids 1\nOBJECT poly\nrot 1e300 0 0 0 1e300 0 0 0 "
+                     "1e300\nnumvert 3\n1e10 0 0\n0 1 0\n0 0 1\nnumsurf 1\nSURF 0x10\nmat 0\n"
+                     "refs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n")
+    assert main(["info", str(model)]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err == (f"refsim: error: {model}:4: a vertex's world coordinates overflow (not "
+                   "finite) after applying rot/loc\n")

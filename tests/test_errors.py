@@ -111,6 +111,20 @@ def test_check_count_refuses_what_is_not_a_count(value, error):
      "b must be an array of real numbers, got ndarray"),
     (lambda: refsim.triangles_intersect(np.eye(3), [[0, 0], [1, 0, 0], [0, 1, 0]]),
      ArgumentTypeError, "b must be an array of real numbers, got list"),
+    # found by the second fuzz campaign: a derivative of the wrong kind or
+    # shape (the shape used to broadcast into a (7,) "answer")
+    (lambda: refsim.SOLVERS["rk4"].step(lambda t, y: None, 0.0, np.ones(1), 0.1),
+     ArgumentTypeError, "f(t, y) must be an array of numbers, got NoneType"),
+    (lambda: refsim.SOLVERS["backwards-euler"].step(lambda t, y: "x", 0.0, np.ones(2), 0.1),
+     ArgumentTypeError, "f(t, y) must be an array of numbers, got str"),
+    (lambda: refsim.SOLVERS["rk4"].step(lambda t, y: np.zeros(7), 0.0, np.ones(1), 0.1),
+     StateError, "f(t, y) must return the state's shape (1,), got shape (7,)"),
+    (lambda: refsim.load_scene("bounce.toml\x00"), refsim.SceneError,
+     "bounce.toml\x00: a file name cannot contain a NUL byte"),
+    (lambda: refsim.load_model("cu\x00be.ac"), refsim.ModelError, "cannot contain a NUL byte"),
+    (lambda: refsim.ParticleSystem(refsim.ParticleConfig(count=10), positions="abc",
+                                   velocities="abc"),
+     ArgumentTypeError, "positions must be an array of real numbers, got str"),
 ])
 def test_bad_arguments_raise_refsim_errors_naming_them(call, error, phrase):
     with pytest.raises(error) as info:

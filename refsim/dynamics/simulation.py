@@ -223,7 +223,9 @@ class Simulation:
             raise ArgumentTypeError(f"scene must be a refsim.Scene (refsim.load_scene(path)), "
                                     f"got {type(scene).__name__}")
         world, dyn, col = scene.world, scene.dynamics, scene.collision
-        self.wall_speed = check_option("wall_speed", wall_speed or world.wall_speed, SPEEDS)
+        self.wall_speed = check_option("wall_speed",
+                                       world.wall_speed if wall_speed is None else wall_speed,
+                                       SPEEDS)
         self.boxes = check_option("boxes", boxes, BOXES)
         self.kernel = choose_kernel(kernel)
         self.scene = scene
@@ -663,7 +665,7 @@ def default_every(n_steps: int) -> int:
 
 
 def simulate(scene, *, every: int | None = None, duration: float | None = None,
-             wall_speed: str = "wall", boxes: str = "auto",
+             wall_speed: str | None = None, boxes: str = "auto",
              sink: FrameSink | None = None) -> Trajectory:
     """Run ``scene`` and return its trajectory.
 
@@ -675,8 +677,9 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
         :func:`default_every` (at most about 1000 frames).
     duration : float, optional
         Override ``integration.duration`` (seconds).
-    wall_speed, boxes : str
-        See :class:`Simulation`.
+    wall_speed, boxes : str, optional
+        See :class:`Simulation` (``wall_speed``: default the scene's
+        ``world.wall_speed``).
     sink : refsim.frames.FrameSink, optional
         Where the frames go as they are computed. Default: a
         :class:`refsim.frames.MemorySink` sized for the run's frames, and the

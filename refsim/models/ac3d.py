@@ -502,12 +502,13 @@ class _Parser:
         """Move one object's vertices to world space and its polygons to triangles."""
         local = obj.vertices
         world = local
-        while chain is not None and len(world):  # child first, up to the root
-            rot, loc, chain = chain
-            if rot is not None:
-                world = world @ rot
-            if loc is not None:
-                world = world + loc
+        with np.errstate(over="ignore", invalid="ignore"):  # overflow refused below
+            while chain is not None and len(world):  # child first, up to the root
+                rot, loc, chain = chain
+                if rot is not None:
+                    world = world @ rot
+                if loc is not None:
+                    world = world + loc
         if not np.isfinite(world).all():
             raise self.error("a vertex's world coordinates overflow (not finite) after "
                              "applying rot/loc", obj.line)

@@ -31,7 +31,7 @@ import numpy as np
 
 from refsim.dynamics.forces import acceleration, acceleration_into
 from refsim.dynamics.walls import wall_response_points, wall_response_points_inplace
-from refsim.errors import DivergenceError, OptionError, StateError, check_count
+from refsim.errors import DivergenceError, OptionError, StateError, as_numbers, check_count
 from refsim.kernels import choose_kernel
 from refsim.limits import MAX_STEPS
 from refsim.particles.config import ParticleConfig
@@ -98,8 +98,8 @@ class ParticleSystem:
             positions, velocities = config.initial_state()
         elif positions is None or velocities is None:
             raise StateError("give both positions and velocities, or neither")
-        positions = np.asarray(positions, dtype=np.float64)
-        velocities = np.asarray(velocities, dtype=np.float64)
+        positions = as_numbers("positions", positions)
+        velocities = as_numbers("velocities", velocities)
         if positions.ndim != 2 or positions.shape[1] != 3 or velocities.shape != positions.shape:
             raise StateError(f"positions and velocities must both be (N, 3), got "
                              f"{positions.shape} and {velocities.shape}")

@@ -278,14 +278,23 @@ def _convert(value, kind: str, path, key):
 
 
 def _resolve_model(name: str, scene_path: Path | None, key: str) -> Path:
-    """The model file: relative to the scene's directory, then the bundled models."""
+    """The model file: relative to the scene's directory, then the bundled
+    models. The first name that exists is taken whatever it is (a directory
+    or a FIFO is then refused by the model reader as not a regular file,
+    rather than reported missing); a name the system cannot look up (too
+    long, behind an unsearchable directory) is refused here."""
     candidates = []
     if scene_path is not None:
         candidates.append(Path(scene_path).parent / name)
     candidates.append(models_dir() / name)
     for candidate in candidates:
-        if candidate.is_file():
-            return candidate.resolve()
+        try:
+            if candidate.exists():
+                return candidate.resolve()
+        except (OSError, ValueError) as exc:    # ValueError: a NUL byte in the name
+            reason = exc.strerror if isinstance(exc, OSError) else "it contains a NUL byte"
+            raise SceneError(f"model {name[:60]!r}{'...' if len(name) > 60 else ''} cannot "
+                             f"be looked up: {reason}", scene_path, key) from None
     looked = ", ".join(str(c) for c in candidates)
     raise SceneError(f"model {name!r} not found (looked in {looked})", scene_path, key)
 

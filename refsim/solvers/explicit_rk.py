@@ -197,16 +197,32 @@ class ExplicitRungeKutta:
         ArgumentTypeError
             ``f`` not callable, ``t`` or ``h`` not a real number, ``y`` not
             an array of numbers (real or complex).
+            ``f`` returns something that is not an array of numbers.
         StateError
-            ``y`` not a vector. (Values are not checked: a step from a
-            non-finite state gives a non-finite one, as the arithmetic does.)
+            ``y`` not a vector, or ``f`` returns a shape other than ``y``'s.
+            (Values are not checked: a step from a non-finite state gives a
+            non-finite one, as the arithmetic does.)
         """
         check_callable("f", f)
         if not (isinstance(y, np.ndarray) and y.dtype in (np.float64, np.complex128)):
             y = as_numbers("y", y, complex_ok=True)   # complex: the linear test equation
         if y.ndim != 1:
             raise StateError(f"y must be a vector (d,), got shape {y.shape}")
-        return rk_step(self, f, check_number("t", t), y, check_number("h", h))
+        return rk_step(self, _checked_derivative(f, y.shape), check_number("t", t), y,
+                       check_number("h", h))
+
+
+def _checked_derivative(f, shape: tuple):
+    """``f`` with each of its results checked: numbers (real or complex) of
+    the state's shape, else an error naming ``f`` (numpy would otherwise
+    broadcast a wrong shape into a wrong answer, or fail deep in a stage)."""
+    def checked(t, y):
+        value = as_numbers("f(t, y)", f(t, y), complex_ok=True)
+        if value.shape != shape:
+            raise StateError(f"f(t, y) must return the state's shape {shape}, "
+                             f"got shape {value.shape}")
+        return value
+    return checked
 
 
 def rk_step(method: ExplicitRungeKutta, f, t: float, y: np.ndarray, h: float) -> np.ndarray:

@@ -79,6 +79,22 @@ def test_wall_hit_in_the_loop_pushes_back_exactly_and_records_an_event():
         ("wall", "cube", "y-", 1)]
 
 
+def test_the_scenes_wall_speed_is_the_default_of_simulate_and_simulation():
+    # the same first step as above: the scene's world.wall_speed = "seed"
+    # chooses the seed's speed (-2 - g h, flipped), an explicit argument wins
+    bodies = [{**CUBE, "position": [0.0, -4.499, 0.0], "velocity": [1.0, -2.0, 0.0]}]
+    world = {"restitution": 0.5, "friction": 0.2}
+    seed_scene = _scene(bodies, world={**world, "wall_speed": "seed"},
+                        integration={"duration": 1e-3})
+    v_seed = -0.5 * (-2.0 - 9.81 * 1e-3)
+    assert Simulation(seed_scene).wall_speed == "seed"
+    assert simulate(seed_scene, every=1).velocity[-1, 0, 1] == pytest.approx(v_seed, rel=1e-12)
+    corrected = simulate(seed_scene, every=1, wall_speed="wall").velocity[-1, 0, 1]
+    assert corrected != pytest.approx(v_seed, rel=1e-6)
+    with pytest.raises(refsim.OptionError, match="wall_speed must be one of"):
+        Simulation(seed_scene, wall_speed="")
+
+
 def test_equal_masses_exchange_velocities_in_the_loop():
     scene = refsim.load_scene(scenes_dir() / "head-on.toml")
     traj = simulate(scene, duration=2.5)

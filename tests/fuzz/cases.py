@@ -155,7 +155,8 @@ def _model_mutant(mutator: str, rng: random.Random):
         mutant = mutate.scale_by(data, fmt, factor)
         if factor in mutate.SHAPE_KEEPING_FACTORS:
             base = subject if fmt == "ac" else corpus.EXPORTED_MODEL
-            facts = tuple(sorted(corpus.model_facts(base).items()))
+            facts = tuple(sorted((key, value) for key, value in corpus.model_facts(base).items()
+                                 if factor > 0 or key != "convex"))
     else:
         mutant = _mutant(mutator, data, fmt, rng)
     return fmt, subject, mutant, facts
@@ -299,7 +300,7 @@ def special_cases() -> list[Case]:
           names=(("{in}/p.ac", "line"),), timeout=FAST)
     scene("empty", "{in}/e.toml", files=(("{in}/e.toml", b""),), forbid=(),
           names=(("{in}/e.toml", "key"),))
-    scene("dev-null", "/dev/null", forbid=(), names=(("/dev/null", "key"),))
+    scene("dev-null", "/dev/null", forbid=(), names=(("/dev/null", "file"),))
     for name, node in (("fifo", Special("fifo", "{in}/m.ac")),
                        ("directory", Special("dir", "{in}/m.ac")),
                        ("dev-null-link", Special("symlink", "{in}/m.ac", "/dev/null"))):

@@ -64,7 +64,8 @@ def exports() -> dict[str, bytes]:
 @functools.cache
 def model_facts(name: str) -> dict[str, str]:
     """``refsim info``'s convex and closed lines of a bundled model: a uniform
-    scale of the model must print the same."""
+    scale of the model by a positive factor must print the same (a negative
+    one, the same closed line)."""
     from refsim.models.facts import describe
     from refsim.models.loading import load_model
 

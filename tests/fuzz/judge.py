@@ -172,7 +172,10 @@ def _names_location(message: str, case: Case, places: dict) -> bool:
         # stderr escapes a name's undecodable bytes (\\udcff): that spelling names it too
         spelled = fill(path, places)
         escaped = spelled.encode("utf-8", "backslashreplace").decode("utf-8")
-        p = "(?:" + re.escape(spelled) + "|" + re.escape(escaped) + ")"
+        # and a control character in a name is written as its escape (\\n)
+        controls = "".join(c if c.isprintable() or c == " " else repr(c)[1:-1]
+                           for c in spelled)
+        p = "(?:" + "|".join(re.escape(s) for s in (spelled, escaped, controls)) + ")"
         patterns = {
             "line": [rf"^{p}:\d+: ", rf"^{p}: .*(?:{'|'.join(WHOLE_FILE_MODEL)})"],
             "file": [rf"^{p}(?::\d+)?: "],

@@ -357,7 +357,9 @@ def long_line(data: bytes, fmt: str, rng: random.Random) -> bytes:
 SCALE_FACTORS = (1e155, 1e154, -1e155, 1e150, 1e300, 1e-300, 1e-320, 1e62, 1e-65, 0.0)
 
 #: The factors of SCALE_FACTORS that keep a mesh's shape (no underflow, no
-#: zero): a convex model stays convex, a closed one closed.
+#: zero): a closed model stays closed, and a convex one convex unless the
+#: factor is negative (a reflection turns the faces' winding inward, and
+#: "convex" means a solid bounded by outward faces: refsim then says no).
 SHAPE_KEEPING_FACTORS = (1e155, 1e154, -1e155, 1e150, 1e62)
 
 
