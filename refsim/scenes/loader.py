@@ -290,7 +290,7 @@ def _resolve_model(name: str, scene_path: Path | None, key: str) -> Path:
     for candidate in candidates:
         try:
             if candidate.exists():
-                return candidate.resolve()
+                return candidate.absolute()   # a symlink keeps the name (and suffix) given
         except (OSError, ValueError) as exc:    # ValueError: a NUL byte in the name
             reason = exc.strerror if isinstance(exc, OSError) else "it contains a NUL byte"
             raise SceneError(f"model {name[:60]!r}{'...' if len(name) > 60 else ''} cannot "
