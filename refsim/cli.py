@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import warnings
 from dataclasses import asdict
@@ -302,6 +303,10 @@ def _conform(args) -> int:
             print(f"  {d.engine:17} {d.check:22} {d.status:8} {d.reason}")
         print(f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine")
         return 0 if matrix.ok else EXIT_CHECK_FAILED
+    # MODULE is looked up in the current directory first, as `python -m`
+    # does: a user's myengine.py beside them is found without PYTHONPATH
+    if os.getcwd() not in sys.path:
+        sys.path.insert(0, os.getcwd())
     try:
         engine = load_engine(args.engine)
     except (OracleUnavailable, ImportError) as exc:
