@@ -331,13 +331,26 @@ def descend(mesh_a, pose_a, mesh_b, pose_b, *,
 
 
 @functools.cache
+@functools.cache
 def _compiled():
-    """The compiled ``exact_query``, or None without numba."""
+    """The compiled ``exact_query``, or None without numba (looked up once:
+    a query costs a few microseconds, and an import statement a fraction)."""
     try:
         from refsim.collision import _numba_kernels as nk
     except ImportError:
         return None
     return nk.exact_query
+
+
+def _kernel_arrays(mesh) -> tuple:
+    """The six arrays the compiled query takes for one mesh (vertices, faces,
+    the tree's links, order, boxes, reach), gathered once and kept with the
+    mesh: twelve attribute lookups per query would be a tenth of it."""
+    def gather(m):
+        tree = frame_tree_of(m)
+        return (m.vertices, m.faces, tree.links, tree.tree.order, tree.boxes, tree.reach,
+                tree.axes_deviation)
+    return mesh.derived("frame_tree_kernel_arrays", gather)
 
 
 _FLOAT64 = np.dtype(np.float64)
@@ -374,11 +387,12 @@ def query_compiled(mesh_a, pose_a, mesh_b, pose_b, mode: int, *,
     """
     ra, ta = pose_a = _pose_arrays(pose_a, "pose_a")
     rb, tb = pose_b = _pose_arrays(pose_b, "pose_b")
-    fa, fb = frame_tree_of(mesh_a), frame_tree_of(mesh_b)
+    va, fa, links_a, order_a, boxes_a, reach_a, dev_a = _kernel_arrays(mesh_a)
+    vb, fb, links_b, order_b, boxes_b, reach_b, dev_b = _kernel_arrays(mesh_b)
     status, found, uncertain = _compiled()(
-        mesh_a.vertices, mesh_a.faces, fa.links, fa.tree.order, fa.boxes, fa.reach, ra, ta,
-        mesh_b.vertices, mesh_b.faces, fb.links, fb.tree.order, fb.boxes, fb.reach, rb, tb,
-        max(fa.axes_deviation, fb.axes_deviation), mode, ORTHONORMAL_TOL, margin_rounding,
+        va, fa, links_a, order_a, boxes_a, reach_a, ra, ta,
+        vb, fb, links_b, order_b, boxes_b, reach_b, rb, tb,
+        dev_a if dev_a > dev_b else dev_b, mode, ORTHONORMAL_TOL, margin_rounding,
         margin_per_deviation)
     if status:
         what, pose = ("pose_a", pose_a) if status == 1 else ("pose_b", pose_b)

@@ -16,10 +16,63 @@ import numpy as np
 import pytest
 from refsim.oracles.fcl_adapter import FCLOracle
 
+import refsim
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 from refsim.studies.levels import SPEED_CONFIGURATIONS
 
 CASES = {f"{c.model}-{c.kind}": c.as_configuration() for c in SPEED_CONFIGURATIONS}
+
+#: Issue 16's further configurations, where a query is mostly its fixed cost:
+#: (model, pose of the second body; the first at the identity, exact answer).
+_TURN_X = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+APART = {
+    # spheres of radius 1, 10 apart: the root boxes are apart
+    "sphere-2k-far": ("sphere-2k.ac", (np.eye(3), np.array([10.0, 0.0, 0.0]))),
+    # 2.05 apart along x: boxes [-1, 1] and [1.05, 3.05], apart by 0.05
+    "sphere-2k-boxes-apart-close": ("sphere-2k.ac", (np.eye(3), np.array([2.05, 0.0, 0.0]))),
+    # two tori linked like a chain (centre circles of radius 1 in the xz and
+    # xy planes, 1 apart at the closest; tubes 0.35): boxes overlap, no contact
+    "torus-linked": ("torus.ac", (_TURN_X, np.array([1.0, 0.0, 0.0]))),
+}
+
+
+class PosedFCL:
+    """FCL as a simulation loop uses it: the two collision objects built once,
+    both poses set before every query (setTransform), then ``collide``."""
+
+    def __init__(self, adapter, mesh_a, mesh_b):
+        self.fcl = fcl = adapter.fcl
+        self.a = fcl.CollisionObject(adapter._models.get(mesh_a.vertices, mesh_a.faces))
+        self.b = fcl.CollisionObject(adapter._models.get(mesh_b.vertices, mesh_b.faces))
+        self.request = fcl.CollisionRequest()
+
+    def collide(self, pose_a, pose_b) -> bool:
+        fcl = self.fcl
+        self.a.setTransform(fcl.Transform(*pose_a))
+        self.b.setTransform(fcl.Transform(*pose_b))
+        return fcl.collide(self.a, self.b, self.request, fcl.CollisionResult()) > 0
+
+
+@pytest.mark.parametrize("name", list(APART) + list(CASES))
+@pytest.mark.parametrize("engine", ["refsim-bvh", "fcl-posed"])
+def test_boolean_fixed_cost(benchmark, fcl, name, engine):
+    if name in APART:
+        model, pose_b = APART[name]
+        mesh_a = mesh_b = refsim.load_model(model)
+        pose_a = (np.eye(3), np.zeros(3))
+        expected = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, method="seed")
+    else:
+        mesh_a, pose_a, mesh_b, pose_b, expected = _setup(name)
+    benchmark.group = f"boolean, poses set per query: {name}"
+    if engine == "fcl-posed":
+        posed = PosedFCL(fcl, mesh_a, mesh_b)
+        query = lambda: posed.collide(pose_a, pose_b)  # noqa: E731
+    else:
+        query = lambda: bodies_collide(mesh_a, pose_a, mesh_b, pose_b)  # noqa: E731
+    query()
+    assert benchmark(query) == (len(expected) > 0)
+    if name in APART:
+        assert len(expected) == 0
 
 
 @pytest.fixture
