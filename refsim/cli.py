@@ -91,7 +91,12 @@ def _with_duration(scene, duration: float):
     try:
         whole_steps(duration, scene.integration.step)
     except StateError as exc:
-        raise RefsimError(f"--duration {duration!r}: {exc}") from None
+        if not 0.0 < duration < scene.integration.step:   # the option's own fault
+            raise RefsimError(f"--duration {duration!r}: {exc}") from None
+        # no whole step fits: the option against the scene's step, both named
+        raise SceneError(f"the step {scene.integration.step:g} is longer than --duration "
+                         f"{duration!r}: no whole step fits", scene.path,
+                         "integration.step") from None
     return replace(scene, integration=replace(scene.integration, duration=duration))
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from refsim.errors import StateError
+from refsim.errors import StateError, as_numbers
 
 Pose = tuple[np.ndarray, np.ndarray]
 
@@ -33,13 +33,16 @@ def as_pose(pose, *, what: str = "pose") -> Pose:
     StateError
         When the shapes are wrong, a value is not finite, or the rotation is
         not orthonormal within ``ORTHONORMAL_TOL``.
+    ArgumentTypeError
+        When an entry is not a real number (a string such as ``'0'``, which
+        numpy would otherwise read as the number, a complex number, None).
     """
     try:
         rotation, translation = pose
     except (TypeError, ValueError):
         raise StateError(f"{what}: expected (rotation, translation)") from None
-    rotation = np.asarray(rotation, dtype=np.float64)
-    translation = np.asarray(translation, dtype=np.float64)
+    rotation = as_numbers(f"{what} rotation", rotation)
+    translation = as_numbers(f"{what} translation", translation)
     if rotation.shape != (3, 3) or translation.shape != (3,):
         raise StateError(f"{what}: expected shapes (3, 3) and (3,), got "
                          f"{rotation.shape} and {translation.shape}")

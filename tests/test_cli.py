@@ -166,3 +166,29 @@ def test_a_rotation_that_overflows_is_refused_without_a_numpy_warning(tmp_path, 
     err = capsys.readouterr().err
     assert err == (f"refsim: error: {model}:4: a vertex's world coordinates overflow (not "
                    "finite) after applying rot/loc\n")
+
+
+def test_a_duration_shorter_than_the_scenes_step_names_the_scene_and_its_step(tmp_path, capsys):
+    from refsim.bundled import scenes_dir
+    scene = scenes_dir() / "bounce.toml"
+    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz"),
+                 "--duration", "0.0005"]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (
+        f"refsim: error: {scene}: integration.step: the step 0.001 is longer than --duration "
+        "0.0005: no whole step fits\n")
+    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz"),
+                 "--duration", "nan"]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err.startswith("refsim: error: --duration nan: ")
+
+
+def test_a_body_wider_than_float64_is_refused_without_a_numpy_warning(tmp_path, capsys):
+    model = tmp_path / "wide.ac"
+    model.write_text("AC3Db\nOBJECT poly\nnumvert 3\n-1e308 0 0\n1e308 1 0\n0 0 1\nnumsurf 1\n"
+                     "SURF 0x10\nmat 0\nrefs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n")
+    scene = tmp_path / "s.toml"
+    scene.write_text('[[body]]\nmodel = "wide.ac"\nposition = [0.0, 0.0, 0.0]\n')
+    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "warning" not in err
+    assert err.startswith(f"refsim: error: {scene}: body[0].model: model wide.ac at scale 1 is "
+                          "larger than the world cube: its box spans inf x ")

@@ -330,11 +330,12 @@ def _check_body(body: BodyConfig, mesh, world, path, where: str) -> None:
     with np.errstate(over="ignore"):          # a box beyond float64 is refused below
         world_vertices = transform_points(scaled.vertices,
                                           (rotation, np.array(body.position)))
-    lo, hi = world_vertices.min(axis=0), world_vertices.max(axis=0)
+        lo, hi = world_vertices.min(axis=0), world_vertices.max(axis=0)
+        span = hi - lo                        # inf for a box wider than float64's range
     slack = START_INSIDE_RTOL * H
-    if ((hi - lo) > 2.0 * H + slack).any():
+    if (span > 2.0 * H + slack).any():
         raise SceneError(f"model {name} at scale {body.scale:g} is larger than the world "
-                         f"cube: its box spans {_spans(hi - lo)}, the cube {2.0 * H:g}",
+                         f"cube: its box spans {_spans(span)}, the cube {2.0 * H:g}",
                          path, f"{where}.scale" if body.scale != 1.0 else f"{where}.model")
     for k in range(3):
         if lo[k] < -H - slack or hi[k] > H + slack:
