@@ -100,7 +100,16 @@ def ode_cases(seed: int = 0) -> OdeCases:
 
 
 def end_error(step, problem: problems.Problem, n: int) -> float:
-    """Relative error at ``t1`` after ``n`` equal steps of ``step(f, t, y, h)``."""
+    """Relative error at ``t1`` after ``n`` equal steps of ``step(f, t, y, h)``.
+
+    Raises
+    ------
+    ValueError
+        ``problem`` has no exact solution to compare with.
+    """
+    if problem.exact is None:
+        raise ValueError(f"problem {problem.name!r} has no exact solution: "
+                         "its end error cannot be measured")
     h = (problem.t1 - problem.t0) / n
     y = np.array(problem.y0, dtype=np.float64)
     for k in range(n):

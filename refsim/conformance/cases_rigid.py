@@ -56,10 +56,14 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from refsim.dynamics import analytic
+
+if TYPE_CHECKING:
+    from refsim.scenes.schema import Scene
 
 HALF_SIZE = 5.0
 GRAVITY = 9.81
@@ -93,7 +97,7 @@ class RigidScene:
 
     name: str
     kind: str
-    scene: object
+    scene: Scene
     e: float
     friction: float = 0.0
     height: float = 0.0

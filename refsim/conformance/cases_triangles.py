@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.sat_exact import triangles_intersect_sat
-from refsim.conformance.draw import NumpyDraw, dot3, signed_permutations, strategy
+from refsim.conformance.draw import Draw, NumpyDraw, dot3, signed_permutations, strategy
 
 FAMILIES = ("random", "vertex-on-face", "edge-on-edge", "near-parallel", "touching-exact",
             "coplanar-exact")
@@ -164,7 +164,7 @@ class TrianglePair:
                 "truth": self.truth}
 
 
-def build_pair(draw, family: str) -> TrianglePair:
+def build_pair(draw: Draw, family: str) -> TrianglePair:
     """A non-degenerate pair of ``family`` with its exact answer (draws
     again while a triangle is degenerate, up to ``draw.retries`` times: the
     integer families are degenerate about one time in five)."""

@@ -99,7 +99,8 @@ def classify_triangles(a, b) -> str:
 
 def _triangle_check(name: str, answer, cases) -> CheckResult:
     start = time.perf_counter()
-    outcomes, found = [], []
+    outcomes: list[str | None] = []  # per case: None (passed) or its class
+    found: list[dict] = []
     for index, pair in enumerate(cases.pairs):
         got = bool(answer(pair.a, pair.b))
         if got == pair.truth:
@@ -265,7 +266,8 @@ def check_pairs_agreement(engine, cases) -> CheckResult:
     set of intersecting face pairs on every pose (as a set: order and
     duplicates do not matter)."""
     start = time.perf_counter()
-    outcomes, found = [], []
+    outcomes: list[str | None] = []  # per case: None (passed) or its class
+    found: list[dict] = []
     extra = missing = 0
     for index, case in enumerate(cases.cases):
         got = _call(engine, "intersecting_pairs", case)
@@ -297,7 +299,8 @@ def check_collide_agreement(engine, cases) -> CheckResult:
     """``collide.agreement``: the engine's ``bodies_collide`` is true exactly
     when some triangle of one surface meets a triangle of the other."""
     start = time.perf_counter()
-    outcomes, found = [], []
+    outcomes: list[str | None] = []  # per case: None (passed) or its class
+    found: list[dict] = []
     for index, case in enumerate(cases.cases):
         got = bool(_call(engine, "bodies_collide", case))
         if got == (len(case.truth) > 0):
@@ -363,7 +366,8 @@ def _classify_box(case, excess: float, lo, hi) -> str:
 
 def _box_check(name: str, engine, cases, side: int) -> CheckResult:
     start = time.perf_counter()
-    outcomes, found = [], []
+    outcomes: list[str | None] = []  # per case: None (passed) or its class
+    found: list[dict] = []
     worst = 0.0
     for index, case in enumerate(cases.cases):
         lo, hi = _box(engine, case)

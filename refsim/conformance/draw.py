@@ -21,8 +21,30 @@ Cost: O(1) per number drawn.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import Any, NoReturn, Protocol
 
 import numpy as np
+
+
+class Draw(Protocol):
+    """What a builder asks of its source of numbers: :class:`NumpyDraw` or
+    :class:`HypothesisDraw`."""
+
+    #: How many times a builder may draw again after an unusable case.
+    retries: int
+
+    def reject(self) -> NoReturn:
+        """Give up on this case: every draw made an unusable one."""
+        ...
+
+    def uniform(self, lo: float, hi: float, n: int = 1) -> list[float]: ...
+
+    def integers(self, lo: int, hi: int, n: int = 1) -> list[int]: ...
+
+    def choice(self, options: Sequence[Any]) -> Any: ...
+
+    def log_uniform(self, lo_exp: float, hi_exp: float) -> float: ...
 
 
 class NumpyDraw:
@@ -37,7 +59,7 @@ class NumpyDraw:
     def __init__(self, rng: np.random.Generator):
         self.rng = rng
 
-    def reject(self) -> None:
+    def reject(self) -> NoReturn:
         raise RuntimeError("a case builder made only unusable cases: a bug in the builder")
 
     def uniform(self, lo: float, hi: float, n: int = 1) -> list[float]:
@@ -66,7 +88,7 @@ class HypothesisDraw:
     def __init__(self, draw):
         self.draw = draw
 
-    def reject(self) -> None:
+    def reject(self) -> NoReturn:
         from hypothesis import reject
 
         reject()

@@ -207,7 +207,7 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
 
         raise OptionError("no engine to run: " + ("; ".join(unavailable.values())
                                                   or f"none has the capability {only!r}"))
-    needed = set()
+    needed: set[str] = set()
     for engine in engines.values():
         caps = capabilities(engine) if only is None else (only,)
         needed.update(needed_case_sets(caps))

@@ -101,7 +101,7 @@ class CheckItem(pytest.Item):
 class ConformanceSuite(pytest.Collector):
     """The engine, its declarations and the case sets, shared by its checks."""
 
-    def __init__(self, *, spec, options, **kwargs):
+    def __init__(self, *, spec, options, **kwargs) -> None:
         super().__init__(**kwargs)
         self.spec = spec
         self.options = options

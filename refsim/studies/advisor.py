@@ -430,7 +430,7 @@ class Advice:
 
 
 #: What each number of an :class:`Advice` is measured in.
-UNITS = {
+UNITS: dict[str, str] = {
     "tolerance": "m",
     "step": "s",
     "duration": "s",
@@ -670,10 +670,10 @@ def _last_chance(measured: list[tuple[int, float, bool]], passing: set[int],
 
 
 def _propose(solver: str, measured: list[tuple[int, float, bool]],
-             m_max: float = math.inf) -> int | None:
+             m_max: int | None = None) -> int | None:
     """The next ``m`` to run for ``solver`` from its ``(m, ratio, meets)``
-    measurements, at most ``m_max``, or None when its search is done
-    (module docstring, 3)."""
+    measurements, at most ``m_max`` (None: no bound), or None when its search
+    is done (module docstring, 3)."""
     order = max(1, SOLVERS[solver].order)
     meeting = [m for m, _, ok in measured if ok]
     target = PROBE_TARGET if meeting else PREDICTION_TARGET
@@ -684,7 +684,7 @@ def _propose(solver: str, measured: list[tuple[int, float, bool]],
     if not usable:
         proposal = 2 * max(m for m, _, _ in measured)       # no error to fit: halve the step
     else:
-        p = order
+        p: float = order
         positive = [(m, r) for m, r in usable if r > 0.0]
         if len(positive) >= 2:
             (m1, r1), (m2, r2) = positive[-2:]               # the two finest steps measured
@@ -703,8 +703,10 @@ def _propose(solver: str, measured: list[tuple[int, float, bool]],
     if meeting and m_fail and not m_fail < proposal < m_pass:
         # the model points outside the bracket: bisect it (on a log scale)
         proposal = round(math.sqrt(m_fail * m_pass))
-    proposal = max(min(proposal, m_max), m_fail + 1)
-    if proposal >= m_pass or proposal > m_max:
+    if m_max is not None:
+        proposal = min(proposal, m_max)
+    proposal = max(proposal, m_fail + 1)
+    if proposal >= m_pass or (m_max is not None and proposal > m_max):
         return None
     if any(m == proposal for m, _, _ in measured):
         return None

@@ -52,7 +52,7 @@ import numpy as np
 from refsim.dynamics import analytic
 from refsim.dynamics.energy import trajectory_energy
 from refsim.solvers.methods import SOLVERS
-from refsim.studies import timing_field
+from refsim.studies import TIMED
 
 #: The sphere-like body and the cube of the studies (bundled models).
 SPHERE = "sphere-2k.ac"
@@ -502,7 +502,7 @@ class CostPoint:
     step: float
     ratio: float           # measured apex ratio (geometric mean over BOUNCES)
     error: float           # |ratio - e^2| / e^2
-    seconds_per_second: float = timing_field()  # wall time per simulated second
+    seconds_per_second: float = field(metadata=TIMED)  # wall time per simulated second
 
 
 @dataclass(frozen=True)
@@ -650,10 +650,10 @@ class StepCost:
     bodies: int
     rotation: str
     warmup: int                         # steps taken before the timed ones
-    refsim_seconds: float = timing_field()
-    pybullet_seconds: float = timing_field()
-    ratio: float = timing_field()
-    refsim_stage_seconds: dict = timing_field()  # per step, by stage of refsim's loop
+    refsim_seconds: float = field(metadata=TIMED)
+    pybullet_seconds: float = field(metadata=TIMED)
+    ratio: float = field(metadata=TIMED)
+    refsim_stage_seconds: dict = field(metadata=TIMED)  # per step, by stage of refsim's loop
     steps: int = 0                      # timed steps per repeat
     repeats: int = 0                    # repeats (the fastest kept)
 

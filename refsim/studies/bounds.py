@@ -28,7 +28,7 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -37,7 +37,7 @@ from refsim.bounds.aabb_linear import LinearAABB, aabb_linear
 from refsim.kernels import numba_usable
 from refsim.models import shapes
 from refsim.models.mesh import Mesh
-from refsim.studies import timing_field
+from refsim.studies import TIMED
 from refsim.types import as_pose, random_rotation, rotation_about_axis, transform_points
 
 #: The sweep of C1: box (12 triangles), icosahedron (20) and geodesic spheres
@@ -124,7 +124,7 @@ class UpdateCost:
     n_vertices: int
     motion: str
     method: str
-    seconds_per_update: float = timing_field()
+    seconds_per_update: float = field(metadata=TIMED)
     visits_per_update: float
     max_visits: int
     evaluations_per_update: float
@@ -145,9 +145,9 @@ class UpdateCostStudy:
     frames: int
     repeats: int
     seed: int
-    pose_check_seconds: float = timing_field()
-    crossovers: dict = timing_field(default_factory=dict)
-    speedups: dict = timing_field(default_factory=dict)
+    pose_check_seconds: float = field(metadata=TIMED)
+    crossovers: dict = field(default_factory=dict, metadata=TIMED)
+    speedups: dict = field(default_factory=dict, metadata=TIMED)
 
     def row(self, mesh: str, motion: str, method: str) -> UpdateCost:
         for r in self.rows:
@@ -298,16 +298,18 @@ def measure_incremental_error(meshes=None, *, motion: str = "coherent", frames: 
         tracker = IncrementalAABB(mesh, kernel=kernel, allow_nonconvex=True)
         scan = LinearAABB(mesh)
         tracker.update_unchecked(*poses[0])
-        deficits, wrong_sides, visits = [], 0, []
+        deficit_list: list[float] = []
+        wrong_sides = 0
+        visits: list[int] = []
         for rotation, translation in poses[1:]:
             lo_i, hi_i = tracker.update_unchecked(rotation, translation)
             lo_s, hi_s = scan.update_unchecked(rotation, translation)
             extent = hi_s - lo_s
             outward = np.concatenate([(lo_i - lo_s) / extent, (hi_s - hi_i) / extent])
             wrong_sides += int((outward != 0.0).sum())
-            deficits.append(float(outward.max()))
+            deficit_list.append(float(outward.max()))
             visits.append(tracker.visits)
-        deficits = np.array(deficits)
+        deficits = np.array(deficit_list)
         wrong = deficits[deficits != 0.0]
         results.append(IncrementalError(
             mesh=mesh.name, n_triangles=mesh.n_faces, convex=bool(mesh.is_convex),
@@ -332,10 +334,10 @@ class CompileCost:
     later tracker update (2000-triangle sphere, 1 degree per frame).
     """
 
-    import_numba: float = timing_field()
-    cold_first_call: float = timing_field()
-    cached_first_call: float = timing_field()
-    steady_call: float = timing_field()
+    import_numba: float = field(metadata=TIMED)
+    cold_first_call: float = field(metadata=TIMED)
+    cached_first_call: float = field(metadata=TIMED)
+    steady_call: float = field(metadata=TIMED)
 
 
 _COMPILE_PROBE = r"""

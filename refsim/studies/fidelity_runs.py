@@ -200,12 +200,15 @@ def measure_run(*, seed: int, scene: dict, solver: str, step: float, level: str,
     n_steps = run_scene.integration.n_steps
     if n_steps % every:
         raise StateError(f"{n_steps} steps are not a whole number of samples of {every} steps")
-    record, seconds = None, []
+    record: dict | None = None
+    seconds: list[float] = []
     for _ in range(repeats):
         start = time.perf_counter()
         result = _run(run_scene, n_steps, every)
         seconds.append(time.perf_counter() - start)
-        record = record or result
+        if record is None:
+            record = result
+    assert record is not None, "repeats >= 1 (checked above): the loop ran"
     record["wall_seconds"] = seconds
     return record
 
@@ -220,7 +223,7 @@ def _run(scene: Scene, n_steps: int, every: int) -> dict:
     position = np.empty((samples, B, 3))
     orientation = np.empty((samples, B, 3, 3))
     energy = np.empty(samples)
-    events = []
+    events: list[list] = []  # [kind, body, other, step, time, speed], see _note_events
     # the farthest vertex from the reported position (the mesh origin), per body
     radius = [float(np.sqrt((b.mesh.vertices ** 2).sum(axis=1)).max()) for b in sim.bodies]
 

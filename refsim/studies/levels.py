@@ -50,7 +50,7 @@ from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
 from refsim.collision.spheres import bounding_sphere
 from refsim.kernels import choose_kernel
-from refsim.studies import timing_field
+from refsim.studies import TIMED
 from refsim.studies.triangles import DISAGREEMENT_KINDS, _strict_crossing, classify_disagreement
 from refsim.types import Pose, random_rotation, rotation_about_axis
 
@@ -111,7 +111,7 @@ class Configuration:
     model_b: str
     scale_a: float = 1.0
     scale_b: float = 1.0
-    rotation_b: object = "fixed"
+    rotation_b: str | tuple[str, float] = "fixed"
     direction: tuple = (1.0, 0.0, 0.0)
     distance: float = 0.0
     intended: bool = False          # the exact answer by construction
@@ -126,9 +126,12 @@ class Configuration:
             rotation = np.eye(3)
         elif self.rotation_b == "half-turn-z":
             rotation = np.array(HALF_TURN_Z)
-        else:
+        elif isinstance(self.rotation_b, tuple):
             axis, angle = self.rotation_b
             rotation = rotation_about_axis(np.eye(3)["xyz".index(axis)], angle)
+        else:
+            raise ValueError(f"rotation_b {self.rotation_b!r}: not 'fixed', 'identity', "
+                             "'half-turn-z' or (axis, angle)")
         direction = np.asarray(self.direction, dtype=np.float64)
         if np.count_nonzero(direction) == 1:
             translation = direction * self.distance          # exact for axis directions
@@ -253,12 +256,13 @@ class ConfigurationLevels:
     description: str
     intended: bool                  # the exact answer by construction
     answers: dict                   # level -> bool (bodies_collide, method "bvh")
-    seconds: dict = timing_field()  # level -> median seconds per boolean query ("bvh")
-    seed_seconds: dict = timing_field()  # "triangle-aabb", "exact" -> median s, method "seed"
+    seconds: dict = field(metadata=TIMED)  # level -> median seconds per boolean query ("bvh")
+    # "triangle-aabb", "exact" -> median seconds, method "seed"
+    seed_seconds: dict = field(metadata=TIMED)
     candidate_pairs: int            # triangle-aabb pairs
     exact_pairs: int
     # "bvh", "seed" -> median seconds of intersecting_pairs at the exact level
-    pairs_seconds: dict = timing_field()
+    pairs_seconds: dict = field(metadata=TIMED)
     seed_answers_equal: bool        # method "seed" gave the same answers and pairs
 
     @property
@@ -290,7 +294,7 @@ class RandomLevels:
 @dataclass(frozen=True)
 class LevelSummary:
     level: str
-    median_seconds: float = timing_field()  # median over the configurations of their medians
+    median_seconds: float = field(metadata=TIMED)  # median over the configurations of their medians
     false_positives: int            # configurations + random poses
     negatives: int                  # queries where exact says no (the most FPs possible)
     false_negatives: int
@@ -631,22 +635,22 @@ def measure_body_oracles(collide_engines: tuple = (), pairs_engine=None, *,
 
     bodies = []
     for (name, source), rows in body_rows.items():
-        found = tuple(BodyDisagreement(source, case, ours, theirs, kind)
-                      for case, ours, theirs, kind in rows if kind)
+        body_found = tuple(BodyDisagreement(source, case, ours, theirs, kind)
+                           for case, ours, theirs, kind in rows if kind)
         bodies.append(BodyAgreement(
-            oracle=name, source=source, n=len(rows), agree=len(rows) - len(found),
+            oracle=name, source=source, n=len(rows), agree=len(rows) - len(body_found),
             refsim_true=sum(r[1] for r in rows), oracle_true=sum(r[2] for r in rows),
-            counts={k: sum(d.kind == k for d in found) for k in BODY_DISAGREEMENT_KINDS},
-            disagreements=found))
+            counts={k: sum(d.kind == k for d in body_found) for k in BODY_DISAGREEMENT_KINDS},
+            disagreements=body_found))
     pairs = []
     for source, rows in pair_rows.items():
-        found = tuple(d for r in rows for d in r[3])
+        pair_found = tuple(d for r in rows for d in r[3])
         pairs.append(PairAgreement(
             source=source, queries=len(rows), queries_equal=sum(not r[3] for r in rows),
             refsim_pairs=sum(r[0] for r in rows), oracle_pairs=sum(r[1] for r in rows),
             common_pairs=sum(r[2] for r in rows),
-            counts={k: sum(d.kind == k for d in found) for k in DISAGREEMENT_KINDS},
-            disagreements=found))
+            counts={k: sum(d.kind == k for d in pair_found) for k in DISAGREEMENT_KINDS},
+            disagreements=pair_found))
     labels = tuple(f"{model_label(*a)} / {model_label(*b)}" for a, b in random_pairs)
     return OracleAgreement(seed=seed, random_per_pair=random_per_pair, model_pairs=labels,
                            bodies=tuple(bodies), pairs=tuple(pairs))
@@ -700,11 +704,11 @@ class SpeedCase:
     candidate_pairs: int            # triangle-box pairs (test 2)
     exact_pairs: int
     fcl_pairs: int | None
-    bvh_seconds: float = timing_field()  # intersecting_pairs, method "bvh"
-    seed_seconds: float = timing_field()  # intersecting_pairs, method "seed"
-    fcl_seconds: float | None = timing_field()  # FCL's all intersecting pairs
-    bvh_boolean_seconds: float = timing_field()  # bodies_collide exact, method "bvh"
-    fcl_boolean_seconds: float | None = timing_field()
+    bvh_seconds: float = field(metadata=TIMED)  # intersecting_pairs, method "bvh"
+    seed_seconds: float = field(metadata=TIMED)  # intersecting_pairs, method "seed"
+    fcl_seconds: float | None = field(metadata=TIMED)  # FCL's all intersecting pairs
+    bvh_boolean_seconds: float = field(metadata=TIMED)  # bodies_collide exact, method "bvh"
+    fcl_boolean_seconds: float | None = field(metadata=TIMED)
 
     @property
     def pairs_ratio(self) -> float | None:
@@ -729,9 +733,10 @@ class CompileCost:
     loading the machine code)."""
 
     # triangle_numba.measure_numba_compile_seconds
-    triangle_kernel_cold_seconds: float = timing_field()
-    hierarchy_cold_seconds: float = timing_field()  # every compiled kernel the hierarchy uses
-    hierarchy_warm_seconds: float = timing_field()
+    triangle_kernel_cold_seconds: float = field(metadata=TIMED)
+    # every compiled kernel the hierarchy uses
+    hierarchy_cold_seconds: float = field(metadata=TIMED)
+    hierarchy_warm_seconds: float = field(metadata=TIMED)
 
 
 @dataclass(frozen=True)

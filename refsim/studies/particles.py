@@ -30,14 +30,14 @@ from __future__ import annotations
 import math
 import time
 import tracemalloc
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from refsim.particles.config import ParticleConfig
 from refsim.particles.system import ParticleSystem, particle_rhs
 from refsim.solvers.methods import SOLVERS
-from refsim.studies import timing_field
+from refsim.studies import TIMED
 from refsim.studies.solvers import WorkPoint, fit_order
 
 # --------------------------------------------------------------------------
@@ -186,7 +186,7 @@ class DragComparison:
     same_terminal_difference: float
     same_terminal_distance: float
     same_k_difference: float
-    cost_ratio: float = timing_field()
+    cost_ratio: float = field(metadata=TIMED)
 
 
 def _trajectory(config: ParticleConfig, x0, v0, t_eval, oracle):
@@ -246,6 +246,22 @@ def measure_drag_models(oracle, terminal_speed: float = 10.0, launch_speed: floa
 MAX_CONTACTS = 200
 
 
+@dataclass(frozen=True)
+class _WallEvent:
+    """The wall at ``sign * x[axis] = L`` as a scipy event: a callable with
+    ``terminal`` and ``direction`` (``solve_ivp``'s protocol), > 0 beyond the
+    wall, stopping the integration when crossed outward."""
+
+    axis: int
+    sign: float
+    L: float
+    terminal: bool = True
+    direction: float = 1.0
+
+    def __call__(self, t: float, y: np.ndarray) -> float:
+        return self.sign * y[self.axis] - self.L
+
+
 def wall_reference(config: ParticleConfig, x0: np.ndarray, v0: np.ndarray,
                    t1: float, oracle) -> np.ndarray:
     """Positions and velocities at ``t1`` with each wall contact located exactly.
@@ -264,15 +280,7 @@ def wall_reference(config: ParticleConfig, x0: np.ndarray, v0: np.ndarray,
     """
     f = particle_rhs(config, count=1)
     L = config.half_size
-    events = []
-    for axis in range(3):
-        for sign in (-1.0, 1.0):
-            def event(t, y, axis=axis, sign=sign):
-                return sign * y[axis] - L          # > 0 beyond the wall
-            event.terminal = True
-            event.direction = 1.0
-            event.axis, event.sign = axis, sign
-            events.append(event)
+    events = [_WallEvent(axis, sign, L) for axis in range(3) for sign in (-1.0, 1.0)]
     out = np.empty((2, len(x0), 3))
     for i in range(len(x0)):
         t, y = 0.0, np.concatenate([x0[i], v0[i]])
@@ -462,10 +470,10 @@ class Throughput:
 
     count: int
     solver: str
-    particle_steps_per_s: float = timing_field()
-    streaming_particle_steps_per_s: float = timing_field()
-    streaming_bytes_per_s: float = timing_field()
-    ratio: float = timing_field()
+    particle_steps_per_s: float = field(metadata=TIMED)
+    streaming_particle_steps_per_s: float = field(metadata=TIMED)
+    streaming_bytes_per_s: float = field(metadata=TIMED)
+    ratio: float = field(metadata=TIMED)
 
 
 def measure_throughput(count: int, solver: str, repeats: int = 10,

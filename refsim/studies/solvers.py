@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -48,7 +48,7 @@ from refsim.solvers.problems import (
     projectile_linear_drag,
 )
 from refsim.solvers.stability import imaginary_axis_limit, real_axis_limit
-from refsim.studies import timing_field
+from refsim.studies import TIMED
 
 EPS = np.finfo(np.float64).eps
 
@@ -471,7 +471,7 @@ class WorkPoint:
     parameter: float
     error: float
     nfev: int
-    wall_time: float = timing_field()
+    wall_time: float = field(metadata=TIMED)
 
 
 #: The scipy tolerances of the work-precision anchors.

@@ -40,9 +40,9 @@ import os
 import statistics
 import tempfile
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
-from refsim.studies import timing_field
+from refsim.studies import TIMED
 from refsim.sweep.backend import BACKENDS
 from refsim.sweep.examples import bounce, trivial
 from refsim.sweep.run import run_sweep
@@ -59,13 +59,13 @@ class BackendSpeed:
 
     backend: str
     workers: int | None
-    bench_seconds: float = timing_field()  # the sweep of the CPU-bound tasks
-    bench_cpu_seconds: float = timing_field()  # CPU time of that sweep, here and in workers
-    speedup: float = timing_field()  # in-process bench_seconds over this one's
-    startup_seconds: float = timing_field()  # a sweep of one trivial task per worker
-    trivial_seconds: float = timing_field()  # a sweep of ``trivial`` trivial tasks
+    bench_seconds: float = field(metadata=TIMED)  # the sweep of the CPU-bound tasks
+    bench_cpu_seconds: float = field(metadata=TIMED)  # CPU time of that sweep, here and in workers
+    speedup: float = field(metadata=TIMED)  # in-process bench_seconds over this one's
+    startup_seconds: float = field(metadata=TIMED)  # a sweep of one trivial task per worker
+    trivial_seconds: float = field(metadata=TIMED)  # a sweep of ``trivial`` trivial tasks
     # (trivial_seconds - startup_seconds) / (trivial - workers)
-    per_task_seconds: float = timing_field()
+    per_task_seconds: float = field(metadata=TIMED)
 
 
 @dataclass(frozen=True)
@@ -74,11 +74,11 @@ class SweepSpeed:
     duration: float
     trivial: int
     repeats: int
-    task_seconds: float = timing_field()  # median wall time of one benchmark task in-process
-    store_per_task_seconds: float = timing_field()  # added per task by a store
+    task_seconds: float = field(metadata=TIMED)  # median wall time of one benchmark task in-process
+    store_per_task_seconds: float = field(metadata=TIMED)  # added per task by a store
     # The machine's 1-minute load, before and after: it varies from run to run
     # as the timings do.
-    load_average: tuple[float, float] = timing_field()
+    load_average: tuple[float, float] = field(metadata=TIMED)
     backends: tuple[BackendSpeed, ...]
 
 
@@ -130,7 +130,7 @@ def measure_sweep_speed(*, tasks: int = 16, duration: float = BENCH_DURATION, wo
     options = {b: {"backend": b} if b == "inprocess" else {"backend": b, "workers": workers}
                for b in backends}
     started = {b: options[b].get("workers", 1) for b in backends}
-    times = {(b, what): [] for b in backends
+    times: dict[tuple[str, str], list[float]] = {(b, what): [] for b in backends
              for what in ("bench", "bench_cpu", "startup", "trivial")}
     stored, plain = [], []
     for _ in range(repeats):

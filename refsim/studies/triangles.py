@@ -46,7 +46,7 @@ from refsim.collision.triangle import (
     triangles_intersect_float,
 )
 from refsim.collision.triangle_batch import certified_batch, triangles_intersect_batch
-from refsim.studies import timing_field
+from refsim.studies import TIMED
 from refsim.types import random_rotation, rotation_about_axis, transform_points
 
 TriangleTest = Callable[[np.ndarray, np.ndarray], bool]
@@ -186,12 +186,12 @@ def _strict_crossing(t1, t2) -> bool:
     """Some edge of one triangle crosses the other's OPEN interior
     transversally, decided with strict signs only (no zero involved)."""
     for e, t in ((t1, t2), (t2, t1)):
+        a, b, c = t
         for i in range(3):
             p, q = e[i], e[(i + 1) % 3]
-            sp, sq = orient3d(*t, p), orient3d(*t, q)
+            sp, sq = orient3d(a, b, c, p), orient3d(a, b, c, q)
             if sp * sq >= 0:
                 continue
-            a, b, c = t
             signs = {orient3d(p, q, a, b), orient3d(p, q, b, c), orient3d(p, q, c, a)}
             if signs in ({1}, {-1}):
                 return True
@@ -217,13 +217,13 @@ def decision_margin(t1, t2) -> float:
 
     margins = []
     for e, t in ((t1, t2), (t2, t1)):
-        sides = [rel(*t, p) for p in e]
+        a, b, c = t
+        sides = [rel(a, b, c, p) for p in e]
         margins += sides
         for i in range(3):
             p, q = e[i], e[(i + 1) % 3]
-            if orient3d(*t, p) * orient3d(*t, q) > 0:
+            if orient3d(a, b, c, p) * orient3d(a, b, c, q) > 0:
                 continue
-            a, b, c = t
             margins += [rel(p, q, a, b), rel(p, q, b, c), rel(p, q, c, a)]
     return min(margins)
 
@@ -515,13 +515,13 @@ class Throughput:
     """Pairs per second on the same random pairs (higher is faster)."""
 
     n: int
-    readable: float = timing_field()
-    batch: float = timing_field()
-    oracle: float | None = timing_field()
+    readable: float = field(metadata=TIMED)
+    batch: float = field(metadata=TIMED)
+    oracle: float | None = field(metadata=TIMED)
     batch_fallback_fraction: float
-    numba: float | None = timing_field(default=None)  # None when numba is not installed
+    numba: float | None = field(default=None, metadata=TIMED)  # None when numba is not installed
     # Compiling the kernel from nothing (fresh interpreter, empty numba cache).
-    numba_compile_seconds: float | None = timing_field(default=None)
+    numba_compile_seconds: float | None = field(default=None, metadata=TIMED)
 
 
 def measure_throughput(n: int = 20_000, seed: int = 0,

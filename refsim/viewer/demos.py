@@ -23,6 +23,7 @@ state nothing about them (the report's claims do). Run all three with
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
@@ -114,8 +115,9 @@ def demo_wall_bounce(path, *, external=pybullet_trajectory, label: str = "pybull
                         title=f"a wall bounce: refsim beside {label}")
 
 
-DEMOS = {"c12-spin.html": demo_c12, "c11-interpenetration.html": demo_c11,
-         "wall-bounce.html": demo_wall_bounce}
+DEMOS: dict[str, Callable[..., ReplayInfo]] = {
+    "c12-spin.html": demo_c12, "c11-interpenetration.html": demo_c11,
+    "wall-bounce.html": demo_wall_bounce}
 
 
 def write_demos(folder, *, max_bytes: int = REPLAY_MAX_BYTES) -> list[ReplayInfo]:

@@ -30,10 +30,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from refsim.errors import DivergenceError, RefsimError
+from refsim.dynamics.trajectory import Trajectory
+from refsim.errors import DivergenceError, RefsimError, SceneError
+from refsim.scenes.schema import Scene
 from refsim.viewer import draw
 from refsim.viewer.overlays import (
     OPTIONS,
+    Energy,
+    WallHit,
     body_boxes,
     body_meshes,
     contacting_triangles,
@@ -41,7 +45,7 @@ from refsim.viewer.overlays import (
     scene_with,
     wall_hits,
 )
-from refsim.viewer.runs import Cancelled, run_bodies, run_particles
+from refsim.viewer.runs import Cancelled, ParticleRun, run_bodies, run_particles
 from refsim.viewer.server import LOCAL_HOST, start_server, stop_server, url
 
 #: The player's tick: frames are drawn at most this often (s), about 30 per second.
@@ -80,14 +84,15 @@ def scene_options(scene) -> dict:
 class Run:
     """A finished run and what the overlays need of it, for every frame."""
 
-    scene: object
+    scene: Scene
     generation: int
-    t: np.ndarray                     # (F,)
-    trajectory: object = None         # refsim.Trajectory of the bodies, if any
-    boxes: np.ndarray | None = None   # (F, B, 2, 3)
-    energy: object = None             # overlays.Energy
-    hits: list | None = None          # overlays.WallHit
-    particles: object = None          # runs.ParticleRun
+    t: np.ndarray                            # (F,)
+    # The bodies' frames and their overlays: all four or none (no bodies).
+    trajectory: Trajectory | None = None
+    boxes: np.ndarray | None = None          # (F, B, 2, 3)
+    energy: Energy | None = None
+    hits: list[WallHit] | None = None
+    particles: ParticleRun | None = None
     note: str = ""                    # e.g. "diverged at step 812"
     seconds: float = 0.0              # wall time of the simulation
 
@@ -127,10 +132,14 @@ class Viewer:
     def __init__(self, scene, *, host: str = LOCAL_HOST, port: int = 0,
                  every: int | None = None, play: bool = True):
         from refsim.scenes.loader import load_scene
-        from refsim.scenes.schema import Scene
 
         if not isinstance(scene, Scene):
             scene = load_scene(scene)
+        if not scene.bodies and scene.particles is None:
+            # the loader refuses such a scene; one built in Python is checked here
+            # (a run has a trajectory or particles: Run, _every)
+            raise SceneError("a scene needs at least one [[body]] or a [particles] table",
+                             scene.path, "body")
         self.scene = scene
         self.every = every
         self.meshes = body_meshes(scene)
@@ -148,7 +157,7 @@ class Viewer:
         self._finished_generation = 0         # the latest run shown
         self._contacts: dict[int, list] = {}  # frame -> contacting triangles (this run)
         self._hit_key: tuple = ()
-        self._contact_key = None
+        self._contact_key: tuple[int, int] | None = None   # (run, frame) of the contacts drawn
         self._stop = threading.Event()
         self._workers: list[threading.Thread] = []
         name = scene.path.name if scene.path is not None else "scene"
@@ -291,13 +300,16 @@ class Viewer:
 
     def wait(self, generation: int | None = None, timeout: float = 60.0) -> Run:
         """Block until run ``generation`` (default: the latest requested) is
-        shown; TimeoutError after ``timeout`` seconds."""
+        shown; TimeoutError after ``timeout`` seconds, RefsimError when the
+        viewer is closed before it is shown."""
         with self._finished:
             target = self._generation if generation is None else generation
             if not self._finished.wait_for(
                     lambda: self._finished_generation >= target or self._stop.is_set(),
                     timeout):
                 raise TimeoutError(f"run {target} not finished after {timeout} s")
+            if self._finished_generation < target or self.run is None:
+                raise RefsimError(f"the viewer was closed before run {target} was shown")
             return self.run
 
     def _work(self, generation: int, scene) -> None:
@@ -393,6 +405,7 @@ class Viewer:
     def _every(run: Run) -> int:
         if run.trajectory is not None:
             return int(run.trajectory.settings.get("every", 1))
+        assert run.particles is not None, "a scene has bodies or particles (Viewer checks)"
         return run.particles.every
 
     # -- playback -------------------------------------------------------------------
@@ -428,15 +441,18 @@ class Viewer:
     def _draw(self, run: Run, k: int) -> None:
         traj = run.trajectory
         if traj is not None:
+            assert run.boxes is not None and run.hits is not None, \
+                "set with the trajectory (_simulate)"
             R, x = traj.orientation[k], traj.position[k]
             for b, handle in enumerate(self.bodies):
                 draw.set_pose(handle, R[b], x[b])
-            self._draw_boxes(run, k)
-            self._draw_contacts(run, k)
-            self._draw_hits(run, k)
+            self._draw_boxes(run.boxes[k])
+            self._draw_contacts(run.generation, traj, k)
+            self._draw_hits(run, run.hits, k)
         if run.particles is not None:
             f = min(int(np.searchsorted(run.particles.t, run.t[k] - 1e-12)),
                     len(run.particles.t) - 1)
+            assert self.points is not None, "made by _build_scene for a scene with particles"
             self.points.points = run.particles.position[f]
         self.frame_slider.value = k
         text = f"t = {run.t[k]:.4g} s, frame {k} of {run.n_frames - 1}"
@@ -444,15 +460,16 @@ class Viewer:
             text += f"  \nE = {run.energy.total[k]:.6g} J"
         self.readout.content = text
 
-    def _draw_boxes(self, run: Run, k: int) -> None:
+    def _draw_boxes(self, boxes: np.ndarray) -> None:
+        """The bodies' boxes of one frame, (B, 2, 3)."""
         if not self.show_boxes.value:
             if self.boxes is not None:
                 self.boxes.visible = False
             return
         if self.boxes is None:
-            self.boxes = draw.add_boxes(self.server.scene, "/overlays/boxes", run.boxes[k])
+            self.boxes = draw.add_boxes(self.server.scene, "/overlays/boxes", boxes)
         else:
-            self.boxes.points = draw.boxes_segments(run.boxes[k]).astype(np.float32)
+            self.boxes.points = draw.boxes_segments(boxes).astype(np.float32)
             self.boxes.visible = True
 
     def contacts(self, k: int) -> list:
@@ -463,15 +480,16 @@ class Viewer:
             cached = self._contacts.get(k)
         if cached is not None or run is None or run.trajectory is None:
             return cached or []
+        assert run.boxes is not None, "set with the trajectory (_simulate)"
         found = contacting_triangles(self.meshes, run.trajectory, k, run.boxes[k])
         with self._lock:
             if self.run is run:
                 self._contacts[k] = found
         return found
 
-    def _draw_contacts(self, run: Run, k: int) -> None:
+    def _draw_contacts(self, generation: int, traj: Trajectory, k: int) -> None:
         found = self.contacts(k) if self.show_contacts.value else []
-        key = (run.generation, k) if found else None
+        key = (generation, k) if found else None
         if key == self._contact_key:
             return
         self._contact_key = key
@@ -479,16 +497,15 @@ class Viewer:
             self.contact_node.remove()
             self.contact_node = None
         if found:
-            traj = run.trajectory
             vertices, faces = draw.contact_mesh(self.meshes, traj.orientation[k],
                                                 traj.position[k], found)
             self.contact_node = self.server.scene.add_mesh_simple(
                 "/overlays/contacts", vertices, faces, color=draw.CONTACT_COLOR,
                 side="double", flat_shading=True)
 
-    def _draw_hits(self, run: Run, k: int) -> None:
+    def _draw_hits(self, run: Run, run_hits: list[WallHit], k: int) -> None:
         t = run.t[k]
-        hits = [h for h in run.hits if h.time <= t + 1e-12 and t - h.time <= HIT_SECONDS] \
+        hits = [h for h in run_hits if h.time <= t + 1e-12 and t - h.time <= HIT_SECONDS] \
             if self.show_hits.value else []
         key = (run.generation, tuple((h.frame, h.body, h.wall) for h in hits))
         if key == self._hit_key:

@@ -39,11 +39,15 @@ import json
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from refsim.errors import OutputError, RefsimError, check_count
 from refsim.viewer import REPLAY_MAX_BYTES as DEFAULT_MAX_BYTES
+
+if TYPE_CHECKING:
+    from refsim.dynamics.trajectory import Trajectory
 
 #: Space between two runs side by side, as a fraction of the larger cube's size.
 GAP = 0.25
@@ -88,7 +92,7 @@ class ReplayRun:
     """
 
     label: str
-    trajectory: object
+    trajectory: Trajectory
     meshes: tuple
     half_size: float
     settings: dict = field(default_factory=dict)
@@ -322,7 +326,7 @@ class _Page:
             first = -0.5 * pitch * (len(runs) - 1)
             self.offsets = [np.array([first + i * pitch, 0.0, 0.0]) for i in range(len(runs))]
         self.frames = [frame_at(r.trajectory.t, times) for r in runs]
-        self.box_frames = None
+        self.box_frames: list[np.ndarray] | None = None     # per run, (F, B, 2, 3)
         if boxes:
             from refsim.viewer.overlays import body_boxes
 
@@ -362,7 +366,7 @@ class _Page:
             serializer = server.get_scene_serializer()
             nodes = self._add_nodes(s, draw)
             keep = kept_frames(len(self.times), stride)
-            shown = [None] * len(self.runs)
+            shown: list[int | None] = [None] * len(self.runs)   # the frame posed, per run
             for j, i in enumerate(keep):
                 if j:
                     serializer.insert_sleep(float(self.times[i] - self.times[keep[j - 1]]))
@@ -407,6 +411,7 @@ class _Page:
         for b, handle in enumerate(node["bodies"]):
             draw.set_pose(handle, traj.orientation[f, b], traj.position[f, b], self.offsets[r])
         if node["boxes"] is not None:
+            assert self.box_frames is not None, "a box node is made only with box_frames"
             node["boxes"].points = draw.boxes_segments(self.box_frames[r][f],
                                                        self.offsets[r]).astype(np.float32)
 

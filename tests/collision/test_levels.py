@@ -27,6 +27,7 @@ from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
 from refsim.studies.levels import (
     CONFIGURATIONS,
     SPEED_CONFIGURATIONS,
+    Configuration,
     bundled_mesh,
     classify_body_disagreement,
     measure_body_oracles,
@@ -116,6 +117,13 @@ def test_constructed_configurations(config, method):
     got = answers(mesh_a, pose_a, mesh_b, pose_b, method=method)
     assert got == EXPECTED[config.name]
     assert got["exact"] == config.intended
+
+
+def test_an_unknown_rotation_is_named():
+    # it was unpacked as (axis, angle): "too many values to unpack"
+    config = Configuration("x", "separated-far", "", "cube", "cube", rotation_b="fixd")
+    with pytest.raises(ValueError, match="rotation_b 'fixd'"):
+        config.poses()
 
 
 def test_cubes_sharing_a_face_touch():

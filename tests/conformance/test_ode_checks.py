@@ -3,11 +3,15 @@ its tableau has) and on the seed's stated orders (claim C10)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from refsim.conformance import check_engine
+from refsim.conformance.cases_ode import end_error
 from refsim.conformance.checks_ode import ORDER_TOL, real_axis_limit
 from refsim.engines.refsim_engines import RefsimEngine
+from refsim.solvers import problems
 from refsim.solvers.methods import SOLVERS
 
 #: Real-axis stability limits on the grid z = -k/8 (the exact ones: 2, 2, 1,
@@ -52,3 +56,11 @@ def test_real_axis_limit_reads_the_grid():
     points = (0.0, -0.5, -1.0, -1.5)
     assert real_axis_limit([1.0, 0.5, 1.0, 1.2], points) == 1.0
     assert real_axis_limit([1.0, 1.1, 0.5, 0.5], points) == 0.0
+
+
+def test_end_error_needs_an_exact_solution():
+    # a problem without a closed form (exact None) was called: "'NoneType' object
+    # is not callable"
+    problem = replace(problems.kepler_orbit(), exact=None)
+    with pytest.raises(ValueError, match="'kepler' has no exact solution"):
+        end_error(SOLVERS["rk4"].step, problem, 10)

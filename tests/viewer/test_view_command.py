@@ -182,6 +182,21 @@ def test_the_page_stays_responsive_during_a_run():
         assert any(0.0 < p < 100.0 for p in progress)
 
 
+def test_waiting_on_a_closed_viewer_says_so():
+    # the run is cancelled by close(): wait() has no run to give (it gave None)
+    with Viewer(refsim.load_scene("spinning-cube.toml"), play=False) as v:   # 6000 steps
+        pass
+    with pytest.raises(refsim.RefsimError, match="closed before run 1 was shown"):
+        v.wait(timeout=START_TIMEOUT)
+
+
+def test_a_scene_with_nothing_to_show_is_refused():
+    # the loader refuses it; built in Python it got a server whose run failed
+    # in its thread, and wait() then timed out
+    with pytest.raises(refsim.SceneError, match=r"at least one \[\[body\]\]"):
+        Viewer(refsim.Scene(path=None), play=False)
+
+
 def test_a_bad_option_is_refused_before_running(viewer):
     with pytest.raises(refsim.RefsimError, match="integration.step"):
         viewer.rerun(step=0.0007)                         # 1.2 s is not whole steps of it
