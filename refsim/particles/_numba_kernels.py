@@ -1,23 +1,48 @@
-"""The particle system's Euler step fused into one compiled loop (S10), for
-the optional extra ``fast``.
+"""The particle system's step fused into one compiled loop (S10): every
+solver, many steps per call, one pass over memory per call.
 
-numpy's Euler step makes about fifteen passes over the state arrays (copy v,
-the drag product, gravity, two scaled adds, six wall comparisons and their
-masked updates); at a million particles each pass streams 24 MB, so the step
-runs at a quarter of the machine's streaming rate. This loop reads each
-particle's position and velocity once and writes them once.
+Why: numpy's step makes one pass over the state-sized arrays per operation
+(RK4: about seventy, counting stage states, products, sums, the forces and
+the six wall tests), so at a million particles it runs at a few percent of
+the machine's streaming rate. Here each particle's stages live in registers:
+the state is read once and written once per call, however many stages and
+steps the call takes.
 
 Same arithmetic, operation for operation, as
-:meth:`refsim.particles.system.ParticleSystem.step` with the Euler tableau
-(b = 1, so ``h * b`` is ``h`` exactly) and
-:func:`refsim.dynamics.walls.wall_response_points_inplace`: the drag product
-``v * (-k/m)`` (quadratic: ``v * (|v| * (-k/m))`` with ``|v|`` summed
-``(vx vx + vy vy) + vz vz``), gravity subtracted from the y component,
-``x + v h`` and ``v + a h``, then for axis 0, 1, 2 the low wall and then
-the high wall. Particles do not interact, so taking them one at a time gives
-the same bits as taking each operation over all of them
-(tests/particles/test_fused_step.py checks it). No fast-math: each operation
-is rounded once.
+:meth:`refsim.particles.system.ParticleSystem.step` with the readable kernel,
+that is :func:`refsim.solvers.explicit_rk.rk_step_into` over
+:func:`refsim.dynamics.forces.acceleration_into`, then
+:func:`refsim.dynamics.walls.wall_response_points_inplace`:
+
+- the stage state's velocity is ``(h a_i,i-1) k_i-1 + v`` (rk_step_into's
+  first term, ``K * (h a) + Y``). The stage state's position is never read
+  (the forces depend on velocity only), so it is not formed;
+- the stage derivative is ``(u, a(u))``: linear drag ``u * (-k/m)``,
+  quadratic ``u * (|u| (-k/m))`` with ``|u|^2 = (ux ux + uy uy) + uz uz``;
+  then gravity subtracted from the y component;
+- the update adds ``k_i (h b_i)`` to the state in stage order, skipping zero
+  weights, first to the position (with ``k_i``'s velocity part, the stage
+  velocity), then to the velocity;
+- then the walls: axis 0, 1, 2, the low wall and then the high wall, strict
+  comparisons, the speed at the wall as :func:`refsim.dynamics.walls.wall_speed`
+  writes it.
+
+Particles do not interact, so taking them one at a time (and a block of them
+through several steps before the next block) gives the same bits as taking
+each operation over all of them; tests/particles/test_fused_step.py checks it
+for every solver. No fast-math: each operation is rounded once, and LLVM does
+not contract a multiply and an add into an FMA without it.
+
+Linear drag's kernel walks the (N, 3) arrays flat, 3 N numbers, so that the
+compiler vectorizes it; gravity is subtracted from every component as the
+pattern ``(0, g, 0)``, and ``a - 0.0`` is ``a`` to the bit for every float
+(``-0.0 - 0.0 = -0.0``). Quadratic drag couples a particle's three
+components through ``|u|``, so its kernel takes a particle at a time.
+
+The tableaux: every stage evaluated at ``y + h a_i,i-1 k_i-1`` (only the
+subdiagonal of ``A`` nonzero), with 1, 2 or 4 stages: the seed's five
+solvers and its literal RK4 reading. :func:`fusable` says whether a tableau
+is of that shape.
 
 This module imports numba at import time; import it only when the compiled
 step is chosen.
@@ -28,60 +53,197 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+#: Particles per block. A block is taken through all the steps of a call
+#: before the next block; its state (48 bytes a particle) stays in the
+#: first-level cache meanwhile.
+BLOCK = 512
+
 
 @numba.njit(cache=True)
-def euler_step_fused(x, v, h, gravity, rate, quadratic, walls, half_size, restitution,
-                     k_friction, at_wall):
+def rk_steps_fused(x, v, steps, stages, hA, hb, b_used, gravity, rate, quadratic, walls,
+                   half_size, restitution, k_friction, at_wall):
     """Mirrors :meth:`refsim.particles.system.ParticleSystem.step` with the
-    Euler tableau: :func:`refsim.dynamics.forces.acceleration_into`, the
-    solver's update and :func:`refsim.dynamics.walls.wall_response_points_inplace`
-    (``at_wall``: the wall speed "wall", else the seed's literal one).
+    readable kernel (``rk_step_into`` over ``acceleration_into``, then
+    ``wall_response_points_inplace``), ``steps`` times, in place.
 
-    One Euler step of all particles, in place; returns the wall hits."""
+    Parameters
+    ----------
+    x, v : numpy.ndarray
+        (N, 3) float64, C-contiguous: positions and velocities.
+    steps : int
+    stages : int
+        ``s``, 1, 2 or 4.
+    hA : numpy.ndarray
+        (s,) ``h * A[i, i-1]`` (entry 0 unused), each product rounded once
+        as the readable step rounds it.
+    hb, b_used : numpy.ndarray
+        (s,) ``h * b[i]`` and ``b[i] != 0``.
+    gravity, rate : float
+        ``g`` and the drag rate ``k / m``.
+    quadratic, walls, at_wall : bool
+        Quadratic drag; the wall response on; the speed at the wall
+        (``wall_speed="wall"``) rather than the seed's literal one.
+    half_size, restitution, k_friction : float
+        The cube, ``e`` and ``1 - friction``.
+
+    Returns the number of (particle, wall) bounces.
+    """
     n = x.shape[0]
+    flat_x = x.reshape(3 * n)
+    flat_v = v.reshape(3 * n)
+    # gravity as the pattern (0, g, 0) over a block's flat components
+    g = np.zeros(3 * BLOCK)
+    for k in range(1, 3 * BLOCK, 3):
+        g[k] = gravity
     bounces = 0
-    for i in range(n):
+    for start in range(0, n, BLOCK):
+        stop = min(start + BLOCK, n)
+        # the block's components, flat; slices starting at 0 let the
+        # compiler vectorize the loops over them
+        xb = flat_x[3 * start:3 * stop]
+        vb = flat_v[3 * start:3 * stop]
+        for _ in range(steps):
+            if quadratic:
+                _quadratic_block(x, v, start, stop, stages, hA, hb, b_used, gravity, rate)
+            elif stages == 1:
+                _linear_block_1(xb, vb, g, hb[0], rate)
+            elif stages == 2:
+                _linear_block_2(xb, vb, g, hA[1], hb[0], hb[1], b_used[0], b_used[1], rate)
+            else:
+                _linear_block_4(xb, vb, g, hA[1], hA[2], hA[3], hb[0], hb[1], hb[2], hb[3],
+                                b_used[0], b_used[1], b_used[2], b_used[3], rate)
+            if walls and _beyond(xb, half_size):
+                bounces += _walls_block(x, v, start, stop, half_size, restitution, k_friction,
+                                        gravity, at_wall)
+    return bounces
+
+
+@numba.njit(cache=True, inline="always")
+def _linear_block_1(x, v, g, hb0, rate):
+    """One stage (Euler): ``x + v (h b1)``, ``v + k1 (h b1)``, over a block's
+    flat components; ``g`` the gravity pattern."""
+    for k in range(x.shape[0]):
+        vk = v[k]
+        k1 = vk * -rate - g[k]
+        x[k] = x[k] + vk * hb0
+        v[k] = vk + k1 * hb0
+
+
+@numba.njit(cache=True, inline="always")
+def _linear_block_2(x, v, g, hA1, hb0, hb1, b0, b1, rate):
+    """Two stages (averaged Euler, backwards Euler, midpoint), as
+    :func:`_linear_block_1`; ``b0``, ``b1`` say which weights are nonzero."""
+    for k in range(x.shape[0]):
+        vk, gk = v[k], g[k]
+        k1 = vk * -rate - gk
+        u2 = k1 * hA1 + vk
+        k2 = u2 * -rate - gk
+        xk, wk = x[k], vk
+        if b0:
+            xk = xk + vk * hb0
+            wk = wk + k1 * hb0
+        if b1:
+            xk = xk + u2 * hb1
+            wk = wk + k2 * hb1
+        x[k] = xk
+        v[k] = wk
+
+
+@numba.njit(cache=True, inline="always")
+def _linear_block_4(x, v, g, hA1, hA2, hA3, hb0, hb1, hb2, hb3, b0, b1, b2, b3, rate):
+    """Four stages (RK4, the seed's literal RK4), as :func:`_linear_block_1`."""
+    for k in range(x.shape[0]):
+        vk, gk = v[k], g[k]
+        k1 = vk * -rate - gk
+        u2 = k1 * hA1 + vk
+        k2 = u2 * -rate - gk
+        u3 = k2 * hA2 + vk
+        k3 = u3 * -rate - gk
+        u4 = k3 * hA3 + vk
+        k4 = u4 * -rate - gk
+        xk, wk = x[k], vk
+        if b0:
+            xk = xk + vk * hb0
+            wk = wk + k1 * hb0
+        if b1:
+            xk = xk + u2 * hb1
+            wk = wk + k2 * hb1
+        if b2:
+            xk = xk + u3 * hb2
+            wk = wk + k3 * hb2
+        if b3:
+            xk = xk + u4 * hb3
+            wk = wk + k4 * hb3
+        x[k] = xk
+        v[k] = wk
+
+
+@numba.njit(cache=True, inline="always")
+def _quadratic_block(x, v, start, stop, stages, hA, hb, b_used, gravity, rate):
+    """Any of the tableaux with quadratic drag, particles ``start:stop``."""
+    for i in range(start, stop):
         vx, vy, vz = v[i, 0], v[i, 1], v[i, 2]
-        if quadratic:
-            s = np.sqrt((vx * vx + vy * vy) + vz * vz) * (-rate)
-            ax, ay, az = vx * s, vy * s, vz * s
-        else:
-            ax, ay, az = vx * (-rate), vy * (-rate), vz * (-rate)
-        ay = ay - gravity
-        px, py, pz = x[i, 0] + vx * h, x[i, 1] + vy * h, x[i, 2] + vz * h
-        ux, uy, uz = vx + ax * h, vy + ay * h, vz + az * h
-        if walls and not (-half_size <= px <= half_size and -half_size <= py <= half_size
-                          and -half_size <= pz <= half_size):
-            # rare: the particle is beyond a wall (or not finite); the walls in
-            # the order of wall_response_inplace
-            p = np.array([px, py, pz])
-            u = np.array([ux, uy, uz])
-            bounces += _walls(p, u, half_size, restitution, k_friction, gravity, at_wall)
-            px, py, pz = p[0], p[1], p[2]
-            ux, uy, uz = u[0], u[1], u[2]
+        px, py, pz = x[i, 0], x[i, 1], x[i, 2]
+        wx, wy, wz = vx, vy, vz
+        kx = ky = kz = 0.0
+        for j in range(stages):
+            if j == 0:
+                ux, uy, uz = vx, vy, vz
+            else:
+                a = hA[j]
+                ux, uy, uz = kx * a + vx, ky * a + vy, kz * a + vz
+            s = np.sqrt((ux * ux + uy * uy) + uz * uz) * -rate
+            kx, ky, kz = ux * s, uy * s - gravity, uz * s
+            if b_used[j]:
+                b = hb[j]
+                px, py, pz = px + ux * b, py + uy * b, pz + uz * b
+                wx, wy, wz = wx + kx * b, wy + ky * b, wz + kz * b
         x[i, 0], x[i, 1], x[i, 2] = px, py, pz
-        v[i, 0], v[i, 1], v[i, 2] = ux, uy, uz
+        v[i, 0], v[i, 1], v[i, 2] = wx, wy, wz
+
+
+@numba.njit(cache=True, inline="always")
+def _beyond(xb, half_size):
+    """Whether a block's flat positions ``xb`` have a component beyond the
+    cube: a count in one vectorized pass over the block in cache, so that the
+    usual answer, none, is cheap (a NaN is beyond nothing, as in the readable
+    wall response)."""
+    count = 0
+    for k in range(xb.shape[0]):
+        count += (xb[k] < -half_size) | (xb[k] > half_size)
+    return count > 0
+
+
+@numba.njit(cache=True)
+def _walls_block(x, v, start, stop, half_size, restitution, k_friction, gravity, at_wall):
+    """The wall response of particles ``start:stop``, one by one: axis 0, 1,
+    2, the low wall, then the high one, as
+    :func:`refsim.dynamics.walls.wall_response_points_inplace` takes them
+    over all particles. Returns the bounces."""
+    bounces = 0
+    for i in range(start, stop):
+        for axis in range(3):
+            a_k = -gravity if axis == 1 else 0.0
+            for side in range(2):
+                wall = -half_size if side == 0 else half_size
+                hit = x[i, axis] < wall if side == 0 else x[i, axis] > wall
+                if hit:
+                    if at_wall:
+                        squared = v[i, axis] * v[i, axis] + 2.0 * a_k * (wall - x[i, axis])
+                        v[i, axis] = np.copysign(np.sqrt(max(squared, 0.0)), v[i, axis])
+                    x[i, axis] = wall
+                    v[i, axis] = v[i, axis] * -restitution
+                    for lateral in range(3):
+                        if lateral != axis:
+                            v[i, lateral] = v[i, lateral] * k_friction
+                    bounces += 1
     return bounces
 
 
 @numba.njit(cache=True)
-def _walls(p, u, half_size, restitution, k_friction, gravity, at_wall):
-    """Axis 0, 1, 2; the low wall, then the high one (strict comparisons);
-    the speed at the wall as :func:`refsim.dynamics.walls.wall_speed` writes it."""
-    bounces = 0
-    for axis in range(3):
-        a_k = -gravity if axis == 1 else 0.0
-        for side in range(2):
-            wall = -half_size if side == 0 else half_size
-            beyond = p[axis] < wall if side == 0 else p[axis] > wall
-            if beyond:
-                if at_wall:
-                    squared = u[axis] * u[axis] + 2.0 * a_k * (wall - p[axis])
-                    u[axis] = np.copysign(np.sqrt(max(squared, 0.0)), u[axis])
-                p[axis] = wall
-                u[axis] = u[axis] * -restitution
-                for lateral in range(3):
-                    if lateral != axis:
-                        u[lateral] = u[lateral] * k_friction
-                bounces += 1
-    return bounces
+def advance_time(t, h, steps):
+    """Mirrors the readable step's ``self.t += h`` (ParticleSystem.step),
+    ``steps`` times: the same sum, rounded after each step."""
+    for _ in range(steps):
+        t = t + h
+    return t
