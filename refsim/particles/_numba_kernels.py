@@ -33,11 +33,12 @@ each operation over all of them; tests/particles/test_fused_step.py checks it
 for every solver. No fast-math: each operation is rounded once, and LLVM does
 not contract a multiply and an add into an FMA without it.
 
-Linear drag's kernel walks the (N, 3) arrays flat, 3 N numbers, so that the
-compiler vectorizes it; gravity is subtracted from every component as the
-pattern ``(0, g, 0)``, and ``a - 0.0`` is ``a`` to the bit for every float
+The kernels walk the (N, 3) arrays flat, 3 N numbers, so that the compiler
+vectorizes them; gravity is subtracted from every component as the pattern
+``(0, g, 0)``, and ``a - 0.0`` is ``a`` to the bit for every float
 (``-0.0 - 0.0 = -0.0``). Quadratic drag couples a particle's three
-components through ``|u|``, so its kernel takes a particle at a time.
+components through ``|u|``: that one product is formed a particle at a time,
+into scratch the size of a block.
 
 The tableaux: every stage evaluated at ``y + h a_i,i-1 k_i-1`` (only the
 subdiagonal of ``A`` nonzero), with 1, 2 or 4 stages: the seed's five
@@ -103,15 +104,19 @@ def rk_steps_fused(x, v, steps, stages, hA, hb, b_used, gravity, rate, quadratic
         xb = flat_x[3 * start:3 * stop]
         vb = flat_v[3 * start:3 * stop]
         for _ in range(steps):
-            if quadratic:
-                _quadratic_block(x, v, start, stop, stages, hA, hb, b_used, gravity, rate)
+            # the stage count as a constant in each call, for the compiler
+            if quadratic and stages == 1:
+                _quadratic_block(xb, vb, 1, hA, hb, b_used, gravity, rate)
+            elif quadratic and stages == 2:
+                _quadratic_block(xb, vb, 2, hA, hb, b_used, gravity, rate)
+            elif quadratic:
+                _quadratic_block(xb, vb, 4, hA, hb, b_used, gravity, rate)
             elif stages == 1:
-                _linear_block_1(xb, vb, g, hb[0], rate)
+                _linear_block(xb, vb, g, 1, hA, hb, b_used, rate)
             elif stages == 2:
-                _linear_block_2(xb, vb, g, hA[1], hb[0], hb[1], b_used[0], b_used[1], rate)
+                _linear_block(xb, vb, g, 2, hA, hb, b_used, rate)
             else:
-                _linear_block_4(xb, vb, g, hA[1], hA[2], hA[3], hb[0], hb[1], hb[2], hb[3],
-                                b_used[0], b_used[1], b_used[2], b_used[3], rate)
+                _linear_block(xb, vb, g, 4, hA, hb, b_used, rate)
             if walls and _beyond(xb, half_size):
                 bounces += _walls_block(x, v, start, stop, half_size, restitution, k_friction,
                                         gravity, at_wall)
@@ -119,77 +124,42 @@ def rk_steps_fused(x, v, steps, stages, hA, hb, b_used, gravity, rate, quadratic
 
 
 @numba.njit(cache=True, inline="always")
-def _linear_block_1(x, v, g, hb0, rate):
-    """One stage (Euler): ``x + v (h b1)``, ``v + k1 (h b1)``, over a block's
-    flat components; ``g`` the gravity pattern."""
-    for k in range(x.shape[0]):
-        vk = v[k]
-        k1 = vk * -rate - g[k]
-        x[k] = x[k] + vk * hb0
-        v[k] = vk + k1 * hb0
+def _linear_block(xb, vb, g, stages, hA, hb, b_used, rate):
+    """Linear drag: one step of a block's flat components ``xb``, ``vb``
+    (positions, velocities); ``g`` the gravity pattern ``(0, g, 0, 0, g, 0, ...)``.
+
+    ``stages`` is a constant where this is inlined (1, 2 or 4), so the
+    compiler unrolls the stage loop and vectorizes the loop over components.
+    """
+    for k in range(xb.shape[0]):
+        vk, gk = vb[k], g[k]
+        xk, wk = xb[k], vk
+        u = vk                                # the stage velocity: v at stage 1
+        kv = 0.0                              # the stage acceleration
+        for j in range(stages):
+            if j > 0:
+                u = kv * hA[j] + vk
+            kv = u * -rate - gk
+            if b_used[j]:
+                xk = xk + u * hb[j]
+                wk = wk + kv * hb[j]
+        xb[k] = xk
+        vb[k] = wk
 
 
 @numba.njit(cache=True, inline="always")
-def _linear_block_2(x, v, g, hA1, hb0, hb1, b0, b1, rate):
-    """Two stages (averaged Euler, backwards Euler, midpoint), as
-    :func:`_linear_block_1`; ``b0``, ``b1`` say which weights are nonzero."""
-    for k in range(x.shape[0]):
-        vk, gk = v[k], g[k]
-        k1 = vk * -rate - gk
-        u2 = k1 * hA1 + vk
-        k2 = u2 * -rate - gk
-        xk, wk = x[k], vk
-        if b0:
-            xk = xk + vk * hb0
-            wk = wk + k1 * hb0
-        if b1:
-            xk = xk + u2 * hb1
-            wk = wk + k2 * hb1
-        x[k] = xk
-        v[k] = wk
-
-
-@numba.njit(cache=True, inline="always")
-def _linear_block_4(x, v, g, hA1, hA2, hA3, hb0, hb1, hb2, hb3, b0, b1, b2, b3, rate):
-    """Four stages (RK4, the seed's literal RK4), as :func:`_linear_block_1`."""
-    for k in range(x.shape[0]):
-        vk, gk = v[k], g[k]
-        k1 = vk * -rate - gk
-        u2 = k1 * hA1 + vk
-        k2 = u2 * -rate - gk
-        u3 = k2 * hA2 + vk
-        k3 = u3 * -rate - gk
-        u4 = k3 * hA3 + vk
-        k4 = u4 * -rate - gk
-        xk, wk = x[k], vk
-        if b0:
-            xk = xk + vk * hb0
-            wk = wk + k1 * hb0
-        if b1:
-            xk = xk + u2 * hb1
-            wk = wk + k2 * hb1
-        if b2:
-            xk = xk + u3 * hb2
-            wk = wk + k3 * hb2
-        if b3:
-            xk = xk + u4 * hb3
-            wk = wk + k4 * hb3
-        x[k] = xk
-        v[k] = wk
-
-
-@numba.njit(cache=True, inline="always")
-def _quadratic_block(x, v, start, stop, stages, hA, hb, b_used, gravity, rate):
-    """Any of the tableaux with quadratic drag, particles ``start:stop``."""
-    for i in range(start, stop):
-        vx, vy, vz = v[i, 0], v[i, 1], v[i, 2]
-        px, py, pz = x[i, 0], x[i, 1], x[i, 2]
+def _quadratic_block(xb, vb, stages, hA, hb, b_used, gravity, rate):
+    """Quadratic drag: one step of a block's flat components ``xb``, ``vb``,
+    a particle (three components, coupled through ``|u|``) at a time;
+    ``stages`` a constant as in :func:`_linear_block`."""
+    for p in range(0, xb.shape[0], 3):
+        vx, vy, vz = vb[p], vb[p + 1], vb[p + 2]
+        px, py, pz = xb[p], xb[p + 1], xb[p + 2]
         wx, wy, wz = vx, vy, vz
+        ux, uy, uz = vx, vy, vz
         kx = ky = kz = 0.0
         for j in range(stages):
-            if j == 0:
-                ux, uy, uz = vx, vy, vz
-            else:
+            if j > 0:
                 a = hA[j]
                 ux, uy, uz = kx * a + vx, ky * a + vy, kz * a + vz
             s = np.sqrt((ux * ux + uy * uy) + uz * uz) * -rate
@@ -198,8 +168,8 @@ def _quadratic_block(x, v, start, stop, stages, hA, hb, b_used, gravity, rate):
                 b = hb[j]
                 px, py, pz = px + ux * b, py + uy * b, pz + uz * b
                 wx, wy, wz = wx + kx * b, wy + ky * b, wz + kz * b
-        x[i, 0], x[i, 1], x[i, 2] = px, py, pz
-        v[i, 0], v[i, 1], v[i, 2] = wx, wy, wz
+        xb[p], xb[p + 1], xb[p + 2] = px, py, pz
+        vb[p], vb[p + 1], vb[p + 2] = wx, wy, wz
 
 
 @numba.njit(cache=True, inline="always")
