@@ -87,7 +87,12 @@ def rk_steps_fused(x, v, steps, stages, hA, hb, b_used, gravity, rate, quadratic
     half_size, restitution, k_friction : float
         The cube, ``e`` and ``1 - friction``.
 
-    Returns the number of (particle, wall) bounces.
+    Returns
+    -------
+    (bounces, non_finite) : (int, int)
+        The (particle, wall) bounces, and the number of components of the
+        final state that are not finite (what ``ParticleSystem.run``
+        checks, counted here without another pass over memory).
     """
     n = x.shape[0]
     flat_x = x.reshape(3 * n)
@@ -97,6 +102,7 @@ def rk_steps_fused(x, v, steps, stages, hA, hb, b_used, gravity, rate, quadratic
     for k in range(1, 3 * BLOCK, 3):
         g[k] = gravity
     bounces = 0
+    non_finite = 0
     for start in range(0, n, BLOCK):
         stop = min(start + BLOCK, n)
         # the block's components, flat; slices starting at 0 let the
@@ -120,7 +126,11 @@ def rk_steps_fused(x, v, steps, stages, hA, hb, b_used, gravity, rate, quadratic
             if walls and _beyond(xb, half_size):
                 bounces += _walls_block(x, v, start, stop, half_size, restitution, k_friction,
                                         gravity, at_wall)
-    return bounces
+        # the block's final state, checked while it is in cache: c - c is
+        # 0.0 for a finite c and NaN for an infinite or NaN one
+        for k in range(xb.shape[0]):
+            non_finite += (xb[k] - xb[k] != 0.0) | (vb[k] - vb[k] != 0.0)
+    return bounces, non_finite
 
 
 @numba.njit(cache=True, inline="always")
@@ -152,7 +162,10 @@ def _quadratic_block(xb, vb, stages, hA, hb, b_used, gravity, rate):
     """Quadratic drag: one step of a block's flat components ``xb``, ``vb``,
     a particle (three components, coupled through ``|u|``) at a time;
     ``stages`` a constant as in :func:`_linear_block`."""
-    for p in range(0, xb.shape[0], 3):
+    for i in range(xb.shape[0] // 3):
+        # (a loop over i, not over p in steps of 3: the compiler vectorizes
+        # only the former)
+        p = 3 * i
         vx, vy, vz = vb[p], vb[p + 1], vb[p + 2]
         px, py, pz = xb[p], xb[p + 1], xb[p + 2]
         wx, wy, wz = vx, vy, vz

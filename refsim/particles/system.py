@@ -187,24 +187,27 @@ class ParticleSystem:
         self.steps += 1
         self.nfev += self.method.stages
 
-    def _steps_fused(self, steps: int) -> None:
+    def _steps_fused(self, steps: int) -> int:
         """``steps`` steps as one compiled loop (``kernel="compiled"``): each
         block of particles through all of them, in one pass over the state;
-        the same bits as :meth:`step` with the readable kernel."""
+        the same bits as :meth:`step` with the readable kernel. Returns the
+        number of non-finite numbers in the state after them."""
         from refsim.particles._numba_kernels import advance_time, rk_steps_fused
 
         c = self.config
         if self._tableau is None:        # _choose_kernel refuses "compiled" then
             raise OptionError(f"no fused step for {self.method.name!r}")
         hA, hb, b_used = self._tableau
-        self.bounces += rk_steps_fused(
+        bounces, non_finite = rk_steps_fused(
             self.state[0], self.state[1], steps, self.method.stages, hA, hb, b_used,
             c.gravity, c.drag / c.mass, c.drag_model == "quadratic", c.walls, c.half_size,
             c.restitution, 1.0 - c.friction, c.wall_speed == "wall")
+        self.bounces += bounces
         # t as the readable step sums it: h added once per step
         self.t = advance_time(self.t, c.step, steps)
         self.steps += steps
         self.nfev += steps * self.method.stages
+        return non_finite
 
     def run(self, steps: int) -> None:
         """Take ``steps`` steps, then check the state is finite.
@@ -223,22 +226,25 @@ class ParticleSystem:
             an integer.
         """
         steps = check_count("steps", steps, maximum=MAX_STEPS)
-        if self.kernel == "compiled":
+        if self.kernel == "compiled" and steps > 0:
             per_call = max(1, FUSED_PARTICLE_STEPS // self.count)
             done = 0
             while done < steps:
                 block = min(per_call, steps - done)
-                self._steps_fused(block)
+                non_finite = self._steps_fused(block)
                 done += block
+            # the last call counted the final state's non-finite numbers
+            finite = non_finite == 0
         else:
             # Overflow on the way to inf is what the check below reports, once;
             # numpy's warnings would print it again, per operation.
             with np.errstate(over="ignore", invalid="ignore"):
                 for _ in range(steps):
                     self.step()
-        # max and min propagate NaN and see +-inf, without the (2, N, 3) bool
-        # temporary of np.isfinite(state).all().
-        if not (np.isfinite(self.state.max()) and np.isfinite(self.state.min())):
+            # max and min propagate NaN and see +-inf, without the (2, N, 3)
+            # bool temporary of np.isfinite(state).all().
+            finite = bool(np.isfinite(self.state.max()) and np.isfinite(self.state.min()))
+        if not finite:
             raise DivergenceError("particle state is not finite", step=self.steps,
                                   time=self.t)
 

@@ -557,7 +557,7 @@ def measure_streaming_bound(count: int, solver: str, kernel: str | None = None,
         if steps_per_call == 1:
             system.step()
         else:
-            system.run(steps_per_call)
+            system.run(steps_per_call)      # with its check that the state is finite
         steps.append((time.perf_counter() - start) / steps_per_call)
         start = time.perf_counter()
         np.copyto(copy, system.state)
