@@ -19,10 +19,17 @@ method with ``s`` stages (``s`` stage derivatives ``K``, one stage state, one
 product scratch); Euler needs ``s + 1`` (its only stage is the state itself).
 RK4: 6 state-sized arrays in all, 48 bytes each per particle.
 
+The step buffers belong to the readable kernel; they are allocated for both
+kernels (``buffer_bytes`` reports them) and the compiled kernel never touches
+them, so a large system's are address space without pages behind them.
+
 The fast path here does the same arithmetic in the same order as the plain
 path (:func:`plain_step`: :func:`refsim.solvers.explicit_rk.rk_step` on the
 flattened state, then :func:`refsim.dynamics.walls.wall_response_points`), so the
-two agree to the last bit; the tests check that.
+two agree to the last bit; the tests check that. The compiled kernel does it
+once more, fused into one loop over the particles, and agrees with both
+(tests/particles/test_fused_step.py; docs/decisions/particles-fused-step.md
+says how it is laid out and what it was measured at).
 """
 
 from __future__ import annotations
@@ -80,6 +87,14 @@ class ParticleSystem:
     config : ParticleConfig
     positions, velocities : array_like, optional
         (N, 3) initial state; default ``config.initial_state()``. Copied.
+    kernel : {"readable", "compiled"}, optional
+        ``"readable"``: the generic step over the tableau, numpy operation
+        by operation (:meth:`step`). ``"compiled"``: the same arithmetic fused
+        into one compiled loop over the particles, many steps a call
+        (:func:`refsim.particles._numba_kernels.rk_steps_fused`; the tableaux
+        :func:`fused_tableau` takes). The two give the same bits. Default
+        (:mod:`refsim.kernels`): ``"compiled"`` where numba works and the
+        tableau is of the fused loop's shape, else ``"readable"``.
 
     Attributes
     ----------
