@@ -37,13 +37,15 @@ The kernels walk the (N, 3) arrays flat, 3 N numbers, so that the compiler
 vectorizes them; gravity is subtracted from every component as the pattern
 ``(0, g, 0)``, and ``a - 0.0`` is ``a`` to the bit for every float
 (``-0.0 - 0.0 = -0.0``). Quadratic drag couples a particle's three
-components through ``|u|``: that one product is formed a particle at a time,
-into scratch the size of a block.
+components through ``|u|``, so its loop takes a particle at a time (the
+compiler vectorizes that loop too, square root included).
 
 The tableaux: every stage evaluated at ``y + h a_i,i-1 k_i-1`` (only the
 subdiagonal of ``A`` nonzero), with 1, 2 or 4 stages: the seed's five
-solvers and its literal RK4 reading. :func:`fusable` says whether a tableau
-is of that shape.
+solvers and its literal RK4 reading.
+:func:`refsim.particles.system.fused_tableau` says whether a tableau is of
+that shape and gives its coefficients. docs/decisions/particles-fused-step.md
+records the layouts tried and the measurements.
 
 This module imports numba at import time; import it only when the compiled
 step is chosen.
