@@ -115,7 +115,7 @@ class ParticleSystem:
         self.config = config
         self.method = resolve_method(config.solver)
         self.kernel = _choose_kernel(kernel, self.method)
-        self._tableau = fused_tableau(self.method, config.step)
+        self._fused_arguments = _fused_arguments(config, self.method)
         if positions is None and velocities is None:
             positions, velocities = config.initial_state()
         elif positions is None or velocities is None:
@@ -209,17 +209,14 @@ class ParticleSystem:
         number of non-finite numbers in the state after them."""
         from refsim.particles._numba_kernels import advance_time, rk_steps_fused
 
-        c = self.config
-        if self._tableau is None:        # _choose_kernel refuses "compiled" then
+        if self._fused_arguments is None:     # _choose_kernel refuses "compiled" then
             raise OptionError(f"no fused step for {self.method.name!r}")
-        hA, hb, b_used = self._tableau
-        bounces, non_finite = rk_steps_fused(
-            self.state[0], self.state[1], steps, self.method.stages, hA, hb, b_used,
-            c.gravity, c.drag / c.mass, c.drag_model == "quadratic", c.walls, c.half_size,
-            c.restitution, 1.0 - c.friction, c.wall_speed == "wall")
+        bounces, non_finite = rk_steps_fused(self.state[0], self.state[1], steps,
+                                             *self._fused_arguments)
         self.bounces += bounces
         # t as the readable step sums it: h added once per step
-        self.t = advance_time(self.t, c.step, steps)
+        h = self.config.step
+        self.t = self.t + h if steps == 1 else advance_time(self.t, h, steps)
         self.steps += steps
         self.nfev += steps * self.method.stages
         return non_finite
@@ -292,6 +289,18 @@ def fused_tableau(method, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]
     hA = np.array([h * A[i, i - 1] if i > 0 else 0.0 for i in range(s)])
     hb = np.array([h * b[i] for i in range(s)])
     return hA, hb, b != 0.0
+
+
+def _fused_arguments(config: ParticleConfig, method) -> tuple | None:
+    """The arguments of :func:`refsim.particles._numba_kernels.rk_steps_fused`
+    after ``x, v, steps``, made once per system; None when the tableau is not
+    of the fused loop's shape (:func:`fused_tableau`)."""
+    tableau = fused_tableau(method, config.step)
+    if tableau is None:
+        return None
+    c = config
+    return (method.stages, *tableau, c.gravity, c.drag / c.mass, c.drag_model == "quadratic",
+            c.walls, c.half_size, c.restitution, 1.0 - c.friction, c.wall_speed == "wall")
 
 
 def _choose_kernel(kernel: str | None, method) -> str:
