@@ -147,6 +147,6 @@ PAIRS: dict[str, tuple[str, str, str]] = {
                                   "refsim.collision._numba_kernels:certified", MIRRORS),
     "exact hierarchy query": ("refsim.collision.bvh_exact:descend",
                               "refsim.collision._numba_kernels:exact_query", MIRRORS),
-    "fused Euler particle step": ("refsim.particles.system:ParticleSystem",
-                                  "refsim.particles._numba_kernels:euler_step_fused", MIRRORS),
+    "fused particle steps": ("refsim.particles.system:ParticleSystem",
+                             "refsim.particles._numba_kernels:rk_steps_fused", MIRRORS),
 }

@@ -116,13 +116,18 @@ def _exact_hierarchy(kernel):
                               kernel=kernel)]
 
 
-def _euler_particles(kernel):
-    config = refsim.ParticleConfig(count=300, seed=4, solver="euler", step=0.01, drag=0.7,
-                                   drag_model="quadratic", half_size=0.5, speed_min=5.0,
-                                   speed_max=40.0, box_lo=(-0.5,) * 3, box_hi=(0.5,) * 3)
-    system = refsim.ParticleSystem(config, kernel=kernel)
-    system.run(30)
-    return system.state, system.bounces
+def _particles(kernel):
+    out = []
+    for solver in sorted(refsim.SOLVERS):
+        for drag_model in ("linear", "quadratic"):
+            config = refsim.ParticleConfig(count=300, seed=4, solver=solver, step=0.01,
+                                           drag=0.7, drag_model=drag_model, half_size=0.5,
+                                           speed_min=5.0, speed_max=40.0,
+                                           box_lo=(-0.5,) * 3, box_hi=(0.5,) * 3)
+            system = refsim.ParticleSystem(config, kernel=kernel)
+            system.run(30)
+            out.append((system.state, system.bounces, system.t))
+    return out
 
 
 #: The cases of each registry entry, run with each kernel.
@@ -138,7 +143,7 @@ CASES = {
     "hierarchy traversal": _hierarchy_boxes,
     "certified triangle filter": _certified_filter,
     "exact hierarchy query": _exact_hierarchy,
-    "fused Euler particle step": _euler_particles,
+    "fused particle steps": _particles,
 }
 
 

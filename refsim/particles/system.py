@@ -19,10 +19,17 @@ method with ``s`` stages (``s`` stage derivatives ``K``, one stage state, one
 product scratch); Euler needs ``s + 1`` (its only stage is the state itself).
 RK4: 6 state-sized arrays in all, 48 bytes each per particle.
 
+The step buffers belong to the readable kernel; they are allocated for both
+kernels (``buffer_bytes`` reports them) and the compiled kernel never touches
+them, so a large system's are address space without pages behind them.
+
 The fast path here does the same arithmetic in the same order as the plain
 path (:func:`plain_step`: :func:`refsim.solvers.explicit_rk.rk_step` on the
 flattened state, then :func:`refsim.dynamics.walls.wall_response_points`), so the
-two agree to the last bit; the tests check that.
+two agree to the last bit; the tests check that. The compiled kernel does it
+once more, fused into one loop over the particles, and agrees with both
+(tests/particles/test_fused_step.py; docs/decisions/particles-fused-step.md
+says how it is laid out and what it was measured at).
 """
 
 from __future__ import annotations
@@ -37,6 +44,12 @@ from refsim.limits import MAX_STEPS
 from refsim.particles.config import ParticleConfig
 from refsim.solvers.explicit_rk import rk_step, rk_step_into, stages_with_own_state
 from refsim.solvers.integrate import resolve_method
+
+#: Particle-steps per call of the fused loop in :meth:`ParticleSystem.run`:
+#: a fraction of a second each, so that a long run is many calls (between
+#: which Python sees Ctrl-C) while each call still takes a block of
+#: particles through many steps.
+FUSED_PARTICLE_STEPS = 50_000_000
 
 
 def particle_rhs(config: ParticleConfig, count: int | None = None):
@@ -74,6 +87,14 @@ class ParticleSystem:
     config : ParticleConfig
     positions, velocities : array_like, optional
         (N, 3) initial state; default ``config.initial_state()``. Copied.
+    kernel : {"readable", "compiled"}, optional
+        ``"readable"``: the generic step over the tableau, numpy operation
+        by operation (:meth:`step`). ``"compiled"``: the same arithmetic fused
+        into one compiled loop over the particles, many steps a call
+        (:func:`refsim.particles._numba_kernels.rk_steps_fused`; the tableaux
+        :func:`fused_tableau` takes). The two give the same bits. Default
+        (:mod:`refsim.kernels`): ``"compiled"`` where numba works and the
+        tableau is of the fused loop's shape, else ``"readable"``.
 
     Attributes
     ----------
@@ -94,6 +115,7 @@ class ParticleSystem:
         self.config = config
         self.method = resolve_method(config.solver)
         self.kernel = _choose_kernel(kernel, self.method)
+        self._fused_arguments = _fused_arguments(config, self.method)
         if positions is None and velocities is None:
             positions, velocities = config.initial_state()
         elif positions is None or velocities is None:
@@ -157,15 +179,17 @@ class ParticleSystem:
     def step(self) -> None:
         """Advance one step of ``config.step``: the solver, then the walls.
 
-        The Runge-Kutta step in place into the system's buffers
-        (:func:`refsim.solvers.explicit_rk.rk_step_into`, the arithmetic of
-        :func:`refsim.solvers.explicit_rk.rk_step` term by term), then the
-        walls in place; or, with the compiled kernel, the fused Euler step.
+        The readable kernel: the Runge-Kutta step in place into the system's
+        buffers (:func:`refsim.solvers.explicit_rk.rk_step_into`, the
+        arithmetic of :func:`refsim.solvers.explicit_rk.rk_step` term by
+        term), then the walls in place. The compiled kernel: the same
+        arithmetic fused into one loop over the particles
+        (:func:`refsim.particles._numba_kernels.rk_steps_fused`).
         """
-        h = self.config.step
         if self.kernel == "compiled":
-            self._step_fused(h)
+            self._steps_fused(1)
             return
+        h = self.config.step
         rk_step_into(self.method, self._derivative_into, self.t, self.state, h, self._K,
                      self._stage, self._product)
         Y = self.state
@@ -178,22 +202,31 @@ class ParticleSystem:
         self.steps += 1
         self.nfev += self.method.stages
 
-    def _step_fused(self, h: float) -> None:
-        """The Euler step as one compiled loop (``kernel="compiled"``): the same
-        bits as the generic step above, in one pass over the state."""
-        from refsim.particles._numba_kernels import euler_step_fused
+    def _steps_fused(self, steps: int) -> int:
+        """``steps`` steps as one compiled loop (``kernel="compiled"``): each
+        block of particles through all of them, in one pass over the state;
+        the same bits as :meth:`step` with the readable kernel. Returns the
+        number of non-finite numbers in the state after them."""
+        from refsim.particles._numba_kernels import advance_time, rk_steps_fused
 
-        c = self.config
-        self.bounces += euler_step_fused(
-            self.state[0], self.state[1], h, c.gravity, c.drag / c.mass,
-            c.drag_model == "quadratic", c.walls, c.half_size, c.restitution,
-            1.0 - c.friction, c.wall_speed == "wall")
-        self.t += h
-        self.steps += 1
-        self.nfev += 1
+        if self._fused_arguments is None:     # _choose_kernel refuses "compiled" then
+            raise OptionError(f"no fused step for {self.method.name!r}")
+        bounces, non_finite = rk_steps_fused(self.state[0], self.state[1], steps,
+                                             *self._fused_arguments)
+        self.bounces += bounces
+        # t as the readable step sums it: h added once per step
+        h = self.config.step
+        self.t = self.t + h if steps == 1 else advance_time(self.t, h, steps)
+        self.steps += steps
+        self.nfev += steps * self.method.stages
+        return non_finite
 
     def run(self, steps: int) -> None:
         """Take ``steps`` steps, then check the state is finite.
+
+        With the compiled kernel the steps go to the fused loop in calls of
+        at most :data:`FUSED_PARTICLE_STEPS` particle-steps (a fraction of a
+        second each), each call one pass over the state.
 
         Raises
         ------
@@ -205,14 +238,25 @@ class ParticleSystem:
             an integer.
         """
         steps = check_count("steps", steps, maximum=MAX_STEPS)
-        # Overflow on the way to inf is what the check below reports, once;
-        # numpy's warnings would print it again, per operation.
-        with np.errstate(over="ignore", invalid="ignore"):
-            for _ in range(steps):
-                self.step()
-        # max and min propagate NaN and see +-inf, without the (2, N, 3) bool
-        # temporary of np.isfinite(state).all().
-        if not (np.isfinite(self.state.max()) and np.isfinite(self.state.min())):
+        if self.kernel == "compiled" and steps > 0:
+            per_call = max(1, FUSED_PARTICLE_STEPS // self.count)
+            done = 0
+            while done < steps:
+                block = min(per_call, steps - done)
+                non_finite = self._steps_fused(block)
+                done += block
+            # the last call counted the final state's non-finite numbers
+            finite = non_finite == 0
+        else:
+            # Overflow on the way to inf is what the check below reports, once;
+            # numpy's warnings would print it again, per operation.
+            with np.errstate(over="ignore", invalid="ignore"):
+                for _ in range(steps):
+                    self.step()
+            # max and min propagate NaN and see +-inf, without the (2, N, 3)
+            # bool temporary of np.isfinite(state).all().
+            finite = bool(np.isfinite(self.state.max()) and np.isfinite(self.state.min()))
+        if not finite:
             raise DivergenceError("particle state is not finite", step=self.steps,
                                   time=self.t)
 
@@ -225,16 +269,51 @@ class ParticleSystem:
         return self.config.mass * self.config.gravity * float(self.positions[:, 1].sum())
 
 
+def fused_tableau(method, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The coefficients the fused step takes for step ``h``, or None when the
+    tableau is not of its shape.
+
+    The fused loop (:func:`refsim.particles._numba_kernels.rk_steps_fused`)
+    takes tableaux with 1, 2 or 4 stages whose every stage after the first
+    is evaluated at ``y + h a_i,i-1 k_i-1`` (``A`` nonzero on its
+    subdiagonal and only there): the seed's five solvers and its literal RK4
+    reading. Returns ``(hA, hb, b_used)``, each (s,): ``h * A[i, i-1]`` (0
+    for the first stage), ``h * b[i]`` and ``b[i] != 0``, each product
+    rounded once, as :func:`refsim.solvers.explicit_rk.rk_step_into` rounds it.
+    """
+    A, b = method.A_, method.b_
+    s = method.stages
+    subdiagonal = all((A[i, j] != 0.0) == (j == i - 1) for i in range(s) for j in range(i))
+    if s not in (1, 2, 4) or not subdiagonal:
+        return None
+    hA = np.array([h * A[i, i - 1] if i > 0 else 0.0 for i in range(s)])
+    hb = np.array([h * b[i] for i in range(s)])
+    return hA, hb, b != 0.0
+
+
+def _fused_arguments(config: ParticleConfig, method) -> tuple | None:
+    """The arguments of :func:`refsim.particles._numba_kernels.rk_steps_fused`
+    after ``x, v, steps``, made once per system; None when the tableau is not
+    of the fused loop's shape (:func:`fused_tableau`)."""
+    tableau = fused_tableau(method, config.step)
+    if tableau is None:
+        return None
+    c = config
+    return (method.stages, *tableau, c.gravity, c.drag / c.mass, c.drag_model == "quadratic",
+            c.walls, c.half_size, c.restitution, 1.0 - c.friction, c.wall_speed == "wall")
+
+
 def _choose_kernel(kernel: str | None, method) -> str:
     """"readable": the generic step over the tableau (any solver).
-    "compiled": the Euler step fused into one compiled loop (solver "euler"
-    only). Default: "compiled" for Euler where numba works, else "readable"
-    (:mod:`refsim.kernels`)."""
-    euler = method.name == "euler"
-    if kernel is None and not euler:
+    "compiled": the step fused into one compiled loop (the tableaux
+    :func:`fused_tableau` takes: the seed's five solvers and its literal
+    RK4). Default: "compiled" where numba works and the tableau is of that
+    shape, else "readable" (:mod:`refsim.kernels`)."""
+    fusable = fused_tableau(method, 1.0) is not None
+    if kernel is None and not fusable:
         return "readable"
     kernel = choose_kernel(kernel)
-    if kernel == "compiled" and not euler:
-        raise OptionError(f"kernel 'compiled' is the fused Euler step only, not "
-                          f"{method.name!r}")
+    if kernel == "compiled" and not fusable:
+        raise OptionError(f"kernel 'compiled' takes tableaux with 1, 2 or 4 stages and A "
+                          f"nonzero on its subdiagonal only, not {method.name!r}")
     return kernel

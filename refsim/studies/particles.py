@@ -13,6 +13,8 @@ What: plain numbers and frozen dataclasses for the report and the tests.
   stopped exactly at each wall contact).
 - :func:`measure_throughput`: particle-steps per second against the
   streaming rate of the same memory (:func:`streaming_step`).
+- :func:`measure_streaming_bound`: a step's time against its own
+  streaming bound, the time to copy the state it reads and writes.
 - :func:`measure_step_memory`: tracemalloc peak of a run of steps.
 
 Seed section: S10 with S5, S6, S7.
@@ -495,6 +497,82 @@ def measure_throughput(count: int, solver: str, repeats: int = 10,
     stream = count / best_stream
     return Throughput(count, solver, rate, stream, stream * STREAMING_BYTES_PER_PARTICLE,
                       stream / rate)
+
+
+#: Bytes a particle step must move per particle: the state read once and
+#: written once, position and velocity, 6 float64 each way.
+STEP_BYTES_PER_PARTICLE = 2 * 48
+
+
+@dataclass(frozen=True)
+class StreamingBound:
+    """A particle step against its own streaming bound, medians of one run.
+
+    The bound is the time to move the bytes a step must read and write
+    (:data:`STEP_BYTES_PER_PARTICLE`: the state in and out once) at the
+    machine's copy rate, measured in the same run as the step: the median
+    time of ``np.copyto`` of a state-sized array, which moves those bytes.
+    Each round times one call of the step and one copy, one after the other,
+    so that a machine busy with other work slows both alike.
+
+    Attributes
+    ----------
+    count : int
+    solver, kernel : str
+    steps_per_call : int
+        Steps per timed call (1: ``step()``; more: ``run(steps_per_call)``).
+    step_s : float
+        Median seconds per step.
+    copy_s : float
+        Median seconds of one copy of the state: the bound.
+    copy_bytes_per_s : float
+        The copy rate, bytes read plus written per second.
+    fraction : float
+        ``copy_s / step_s``: the step's speed as a fraction of its bound
+        (above 1 when several steps share one pass over memory).
+    """
+
+    count: int
+    solver: str
+    kernel: str
+    steps_per_call: int
+    step_s: float = timing_field()
+    copy_s: float = timing_field()
+    copy_bytes_per_s: float = timing_field()
+    fraction: float = timing_field()
+
+
+def measure_streaming_bound(count: int, solver: str, kernel: str | None = None,
+                            rounds: int = 21, steps_per_call: int = 1,
+                            drag_model: str = "linear") -> StreamingBound:
+    """Median time of a step of ``count`` particles and of a copy of their
+    state, over ``rounds`` interleaved rounds (:class:`StreamingBound`).
+
+    The system is the throughput benchmark's (drag 0.1, h = 1e-3, the default
+    cube: no particle reaches a wall in these steps, as in most steps of a
+    large system). One step is taken before timing, so a compiled kernel's
+    load is not timed.
+    """
+    config = ParticleConfig(count=count, solver=solver, drag=0.1, drag_model=drag_model,
+                            step=1e-3)
+    system = ParticleSystem(config, kernel=kernel)
+    system.step()
+    copy = np.empty_like(system.state)
+    np.copyto(copy, system.state)
+    steps, copies = [], []
+    for _ in range(rounds):
+        start = time.perf_counter()
+        if steps_per_call == 1:
+            system.step()
+        else:
+            system.run(steps_per_call)      # with its check that the state is finite
+        steps.append((time.perf_counter() - start) / steps_per_call)
+        start = time.perf_counter()
+        np.copyto(copy, system.state)
+        copies.append(time.perf_counter() - start)
+    step_s, copy_s = float(np.median(steps)), float(np.median(copies))
+    return StreamingBound(count, solver, system.kernel, steps_per_call, step_s, copy_s,
+                          STEP_BYTES_PER_PARTICLE * count / copy_s, copy_s / step_s)
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ from refsim.studies.particles import (
     measure_particle_work_precision,
     measure_resting_jitter,
     measure_step_memory,
+    measure_streaming_bound,
     observed_orders,
     particle_test_config,
     wall_reference,
@@ -229,3 +230,16 @@ def test_memory_is_stable_over_ten_thousand_steps(solver):
     print(short, long, sep="\n")
     assert long.retained_bytes <= FIXED_OVERHEAD
     assert long.transient_bytes <= short.transient_bytes + FIXED_OVERHEAD
+
+
+@pytest.mark.parametrize("steps_per_call", [1, 3])
+@pytest.mark.parametrize("kernel", ["compiled", "readable"])
+def test_streaming_bound_is_the_copy_time_over_the_step_time(kernel, steps_per_call):
+    # the numbers' relations, not their values (timings differ per machine)
+    b = measure_streaming_bound(2000, "rk4", kernel, rounds=3, steps_per_call=steps_per_call)
+    assert (b.count, b.solver, b.kernel, b.steps_per_call) == \
+        (2000, "rk4", kernel, steps_per_call)
+    assert b.step_s > 0 and b.copy_s > 0
+    assert b.fraction == b.copy_s / b.step_s
+    # the bytes a step must move: the state (48 bytes a particle) in and out
+    assert b.copy_bytes_per_s == 96 * 2000 / b.copy_s
