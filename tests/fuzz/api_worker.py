@@ -315,20 +315,32 @@ class ProbeRunner:
             self._process.kill()
         code = self._process.wait()
         stack = self._stack_since(offset)
-        self._err.close()
+        self._close_pipes()
         self._start()
         return ProbeOutcome({}, signal=None if timed_out else -code, timed_out=timed_out,
                             stack=stack, seconds=time.monotonic() - start)
 
+    def _close_pipes(self) -> None:
+        """Close this side of the worker's pipes and its log (a replaced
+        worker's would otherwise stay open until the interpreter exits)."""
+        for stream in (self._process.stdin, self._process.stdout, self._err):
+            try:
+                stream.close()
+            except OSError:                   # a pipe whose reader is gone
+                pass
+
     def close(self) -> None:
         if self._process is not None and self._process.poll() is None:
-            self._process.stdin.close()
+            try:
+                self._process.stdin.close()
+            except OSError:
+                pass
             try:
                 self._process.wait(10)
             except subprocess.TimeoutExpired:
                 self._process.kill()
                 self._process.wait()
-        self._err.close()
+        self._close_pipes()
         shutil.rmtree(self._base, ignore_errors=True)
 
 

@@ -285,9 +285,13 @@ class ForkServer:
 
     def _start(self) -> None:
         err = open(self.log, "ab") if self.log else subprocess.DEVNULL
-        self._process = subprocess.Popen(
-            [self.python, "-m", "tests.fuzz.zygote"], cwd=ROOT, env=ENV,
-            stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err)
+        try:
+            self._process = subprocess.Popen(
+                [self.python, "-m", "tests.fuzz.zygote"], cwd=ROOT, env=ENV,
+                stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err)
+        finally:
+            if err is not subprocess.DEVNULL:
+                err.close()                   # the server holds its own copy
         self._buffer = b""
         ready = self._message(600.0)
         if ready is None or "ready" not in ready:
@@ -310,6 +314,7 @@ class ForkServer:
 
     def run(self, command: Command) -> Outcome:
         if self._process.poll() is not None:
+            self._close_pipes()
             self._start()
         start = time.monotonic()
         request = {"argv": list(command.argv), "cwd": str(command.cwd),
@@ -327,11 +332,25 @@ class ForkServer:
         return Outcome(code, timed_out, interrupted, _read(command.stdout),
                        _read(command.stderr), time.monotonic() - start)
 
+    def _close_pipes(self) -> None:
+        """Close this side of the server's pipes (a replaced server's would
+        otherwise stay open until the interpreter exits)."""
+        for stream in (self._process.stdin, self._process.stdout):
+            try:
+                stream.close()
+            except OSError:                   # a pipe whose reader is gone
+                pass
+
     def close(self) -> None:
         if self._process is not None and self._process.poll() is None:
-            self._process.stdin.close()
+            try:
+                self._process.stdin.close()
+            except OSError:
+                pass
             try:
                 self._process.wait(10)
             except subprocess.TimeoutExpired:
                 self._process.kill()
                 self._process.wait()
+        if self._process is not None:
+            self._close_pipes()
