@@ -180,6 +180,7 @@ def _run_particles(scene, out: Path, every: int | None) -> int:
             frames = run_particles(config, n_steps, every, sink=sink)
         except DivergenceError as exc:
             partial = exc.partial
+            assert partial is not None, "run_particles keeps the frames before a divergence"
             save(partial, f"diverged at step {exc.step}, t = {exc.time:.6g}")
             raise DivergenceError(
                 f"particle state is not finite; wrote the {len(partial.t)} frames before it "

@@ -26,6 +26,7 @@ for Python's conventions (``except ValueError``) catches them too:
 from __future__ import annotations
 
 from os import PathLike
+from typing import Any
 
 
 class RefsimError(Exception):
@@ -136,7 +137,7 @@ class DivergenceError(RefsimError):
     """
 
     def __init__(self, message: str, step: int, time: float, body: str | None = None,
-                 partial=None):
+                 partial: Any = None):
         self.message = message
         self.step = step
         self.time = time

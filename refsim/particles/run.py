@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 from refsim.errors import DivergenceError
 
@@ -57,10 +58,11 @@ class ParticleFrames:
         (frames, N, 3) float64.
     """
 
-    step: object
-    t: object
-    position: object
-    velocity: object
+    # numpy arrays or SpilledArrays: both index and have a length
+    step: Any
+    t: Any
+    position: Any
+    velocity: Any
 
 
 def run_particles(config, n_steps: int, every: int, *, sink=None) -> ParticleFrames:

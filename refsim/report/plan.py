@@ -482,7 +482,8 @@ CHOICE_COUNT = 50
 CHOICE_MAX_STEPS = 8 * 2**11
 
 #: |R(z)| is drawn on this grid of z = h lambda.
-STABILITY_GRID = {"re": (-5.5, 1.5), "im": (-3.5, 3.5), "n": 281}
+STABILITY_GRID_RE, STABILITY_GRID_IM, STABILITY_GRID_N = (-5.5, 1.5), (-3.5, 3.5), 281
+STABILITY_GRID = {"re": STABILITY_GRID_RE, "im": STABILITY_GRID_IM, "n": STABILITY_GRID_N}
 
 
 def _failing_conditions(solver) -> list[str]:
@@ -544,8 +545,8 @@ def _solvers_stability(run: Run):
     regions = []
     x = y = None
     for names in groups.values():
-        x, y, absR = stability_grid(SOLVERS[names[0]], re=STABILITY_GRID["re"],
-                                    im=STABILITY_GRID["im"], n=STABILITY_GRID["n"])
+        x, y, absR = stability_grid(SOLVERS[names[0]], re=STABILITY_GRID_RE,
+                                    im=STABILITY_GRID_IM, n=STABILITY_GRID_N)
         regions.append((" = ".join(names) + (" (same R)" if len(names) > 1 else ""), absR))
     return StabilityRun(limits, polynomials, STABILITY_GRID, x, y, regions)
 

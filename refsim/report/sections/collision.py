@@ -365,11 +365,11 @@ def _divergences(triangle_rows, agreement) -> list[Divergence]:
                 "; ".join(f"{count} of {n} {label}" for label, n, count in found)
                 + f" ({KIND_MEANING[kind]})", "collision-fcl-pairs"))
     for kind in measure_levels.BODY_DISAGREEMENT_KINDS:
-        found = [b for b in agreement.bodies if b.counts[kind]]
-        if found:
+        bodies = [b for b in agreement.bodies if b.counts[kind]]
+        if bodies:
             entries.append(Divergence(
                 f"body-level answers: {kind}", f"oracle disagreement: {kind}",
-                "; ".join(f"{b.oracle} ({b.source}): {b.counts[kind]} of {b.n}" for b in found)
+                "; ".join(f"{b.oracle} ({b.source}): {b.counts[kind]} of {b.n}" for b in bodies)
                 + f" ({KIND_MEANING[kind]})", "collision-body-oracles"))
     return entries
 
