@@ -122,6 +122,8 @@ def test_check_count_refuses_what_is_not_a_count(value, error):
     (lambda: refsim.load_scene("bounce.toml\x00"), refsim.SceneError,
      "bounce.toml\x00: a file name cannot contain a NUL byte"),
     (lambda: refsim.load_model("cu\x00be.ac"), refsim.ModelError, "cannot contain a NUL byte"),
+    (lambda: refsim.simulate(refsim.load_scene("bounce.toml"), duration="0.1"),
+     ArgumentTypeError, "duration must be a real number, got str '0.1'"),
     (lambda: refsim.aabb_linear(CUBE, (np.eye(3), ["0", 0, 0]), kernel="readable"),
      ArgumentTypeError, "pose translation must be an array of real numbers, got list"),
     (lambda: refsim.bodies_collide(CUBE, POSE, CUBE, (np.eye(3).astype(str), np.zeros(3))),

@@ -100,23 +100,29 @@ _WILD = _st.floats(min_value=-1e50, max_value=1e50, allow_nan=False, allow_infin
 
 @_st.composite
 def random_two_body_scenes(draw):
-    """Two small bodies anywhere in a 3 m cube with wild velocities and spins
-    (up to 1e50, the most a scene allows), any solver, models and step; for
-    "no silent non-finite"."""
+    """Two small bodies anywhere in a 3 m cube with wild spins (up to 1e50,
+    the most a scene allows), velocities up to the most a scene allows (a
+    step covers at most half the cube), drags up to 1e50 (the most a scene
+    allows: quadratic drag then overflows within a step), any solver,
+    models and step; for "no silent non-finite"."""
     from refsim.scenes.schema import RESPONSE_MODELS, ROTATION_MODELS, SOLVER_NAMES
+
+    half_size, step = 3.0, draw(_st.sampled_from([1e-3, 1e-2, 0.1]))
+    fastest = half_size / step / 3.0 ** 0.5 * (1.0 - 1e-12)     # per component
+    velocity = _st.floats(min_value=-fastest, max_value=fastest)
 
     def body(name):
         return {"name": name, "model": draw(_st.sampled_from(["cube.ac", "tetrahedron.ac"])),
                 "position": [draw(_st.floats(min_value=-2.0, max_value=2.0))
                              for _ in range(3)],
-                "velocity": [draw(_WILD) for _ in range(3)],
+                "velocity": [draw(velocity) for _ in range(3)],
                 "angular_velocity": [draw(_WILD) for _ in range(3)]}
 
     return {
-        "world": {"half_size": 3.0, "drag": draw(_st.sampled_from([0.0, 0.5, 1e3])),
+        "world": {"half_size": half_size,
+                  "drag": draw(_st.sampled_from([0.0, 0.5, 1e3, 1e50])),
                   "drag_model": draw(_st.sampled_from(["linear", "quadratic"]))},
-        "integration": {"solver": draw(_st.sampled_from(SOLVER_NAMES)),
-                        "step": draw(_st.sampled_from([1e-3, 1e-2, 0.1])),
+        "integration": {"solver": draw(_st.sampled_from(SOLVER_NAMES)), "step": step,
                         "duration": 1.0},
         "collision": {"level": draw(_st.sampled_from(["none", "aabb"]))},
         "dynamics": {"rotation": draw(_st.sampled_from(ROTATION_MODELS)),

@@ -89,6 +89,7 @@ from refsim.errors import (
     DivergenceError,
     StateError,
     check_count,
+    check_number,
     check_option,
 )
 from refsim.frames import FrameSink, MemorySink, frame_count
@@ -700,6 +701,7 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
         raise ArgumentTypeError(f"scene must be a refsim.Scene (refsim.load_scene(path)), "
                                 f"got {type(scene).__name__}")
     if duration is not None:
+        duration = check_number("duration", duration)
         whole_steps(duration, scene.integration.step)          # refuse before any work
         scene = replace(scene, integration=replace(scene.integration, duration=duration))
     n_steps = scene.integration.n_steps

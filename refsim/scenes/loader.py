@@ -179,6 +179,7 @@ def scene_from_dict(data: dict, path: Path | None = None) -> Scene:
         raise SceneError("a scene needs at least one [[body]] or a [particles] table",
                          path, "body")
 
+    _check_speeds(bodies, particles, configs["world"].half_size, integration.step, path)
     meshes = _load_meshes(bodies, path)
     for i, body in enumerate(bodies):
         _check_body(body, meshes[body.model], configs["world"], path, f"body[{i}]")
@@ -310,6 +311,26 @@ def _load_meshes(bodies, scene_path) -> dict:
             except ModelError as exc:           # the model's own error stays the cause
                 raise SceneError(str(exc), scene_path, f"body[{i}].model") from exc
     return meshes
+
+
+def _check_speeds(bodies, particles, half_size: float, step: float, path) -> None:
+    """No body or particle starts fast enough to cross half the world cube in
+    one step: the wall stage would then put it back at a wall it never
+    reached (a step would skip the walls between), which is no simulation of
+    the scene. Refused at the key, with the distance a step covers."""
+    for i, body in enumerate(bodies):
+        speed = math.hypot(*body.velocity)
+        if speed * step > half_size:
+            raise SceneError(f"speed {speed:.6g} m/s covers {speed * step:.6g} m in one step "
+                             f"of {step:g} s, more than half the world cube ({half_size:g} "
+                             "m); lower the speed or the step", path, f"body[{i}].velocity")
+    if particles is None or not particles.walls:
+        return
+    speed, step, half_size = particles.speed_max, particles.step, particles.half_size
+    if speed * step > half_size:
+        raise SceneError(f"speed {speed:.6g} m/s covers {speed * step:.6g} m in one step of "
+                         f"{step:g} s, more than half the world cube ({half_size:g} m); lower "
+                         "the speed or the step", path, "particles.speed_max")
 
 
 def _check_body(body: BodyConfig, mesh, world, path, where: str) -> None:

@@ -273,3 +273,17 @@ def test_particles_take_the_worlds_wall_speed(tmp_path):
     text = '[world]\nwall_speed = "seed"\n[particles]\ncount = 5\n'
     assert load_scene(write(tmp_path, text)).particles.wall_speed == "seed"
     assert load_scene(write(tmp_path, "[particles]\ncount = 5\n")).particles.wall_speed == "wall"
+
+
+def test_a_body_or_particles_crossing_half_the_cube_in_one_step_are_refused(tmp_path):
+    # H = 5 m, h = 1e-3 s: 5000 m/s covers exactly half the cube and is kept;
+    # faster would be put back at walls it never reached
+    fast = '[integration]\nstep = 0.001\n[[body]]\nmodel = "cube.ac"\nvelocity = [{}, 0, 0]\n'
+    assert load_scene(write(tmp_path, fast.format(5000.0))).bodies[0].velocity[0] == 5000.0
+    assert_scene_error(tmp_path, fast.format(3.0e4), "body[0].velocity",
+                       "speed 30000 m/s covers 30 m in one step of 0.001 s, more than half "
+                       "the world cube (5 m)")
+    particles = "[integration]\nstep = 0.01\n[particles]\ncount = 10\nspeed_max = {}\n"
+    assert load_scene(write(tmp_path, particles.format(500.0))).particles.speed_max == 500.0
+    assert_scene_error(tmp_path, particles.format(501.0), "particles.speed_max",
+                       "covers 5.01 m in one step of 0.01 s")
