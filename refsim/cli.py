@@ -3,7 +3,8 @@
     refsim info MODEL                  facts about a model file
     refsim run SCENE [-o OUT.npz] [--every K]
                                        simulate a scene (bodies or particles), write frames
-    refsim report [--quick] [-o DIR]   write the HTML accuracy report
+    refsim report [--quick] [-o DIR] [--workers N]
+                                       write the HTML accuracy report
     refsim study NAME [--quick] [--seed S]
                                        run one of the report's studies, print its
                                        records and the verdicts they back
@@ -195,11 +196,13 @@ def _run_particles(scene, out: Path, every: int | None) -> int:
 
 
 def _report(args) -> int:
+    from refsim.errors import check_count
     from refsim.report.build import build_report
 
     out = Path(args.output)
+    workers = None if args.workers is None else check_count("--workers", args.workers, 1)
     try:
-        page = build_report(out, quick=args.quick)
+        page = build_report(out, quick=args.quick, workers=workers)
     except OSError as exc:
         raise RefsimError(f"{out}: cannot write the report: {exc.strerror or exc}") from exc
     print(f"wrote {page}")
@@ -230,11 +233,18 @@ def _replay(args) -> int:
 def _study(args) -> int:
     """Run one entry of the report's plan and print its records, then the
     verdicts on the seed claims it backs (each with its facts)."""
+    from refsim.errors import check_count
     from refsim.oracles import OracleUnavailable
     from refsim.report.plan import STUDIES, Run
     from refsim.report.text import TIMING_NOTE, format_claim, format_records
 
-    run = Run(quick=args.quick, seed=args.seed,
+    workers = None if args.workers is None else check_count("--workers", args.workers, 1)
+    out = None
+    if args.output is not None:
+        from refsim.conformance.matrix import make_directory
+
+        out = make_directory(args.output)
+    run = Run(quick=args.quick, seed=args.seed, out_dir=out, workers=workers,
               announce=lambda text: print(f"refsim: measuring {text}", file=sys.stderr))
     try:
         records = run.get(args.name)
@@ -268,6 +278,12 @@ def _add_study_command(commands) -> None:
                        help="the quick report's sizes (fewer sizes and repeats)")
     study.add_argument("--seed", type=int, default=REPORT_SEED, metavar="S",
                        help=f"seed of the random choices (default {REPORT_SEED}, the report's)")
+    study.add_argument("-o", "--output", metavar="DIR",
+                       help="where studies that write pages put them (the conformance "
+                            "pages, the replays); created if missing (default: none written)")
+    study.add_argument("--workers", type=int, metavar="N",
+                       help="run the studies that go through refsim.sweep (conformance-matrix, "
+                            "replays, advisor) on N local processes")
     study.set_defaults(run=_study)
 
 
@@ -563,6 +579,10 @@ def build_parser() -> argparse.ArgumentParser:
                         help="fewer sizes and repeats (under a minute)")
     report.add_argument("-o", "--output", default="reports/out", metavar="DIR",
                         help="output directory (default: reports/out)")
+    report.add_argument("--workers", type=int, metavar="N",
+                        help="run the report's sweeps (the conformance matrix, the replays, "
+                             "the advisor) on N local processes; the results are the same "
+                             "(default: in this process)")
     report.set_defaults(run=_report)
     _add_study_command(commands)
     _add_viewer_commands(commands)

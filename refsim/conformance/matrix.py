@@ -73,6 +73,14 @@ class Matrix:
         """No check of any engine failed (expected failures aside)."""
         return not any(c.status == "failed" for c in self.cells.values())
 
+    def status_counts(self, engine: str) -> dict:
+        """How many of ``engine``'s checks ended in each status
+        (:data:`refsim.conformance.results.STATUSES`, those that occur, in that order)."""
+        from refsim.conformance.results import STATUSES
+
+        found = [c.status for (_, e), c in self.cells.items() if e == engine]
+        return {status: found.count(status) for status in STATUSES if status in found}
+
     def to_dict(self) -> dict:
         return {"refsim": self.refsim, "seed": self.seed, "cases": self.cases,
                 "engines": list(self.engines), "checks": list(self.checks),
@@ -174,8 +182,42 @@ def load_shipped(name: str, spec: str):
         return None, f"{name}: {exc}"
 
 
+#: ``engine_task``'s ``expected`` that means "the engine's own bundled file".
+SHIPPED_EXPECTED = "shipped"
+
+
+def engine_task(*, seed: int, name: str, spec: str, cases: int, case_seed: int,
+                only: str | None = None, expected: str | None = SHIPPED_EXPECTED) -> dict:
+    """One engine of the matrix as a sweep task (:mod:`refsim.sweep`): load
+    ``spec``, build the case sets it needs (seeded by ``case_seed``, so that
+    every engine meets the same cases; the sweep's ``seed`` is not used) and
+    run its checks.
+
+    ``expected``: a declarations file, None for none, or
+    :data:`SHIPPED_EXPECTED` for the engine's bundled file. Returns plain
+    data: ``{"result": ConformanceResult.to_dict()}``, ``{"unavailable":
+    reason}`` when the engine cannot be loaded, or ``{"absent": capability}``
+    when it lacks ``only``.
+    """
+    from refsim.conformance.expected import shipped_expected_failures
+    from refsim.conformance.runner import check_engine
+    from refsim.engines import capabilities
+
+    engine, reason = load_shipped(name, spec)
+    if engine is None:
+        return {"unavailable": reason}
+    if only is not None and only not in capabilities(engine):
+        return {"absent": only}
+    file = shipped_expected_failures(engine.name) if expected == SHIPPED_EXPECTED else expected
+    result = check_engine(engine, cases=cases, seed=case_seed, only=only,
+                          expected_failures=file, spec=spec)
+    return {"result": result.to_dict()}
+
+
 def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=None,
-               only=None, expected: dict | None = None) -> tuple[Matrix, dict]:
+               only=None, expected: dict | None = None, backend: str | None = None,
+               workers: int | None = None, scheduler: str | None = None,
+               progress: bool = False) -> tuple[Matrix, dict]:
     """Run every engine of ``specs`` (name -> ``module:factory``; default the
     shipped six) with shared case sets, and write the pages under ``out_dir``
     when given (module docstring).
@@ -186,15 +228,27 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
     engine that cannot be loaded is left out and named in
     ``Matrix.unavailable``.
 
+    ``backend`` (with ``workers``, ``scheduler`` and ``progress``, as
+    :func:`refsim.sweep.run_sweep` takes them): run each engine as a sweep
+    task (:func:`engine_task`), in this process ("inprocess"), on local
+    processes or on a Dask cluster. Each task builds its own case sets from
+    the same seed, so the cells are those of the shared run, on every
+    backend; only the timings differ.
+
     Returns the matrix and the results by engine name.
     """
+    from refsim.conformance.shipped import SHIPPED_ENGINES
+
+    specs = dict(SHIPPED_ENGINES if specs is None else specs)
+    if backend is not None:
+        return _run_matrix_sweep(specs, cases=cases, seed=seed, out_dir=out_dir, only=only,
+                                 expected=expected, backend=backend, workers=workers,
+                                 scheduler=scheduler, progress=progress)
     from refsim.conformance.expected import shipped_expected_failures
     from refsim.conformance.registry import build_cases
     from refsim.conformance.runner import check_engine, needed_case_sets
-    from refsim.conformance.shipped import SHIPPED_ENGINES
     from refsim.engines import capabilities
 
-    specs = dict(SHIPPED_ENGINES if specs is None else specs)
     engines, unavailable = {}, {}
     for name, spec in specs.items():
         engine, reason = load_shipped(name, spec)
@@ -225,6 +279,11 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
         if out_dir is not None:
             write_engine_pages(result, Path(out_dir) / name)
             pages[result.engine] = f"{name}/index.html"
+    return _finish(results, pages, unavailable, seconds, out_dir), results
+
+
+def _finish(results: dict, pages: dict, unavailable: dict, seconds: dict, out_dir) -> Matrix:
+    """The matrix of ``results``, with its page and JSON written under ``out_dir``."""
     matrix = conformance_matrix(results, pages, unavailable, seconds)
     if out_dir is not None:
         from refsim.conformance.page import matrix_page
@@ -233,4 +292,39 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
         make_directory(out_dir)
         write_text_atomic(Path(out_dir) / "matrix.json", matrix.to_json())
         write_text_atomic(Path(out_dir) / "index.html", matrix_page(matrix))
-    return matrix, results
+    return matrix
+
+
+def _run_matrix_sweep(specs: dict, *, cases: int, seed: int, out_dir, only, expected,
+                      backend: str, workers, scheduler, progress: bool) -> tuple[Matrix, dict]:
+    """:func:`run_matrix` with one sweep task per engine (its ``backend``)."""
+    from refsim.conformance.results import ConformanceResult
+    from refsim.errors import OptionError, SweepError
+    from refsim.sweep import Task, run_sweep
+
+    tasks = [Task(f"conform-{name}", engine_task,
+                  {"name": name, "spec": spec, "cases": cases, "case_seed": seed, "only": only,
+                   "expected": (SHIPPED_EXPECTED if expected is None
+                                else None if expected.get(name) is None
+                                else str(expected[name]))})
+             for name, spec in specs.items()]
+    sweep = run_sweep(tasks, backend=backend, workers=workers, scheduler=scheduler,
+                      progress=progress, seed=seed)
+    if sweep.failures:
+        raise SweepError("conformance run failed: " + "; ".join(
+            f"{key}: {why}" for key, why in sweep.failures.items()))
+    results, pages, unavailable, seconds = {}, {}, {}, {}
+    for name, answer in zip(specs, sweep.values, strict=True):
+        if "unavailable" in answer:
+            unavailable[name] = answer["unavailable"]
+        elif "result" in answer:
+            result = ConformanceResult.from_dict(answer["result"])
+            results[name] = result
+            seconds[name] = result.seconds
+            if out_dir is not None:
+                write_engine_pages(result, Path(out_dir) / name)
+                pages[result.engine] = f"{name}/index.html"
+    if not results:
+        raise OptionError("no engine to run: " + ("; ".join(unavailable.values())
+                                                  or f"none has the capability {only!r}"))
+    return _finish(results, pages, unavailable, seconds, out_dir), results

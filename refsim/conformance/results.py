@@ -123,6 +123,11 @@ class CheckResult:
     def to_dict(self) -> dict:
         return asdict(self)
 
+    @classmethod
+    def from_dict(cls, data: dict) -> CheckResult:
+        """The result :meth:`to_dict` gave (after a JSON round trip)."""
+        return cls(**data)
+
 
 def tally(capability: str, check: str, outcomes, *, examples=(), measured=None,
           seconds: float = 0.0) -> CheckResult:
@@ -197,6 +202,16 @@ class ConformanceResult:
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=1, sort_keys=False, default=_jsonable) + "\n"
+
+    @classmethod
+    def from_dict(cls, data: dict) -> ConformanceResult:
+        """The result :meth:`to_dict` gave, after a JSON round trip (a sweep
+        task's answer, :func:`refsim.conformance.matrix.run_matrix`): tuples
+        come back from lists; examples stay plain JSON data."""
+        data = dict(data)
+        data["capabilities"] = tuple(data["capabilities"])
+        data["checks"] = tuple(CheckResult.from_dict(c) for c in data["checks"])
+        return cls(**data)
 
 
 def _jsonable(value):

@@ -32,7 +32,7 @@ from pathlib import Path
 from refsim.bundled import templates_dir
 from refsim.claims import CLAIMS, TERMINOLOGY
 from refsim.io import write_text_atomic
-from refsim.report.plan import REPORT_SEED, Run
+from refsim.report.plan import REPORT_SEED, SWEEP_ENTRIES, Run
 from refsim.report.progress import Progress
 from refsim.report.section import Section, to_json
 
@@ -54,6 +54,12 @@ AREAS: tuple[tuple[str, str, str], ...] = (
     ("dynamics", "Rigid-body dynamics",
      "Wall bounces against pybullet and the analytic answer, the seed's rotation model "
      "against the corrected one (C12), body-body interpenetration (C11)."),
+    ("conformance", "Engines side by side: the conformance kit",
+     "The six shipped engines (refsim's seed and corrected models, python-fcl, trimesh, "
+     "pybullet, MuJoCo) through the same checks against exact answers."),
+    ("advisor", "Model no more than a scene needs: the fidelity advisor",
+     "The cheapest solver, step, collision level and box update within TOL of a reference "
+     "run, for each bundled scene, and how the answer moves with TOL."),
 )
 
 # The page's cross-cutting parts: figures and tables (by id prefix) that are
@@ -65,7 +71,7 @@ PARTS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
      "positives against time or work. Timings are medians of repeated runs on a shared "
      "two-core machine; read ratios, not absolute values.",
      ("solvers-wp-", "collision-levels-tradeoff", "collision-speed", "bounds-cost-",
-      "dynamics-error-cost", "dynamics-step-cost")),
+      "dynamics-error-cost", "dynamics-step-cost", "advisor-tolerance")),
     ("stability", "Stability: where each method fails",
      "Predicted limits (from the amplification factor R(z) of each solver, from exact "
      "predicates for the triangle test) next to what the simulations and the oracles "
@@ -90,13 +96,23 @@ class ReportContext:
     run: Run            # the plan's run: every section's records and verdicts
 
 
-def build_report(out_dir: Path, *, quick: bool = False, stream=None) -> Path:
-    """Measure, render and write the report; return the path of index.html."""
+def build_report(out_dir: Path, *, quick: bool = False, stream=None,
+                 workers: int | None = None) -> Path:
+    """Measure, render and write the report; return the path of index.html.
+
+    ``workers``: run the plan's sweep entries (the conformance matrix, the
+    replays, the advisor: :data:`refsim.report.plan.SWEEP_ENTRIES`) on this
+    many local processes, started at once and measured beside the other
+    studies, which run here (:meth:`Run.prefetch`); the results are the
+    same as without workers. The engines' conformance pages and the replays
+    are written into ``out_dir`` beside the page, each whole."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)  # fail before the long work, not after
     sections: list[Section] = []
     with Progress(len(AREAS) + 1, stream=stream) as progress:
-        run = Run(quick=quick, seed=REPORT_SEED, announce=progress.announce)
+        run = Run(quick=quick, seed=REPORT_SEED, announce=progress.announce, out_dir=out_dir,
+                  workers=workers)
+        run.prefetch(SWEEP_ENTRIES)     # with workers: their sweeps run beside the rest
         ctx = ReportContext(quick=quick, seed=REPORT_SEED, progress=progress, run=run)
         for key, title, pending in AREAS:
             progress.announce(title)
@@ -143,6 +159,7 @@ def claim_rows(sections: list[Section]) -> list[dict]:
             "evidence": v.evidence if v else "",
             "command": v.command if v else "",
             "timing": v.timing if v else False,
+            "replays": [r.id for s in sections for r in s.replays if r.claim == claim],
         })
     return rows
 
@@ -187,10 +204,13 @@ def section_json(section: Section, timings: set | None = None) -> dict:
         "results": to_json(section.results, ("sections", section.key, "results"), timings),
         "tables": [{"id": t.id, "title": t.title, "columns": list(t.columns),
                     "rows": [[str(cell) for cell in row] for row in t.rows],
+                    "column_links": list(t.column_links),
                     "timing": t.timing, "part": part_of(t.id)}
                    for t in section.tables],
         "figures": [{"id": f.id, "title": f.title, "part": part_of(f.id)}
                     for f in section.figures],
+        "replays": [{"id": r.id, "title": r.title, "file": r.file, "claim": r.claim,
+                     "missing": r.missing} for r in section.replays],
     }
 
 
@@ -244,7 +264,8 @@ def render(sections: list[Section], environment: dict, *, quick: bool) -> str:
               "groups": [(s, [t for t in s.tables if part_of(t.id) == key],
                           [f for f in s.figures if part_of(f.id) == key]) for s in sections]}
              for key, title, intro, _ in PARTS]
-    return template.render(sections=sections, claims=claim_rows(sections),
+    replays = {r.id: r for s in sections for r in s.replays}
+    return template.render(sections=sections, claims=claim_rows(sections), replays=replays,
                            agreements=agreement_rows(sections), parts=parts,
                            divergences=divergence_rows(sections), part_of=part_of,
                            part_titles={key: title for key, title, _, _ in PARTS},

@@ -18,14 +18,25 @@ An oracle that is not installed raises :class:`refsim.oracles.OracleUnavailable`
 from :meth:`Run.engine`; entries that can do without it ask
 :meth:`Run.optional`, which records why it is missing (:attr:`Run.missing`)
 for the report to say so.
+
+Three entries run through :mod:`refsim.sweep` (:data:`SWEEP_ENTRIES`): the
+shipped engines' conformance matrix, the replays of the viewer's demos and
+the advisor on every bundled scene. A run given ``workers`` sends their
+tasks to that many local processes and starts them at once, beside the
+other entries (:meth:`Run.prefetch`); their records are the same either
+way. A run given ``out_dir`` has the matrix's and the replays' pages
+written there (the report's directory).
 """
 
 from __future__ import annotations
 
 import importlib
 import math
+import threading
 from collections.abc import Callable
+from concurrent.futures import Future
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from refsim.claims.result import ClaimResult
@@ -115,21 +126,66 @@ class Run:
     """
 
     def __init__(self, *, quick: bool = False, seed: int = REPORT_SEED,
-                 announce: Callable[[str], None] | None = None):
+                 announce: Callable[[str], None] | None = None, out_dir=None,
+                 workers: int | None = None):
         self.quick = quick
         self.seed = seed
+        #: Where entries that write pages put them (the report's directory);
+        #: None: such entries write nothing and say so.
+        self.out_dir = None if out_dir is None else Path(out_dir)
+        #: Local processes for the entries that run through refsim.sweep
+        #: (None: in this process); their records are the same either way.
+        self.workers = workers
         self.missing: dict[str, str] = {}     # engine name -> why it is unavailable
         self._announce = announce or (lambda text: None)
         self._records: dict[str, Any] = {}
         self._engines: dict[str, Any] = {}
         self._claims: dict[str, ClaimResult] = {}
+        self._pending: dict[str, Future] = {}    # entries measured beside this thread
 
     def size(self, quick, full):
         """``quick`` in a quick run, ``full`` otherwise."""
         return quick if self.quick else full
 
+    def sweep_options(self) -> dict:
+        """``backend`` and ``workers`` for :func:`refsim.sweep.run_sweep`:
+        local processes when the run was given workers, else this process."""
+        if self.workers is None:
+            return {"backend": "inprocess", "workers": None}
+        return {"backend": "processes", "workers": self.workers}
+
+    def prefetch(self, names) -> None:
+        """Start measuring the :data:`SWEEP_ENTRIES` among ``names`` now, one
+        after the other in a background thread, so that their sweeps run on
+        the run's workers while this thread measures the other entries;
+        :meth:`get` waits for them. Only with workers: the thread spends its
+        time waiting for the workers' answers, and the records are the same
+        as measured in order. (An entry measured here must touch nothing of
+        the run but its settings: these make no engine and read no other
+        entry.)"""
+        wanted = [n for n in names if n in SWEEP_ENTRIES and n not in self._records
+                  and n not in self._pending]
+        if self.workers is None or not wanted:
+            return
+        futures = {name: Future() for name in wanted}
+        self._pending.update(futures)
+
+        def measure() -> None:
+            for name, future in futures.items():
+                if not future.set_running_or_notify_cancel():
+                    continue
+                try:
+                    future.set_result(STUDIES[name].measure(self))
+                except BaseException as exc:  # noqa: BLE001 - handed to get() in the main thread
+                    future.set_exception(exc)
+
+        # a daemon thread: Ctrl-C in the main thread is not held up by it
+        threading.Thread(target=measure, name="refsim-report-sweeps", daemon=True).start()
+
     def get(self, name: str):
         """The records of entry ``name`` (measured on first use)."""
+        if name not in self._records and name in self._pending:
+            self._records[name] = self._pending.pop(name).result()
         if name not in self._records:
             study = STUDIES[name]
             self._announce(study.title)
@@ -800,6 +856,186 @@ def _sweep_speed(run: Run):
     return sweep.measure_sweep_speed()
 
 
+# -- engines side by side (the conformance kit) -------------------------------------------
+
+#: Cases in each generated conformance set (triangle pairs, mesh poses,
+#: boxes): quick, full (the full one is ``refsim conform``'s default). The
+#: rigid-body scenes and the ODE problems are fixed sets, the same in both.
+MATRIX_CASES = (20, 200)
+
+#: Where the engines' conformance pages go, inside the report's directory.
+MATRIX_FOLDER = "conformance"
+
+
+@dataclass(frozen=True)
+class MatrixRun:
+    """The shipped engines through the conformance kit, side by side.
+
+    ``matrix``: :class:`refsim.conformance.matrix.Matrix` (its ``pages``
+    relative to ``folder``); ``folder``: the pages' folder relative to the
+    report's directory ("" when none was written); ``command``: the command
+    that reproduces the matrix and its pages.
+    """
+
+    matrix: Any
+    cases: int
+    folder: str
+    command: str
+
+
+def _conformance_matrix(run: Run):
+    from refsim.conformance.matrix import run_matrix
+
+    cases = run.size(*MATRIX_CASES)
+    out = None if run.out_dir is None else run.out_dir / MATRIX_FOLDER
+    matrix, _ = run_matrix(cases=cases, seed=run.seed, out_dir=out, **run.sweep_options())
+    return MatrixRun(matrix, cases, "" if out is None else MATRIX_FOLDER,
+                     f"refsim conform --all --cases {cases} --seed {run.seed} -o DIR")
+
+
+# -- replays (the viewer's demos) -------------------------------------------------------------
+
+#: Where the replays go, inside the report's directory.
+REPLAY_FOLDER = "replays"
+
+#: Each replay's size budget (bytes): viser's client (~0.8 MB) and a few
+#: hundred frames, so that the report's directory stays a few MB.
+REPORT_REPLAY_BYTES = 2_000_000
+
+#: The replays the report shows: (name of :data:`refsim.report.tasks.DEMO_ENGINES`,
+#: the seed claim it illustrates or "", its title).
+REPLAYS = (
+    ("c11-interpenetration", "C11",
+     "C11: slow contact, the seed's velocity exchange beside the corrected impulse"),
+    ("c12-spin", "C12", "C12: the spinning cube, the seed's rotation beside the corrected one"),
+    ("wall-bounce-pybullet", "", "A wall bounce: refsim beside pybullet"),
+    ("wall-bounce-mujoco", "", "A wall bounce: refsim beside MuJoCo"),
+)
+
+
+@dataclass(frozen=True)
+class ReplayRecord:
+    """One replay page: ``status`` "written" (``file`` relative to the
+    report's directory, its size and frames), "unavailable" (``reason``: the
+    viewer extra or the engine is missing) or "not written" (no output
+    directory)."""
+
+    name: str
+    claim: str
+    title: str
+    status: str
+    file: str = ""
+    reason: str = ""
+    bytes: int = 0
+    frames: int = 0
+    timeline_frames: int = 0
+    stride: int = 0
+    runs: tuple = ()
+
+
+def _replays(run: Run):
+    from refsim.conformance.matrix import make_directory
+    from refsim.errors import SweepError
+    from refsim.report.tasks import write_replay_demo
+    from refsim.sweep import Task, run_sweep
+
+    if run.out_dir is None:
+        return [ReplayRecord(name, claim, title, "not written",
+                             reason="no output directory (refsim report writes them into its own)")
+                for name, claim, title in REPLAYS]
+    folder = make_directory(run.out_dir / REPLAY_FOLDER)
+    tasks = [Task(f"replay-{name}", write_replay_demo,
+                  {"name": name, "path": str(folder / f"{name}.html"),
+                   "max_bytes": REPORT_REPLAY_BYTES}) for name, _, _ in REPLAYS]
+    sweep = run_sweep(tasks, progress=False, seed=run.seed, **run.sweep_options())
+    records = []
+    for (name, claim, title), result in zip(REPLAYS, sweep.results, strict=True):
+        if result.status != "done":
+            raise SweepError(f"replay {name}: {result.error}")
+        answer = result.value
+        if "unavailable" in answer:
+            records.append(ReplayRecord(name, claim, title, "unavailable",
+                                        reason=answer["unavailable"]))
+            continue
+        w = answer["written"]
+        records.append(ReplayRecord(name, claim, title, "written",
+                                    file=f"{REPLAY_FOLDER}/{w['file']}", bytes=w["bytes"],
+                                    frames=w["frames"], timeline_frames=w["timeline_frames"],
+                                    stride=w["stride"], runs=tuple(w["runs"])))
+    return records
+
+
+# -- the fidelity advisor ---------------------------------------------------------------------
+
+#: The advisor's tolerances (m) and simulated duration (s; None: each
+#: scene's own), quick and full. The quick report simulates 1 s of each
+#: scene (its first impacts) and times each run once.
+ADVISOR_TOLERANCES = ((1e-2, 1e-3), (1e-2, 3e-3, 1e-3))
+ADVISOR_DURATION = (1.0, None)
+ADVISOR_REPEATS = (1, 3)
+
+#: Bundled scenes the quick report does not advise, and why (the full report
+#: advises every scene): three bodies in contact need the finest steps at
+#: 1 mm, the costliest advice by far (minutes, where the others take seconds).
+ADVISOR_QUICK_SKIP = {"mixed.toml": "three bodies in contact, the costliest advice by far; "
+                                    "the full report advises it"}
+
+
+@dataclass(frozen=True)
+class AdvisedScene:
+    """The advisor on one bundled scene: ``advice``, one
+    :meth:`refsim.studies.advisor.Advice.as_dict` per tolerance; or
+    ``refused``, the advisor's reason for not tuning the scene; or
+    ``skipped``, why this run did not ask (:data:`ADVISOR_QUICK_SKIP`)."""
+
+    scene: str
+    advice: tuple = ()
+    refused: str = ""
+    skipped: str = ""
+
+
+@dataclass(frozen=True)
+class AdvisorRun:
+    scenes: tuple               # AdvisedScene, one per bundled scene, by name
+    tolerances: tuple           # m
+    duration: float | None      # s simulated (None: each scene's own)
+    repeats: int                # wall-time repeats of each candidate run
+
+
+def _advisor(run: Run):
+    import tempfile
+
+    from refsim.bundled import bundled_scenes
+    from refsim.errors import SweepError
+    from refsim.report.tasks import advise_scene
+    from refsim.sweep import Task, run_sweep
+
+    tolerances = run.size(*ADVISOR_TOLERANCES)
+    duration = run.size(*ADVISOR_DURATION)
+    repeats = run.size(*ADVISOR_REPEATS)
+    every = [path.name for path in bundled_scenes()]
+    skipped = ADVISOR_QUICK_SKIP if run.quick else {}
+    names = [name for name in every if name not in skipped]
+    with tempfile.TemporaryDirectory(prefix="refsim-advise-") as store:
+        # each scene's runs are kept in a store of its own, which its
+        # tolerances share (a run common to two tolerances is made once)
+        tasks = [Task(f"advise-{name}", advise_scene,
+                      {"scene": name, "tolerances": list(tolerances), "duration": duration,
+                       "repeats": repeats, "store": str(Path(store) / Path(name).stem)})
+                 for name in names]
+        sweep = run_sweep(tasks, progress=False, seed=run.seed, **run.sweep_options())
+    answers = {}
+    for name, result in zip(names, sweep.results, strict=True):
+        if result.status != "done":
+            raise SweepError(f"advise {name}: {result.error}")
+        answers[name] = result.value
+    scenes = tuple(AdvisedScene(name, skipped=skipped[name]) if name in skipped
+                   else AdvisedScene(name, tuple(answers[name].get("advice", ())),
+                                     answers[name].get("refused", ""))
+                   for name in every)
+    return AdvisorRun(scenes, tuple(tolerances), duration, repeats)
+
+
 # -- the plan --------------------------------------------------------------------------------
 
 
@@ -884,12 +1120,20 @@ def _entries() -> dict[str, Study]:
         Study("dynamics-rotation-energy", "dynamics: energy of the spinning cube",
               _dynamics_rotation_energy, in_report=False),
         Study("sweep-speed", "sweep: speed of each backend", _sweep_speed, in_report=False),
+        Study("conformance-matrix", "conformance: the shipped engines side by side",
+              _conformance_matrix),
+        Study("replays", "replays: C11, C12 and wall bounces", _replays),
+        Study("advisor", "advisor: every bundled scene at each tolerance", _advisor),
     )
     return {e.name: e for e in entries}
 
 
 #: Every named study run, by name.
 STUDIES: dict[str, Study] = _entries()
+
+#: The entries that run through refsim.sweep (on the run's workers, when it
+#: has them): measured beside the others by :meth:`Run.prefetch`.
+SWEEP_ENTRIES = ("replays", "conformance-matrix", "advisor")   # in the order the page needs them
 
 #: The entry that backs each seed claim.
 CLAIM_STUDY: dict[str, str] = {claim: name for name, study in STUDIES.items()

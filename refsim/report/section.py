@@ -50,6 +50,22 @@ class Table:
     rows: tuple[tuple[Any, ...], ...]
     caption: str = ""
     timing: bool = False  # some cells are timings (they vary run to run)
+    # a link per column heading (a path relative to the page, "" for none)
+    column_links: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Replay:
+    """A replay page written beside the report (S12), embedded where it
+    illustrates a claim or a measurement, or the reason it is not there."""
+
+    id: str
+    title: str
+    file: str           # path relative to the report's page ("" when not written)
+    claim: str = ""     # the seed claim it illustrates ("C12"), or ""
+    caption: str = ""
+    missing: str = ""   # why it was not written (e.g. the viewer extra is not installed)
+    after: str = ""     # id of the section's table or figure it is shown after ("": at the end)
 
 
 @dataclass(frozen=True)
@@ -98,6 +114,7 @@ class Section:
     verdicts: list[Verdict] = field(default_factory=list)
     agreements: list[Agreement] = field(default_factory=list)
     divergences: list[Divergence] = field(default_factory=list)
+    replays: list[Replay] = field(default_factory=list)
     results: dict[str, Any] = field(default_factory=dict)
 
 

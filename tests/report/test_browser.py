@@ -79,7 +79,7 @@ def test_no_broken_images(opened):
 def test_every_chart_is_drawn_with_a_size(opened):
     browser, _, _ = opened
     sizes = browser.execute_script(
-        "return Array.from(document.querySelectorAll('figure')).map(f => {"
+        "return Array.from(document.querySelectorAll('figure:not(.replay)')).map(f => {"
         "  const s = f.querySelector('svg');"
         "  const r = s ? s.getBoundingClientRect() : {width: 0, height: 0};"
         "  return [f.id, r.width, r.height]; });")
@@ -89,6 +89,21 @@ def test_every_chart_is_drawn_with_a_size(opened):
     # every chart fits the window: nothing forces a sideways scroll
     page_width = browser.execute_script("return document.documentElement.scrollWidth;")
     assert page_width <= WINDOW_WIDTH
+
+
+def test_every_replay_has_a_frame_with_a_size(opened):
+    """The replays (iframes of pages beside the report) are laid out where
+    they are shown, each frame at least a readable size."""
+    browser, _, results = opened
+    written = [r for r in results["sections"]["dynamics"]["results"]["replays"]
+               if r["status"] == "written"]
+    sizes = browser.execute_script(
+        "return Array.from(document.querySelectorAll('figure.replay iframe')).map(f => {"
+        "  const r = f.getBoundingClientRect();"
+        "  return [f.getAttribute('src'), r.width, r.height]; });")
+    assert sorted(src for src, _, _ in sizes) == sorted(r["file"] for r in written)
+    for src, width, height in sizes:
+        assert width > 400 and height > 300, src
 
 
 def test_every_section_is_visible(opened):

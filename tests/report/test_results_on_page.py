@@ -22,8 +22,10 @@ def test_every_table_cell_is_on_the_page(quick_report):
     assert tables
     for table in tables:
         block = _table_html(html, table["id"])
-        for column in table["columns"]:
-            assert f"<th>{escape(column)}</th>" in block, (table["id"], column)
+        links = table["column_links"] or [""] * len(table["columns"])
+        for column, link in zip(table["columns"], links, strict=True):
+            heading = f'<a href="{escape(link)}">{escape(column)}</a>' if link else escape(column)
+            assert f"<th>{heading}</th>" in block, (table["id"], column)
         for row in table["rows"]:
             for cell in row:
                 assert f">{escape(cell)}</td>" in block, (table["id"], cell)

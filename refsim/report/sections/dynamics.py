@@ -23,7 +23,7 @@ import math
 from refsim.claims import dynamics as judged
 from refsim.report.charts import Series, line_chart
 from refsim.report.plan import command
-from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Verdict
+from refsim.report.section import Agreement, Divergence, Figure, Replay, Section, Table, Verdict
 
 CHART_SIZE = (7.0, 4.0)
 CMD_APEX = command("dynamics-apex")
@@ -298,11 +298,41 @@ def build(ctx) -> Section:
              "(refsim/dynamics/analytic.py) say what both should give. Then the seed's two "
              "admitted bugs: the angular velocity that does not damp (C12) and bodies that "
              "interpenetrate (C11), each against the corrected model.")
+    replay_rows = run.get("replays")
+    results["replays"] = replay_rows
     return Section(key="dynamics", title="Rigid-body dynamics", intro=intro, figures=figures,
                    tables=tables, verdicts=verdicts, results=results,
+                   replays=[_replay(r) for r in replay_rows],
                    divergences=_divergences(apex_rows, oblique_rows,
                                             judged.tipping_spin(apex_rows)),
                    agreements=_agreements(apex_rows, oblique_rows))
+
+
+#: The item of this section each replay is shown after (by the replay's name).
+REPLAY_AFTER = {"c11-interpenetration": "dynamics-c11", "c12-spin": "dynamics-c12-spin",
+                "wall-bounce-pybullet": "dynamics-bounce-heights",
+                "wall-bounce-mujoco": "dynamics-bounce-heights"}
+
+#: What each replay shows, for its caption (the scene and the runs, not a finding).
+REPLAY_NOTES = {
+    "c11-interpenetration": "The stack case of the C11 table (an icosahedron dropped onto "
+                            "another resting on the floor, 2 s), with each body's box drawn.",
+    "c12-spin": "scenes/spinning-cube.toml, 6 s, under each rotation model.",
+    "wall-bounce-pybullet": "scenes/bounce.toml, 3 s: the drop, the bounce and the rise.",
+    "wall-bounce-mujoco": "scenes/bounce.toml, 3 s, MuJoCo with its one-step damper "
+                          "(oracles/mujoco_adapter.py).",
+}
+
+
+def _replay(r) -> Replay:
+    """A replay record of the plan as the page shows it."""
+    caption = REPLAY_NOTES.get(r.name, "")
+    if r.status == "written":
+        caption += (f" Left to right: {'; '.join(r.runs)}. {r.frames} of {r.timeline_frames} "
+                    f"frames (every {r.stride}), {r.bytes / 1e6:.2f} MB; play, pause and scrub "
+                    "in the frame. Reproduce: refsim study replays -o DIR")
+    return Replay(id=f"replay-{r.name}", title=r.title, file=r.file, claim=r.claim,
+                  caption=caption, missing=r.reason, after=REPLAY_AFTER.get(r.name, ""))
 
 
 #: What each C11 case is, for the verdict sentence (the scene, not a finding).

@@ -1,0 +1,99 @@
+"""The report's sweep tasks: the runs of its newer sections as calls that
+:func:`refsim.sweep.run_sweep` can send to another process.
+
+A sweep task is a module-level function taking ``seed`` and plain
+arguments and returning plain data (:mod:`refsim.sweep.records`), so the
+same call gives the same answer in this process, on local processes or on a
+Dask cluster: ``refsim report --workers N`` changes where these run, never
+what they return. The conformance matrix's task is
+:func:`refsim.conformance.matrix.engine_task`; here are the others:
+
+- :func:`write_replay_demo`: one replay of :mod:`refsim.viewer.demos`
+  (claims C11 and C12, a wall bounce beside pybullet or MuJoCo) written into
+  the report's directory;
+- :func:`advise_scene`: the fidelity advisor
+  (:func:`refsim.studies.advisor.advice_by_tolerance`) on one scene at each
+  tolerance.
+
+Neither uses the sweep's seed: the demos and the advisor are deterministic.
+Cost: the demo's simulations and one replay serialization; the advice's runs.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+#: The demos :func:`write_replay_demo` knows, by name: (function of
+#: :mod:`refsim.viewer.demos`, the engine it runs beside refsim or None).
+DEMO_ENGINES = {"c12-spin": None, "c11-interpenetration": None,
+                "wall-bounce-pybullet": "pybullet", "wall-bounce-mujoco": "mujoco"}
+
+
+def _mujoco_trajectory(scene):
+    """The scene run by MuJoCo (raises OracleUnavailable without it)."""
+    from refsim.dynamics.simulation import default_every
+    from refsim.oracles.mujoco_adapter import MujocoOracle
+
+    return MujocoOracle().simulate(scene, every=default_every(scene.integration.n_steps))
+
+
+def write_replay_demo(*, seed: int, name: str, path: str, max_bytes: int) -> dict:
+    """Write the demo ``name`` (:data:`DEMO_ENGINES`) to ``path``.
+
+    Returns ``{"written": ReplayInfo's numbers}``, or ``{"unavailable":
+    reason}`` when viser (the ``viewer`` extra) or the engine beside refsim
+    is not installed: checked before any simulation runs.
+    """
+    from refsim.oracles import OracleUnavailable
+    from refsim.viewer.demos import demo_c11, demo_c12, demo_wall_bounce
+    from refsim.viewer.server import ViewerUnavailable, require_viser
+
+    if name not in DEMO_ENGINES:
+        raise ValueError(f"no replay demo {name!r} (demos: {', '.join(DEMO_ENGINES)})")
+    try:
+        require_viser()
+        engine = DEMO_ENGINES[name]
+        if engine == "pybullet":
+            from refsim.oracles.pybullet_adapter import PybulletOracle
+
+            PybulletOracle().close()                 # raises here when pybullet is missing
+            info = demo_wall_bounce(path, max_bytes=max_bytes)
+        elif engine == "mujoco":
+            from refsim.oracles.mujoco_adapter import MujocoOracle
+
+            MujocoOracle()                           # raises here when MuJoCo is missing
+            info = demo_wall_bounce(path, external=_mujoco_trajectory, label="MuJoCo",
+                                    max_bytes=max_bytes)
+        elif name == "c12-spin":
+            info = demo_c12(path, max_bytes=max_bytes)
+        else:
+            info = demo_c11(path, max_bytes=max_bytes)
+    except (ViewerUnavailable, OracleUnavailable) as exc:
+        return {"unavailable": str(exc)}
+    return {"written": {"bytes": info.bytes, "stride": info.stride, "frames": info.frames,
+                        "timeline_frames": info.timeline_frames, "runs": list(info.runs),
+                        "file": Path(path).name}}
+
+
+def advise_scene(*, seed: int, scene: str, tolerances: list, duration: float | None,
+                 repeats: int, store: str | None,
+                 max_reference_steps: int | None = None) -> dict:
+    """The advisor's answer for ``scene`` (a bundled name or a path) at each
+    tolerance, in this process, each tolerance sharing the runs of the
+    others through ``store``.
+
+    Returns ``{"advice": [Advice.as_dict(), ...]}`` in the order of
+    ``tolerances``, or ``{"refused": message}`` for a scene the advisor does
+    not tune (a particle scene: its StateError, one line).
+    """
+    from refsim.errors import StateError
+    from refsim.studies.advisor import MAX_REFERENCE_STEPS, advice_by_tolerance
+
+    try:
+        (series,) = advice_by_tolerance(
+            scenes=(scene,), tolerances=tuple(tolerances), store=store, duration=duration,
+            repeats=repeats,
+            max_reference_steps=max_reference_steps or MAX_REFERENCE_STEPS)
+    except StateError as exc:
+        return {"refused": str(exc)}
+    return {"advice": [advice.as_dict() for advice in series.advice]}

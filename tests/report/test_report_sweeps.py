@@ -1,0 +1,268 @@
+"""The report's sweep sections: the conformance matrix (issue 14), the
+replays (issue 15) and the advisor (issue 17), and ``--workers``."""
+
+from __future__ import annotations
+
+import json
+import sys
+from types import SimpleNamespace
+
+import pytest
+from markupsafe import escape
+
+from refsim.bundled import bundled_scenes
+from refsim.claims import CLAIMS
+from refsim.conformance.matrix import conformance_matrix, run_matrix
+from refsim.conformance.results import ConformanceResult, tally
+from refsim.report import plan
+from refsim.report.build import render, section_json
+from refsim.report.section import Section, to_json
+from refsim.report.sections import advisor as advisor_section
+from refsim.report.sections import conformance as conformance_section
+from refsim.report.sections.conformance import ENGINE_TITLES, cell_text
+
+
+def _section(results, key):
+    return results["sections"][key]
+
+
+def _table(results, key, table_id):
+    (table,) = [t for t in _section(results, key)["tables"] if t["id"] == table_id]
+    return table
+
+
+# -- the conformance matrix -------------------------------------------------------------------
+
+
+def test_matrix_has_a_row_per_check_and_a_column_per_engine_that_ran(quick_report):
+    _, _, results = quick_report
+    matrix = _section(results, "conformance")["results"]["matrix"]
+    table = _table(results, "conformance", "conformance-matrix")
+    assert table["columns"] == ["check", *(ENGINE_TITLES[e] for e in matrix["engines"])]
+    assert [row[0] for row in table["rows"]] == matrix["checks"]
+    assert set(matrix["engines"]) | set(matrix["unavailable"]) == set(plan_engines())
+    for row in table["rows"]:
+        for engine, text in zip(matrix["engines"], row[1:], strict=True):
+            cell = matrix["cells"][row[0]].get(engine)
+            if cell is None:
+                assert text == conformance_section.NO_CAPABILITY
+            elif cell["status"] != "n/a":
+                assert f"{cell['passed']}/{cell['cases']}" in text
+
+
+def plan_engines():
+    from refsim.conformance.shipped import SHIPPED_ENGINES
+
+    return SHIPPED_ENGINES
+
+
+def test_matrix_counts_match_an_independent_run(quick_report):
+    """The report's cells for the triangle checks are those of run_matrix
+    run here directly (shared case sets, no sweep)."""
+    _, _, results = quick_report
+    table = _table(results, "conformance", "conformance-matrix")
+    columns = table["columns"]
+    direct, _ = run_matrix(cases=plan.MATRIX_CASES[0], seed=plan.REPORT_SEED, only="triangles")
+    assert direct.checks
+    shown = {row[0]: row for row in table["rows"]}
+    for check in direct.checks:
+        for engine in direct.engines:
+            assert shown[check][columns.index(ENGINE_TITLES[engine])] == \
+                cell_text(direct.cell(check, engine))
+
+
+def test_every_engine_page_is_written_and_linked(quick_report):
+    out, html, results = quick_report
+    matrix = _section(results, "conformance")["results"]["matrix"]
+    assert (out / "conformance" / "index.html").is_file()
+    assert set(matrix["pages"]) == set(matrix["engines"])
+    for engine, page in matrix["pages"].items():
+        assert (out / "conformance" / page).is_file()
+        data = json.loads((out / "conformance" / page).with_name("conformance.json").read_text())
+        assert data["engine"] == engine
+        assert f'<a href="conformance/{page}">{ENGINE_TITLES[engine]}</a>' in html
+
+
+def test_every_engine_divergence_is_in_the_catalogue(quick_report):
+    _, _, results = quick_report
+    matrix = _section(results, "conformance")["results"]["matrix"]
+    listed = [d for d in results["divergences"] if d["section"] == "conformance"]
+    assert len(listed) == len(matrix["divergences"]) > 0
+    for d, row in zip(matrix["divergences"], listed, strict=True):
+        assert row["title"] == f"{ENGINE_TITLES[d['engine']]}: {d['check']}"
+        assert all(name in row["kind"] for name in d["classes"])
+        assert d["reason"] in row["finding"]
+
+
+def _result(engine: str, failed: int) -> ConformanceResult:
+    check = tally("triangles", "agreement", [None] * 3 + ["touching"] * failed)
+    return ConformanceResult(engine=engine, refsim="0", seed=0, cases=3 + failed,
+                             capabilities=("triangles",), checks=(check,))
+
+
+def test_an_unavailable_engine_is_listed_with_its_reason():
+    why = "mujoco: not installed (pip install mujoco)"
+    matrix = conformance_matrix({"refsim-seed": _result("refsim-seed", 0),
+                                 "fcl": _result("fcl", 2)}, unavailable={"mujoco": why})
+    record = plan.MatrixRun(matrix, 5, "", "refsim conform --all")
+    ctx = SimpleNamespace(quick=True, run=SimpleNamespace(get=lambda name: record))
+    section = conformance_section.build(ctx)
+    matrix_table, unavailable = section.tables
+    assert matrix_table.columns == ("check", "refsim seed", "FCL")
+    assert matrix_table.rows == (("triangles.agreement", "pass 3/3",
+                                  "FAIL 3/5 (touching 2)"),)
+    assert unavailable.rows == (("MuJoCo", why),)
+    assert [d.title for d in section.divergences] == ["FCL: triangles.agreement"]
+    assert "FAILURE (not declared)" in section.divergences[0].kind
+
+
+def test_the_matrix_through_the_sweep_equals_the_shared_run():
+    shared, _ = run_matrix(cases=10, seed=3, only="aabb")
+    swept, _ = run_matrix(cases=10, seed=3, only="aabb", backend="inprocess")
+    assert shared.cells == swept.cells and shared.divergences == swept.divergences
+    assert shared.engines == swept.engines
+
+
+def test_a_missing_engine_in_the_sweep_is_unavailable_not_an_error():
+    specs = {"refsim-corrected": "refsim.engines.refsim_engines:corrected",
+             "nothing": "no_such_module_for_refsim:engine"}
+    matrix, results = run_matrix(specs, cases=5, seed=0, only="aabb", backend="inprocess")
+    assert list(results) == ["refsim-corrected"]
+    assert "nothing" in matrix.unavailable and "no_such_module_for_refsim" in \
+        matrix.unavailable["nothing"]
+
+
+# -- replays ------------------------------------------------------------------------------------
+
+
+def test_replays_are_written_and_shown_at_their_claims(quick_report):
+    out, html, results = quick_report
+    replays = _section(results, "dynamics")["results"]["replays"]
+    assert [r["name"] for r in replays] == [name for name, _, _ in plan.REPLAYS]
+    for r in replays:
+        assert r["status"] == "written", r["reason"]
+        page = out / r["file"]
+        assert page.is_file() and page.stat().st_size == r["bytes"] > 0
+        assert f'<iframe src="{r["file"]}"' in html
+        assert r["frames"] > 1
+    claims = {c["claim"]: c for c in results["claims"]}
+    assert claims["C11"]["replays"] == ["replay-c11-interpenetration"]
+    assert claims["C12"]["replays"] == ["replay-c12-spin"]
+    for claim in CLAIMS:
+        row = html.split(f'id="claim-{claim}"', 1)[1].split("</tr>", 1)[0]
+        assert ('href="#replay-' in row) == (claim in ("C11", "C12"))
+    # each replay sits right after the item it illustrates
+    dynamics = html.split('<section id="dynamics">', 1)[1]
+    assert dynamics.index('id="dynamics-c11"') < dynamics.index('id="replay-c11-interpenetration"')
+    assert dynamics.index('id="dynamics-c12-spin"') < dynamics.index('id="replay-c12-spin"')
+
+
+def test_without_viser_the_report_says_so_in_place(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "viser", None)          # import viser raises ImportError
+    records = plan.Run(quick=True, out_dir=tmp_path).get("replays")
+    assert {r.status for r in records} == {"unavailable"}
+    assert all("viser" in r.reason for r in records)
+    assert list((tmp_path / plan.REPLAY_FOLDER).iterdir()) == []
+    from refsim.report.sections.dynamics import _replay
+
+    section = Section(key="dynamics", title="Rigid-body dynamics",
+                      replays=[_replay(r) for r in records])
+    html = render([section], {"versions": {}, "machine": {"platform": "", "processor": "",
+                                                          "cpus": 1},
+                              "commit": "", "seed": 0}, quick=True)
+    assert "<iframe" not in html
+    for r in records:
+        assert f"no replay here: {escape(r.reason)}" in html
+
+
+def test_replays_without_an_output_directory_are_not_written_and_say_so():
+    records = plan.Run(quick=True).get("replays")
+    assert {r.status for r in records} == {"not written"}
+    assert all(r.file == "" and r.reason for r in records)
+
+
+# -- the advisor --------------------------------------------------------------------------------
+
+
+def test_the_advisor_lists_every_bundled_scene(quick_report):
+    _, html, results = quick_report
+    advisor = _section(results, "advisor")["results"]
+    assert [s["scene"] for s in advisor["scenes"]] == [p.name for p in bundled_scenes()]
+    tolerances = advisor["tolerances"]
+    assert len(tolerances) >= 2
+    table = _table(results, "advisor", "advisor-advice")
+    for scene in advisor["scenes"]:
+        if scene["refused"] or scene["skipped"]:
+            assert scene["advice"] == []
+            assert [r for r in table["rows"] if r[0] == scene["scene"]][0][2] == \
+                (f"not advised: {scene['refused']}" if scene["refused"]
+                 else f"not advised in this run: {scene['skipped']}")
+            continue
+        assert [a["tolerance"] for a in scene["advice"]] == tolerances
+        rows = [r for r in table["rows"] if r[0] == scene["scene"]]
+        assert len(rows) == len(tolerances)
+        for a, row in zip(scene["advice"], rows, strict=True):
+            rec = a["recommended"]
+            assert rec["meets"] is True
+            assert row[2].startswith(f"{rec['solver']}, h = ") and str(rec["proxy"]) == row[3]
+            assert a["proxy_saving"] == pytest.approx(a["own"]["proxy"] / rec["proxy"])
+            assert ("converged" if a["reference"]["converged"] else "not converged") in row[8]
+    assert [s["scene"] for s in advisor["scenes"] if s["refused"]] == ["particles.toml"]
+    assert [s["scene"] for s in advisor["scenes"] if s["skipped"]] == \
+        list(plan.ADVISOR_QUICK_SKIP)
+    by_name = {s["scene"]: s for s in advisor["scenes"]}
+    assert "the scene has no [[body]]" in by_name["particles.toml"]["refused"]
+    assert advisor["duration"] == plan.ADVISOR_DURATION[0]
+    assert "Quick run: the first 1 s of each scene" in html
+
+
+def test_the_advisor_section_lists_a_refused_scene():
+    record = plan.AdvisorRun((plan.AdvisedScene("p.toml", refused="no bodies"),),
+                             (1e-2, 1e-3), 1.0, 1)
+    ctx = SimpleNamespace(quick=True, run=SimpleNamespace(get=lambda name: record))
+    section = advisor_section.build(ctx)
+    assert section.tables[0].rows[0][:3] == ("p.toml", "-", "not advised: no bodies")
+
+
+# -- workers --------------------------------------------------------------------------------------
+
+
+def _untimed(value, timings):
+    """``value`` (JSON) without the paths in ``timings``."""
+    def strip(v, path):
+        if isinstance(v, dict):
+            return {k: strip(x, path + (k,)) for k, x in v.items()
+                    if path + (k,) not in timings}
+        if isinstance(v, list):
+            return [strip(x, path + ("*",)) for x in v]
+        return v
+    return strip(value, ())
+
+
+def test_workers_give_the_serial_results(quick_report, tmp_path):
+    """The sweep entries measured on 2 local processes give the quick
+    report's results (built in this process), timings aside."""
+    _, _, results = quick_report
+    run = plan.Run(quick=True, out_dir=tmp_path, workers=2)
+    run.prefetch(plan.SWEEP_ENTRIES)            # as the report does: beside this thread
+    ctx = SimpleNamespace(quick=True, run=run, seed=plan.REPORT_SEED, progress=None)
+    for key, module in (("conformance", conformance_section), ("advisor", advisor_section)):
+        timings: set = set()
+        parallel = json.loads(json.dumps(section_json(module.build(ctx), timings)))
+        serial = _section(results, key)
+        paths = {tuple(p[3:]) for p in results["timing_paths"] if p[1] == key} | \
+            {tuple(p[3:]) for p in timings}
+        assert _untimed(parallel["results"], paths) == _untimed(serial["results"], paths)
+        assert [t for t in parallel["tables"] if not t["timing"]] == \
+            [t for t in serial["tables"] if not t["timing"]]
+    replays = json.loads(json.dumps(to_json(run.get("replays"))))
+    assert replays == _section(results, "dynamics")["results"]["replays"]
+    assert sorted(p.name for p in (tmp_path / "replays").iterdir()) == \
+        sorted(f"{name}.html" for name, _, _ in plan.REPLAYS)
+
+
+def test_report_command_takes_workers(tmp_path, capsys):
+    from refsim.cli import main
+
+    assert main(["report", "--quick", "-o", str(tmp_path / "r"), "--workers", "0"]) == 2
+    assert "--workers must be at least 1" in capsys.readouterr().err
