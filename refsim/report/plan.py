@@ -167,7 +167,7 @@ class Run:
                   and n not in self._pending]
         if self.workers is None or not wanted:
             return
-        futures = {name: Future() for name in wanted}
+        futures: dict[str, Future] = {name: Future() for name in wanted}
         self._pending.update(futures)
 
         def measure() -> None:
