@@ -166,23 +166,28 @@ def minor(p0, p1, q0, q1, out, at):
 
 
 @numba.njit(cache=True)
-def fast_expansion_sum(e, e_len, f, f_len, h):
-    """h = e + f; returns h's length (Fast-Expansion-Sum with zero elimination,
-    Theorem 13). e and f are strongly nonoverlapping expansions (what every
-    function here produces under round-to-even); h is one too, with no zero
-    component unless it is the single component 0. h must not alias e or f."""
-    if f_len == 1 and f[0] == 0.0:          # shortcuts for a zero term
+def fast_expansion_sum(w, e, e_len, f, f_len, h):
+    """``w[h:]`` = ``w[e:e + e_len]`` + ``w[f:f + f_len]``; returns the
+    result's length (Fast-Expansion-Sum with zero elimination, Theorem 13).
+
+    Expansions live in one scratch array ``w`` and are named by their offset
+    (an array view per operand would be a reference-counted object:
+    docs/decisions/triangle-filter-arguments.md). e and f are strongly
+    nonoverlapping (what every function here produces under round-to-even);
+    so is the result, with no zero component unless it is the single
+    component 0. The result must not overlap e or f."""
+    if f_len == 1 and w[f] == 0.0:          # shortcuts for a zero term
         for i in range(e_len):
-            h[i] = e[i]
+            w[h + i] = w[e + i]
         return e_len
-    if e_len == 1 and e[0] == 0.0:
+    if e_len == 1 and w[e] == 0.0:
         for i in range(f_len):
-            h[i] = f[i]
+            w[h + i] = w[f + i]
         return f_len
     e_i = 0
     f_i = 0
-    e_now = e[0]
-    f_now = f[0]
+    e_now = w[e]
+    f_now = w[f]
     # Merge by increasing magnitude: Q starts as the smallest component.
     if abs(f_now) > abs(e_now):
         q = e_now
@@ -192,8 +197,8 @@ def fast_expansion_sum(e, e_len, f, f_len, h):
         f_i += 1
     h_len = 0
     if e_i < e_len and f_i < f_len:
-        e_now = e[e_i]
-        f_now = f[f_i]
+        e_now = w[e + e_i]
+        f_now = w[f + f_i]
         if abs(f_now) > abs(e_now):
             q, hh = fast_two_sum(e_now, q)
             e_i += 1
@@ -201,11 +206,11 @@ def fast_expansion_sum(e, e_len, f, f_len, h):
             q, hh = fast_two_sum(f_now, q)
             f_i += 1
         if hh != 0.0:
-            h[h_len] = hh
+            w[h + h_len] = hh
             h_len += 1
         while e_i < e_len and f_i < f_len:
-            e_now = e[e_i]
-            f_now = f[f_i]
+            e_now = w[e + e_i]
+            f_now = w[f + f_i]
             if abs(f_now) > abs(e_now):
                 q, hh = two_sum(q, e_now)
                 e_i += 1
@@ -213,50 +218,51 @@ def fast_expansion_sum(e, e_len, f, f_len, h):
                 q, hh = two_sum(q, f_now)
                 f_i += 1
             if hh != 0.0:
-                h[h_len] = hh
+                w[h + h_len] = hh
                 h_len += 1
     while e_i < e_len:
-        q, hh = two_sum(q, e[e_i])
+        q, hh = two_sum(q, w[e + e_i])
         e_i += 1
         if hh != 0.0:
-            h[h_len] = hh
+            w[h + h_len] = hh
             h_len += 1
     while f_i < f_len:
-        q, hh = two_sum(q, f[f_i])
+        q, hh = two_sum(q, w[f + f_i])
         f_i += 1
         if hh != 0.0:
-            h[h_len] = hh
+            w[h + h_len] = hh
             h_len += 1
     if q != 0.0 or h_len == 0:
-        h[h_len] = q
+        w[h + h_len] = q
         h_len += 1
     return h_len
 
 
 @numba.njit(cache=True)
-def scale_expansion(e, e_len, b, h):
-    """h = b e; returns h's length (Scale-Expansion with zero elimination,
-    Theorem 19). h must not alias e."""
-    if b == 0.0 or (e_len == 1 and e[0] == 0.0):
-        h[0] = 0.0
+def scale_expansion(w, e, e_len, b, h):
+    """``w[h:]`` = b ``w[e:e + e_len]``; returns the result's length
+    (Scale-Expansion with zero elimination, Theorem 19). The result must not
+    overlap e."""
+    if b == 0.0 or (e_len == 1 and w[e] == 0.0):
+        w[h] = 0.0
         return 1
-    q, hh = two_product(e[0], b)
+    q, hh = two_product(w[e], b)
     h_len = 0
     if hh != 0.0:
-        h[h_len] = hh
+        w[h + h_len] = hh
         h_len += 1
     for i in range(1, e_len):
-        product1, product0 = two_product(e[i], b)
+        product1, product0 = two_product(w[e + i], b)
         s, hh = two_sum(q, product0)
         if hh != 0.0:
-            h[h_len] = hh
+            w[h + h_len] = hh
             h_len += 1
         q, hh = fast_two_sum(product1, s)
         if hh != 0.0:
-            h[h_len] = hh
+            w[h + h_len] = hh
             h_len += 1
     if q != 0.0 or h_len == 0:
-        h[h_len] = q
+        w[h + h_len] = q
         h_len += 1
     return h_len
 
@@ -267,18 +273,35 @@ def sign_of(x):
 
 
 @numba.njit(cache=True)
-def det3_sum(z0, m0, n0, z1, m1, n1, z2, m2, n2, work, out):
-    """``z0 m0 + z1 m1 + z2 m2`` for expansions m0..m2 of lengths n0..n2 (at
-    most 4) and floats z0..z2, written to ``out``; returns its length (at
-    most 24). ``work`` holds at least 40 floats."""
-    k0 = scale_expansion(m0, n0, z0, work[0:8])
-    k1 = scale_expansion(m1, n1, z1, work[8:16])
-    k01 = fast_expansion_sum(work[0:8], k0, work[8:16], k1, work[24:40])
-    k2 = scale_expansion(m2, n2, z2, work[16:24])
-    return fast_expansion_sum(work[24:40], k01, work[16:24], k2, out)
+def det3_sum(w, z0, m0, n0, z1, m1, n1, z2, m2, n2, work, out):
+    """``z0 m0 + z1 m1 + z2 m2`` for expansions at offsets m0..m2 of lengths
+    n0..n2 (at most 4) and floats z0..z2, written at offset ``out``; returns
+    its length (at most 24). Uses ``w[work:work + 40]``."""
+    k0 = scale_expansion(w, m0, n0, z0, work)
+    k1 = scale_expansion(w, m1, n1, z1, work + 8)
+    k01 = fast_expansion_sum(w, work, k0, work + 8, k1, work + 24)
+    k2 = scale_expansion(w, m2, n2, z2, work + 16)
+    return fast_expansion_sum(w, work + 24, k01, work + 16, k2, out)
 
 
 # -- exact orient3d and orient2d (Shewchuk 1997, section 4) -------------------------
+
+
+#: orient3d_expansion's terms: for each 3 x 3 determinant D(p, q, r) of the
+#: rows (x, y, z) of the points (0..3 for a..d), its sign in the 4 x 4
+#: expansion, and for each of its three terms the row whose z scales the
+#: term, the term's sign and the minor it scales (index into MINOR_ROWS).
+MINOR_ROWS = ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))
+DET3_TERMS = (
+    # + D(a,b,c) = z_a m(b,c) - z_b m(a,c) + z_c m(a,b)
+    ((0, 1.0, 3), (1, -1.0, 1), (2, 1.0, 0)),
+    # - D(a,b,d) = -z_a m(b,d) + z_b m(a,d) - z_d m(a,b)
+    ((0, -1.0, 4), (1, 1.0, 2), (3, -1.0, 0)),
+    # + D(a,c,d) = z_a m(c,d) - z_c m(a,d) + z_d m(a,c)
+    ((0, 1.0, 5), (2, -1.0, 2), (3, 1.0, 1)),
+    # - D(b,c,d) = -z_b m(c,d) + z_c m(b,d) - z_d m(b,c)
+    ((1, -1.0, 5), (2, 1.0, 4), (3, -1.0, 3)),
+)
 
 
 @numba.njit(cache=True)
@@ -290,32 +313,41 @@ def orient3d_expansion(a, b, c, d):
     with rows (x, y, z, 1) of a, b, c, d. Along the last column,
     det = D(a,b,c) - D(a,b,d) + D(a,c,d) - D(b,c,d), where D(p,q,r), the 3 x 3
     determinant of rows (x, y, z), is z_p m(q,r) - z_q m(p,r) + z_r m(p,q)
-    with the 2 x 2 minors m(p,q) = x_p y_q - x_q y_p. (Shewchuk's
-    ``orient3dexact`` groups the same terms.) At most 96 components.
+    with the 2 x 2 minors m(p,q) = x_p y_q - x_q y_p (``DET3_TERMS``;
+    Shewchuk's ``orient3dexact`` groups the same terms). Written as loops
+    over those tables, so that the compiled code holds each expansion
+    operation once. At most 96 components.
+
+    Scratch layout of ``w``: the six minors at 0..23 (4 each), the scaled
+    term at 24..31, the 3 x 3 determinant built at 32..55 (two halves), the
+    running total in two buffers of 96 at 80 and 176.
     """
-    w = np.empty(384)
-    ab, ac, ad, bc, bd, cd = 0, 4, 8, 12, 16, 20
-    n_ab = minor(a[0], a[1], b[0], b[1], w, ab)
-    n_ac = minor(a[0], a[1], c[0], c[1], w, ac)
-    n_ad = minor(a[0], a[1], d[0], d[1], w, ad)
-    n_bc = minor(b[0], b[1], c[0], c[1], w, bc)
-    n_bd = minor(b[0], b[1], d[0], d[1], w, bd)
-    n_cd = minor(c[0], c[1], d[0], d[1], w, cd)
-    work = w[24:64]
-    # + D(a,b,c) - D(a,b,d) + D(a,c,d) - D(b,c,d): scale by the z's with the
-    # signs folded in (negating a float is exact).
-    n_abc = det3_sum(a[2], w[bc:bc + 4], n_bc, -b[2], w[ac:ac + 4], n_ac,
-                     c[2], w[ab:ab + 4], n_ab, work, w[64:88])
-    n_abd = det3_sum(-a[2], w[bd:bd + 4], n_bd, b[2], w[ad:ad + 4], n_ad,
-                     -d[2], w[ab:ab + 4], n_ab, work, w[88:112])
-    n_acd = det3_sum(a[2], w[cd:cd + 4], n_cd, -c[2], w[ad:ad + 4], n_ad,
-                     d[2], w[ac:ac + 4], n_ac, work, w[112:136])
-    n_bcd = det3_sum(-b[2], w[cd:cd + 4], n_cd, c[2], w[bd:bd + 4], n_bd,
-                     -d[2], w[bc:bc + 4], n_bc, work, w[136:160])
-    n_left = fast_expansion_sum(w[64:88], n_abc, w[88:112], n_abd, w[160:208])
-    n_right = fast_expansion_sum(w[112:136], n_acd, w[136:160], n_bcd, w[208:256])
-    n = fast_expansion_sum(w[160:208], n_left, w[208:256], n_right, w[256:352])
-    return sign_of(w[256 + n - 1])
+    points = (a, b, c, d)
+    w = np.empty(272)
+    minor_len = np.empty(6, dtype=np.int64)
+    for m in range(6):
+        p, q = points[MINOR_ROWS[m][0]], points[MINOR_ROWS[m][1]]
+        minor_len[m] = minor(p[0], p[1], q[0], q[1], w, 4 * m)
+    total, total_len, spare = 80, 0, 176
+    for k in range(4):
+        det, det_len, det_spare = 32, 0, 56
+        for row, sign, m in DET3_TERMS[k]:
+            n = scale_expansion(w, 4 * m, minor_len[m], sign * points[row][2], 24)
+            if det_len == 0:
+                for i in range(n):
+                    w[det + i] = w[24 + i]
+                det_len = n
+            else:
+                det_len = fast_expansion_sum(w, det, det_len, 24, n, det_spare)
+                det, det_spare = det_spare, det
+        if total_len == 0:
+            for i in range(det_len):
+                w[total + i] = w[det + i]
+            total_len = det_len
+        else:
+            total_len = fast_expansion_sum(w, total, total_len, det, det_len, spare)
+            total, spare = spare, total
+    return sign_of(w[total + total_len - 1])
 
 
 @numba.njit(cache=True)
@@ -344,8 +376,7 @@ def orient3d_exact(a, b, c, d):
     n_bc = minor(bdx, bdy, cdx, cdy, w, 0)       # bdx cdy - bdy cdx
     n_ca = minor(cdx, cdy, adx, ady, w, 4)       # cdx ady - cdy adx
     n_ab = minor(adx, ady, bdx, bdy, w, 8)       # adx bdy - ady bdx
-    n = det3_sum(adz, w[0:4], n_bc, bdz, w[4:8], n_ca, cdz, w[8:12], n_ab, w[12:52],
-                 w[52:76])
+    n = det3_sum(w, adz, 0, n_bc, bdz, 4, n_ca, cdz, 8, n_ab, 12, 52)
     return sign_of(w[52 + n - 1])
 
 
@@ -386,8 +417,8 @@ def orient2d_expansion(a, b, c):
     n_ab = minor(a[0], a[1], b[0], b[1], w, 0)
     n_bc = minor(b[0], b[1], c[0], c[1], w, 4)
     n_ca = minor(c[0], c[1], a[0], a[1], w, 8)
-    n = fast_expansion_sum(w[0:4], n_ab, w[4:8], n_bc, w[12:20])
-    n = fast_expansion_sum(w[12:20], n, w[8:12], n_ca, w[20:32])
+    n = fast_expansion_sum(w, 0, n_ab, 4, n_bc, 12)
+    n = fast_expansion_sum(w, 12, n, 8, n_ca, 20)
     return sign_of(w[20 + n - 1])
 
 

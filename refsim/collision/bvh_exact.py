@@ -86,6 +86,12 @@ within the margin's bound, so both are right; their candidate lists differ
 only if a node pair lies within a few ulps of the margin, which the tests'
 poses do not produce.
 
+The pairs the compiled filter cannot certify (on touching bodies, nearly
+all of them) are answered by the compiled exact stage
+(:mod:`refsim.collision._numba_exact`: the readable triangle test over exact
+expansion predicates), and the few it does not take (degenerate triangles,
+coordinates outside the filter's range) by the readable exact kernel.
+
 Cost: O(m log m) once per mesh for the boxes (a 3x3 eigenproblem per node);
 per query about O(k log m) node
 tests for k overlapping node pairs, plus O(1) per vertex and triangle of the
