@@ -147,6 +147,8 @@ PAIRS: dict[str, tuple[str, str, str]] = {
                                   "refsim.collision._numba_kernels:certified", MIRRORS),
     "exact hierarchy query": ("refsim.collision.bvh_exact:descend",
                               "refsim.collision._numba_kernels:exact_query", MIRRORS),
+    "exact triangle stage": ("refsim.collision.triangle:_triangle_vs_triangle",
+                             "refsim.collision._numba_exact:triangle_vs_triangle", MIRRORS),
     "fused particle steps": ("refsim.particles.system:ParticleSystem",
                              "refsim.particles._numba_kernels:rk_steps_fused", MIRRORS),
 }

@@ -116,6 +116,16 @@ def _exact_hierarchy(kernel):
                               kernel=kernel)]
 
 
+def _exact_stage(kernel):
+    """Touching bodies, where every candidate pair reaches the exact stage."""
+    sphere = refsim.load_model("sphere-2k.ac")
+    on_top = (np.eye(3), np.array([0.0, 1.5, 0.0]))
+    return [refsim.intersecting_pairs(CUBE, IDENTITY, CUBE, (np.eye(3), offset), kernel=kernel)
+            for offset in np.array([[0.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.5, 1.0, 0.25]])] + [
+        refsim.intersecting_pairs(sphere, IDENTITY, CUBE, on_top, kernel=kernel),
+        refsim.bodies_collide(sphere, IDENTITY, CUBE, on_top, kernel=kernel)]
+
+
 def _particles(kernel):
     out = []
     for solver in sorted(refsim.SOLVERS):
@@ -143,6 +153,7 @@ CASES = {
     "hierarchy traversal": _hierarchy_boxes,
     "certified triangle filter": _certified_filter,
     "exact hierarchy query": _exact_hierarchy,
+    "exact triangle stage": _exact_stage,
     "fused particle steps": _particles,
 }
 

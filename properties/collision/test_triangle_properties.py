@@ -19,7 +19,8 @@ from properties.collision.strategies import (
     exact_rigid_motions,
     triangle_pairs,
 )
-from refsim.collision.triangle import triangles_intersect
+from refsim.collision.predicates import in_filter_range
+from refsim.collision.triangle import as_triangle, point_set, triangles_intersect
 from refsim.collision.triangle_batch import triangles_intersect_batch
 
 
@@ -93,3 +94,23 @@ def test_numba_equals_readable(pairs):
     B = np.array([p[1] for p in pairs])
     expected = np.array([triangles_intersect(a, b) for a, b in pairs])
     np.testing.assert_array_equal(triangles_intersect_numba(A, B), expected)
+
+
+@given(st.lists(st.one_of(triangle_pairs(), constructed_contact_pairs().map(lambda c: c[:2])),
+                min_size=1, max_size=40))
+def test_compiled_exact_stage_equals_readable(pairs):
+    # The stage behind the numba filter (refsim.collision._numba_exact), alone:
+    # every pair it decides is answered as the readable test answers it.
+    from refsim.collision.triangle_numba import compiled_exact_kernels
+
+    A = np.array([p[0] for p in pairs], dtype=np.float64)
+    B = np.array([p[1] for p in pairs], dtype=np.float64)
+    expected = np.array([triangles_intersect(a, b) for a, b in pairs])
+    answer, decided = compiled_exact_kernels().intersect_batch(A, B)
+    np.testing.assert_array_equal(answer[decided], expected[decided])
+    # It decides exactly the pairs of two triangles of positive area with
+    # coordinates in the filter's range.
+    takes = [in_filter_range(np.concatenate([a, b]).ravel().tolist())
+             and point_set(as_triangle(a))[0] == point_set(as_triangle(b))[0] == "triangle"
+             for a, b in zip(A, B, strict=True)]
+    np.testing.assert_array_equal(decided, np.array(takes))

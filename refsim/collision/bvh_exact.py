@@ -86,6 +86,12 @@ within the margin's bound, so both are right; their candidate lists differ
 only if a node pair lies within a few ulps of the margin, which the tests'
 poses do not produce.
 
+The pairs the compiled filter cannot certify (on touching bodies, nearly
+all of them) are answered by the compiled exact stage
+(:mod:`refsim.collision._numba_exact`: the readable triangle test over exact
+expansion predicates), and the few it does not take (degenerate triangles,
+coordinates outside the filter's range) by the readable exact kernel.
+
 Cost: O(m log m) once per mesh for the boxes (a 3x3 eigenproblem per node);
 per query about O(k log m) node
 tests for k overlapping node pairs, plus O(1) per vertex and triangle of the
@@ -104,6 +110,7 @@ from refsim.collision.boxes import triangle_boxes, world_vertices
 from refsim.collision.bvh import TriangleTree, tree_of
 from refsim.collision.seed_levels import exact_pairs
 from refsim.collision.triangle import triangles_intersect
+from refsim.collision.triangle_numba import compiled_exact_kernels
 from refsim.errors import StateError
 from refsim.types import ORTHONORMAL_TOL, as_pose, unit_exponent
 
@@ -407,13 +414,29 @@ def _sorted(pairs: np.ndarray) -> np.ndarray:
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))] if len(pairs) > 1 else pairs
 
 
-def _resolve(mesh_a, pose_a, mesh_b, pose_b, uncertain: np.ndarray) -> np.ndarray:
-    """Which of the pairs the float filter left open intersect (readable
-    exact kernel); bool (k,)."""
-    world_a = world_vertices(mesh_a, as_pose(pose_a))
-    world_b = world_vertices(mesh_b, as_pose(pose_b))
-    return np.array([triangles_intersect(world_a[mesh_a.faces[i]], world_b[mesh_b.faces[j]])
-                     for i, j in uncertain], dtype=bool)
+def _resolve(mesh_a, pose_a, mesh_b, pose_b, uncertain: np.ndarray,
+             first_only: bool = False) -> np.ndarray:
+    """Which of the pairs the float filter left open intersect; bool (k,).
+
+    The compiled exact stage (:func:`refsim.collision._numba_exact.intersect_posed`,
+    expansions) answers the pairs it can take, the readable exact kernel the
+    rest (degenerate triangles, coordinates outside the filter's range): the
+    same answers either way. With ``first_only`` it may stop at the first
+    hit (the caller then only asks whether there is one)."""
+    (ra, ta), (rb, tb) = _pose_arrays(pose_a, "pose_a"), _pose_arrays(pose_b, "pose_b")
+    answer, decided = compiled_exact_kernels().intersect_posed(
+        mesh_a.vertices, mesh_a.faces, ra, ta, mesh_b.vertices, mesh_b.faces, rb, tb,
+        uncertain, first_only)
+    if first_only and answer.any():
+        return answer
+    rest = np.flatnonzero(~decided)
+    if len(rest):
+        world_a = world_vertices(mesh_a, (ra, ta))
+        world_b = world_vertices(mesh_b, (rb, tb))
+        for n in rest:
+            i, j = uncertain[n]
+            answer[n] = triangles_intersect(world_a[mesh_a.faces[i]], world_b[mesh_b.faces[j]])
+    return answer
 
 
 def intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> np.ndarray:
@@ -438,4 +461,4 @@ def collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> bool:
     if len(found):
         return True
     return bool(len(uncertain)) and bool(_resolve(mesh_a, pose_a, mesh_b, pose_b,
-                                                   uncertain).any())
+                                                   uncertain, first_only=True).any())

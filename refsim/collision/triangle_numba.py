@@ -5,7 +5,11 @@ For each pair it returns ``(answer, certain)`` exactly as
 ``certified_batch`` does: the float determinants with Shewchuk's static error
 bounds decide the pair when every sign it needs is certain; otherwise the pair
 is left uncertain and :func:`triangles_intersect_numba` re-answers it with the
-readable exact kernel. The steps (see triangle_batch's docstring):
+compiled exact stage (:mod:`refsim.collision._numba_exact`: the readable
+test's steps over exact expansion predicates) and, for the pairs that stage
+does not take (degenerate triangles, coordinates outside the filter's range),
+with the readable exact kernel. The filter's steps (see triangle_batch's
+docstring):
 
 1. both triangles certainly non-degenerate, coordinates in the filter's range;
 2. plane rejection: one triangle certainly strictly on one side of the other's
@@ -44,6 +48,26 @@ def compiled_kernels():
     return nk.certify_pair, nk.certified, nk.certified_indexed
 
 
+@functools.cache
+def compiled_exact_kernels():
+    """The compiled exact stage, :mod:`refsim.collision._numba_exact` (its
+    ``intersect_batch``, ``intersect_indexed``, ``intersect_posed``), or None
+    without numba."""
+    try:
+        from refsim.collision import _numba_exact
+    except ImportError:
+        return None
+    return _numba_exact
+
+
+def _resolve_open(answer, open_pairs, decided_answer, decided, readable) -> None:
+    """Fill ``answer`` at the indices ``open_pairs``: the compiled exact
+    stage's answer where it decided, ``readable(n)`` for the rest."""
+    answer[open_pairs] = decided_answer
+    for m in np.flatnonzero(~decided):
+        answer[open_pairs[m]] = readable(open_pairs[m])
+
+
 def _kernel():
     """The compiled ``certified(A, B) -> (answer, certain)``, or None."""
     kernels = compiled_kernels()
@@ -52,14 +76,24 @@ def _kernel():
 
 def intersecting_indexed(world_a, faces_a, world_b, faces_b, pairs) -> np.ndarray:
     """Which face pairs ``(i, j)`` of two meshes in world space intersect,
-    exactly: the compiled filter, then the readable kernel where it is unsure.
+    exactly: the compiled filter, then the compiled exact stage where it is
+    unsure, then the readable kernel for what that stage does not take.
     ``world_*`` must be finite float64 (n, 3); returns a bool array (k,)."""
     from refsim.collision.triangle import triangles_intersect
 
     answer, certain = compiled_kernels()[2](world_a, faces_a, world_b, faces_b, pairs)
-    for n in np.flatnonzero(~certain):
-        i, j = pairs[n]
-        answer[n] = triangles_intersect(world_a[faces_a[i]], world_b[faces_b[j]])
+    open_pairs = np.flatnonzero(~certain)
+    if len(open_pairs):
+        world_a = np.ascontiguousarray(world_a, np.float64)
+        world_b = np.ascontiguousarray(world_b, np.float64)
+        decided_answer, decided = compiled_exact_kernels().intersect_indexed(
+            world_a, faces_a, world_b, faces_b, np.ascontiguousarray(pairs[open_pairs]))
+
+        def readable(n):
+            i, j = pairs[n]
+            return triangles_intersect(world_a[faces_a[i]], world_b[faces_b[j]])
+
+        _resolve_open(answer, open_pairs, decided_answer, decided, readable)
     return answer
 
 
@@ -76,16 +110,21 @@ def certified_numba(A: np.ndarray, B: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 
 def triangles_intersect_numba(A, B) -> np.ndarray:
-    """Exact overlap of k triangle pairs: the compiled filter, then the readable
-    exact kernel for the pairs it cannot certify. Same answers as
+    """Exact overlap of k triangle pairs: the compiled filter, then the
+    compiled exact stage for the pairs it cannot certify, then the readable
+    exact kernel for the pairs that stage does not take. Same answers as
     :func:`refsim.collision.triangle_batch.triangles_intersect_batch`."""
     from refsim.collision.triangle import triangles_intersect
     from refsim.collision.triangle_batch import _as_batch
 
     A, B = _as_batch(A, B)
     answer, certain = certified_numba(A, B)
-    for i in np.flatnonzero(~certain):
-        answer[i] = triangles_intersect(A[i], B[i])
+    open_pairs = np.flatnonzero(~certain)
+    if len(open_pairs):
+        decided_answer, decided = compiled_exact_kernels().intersect_batch(
+            np.ascontiguousarray(A[open_pairs]), np.ascontiguousarray(B[open_pairs]))
+        _resolve_open(answer, open_pairs, decided_answer, decided,
+                      lambda n: triangles_intersect(A[n], B[n]))
     return answer
 
 

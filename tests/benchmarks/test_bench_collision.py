@@ -2,7 +2,10 @@
 2000-triangle meshes (sphere pair, torus pair) in three configurations
 (separated with overlapping boxes, grazing, deep), by refsim's hierarchy
 ("bvh", compiled), the seed's pairwise levels ("seed"), and python-fcl, in
-one run; and the boolean query against FCL's.
+one run; and the boolean query against FCL's. Issue 16's touching
+configurations (cubes face to face, a cube resting on a sphere), where the
+exact stage answers every candidate pair, against FCL with the poses set per
+query (``-k touching``).
 
 Read the ratios from the medians of one ``make bench`` run; the same figures,
 with the ratios computed, come from
@@ -12,9 +15,11 @@ section). No speed is asserted; each benchmark checks its answer instead.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
-from refsim.oracles.fcl_adapter import FCLOracle
+from refsim.oracles.fcl_adapter import MAX_CONTACTS, FCLOracle
 
 import refsim
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
@@ -36,6 +41,17 @@ APART = {
 }
 
 
+#: Issue 16's touching configurations, where nearly every candidate pair is
+#: exactly touching and the float filter certifies none: the exact stage
+#: answers them all (model a, model b, pose of b; a at the identity).
+TOUCHING = {
+    # unit cubes sharing the face y = 0.5: 79 candidate pairs, 62 touch
+    "cubes-face-to-face": ("cube.ac", "cube.ac", (np.eye(3), np.array([0.0, 1.0, 0.0]))),
+    # a unit cube resting on the sphere of radius 1 at its top vertex: 12 of 12
+    "cube-on-sphere": ("sphere-2k.ac", "cube.ac", (np.eye(3), np.array([0.0, 1.5, 0.0]))),
+}
+
+
 class PosedFCL:
     """FCL as a simulation loop uses it: the two collision objects built once,
     both poses set before every query (setTransform), then ``collide``."""
@@ -51,6 +67,44 @@ class PosedFCL:
         self.a.setTransform(fcl.Transform(*pose_a))
         self.b.setTransform(fcl.Transform(*pose_b))
         return fcl.collide(self.a, self.b, self.request, fcl.CollisionResult()) > 0
+
+    def intersecting_pairs(self, pose_a, pose_b) -> np.ndarray:
+        """All intersecting face pairs, as the adapter's ``intersecting_pairs``
+        reports them (contacts enabled), with the objects built once."""
+        fcl = self.fcl
+        self.a.setTransform(fcl.Transform(*pose_a))
+        self.b.setTransform(fcl.Transform(*pose_b))
+        request = fcl.CollisionRequest(num_max_contacts=MAX_CONTACTS, enable_contact=True)
+        result = fcl.CollisionResult()
+        fcl.collide(self.a, self.b, request, result)
+        pairs = np.array([(c.b1, c.b2) for c in result.contacts], dtype=np.int64)
+        return np.unique(pairs.reshape(-1, 2), axis=0)
+
+
+@pytest.mark.parametrize("name", list(TOUCHING))
+@pytest.mark.parametrize("query", ["boolean", "all pairs"])
+@pytest.mark.parametrize("engine", ["refsim-bvh", "fcl-posed"])
+def test_touching(benchmark, fcl, name, query, engine):
+    model_a, model_b, pose_b = TOUCHING[name]
+    mesh_a, mesh_b = refsim.load_model(model_a), refsim.load_model(model_b)
+    pose_a = (np.eye(3), np.zeros(3))
+    expected = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, method="seed",
+                                  kernel="readable")
+    benchmark.group = f"touching, poses set per query: {name}, {query}"
+    if engine == "fcl-posed":
+        posed = PosedFCL(fcl, mesh_a, mesh_b)
+        query_fn = posed.collide if query == "boolean" else posed.intersecting_pairs
+    else:
+        query_fn = bodies_collide if query == "boolean" else intersecting_pairs
+        query_fn = functools.partial(query_fn, mesh_a, mesh_b=mesh_b)
+    run = lambda: query_fn(pose_a=pose_a, pose_b=pose_b)  # noqa: E731
+    run()                                     # compile / build the trees outside the timing
+    answer = benchmark(run)
+    assert len(expected) > 0
+    if query == "boolean":
+        assert answer is True
+    else:
+        assert np.array_equal(answer, expected)   # FCL included: the same pairs here
 
 
 @pytest.mark.parametrize("name", list(APART) + list(CASES))

@@ -188,9 +188,10 @@ def test_margin_is_enough_with_node_axes_off_orthonormal():
     assert hits >= 12
 
 
-def test_touching_pairs_go_through_the_readable_kernel():
+def test_touching_pairs_go_through_the_exact_stage():
     """Cubes sharing a face: every float certificate fails, the pairs come
-    back uncertain and the readable exact kernel answers them."""
+    back uncertain and the exact stage answers them (the compiled one,
+    tests/collision/test_numba_exact.py)."""
     touching = (np.eye(3), np.array([1.0, 0.0, 0.0]))
     found, uncertain = bvh_exact.query_compiled(CUBE, IDENTITY, CUBE, touching,
                                                 bvh_exact.ALL_HITS)
