@@ -338,7 +338,6 @@ def descend(mesh_a, pose_a, mesh_b, pose_b, *,
 
 
 @functools.cache
-@functools.cache
 def _compiled():
     """The compiled ``exact_query``, or None without numba (looked up once:
     a query costs a few microseconds, and an import statement a fraction)."""
