@@ -315,9 +315,20 @@ def _conform(args) -> int:
     if args.only is not None and args.only not in CAPABILITIES:
         raise OptionError(f"--only {args.only!r}: not a capability (capabilities: "
                           f"{', '.join(CAPABILITIES)})")
+    if (args.workers is not None or args.scheduler is not None) and not args.all:
+        raise OptionError("--workers and --scheduler run the engines of --all side by side; "
+                          "one engine runs in this process")
+    if args.workers is not None and args.scheduler is not None:
+        raise OptionError("give --workers (local processes) or --scheduler (a Dask "
+                          "cluster), not both")
     if args.all:
+        backend = ("dask" if args.scheduler is not None
+                   else "processes" if args.workers is not None else None)
+        workers = None if args.workers is None else check_count("--workers", args.workers, 1)
         make_directory(out)
-        matrix, results = run_matrix(cases=cases, seed=seed, out_dir=out, only=args.only)
+        matrix, results = run_matrix(cases=cases, seed=seed, out_dir=out, only=args.only,
+                                     backend=backend, workers=workers,
+                                     scheduler=args.scheduler)
         print(matrix.table())
         for name, reason in matrix.unavailable.items():
             print(f"refsim: warning: {name} not run: {one_line(reason)}", file=sys.stderr)
@@ -375,6 +386,12 @@ def _add_conform_command(commands) -> None:
     conform.add_argument("--only", metavar="CAPABILITY",
                          help="check one capability: triangles, pairs, collide, aabb, ode "
                               "or rigid")
+    conform.add_argument("--workers", type=int, metavar="N",
+                         help="with --all: run the engines on N local processes (each builds "
+                              "the same seeded cases; the cells are the same)")
+    conform.add_argument("--scheduler", metavar="ADDRESS",
+                         help="with --all: run the engines on a Dask cluster, e.g. "
+                              "tcp://host:8786 (pip install 'refsim[sweep]')")
     conform.add_argument("--expected-failures", metavar="FILE",
                          help="declared divergences, one a line: "
                               "'capability.check[class,...]  reason'")

@@ -89,6 +89,33 @@ def test_all_runs_the_shipped_engines_with_a_capability(tmp_path, capsys):
     assert 'href="refsim-corrected/index.html"' in (out / "index.html").read_text()
 
 
+def test_all_on_two_local_processes_gives_the_same_cells(tmp_path, capsys):
+    cells = []
+    for extra in ([], ["--workers", "2"]):
+        out = tmp_path / ("serial" if not extra else "workers")
+        assert main(["conform", "--all", "--only", "aabb", "--cases", "15", "-o", str(out),
+                     *extra]) == 0
+        matrix = json.loads((out / "matrix.json").read_text())
+        cells.append({check: {engine: (cell["status"], cell.get("passed"), cell.get("cases"))
+                              for engine, cell in row.items()}
+                      for check, row in matrix["cells"].items()})
+    capsys.readouterr()
+    assert cells[0] == cells[1]
+    assert set(cells[0]["aabb.encloses"]) == {"refsim-seed", "refsim-corrected", "trimesh"}
+    assert cells[0]["aabb.encloses"]["refsim-seed"] == ("passed", 15, 15)
+
+
+@pytest.mark.parametrize("args, phrase", [
+    (["refsim.engines.refsim_engines:corrected", "--workers", "2"], "run the engines of --all"),
+    (["--all", "--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "not both"),
+    (["--all", "--workers", "0"], "--workers"),
+])
+def test_workers_and_scheduler_are_for_all_and_exclusive(tmp_path, capsys, args, phrase):
+    assert main(["conform", *args, "-o", str(tmp_path / "x")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith("refsim: error: ") and phrase in err and err.count("\n") == 1
+
+
 def test_console_script_in_a_fresh_interpreter(tmp_path):
     result = subprocess.run([sys.executable, "-m", "refsim.cli", "conform", "nope:thing",
                              "-o", str(tmp_path / "x")], capture_output=True, text=True)
