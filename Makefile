@@ -17,7 +17,7 @@ $(STAMP): pyproject.toml
 test: $(STAMP)
 	$(BIN)/python -m pytest tests properties --benchmark-disable -n auto
 
-# mypy over the package; pyproject.toml's [tool.mypy] lists what is not yet clean.
+# mypy over the whole package (configuration: pyproject.toml's [tool.mypy]).
 typecheck: $(STAMP)
 	$(BIN)/mypy refsim
 
