@@ -43,7 +43,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from tests.fuzz.judge import Failure, exception_name, hang_site, innermost_frame
-from tests.fuzz.runner import DUMP_GRACE, ENV, ROOT, die_with_parent
+from tests.fuzz.runner import (
+    DUMP_GRACE,
+    ENV,
+    ROOT,
+    close_quietly,
+    die_with_parent,
+    stop_server,
+)
 
 #: Bytes a probe may map beyond what the worker maps after its prelude:
 #: more than any honest call with the fixtures needs, far less than "GB".
@@ -111,6 +118,16 @@ PARTIAL_NPZ = os.path.join(TMP, "partial.npz"); np.savez(PARTIAL_NPZ, t=np.zeros
 PICKLE_NPZ = os.path.join(TMP, "pickle.npz"); np.savez(PICKLE_NPZ, t=np.array([{}], dtype=object))
 JUNK_NPZ = _file("junk.npz", b"not a zip file")
 FIFO_NPZ = _node("pipe.npz", os.mkfifo)
+
+# Compile the kernels the probes reach (or load them from numba's cache)
+# before the worker says it is ready: a first compilation takes tens of
+# seconds on a cold cache and must not count against a probe's timeout.
+_TOUCH = (np.eye(3), np.array([1.0, 0.0, 0.0]))
+bodies_collide(CUBE, ID, CUBE, _TOUCH)
+for _method in ("bvh", "seed"):
+    intersecting_pairs(CUBE, ID, CUBE, _TOUCH, method=_method)
+aabb_linear(CUBE, ID), IncrementalAABB(CUBE).update(ID)
+ParticleSystem(ParticleConfig(count=2)).run(1)
 
 def body_scene(model="sphere-2k.ac", **body):
     """Two bodies of one model, head on, with ``body``'s keys on both."""
@@ -321,25 +338,11 @@ class ProbeRunner:
                             stack=stack, seconds=time.monotonic() - start)
 
     def _close_pipes(self) -> None:
-        """Close this side of the worker's pipes and its log (a replaced
-        worker's would otherwise stay open until the interpreter exits)."""
-        for stream in (self._process.stdin, self._process.stdout, self._err):
-            try:
-                stream.close()
-            except OSError:                   # a pipe whose reader is gone
-                pass
+        close_quietly(self._process.stdin, self._process.stdout, self._err)
 
     def close(self) -> None:
-        if self._process is not None and self._process.poll() is None:
-            try:
-                self._process.stdin.close()
-            except OSError:
-                pass
-            try:
-                self._process.wait(10)
-            except subprocess.TimeoutExpired:
-                self._process.kill()
-                self._process.wait()
+        if self._process is not None:
+            stop_server(self._process)
         self._close_pipes()
         shutil.rmtree(self._base, ignore_errors=True)
 

@@ -128,6 +128,30 @@ def terminal_signals() -> None:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
+def close_quietly(*streams) -> None:
+    """Close this side of a server's pipes and logs (a replaced server's
+    would otherwise stay open until the interpreter exits); a pipe whose
+    reader is gone may refuse to flush, which is no error here."""
+    for stream in streams:
+        try:
+            stream.close()
+        except OSError:
+            pass
+
+
+def stop_server(process: subprocess.Popen) -> None:
+    """End a server that reads requests from its stdin: close that, wait a
+    little, kill it if it is still there."""
+    if process.poll() is not None:
+        return
+    close_quietly(process.stdin)
+    try:
+        process.wait(10)
+    except subprocess.TimeoutExpired:
+        process.kill()
+        process.wait()
+
+
 def die_with_parent() -> None:
     """Have the kernel SIGKILL this process when its parent dies (Linux
     ``prctl(PR_SET_PDEATHSIG)``; elsewhere nothing): a campaign stopped by
@@ -333,24 +357,9 @@ class ForkServer:
                        _read(command.stderr), time.monotonic() - start)
 
     def _close_pipes(self) -> None:
-        """Close this side of the server's pipes (a replaced server's would
-        otherwise stay open until the interpreter exits)."""
-        for stream in (self._process.stdin, self._process.stdout):
-            try:
-                stream.close()
-            except OSError:                   # a pipe whose reader is gone
-                pass
+        close_quietly(self._process.stdin, self._process.stdout)
 
     def close(self) -> None:
-        if self._process is not None and self._process.poll() is None:
-            try:
-                self._process.stdin.close()
-            except OSError:
-                pass
-            try:
-                self._process.wait(10)
-            except subprocess.TimeoutExpired:
-                self._process.kill()
-                self._process.wait()
         if self._process is not None:
+            stop_server(self._process)
             self._close_pipes()

@@ -52,6 +52,7 @@ def warm_up() -> None:
 
     from refsim.bundled import bundled_models, bundled_scenes
     from refsim.cli import main
+    from tests.fuzz.corpus import long_polygon_ac3d
 
     with tempfile.TemporaryDirectory(prefix="refsim-zygote-") as tmp:
         saved = os.dup(1), os.dup(2)
@@ -62,6 +63,10 @@ def warm_up() -> None:
             for scene in bundled_scenes():
                 main(["run", str(scene), "-o", f"{tmp}/warm.npz", "--duration", "0.004"])
             main(["info", str(bundled_models()[0])])
+            # a star polygon: the compiled ear clipper (long_polygon mutants)
+            with open(f"{tmp}/star.ac", "wb") as star:
+                star.write(long_polygon_ac3d(40, star=True))
+            main(["info", f"{tmp}/star.ac"])
             mesh = trimesh.creation.icosahedron()
             for suffix in (".obj", ".stl", ".ply", ".off"):
                 mesh.export(f"{tmp}/warm{suffix}")
