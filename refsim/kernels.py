@@ -149,4 +149,6 @@ PAIRS: dict[str, tuple[str, str, str]] = {
                               "refsim.collision._numba_kernels:exact_query", MIRRORS),
     "fused Euler particle step": ("refsim.particles.system:ParticleSystem",
                                   "refsim.particles._numba_kernels:euler_step_fused", MIRRORS),
+    "simulation loop": ("refsim.dynamics.simulation:Simulation",
+                        "refsim.dynamics._numba_kernels:advance", MIRRORS),
 }

@@ -69,6 +69,7 @@ from refsim.dynamics.body_response import (
     separate_bodies,
 )
 from refsim.dynamics.boxes import boxes_kernel
+from refsim.dynamics.compiled_loop import CompiledLoop, loop_support
 from refsim.dynamics.forces import translational_rhs
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
 from refsim.dynamics.rotation_impulse import (
@@ -313,6 +314,13 @@ class Simulation:
         self._lambda_max = np.linalg.eigvalsh(self.I_body)[:, -1]
         self._energy_limit = DIVERGENCE_FACTOR * (self._energy_bound().sum()
                                                   + self._energy_scale())
+        # The compiled loop (many steps per call), when the kernel is compiled
+        # and the loop does this scene's choices (loop_support).
+        self.loop_seconds = 0.0
+        self.loop_steps = 0
+        self._loop: CompiledLoop | None = None
+        if self.kernel == "compiled" and loop_support(self) is None:
+            self._loop = CompiledLoop(self)
 
     # -- what the scene needs ----------------------------------------------------------
 
@@ -393,6 +401,8 @@ class Simulation:
             The state became non-finite or its energy grew without bound; the
             frames recorded so far are in ``error.partial``.
         """
+        if self._loop is not None:
+            self._loop.sync_set()     # the contacts of the loop's last step, as a set
         timer = self.timer
         timer.start()
         self._integrate()
@@ -433,10 +443,43 @@ class Simulation:
         n_steps = check_count("n_steps", n_steps, maximum=MAX_STEPS)
         every = check_count("every", every, minimum=1)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            for _ in range(n_steps):
-                self.step()
+            while n_steps:
+                stretch = min(n_steps, every - self.steps % every)   # to the next frame
+                self._advance(stretch)
+                n_steps -= stretch
                 if self.steps % every == 0:
                     self.record()
+
+    def advance(self, n_steps: int) -> None:
+        """Take ``n_steps`` steps and record no frame (:meth:`run` without
+        frames): on the compiled kernel, through the compiled loop where the
+        scene allows it (:attr:`loop`), else one :meth:`step` at a time. The
+        same state, events and frames either way, bit for bit."""
+        n_steps = check_count("n_steps", n_steps, maximum=MAX_STEPS)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            self._advance(n_steps)
+
+    @property
+    def loop(self) -> str | None:
+        """Why :meth:`run` and :meth:`advance` take one step at a time (the
+        scene needs what the compiled loop does not do, or the kernel is
+        the readable one), or None when they run the compiled loop."""
+        if self.kernel != "compiled":
+            return "the readable kernel"
+        return loop_support(self)
+
+    def _advance(self, n_steps: int) -> None:
+        loop = self._loop
+        if loop is None:
+            for _ in range(n_steps):
+                self.step()
+            return
+        while n_steps:
+            done, stop = loop.advance(n_steps)
+            n_steps -= done
+            if stop == loop.STOP_READABLE:
+                self.step()           # a step the loop does not take: the readable stages
+                n_steps -= 1
 
     # 1. forces and the solver, all bodies at once (S5, S6)
     def _integrate(self) -> None:
@@ -610,6 +653,8 @@ class Simulation:
             self.events.append(Event(kind=contact.kind, step=self.steps, time=self.t,
                                      body=contact.body, other=contact.other))
         self._touching = touching
+        if self._loop is not None:
+            self._loop.touching_changed()
 
     # -- frames ---------------------------------------------------------------------------
 
