@@ -92,7 +92,7 @@ BODY_HAND_BACK = 2      # any other: a step with an overlapping pair of boxes go
 @numba.njit(cache=True, nogil=True)
 def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
             restitution, friction, wall_speed_at_wall, half_size, vertices_t, first_vertex,
-            centred, offset, lam, mass, energy_limit, body_mode,
+            centred, center, lam, mass, energy_limit, body_mode,
             x, v, w, R, lo, hi, walls, bodies, events):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation.step`, up to
     ``n_steps`` times, in place; returns ``(steps, events, stop)`` (module
@@ -106,9 +106,10 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
     wall_speed_at_wall : bool (``wall_speed="wall"``, else the seed's)
     vertices_t : (3, N) every body's body-space vertices, body b's in
         columns ``first_vertex[b]:first_vertex[b + 1]`` (int64 (B + 1,))
-    centred : bool, every centroid at its mesh origin (box origin = x);
-        else ``offset`` (B, 3), ``R c`` as the readable step computes it
-        (constant: only with rotation "off")
+    centred : bool, every centroid at its mesh origin (mesh origin = x);
+        else the origin is ``x - R c`` for the body-space centroids ``center``
+        (B, 3), ``R c`` summed left to right
+        (:attr:`Simulation.position`, :func:`refsim.dynamics.products.matvec`)
     lam, mass : (B,) largest principal moment, mass
     body_mode : int (``BODY_*``)
     x, v, w : (B, 3); R : (B, 3, 3); lo, hi : (B, 3) the state and boxes
@@ -126,6 +127,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
     R0 = np.empty((B, 3, 3))
     A = np.empty((3, 3))
     corr = np.empty(3)
+    origin = np.empty((B, 3))
     now_walls = np.zeros((B, 6), np.bool_)
     pairs = np.empty((max(B * (B - 1) // 2, 1), 2), np.int64)
     per_step = 6 * B + B * (B - 1) // 2
@@ -209,6 +211,13 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
         # 4. bounds: the linear scan, r_k = (R_k0 x + R_k1 y) + R_k2 z, + origin
         for b in range(B):
             for k in range(3):
+                if centred:
+                    origin[b, k] = x[b, k]
+                else:
+                    origin[b, k] = x[b, k] - ((R[b, k, 0] * center[b, 0]
+                                               + R[b, k, 1] * center[b, 1])
+                                              + R[b, k, 2] * center[b, 2])
+            for k in range(3):
                 a0, a1, a2 = R[b, k, 0], R[b, k, 1], R[b, k, 2]
                 first = first_vertex[b]
                 least = greatest = (a0 * vertices_t[0, first] + a1 * vertices_t[1, first]) \
@@ -219,9 +228,8 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
                         least = r
                     if r > greatest:
                         greatest = r
-                origin = x[b, k] if centred else x[b, k] - offset[b, k]
-                lo[b, k] = least + origin
-                hi[b, k] = greatest + origin
+                lo[b, k] = least + origin[b, k]
+                hi[b, k] = greatest + origin[b, k]
 
         # 5. walls (S3, S7; S9's spin first with the seed's rotation)
         for b in range(B):
@@ -243,7 +251,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
                     corr[k] = (below if below > 0.0 else 0.0) - (above if above > 0.0 else 0.0)
             if seed_rotation:
                 _wall_spin_seed(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1],
-                                x, v, w, R, restitution, friction)
+                                x, center, v, w, R, restitution, friction)
             # wall_response_seed
             for k in range(3):
                 if corr[k] == 0.0:
@@ -323,9 +331,12 @@ def _restore(x, v, R, x0, v0, R0):
 
 
 @numba.njit(cache=True, nogil=True)
-def _wall_spin_seed(b, corr, vertices_t, first, end, x, v, w, R, restitution, friction):
+def _wall_spin_seed(b, corr, vertices_t, first, end, x, center, v, w, R, restitution,
+                    friction):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation._wall_spin_seed`
-    for a centred body (origin = x): for each crossed wall, the contact vertex
+    (the world vertices under :meth:`~refsim.dynamics.simulation.Simulation.pose`,
+    origin ``x - R c`` summed left to right, also for c = 0): for each
+    crossed wall, the contact vertex
     (:func:`refsim.dynamics.rotation_seed.contact_vertex_seed`: the first
     deepest world vertex) and w += Pi x I
     (:func:`refsim.dynamics.rotation_seed.contact_spin_seed`).
@@ -334,25 +345,32 @@ def _wall_spin_seed(b, corr, vertices_t, first, end, x, v, w, R, restitution, fr
     N a signed unit axis: every product is exact, so the sum is the one
     nonzero product in any order, written here ``((0 + p0) + p1) + p2``.
     """
+    o0 = x[b, 0] - ((R[b, 0, 0] * center[b, 0] + R[b, 0, 1] * center[b, 1])
+                    + R[b, 0, 2] * center[b, 2])
+    o1 = x[b, 1] - ((R[b, 1, 0] * center[b, 0] + R[b, 1, 1] * center[b, 1])
+                    + R[b, 1, 2] * center[b, 2])
+    o2 = x[b, 2] - ((R[b, 2, 0] * center[b, 0] + R[b, 2, 1] * center[b, 1])
+                    + R[b, 2, 2] * center[b, 2])
     for k in range(3):
         if corr[k] == 0.0:
             continue
         low = corr[k] > 0.0
+        o_k = o0 if k == 0 else (o1 if k == 1 else o2)
         # the deepest vertex: world coordinate k = r_k + origin_k, first of ties
         best = 0.0
         index = first
         for q in range(first, end):
             r = ((R[b, k, 0] * vertices_t[0, q] + R[b, k, 1] * vertices_t[1, q])
-                 + R[b, k, 2] * vertices_t[2, q]) + x[b, k]
+                 + R[b, k, 2] * vertices_t[2, q]) + o_k
             if q == first or (r < best if low else r > best):
                 best = r
                 index = q
         P0 = (((R[b, 0, 0] * vertices_t[0, index] + R[b, 0, 1] * vertices_t[1, index])
-               + R[b, 0, 2] * vertices_t[2, index]) + x[b, 0]) - x[b, 0]
+               + R[b, 0, 2] * vertices_t[2, index]) + o0) - x[b, 0]
         P1 = (((R[b, 1, 0] * vertices_t[0, index] + R[b, 1, 1] * vertices_t[1, index])
-               + R[b, 1, 2] * vertices_t[2, index]) + x[b, 1]) - x[b, 1]
+               + R[b, 1, 2] * vertices_t[2, index]) + o1) - x[b, 1]
         P2 = (((R[b, 2, 0] * vertices_t[0, index] + R[b, 2, 1] * vertices_t[1, index])
-               + R[b, 2, 2] * vertices_t[2, index]) + x[b, 2]) - x[b, 2]
+               + R[b, 2, 2] * vertices_t[2, index]) + o2) - x[b, 2]
         N0 = N1 = N2 = 0.0
         sign = 1.0 if low else -1.0
         if k == 0:

@@ -44,10 +44,8 @@ WALLS = tuple("xyz"[k // 2] + "-+"[k % 2] for k in range(6))     # flag index ->
 def loop_support(sim: Simulation) -> str | None:
     """Why the compiled loop cannot run ``sim``'s scene (one line), or None.
 
-    It covers rotation "off" and "seed" (the seed's only for bodies whose
-    centroid is their mesh origin: the readable step then computes their
-    pose without a product that BLAS or ``einsum`` would sum in an order of
-    their own), the seed's wall response (either wall speed), any solver,
+    It covers rotation "off" and "seed", the seed's wall response (either
+    wall speed), any solver,
     linear or quadratic drag, and body-body contacts at every level but
     "sphere" (the seed's exchange at level "aabb" in the loop; any other
     level or response hands the steps with overlapping boxes back).
@@ -56,9 +54,6 @@ def loop_support(sim: Simulation) -> str | None:
         return f"rotation {sim.rotation!r} (the loop does 'off' and 'seed')"
     if sim.wall_response != "seed":
         return f"wall response {sim.wall_response!r} (the loop does the seed's)"
-    if sim.rotation == "seed" and not sim._centred:
-        return ("a body whose centroid is not its mesh origin, with the seed's rotation "
-                "(its pose goes through einsum)")
     if sim.body_body and sim.level == "sphere":
         return "collision level 'sphere' (its broad phase is not the boxes')"
     return None
@@ -87,10 +82,7 @@ class CompiledLoop:
         self.first_vertex = np.zeros(B + 1, np.int64)
         self.first_vertex[1:] = np.cumsum([len(vs) for vs in vertices])
         self.vertices_t = np.ascontiguousarray(np.concatenate(vertices).T)
-        # R c, as Simulation.position computes it; R is constant with rotation "off"
-        # (loop_support), so once is enough.
-        self.offset = (np.zeros((B, 3)) if sim._centred
-                       else np.ascontiguousarray(np.einsum("bij,bj->bi", sim.R, sim.center)))
+        self.center = np.ascontiguousarray(sim.center, dtype=np.float64)
         if not sim.body_body:
             self.body_mode = kernels.BODY_NONE
         elif sim.level == "aabb" and sim.body_response == "seed":
@@ -154,7 +146,7 @@ class CompiledLoop:
             n_steps, sim.h, self.hA, self.hb, world.gravity, self.drag_rate, self.quadratic,
             sim.rotation == "seed", world.restitution, world.friction,
             sim.wall_speed == "wall", world.half_size, self.vertices_t, self.first_vertex,
-            sim._centred, self.offset, sim._lambda_max, sim.mass, sim._energy_limit,
+            sim._centred, self.center, sim._lambda_max, sim.mass, sim._energy_limit,
             self.body_mode, sim.x, sim.v, sim.w, sim.R, sim.lo, sim.hi, self.walls,
             self.bodies, self.events)
         sim.loop_seconds += time.perf_counter() - start

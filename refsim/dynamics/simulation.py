@@ -19,6 +19,14 @@ One step (:meth:`Simulation.step`), as an outline:
 7. narrow-phase the scene's collision level on the pairs that pass (S4);
 8. body-response  the seed's velocity exchange (S8) or the corrected impulse.
 
+On the compiled kernel, :meth:`Simulation.run` and :meth:`Simulation.advance`
+take their steps K at a time in one compiled call
+(:mod:`refsim.dynamics.compiled_loop`, :mod:`refsim.dynamics._numba_kernels`)
+for the choices the loop covers, and hand each step it does not take back to
+:meth:`Simulation.step`; the same state, events and frames, bit for bit. The
+loop's wall time is ``loop_seconds`` (not split into stages), its steps
+``loop_steps``.
+
 Stages 2, 6-8 run only when needed: no rotation work with ``rotation =
 "off"``; no body-body work for one body, ``collision.level = "none"`` or
 ``body_response = "off"``; no narrow phase at level "aabb" (the boxes are
@@ -72,6 +80,7 @@ from refsim.dynamics.boxes import boxes_kernel
 from refsim.dynamics.compiled_loop import CompiledLoop, loop_support
 from refsim.dynamics.forces import translational_rhs
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
+from refsim.dynamics.products import matvec
 from refsim.dynamics.rotation_impulse import (
     orientation_step_exact,
     wall_contacts,
@@ -342,10 +351,12 @@ class Simulation:
 
     @property
     def position(self) -> np.ndarray:
-        """(B, 3) reference points (mesh origins): ``x - R c``."""
+        """(B, 3) reference points (mesh origins): ``x - R c``, ``R c`` summed
+        left to right (:func:`refsim.dynamics.products.matvec`, no einsum or
+        BLAS: the same bits on every machine and in the compiled loop)."""
         if self._centred:
             return self.x.copy()
-        return self.x - np.einsum("bij,bj->bi", self.R, self.center)
+        return self.x - matvec(self.R, self.center)
 
     @property
     def velocity(self) -> np.ndarray:
@@ -361,7 +372,7 @@ class Simulation:
 
     def pose(self, i: int) -> tuple[np.ndarray, np.ndarray]:
         """Body i's pose ``(R, origin)``, for the collision and box functions."""
-        return self.R[i], self.x[i] - self.R[i] @ self.center[i]
+        return self.R[i], self.x[i] - matvec(self.R[i], self.center[i])
 
     def world_vertices(self, i: int) -> np.ndarray:
         return transform_vertices(self.bodies[i].mesh.vertices, self.pose(i))

@@ -68,20 +68,23 @@ def test_quadratic_drag_euler_and_the_seeds_wall_speed_bit_for_bit():
     assert any(e.kind == "wall" for e in compiled.events)
 
 
-def test_sphere_off_centre_bit_for_bit():
+@pytest.mark.parametrize("rotation", ["off", "seed"])
+def test_sphere_off_centre_bit_for_bit(rotation):
     # the 2000-triangle sphere's vertex average is ~1e-16 off its origin: the
-    # loop takes the readable R c once (rotation "off")
+    # mesh origin is x - R c, in the loop as in the readable step
     scene = scene_from_dict({
         "world": {"half_size": 2.0, "restitution": 0.9, "friction": 0.2},
         "integration": {"step": 1e-3, "duration": 1.0},
-        "collision": {"level": "none"}, "dynamics": {"rotation": "off"},
+        "collision": {"level": "none"}, "dynamics": {"rotation": rotation},
         "body": [{"name": "ball", "model": "sphere-2k.ac", "position": [0.3, 0.5, -0.2],
-                  "velocity": [4.0, -2.0, 3.0]}]})
+                  "velocity": [4.0, -2.0, 3.0], "angular_velocity": [1.0, 2.0, -3.0]}]})
     readable, compiled = _pair(scene, 1500, every=50)
     assert compiled.loop is None and compiled.loop_steps == 1500
     assert not compiled._centred
     _assert_same(readable, compiled)
     assert len({e.other for e in compiled.events}) >= 3          # several walls
+    if rotation == "seed":
+        assert not np.array_equal(compiled.R[0], np.eye(3))
 
 
 def test_spinning_cube_scene_bit_for_bit():
