@@ -18,10 +18,11 @@ What it runs (one step, the stages of the readable outline, same order):
                 axes with Gram-Schmidt:
                 :func:`refsim.dynamics.rotation_seed.orientation_step_seed_loops`;
 3. check        the energy bound, conservatively (below);
-4. bounds       the linear scan of every body's vertices:
-                :func:`refsim.dynamics.boxes.boxes_loops` (the incremental
-                tracker gives the same boxes on a convex mesh, bit for bit:
-                ``Simulation``'s ``boxes`` option);
+4. bounds       the linear scan of a body's vertices
+                (:func:`refsim.dynamics.boxes.boxes_loops`), or the
+                incremental walk for the bodies the readable step gives a
+                tracker (:meth:`Simulation._bounds`): the same boxes, bit
+                for bit, either way (``Simulation``'s ``boxes`` option);
 5. walls        :func:`refsim.bounds.world_cube.world_cube_test`'s correction,
                 then the seed's response,
                 :func:`refsim.dynamics.walls.wall_response_seed`, after S9's
@@ -76,6 +77,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from refsim.bounds._numba_kernels import incremental_update_numba
+
 #: The kernel took every step it was asked for.
 DONE = 0
 #: The next step needs the readable step (state restored to its start).
@@ -93,7 +96,8 @@ BODY_HAND_BACK = 2      # any other: a step with an overlapping pair of boxes go
 def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
             restitution, friction, wall_speed_at_wall, half_size, vertices_t, first_vertex,
             centred, center, lam, mass, energy_limit, body_mode,
-            x, v, w, R, lo, hi, walls, bodies, events):
+            x, v, w, R, lo, hi, walls, bodies, events, tracked, tracker_rows, trackers_f,
+            trackers_i):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation.step`, up to
     ``n_steps`` times, in place; returns ``(steps, events, stop)`` (module
     docstring: the readable function of each stage, and the hand-back).
@@ -115,6 +119,13 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
     x, v, w : (B, 3); R : (B, 3, 3); lo, hi : (B, 3) the state and boxes
     walls : (B, 6) bool; bodies : (B, B) bool (the contacts, read and written)
     events : (capacity, 4) int64
+    tracked : (B,) int64, the row of ``tracker_rows`` of a body whose box
+        comes from its incremental tracker (the walk of
+        :func:`refsim.bounds._numba_kernels.incremental_update_numba`: the
+        scan's box on a convex mesh, bit for bit), or -1 (the linear scan)
+    tracker_rows : (T, 14) int64, where each tracker's arrays start in the
+        flat ``trackers_f`` (float64) and ``trackers_i`` (int64) (``T_*``;
+        :class:`refsim.dynamics.compiled_loop.CompiledLoop` lays them out)
     """
     B = x.shape[0]
     s = hb.shape[0]
@@ -217,6 +228,10 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
                     origin[b, k] = x[b, k] - ((R[b, k, 0] * center[b, 0]
                                                + R[b, k, 1] * center[b, 1])
                                               + R[b, k, 2] * center[b, 2])
+            if tracked[b] >= 0:
+                _tracker_update(tracker_rows[tracked[b]], trackers_f, trackers_i, R[b],
+                                origin[b], lo[b], hi[b])
+                continue
             for k in range(3):
                 a0, a1, a2 = R[b, k, 0], R[b, k, 1], R[b, k, 2]
                 first = first_vertex[b]
@@ -318,6 +333,37 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
                             n_events += 1
                     bodies[i, j] = now
     return n_steps, n_events, DONE
+
+
+#: Columns of ``tracker_rows`` (one row per tracked body): the number of
+#: vertices n, then where each of the tracker's arrays starts in the flat
+#: float (XYZ, VALUE, TIE) and int (the others) arrays.
+T_N, T_XYZ, T_VALUE, T_TIE, T_OFFSETS, T_INDICES, T_INDICES_END, T_EXTREMES, T_STAMP, \
+    T_TOUCHED, T_SEEN, T_QUEUE, T_GENERATION, T_COUNTS = range(14)
+
+
+@numba.njit(cache=True, nogil=True)
+def _tracker_update(row, trackers_f, trackers_i, rotation, translation, lo, hi):
+    """One incremental box update of a tracked body, its arrays slices of
+    the flat ones: :func:`incremental_update_numba`, which mirrors
+    :meth:`refsim.bounds.aabb_incremental.IncrementalAABB.update`."""
+    n = row[T_N]
+    f, i = trackers_f, trackers_i
+    incremental_update_numba(
+        f[row[T_XYZ]:row[T_XYZ] + 3 * n].reshape(3, n),
+        i[row[T_OFFSETS]:row[T_OFFSETS] + n + 1],
+        i[row[T_INDICES]:row[T_INDICES_END]],
+        rotation, translation,
+        i[row[T_EXTREMES]:row[T_EXTREMES] + 6].reshape(2, 3),
+        f[row[T_TIE]],
+        f[row[T_VALUE]:row[T_VALUE] + 3 * n].reshape(3, n),
+        i[row[T_STAMP]:row[T_STAMP] + 3 * n].reshape(3, n),
+        i[row[T_TOUCHED]:row[T_TOUCHED] + n],
+        i[row[T_SEEN]:row[T_SEEN] + n],
+        i[row[T_QUEUE]:row[T_QUEUE] + n],
+        i[row[T_GENERATION]:row[T_GENERATION] + 2],
+        i[row[T_COUNTS]:row[T_COUNTS] + 2],
+        lo, hi)
 
 
 @numba.njit(cache=True, nogil=True)

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from refsim.bounds.aabb_incremental import IncrementalAABB
 from refsim.dynamics.trajectory import Event
 
 if TYPE_CHECKING:
@@ -83,6 +84,7 @@ class CompiledLoop:
         self.first_vertex[1:] = np.cumsum([len(vs) for vs in vertices])
         self.vertices_t = np.ascontiguousarray(np.concatenate(vertices).T)
         self.center = np.ascontiguousarray(sim.center, dtype=np.float64)
+        self._lay_out_trackers()
         if not sim.body_body:
             self.body_mode = kernels.BODY_NONE
         elif sim.level == "aabb" and sim.body_response == "seed":
@@ -95,6 +97,56 @@ class CompiledLoop:
         self._index = {name: i for i, name in enumerate(sim.names)}
         self._flags_stale = False        # the set changed since the flags were built
         self._set_stale = False          # the flags changed since the set was built
+
+    def _lay_out_trackers(self) -> None:
+        """The incremental trackers of the bodies that have one (the readable
+        step's ``_tracked`` bodies with a convex mesh), as slices of two flat
+        arrays (:data:`refsim.dynamics._numba_kernels.T_N` and on). The loop's
+        walks keep their own extremes and stamps: a walk from any start
+        finds the same box."""
+        sim, k = self.sim, self.kernels
+        self.tracked = np.full(len(sim.bodies), -1, np.int64)
+        rows: list[list[int]] = []
+        floats: list[np.ndarray] = []
+        ints: list[np.ndarray] = []
+        n_f = n_i = 0
+
+        def put(chunks: list[np.ndarray], array, size: int, start: int) -> int:
+            chunks.append(np.ascontiguousarray(array).ravel())
+            assert chunks[-1].size == size
+            return start + size
+
+        for b in sim._tracked:
+            tracker = sim.bodies[b].tracker
+            if not isinstance(tracker, IncrementalAABB):
+                continue                              # the linear scan, in the loop
+            mesh = sim.bodies[b].mesh
+            n = mesh.n_vertices
+            row = [0] * 14
+            row[k.T_N] = n
+            row[k.T_XYZ] = n_f
+            n_f = put(floats, mesh.vertices.T.astype(np.float64), 3 * n, n_f)
+            row[k.T_VALUE] = n_f
+            n_f = put(floats, np.zeros(3 * n), 3 * n, n_f)
+            row[k.T_TIE] = n_f
+            n_f = put(floats, np.array([tracker.tie_window], np.float64), 1, n_f)
+            row[k.T_OFFSETS] = n_i
+            n_i = put(ints, mesh.neighbor_offsets.astype(np.int64), n + 1, n_i)
+            row[k.T_INDICES] = n_i
+            n_indices = len(mesh.neighbor_indices)
+            n_i = put(ints, mesh.neighbor_indices.astype(np.int64), n_indices, n_i)
+            row[k.T_INDICES_END] = n_i
+            row[k.T_EXTREMES] = n_i
+            n_i = put(ints, np.full(6, -1, np.int64), 6, n_i)       # no frame yet
+            for column, size in ((k.T_STAMP, 3 * n), (k.T_TOUCHED, n), (k.T_SEEN, n),
+                                 (k.T_QUEUE, n), (k.T_GENERATION, 2), (k.T_COUNTS, 2)):
+                row[column] = n_i
+                n_i = put(ints, np.zeros(size, np.int64), size, n_i)
+            self.tracked[b] = len(rows)
+            rows.append(row)
+        self.tracker_rows = np.array(rows, np.int64).reshape(-1, 14)
+        self.trackers_f = np.concatenate(floats) if floats else np.zeros(1)
+        self.trackers_i = np.concatenate(ints) if ints else np.zeros(1, np.int64)
 
     # -- contacts: the set of the readable step <-> the loop's flags -----------------------
 
@@ -148,7 +200,8 @@ class CompiledLoop:
             sim.wall_speed == "wall", world.half_size, self.vertices_t, self.first_vertex,
             sim._centred, self.center, sim._lambda_max, sim.mass, sim._energy_limit,
             self.body_mode, sim.x, sim.v, sim.w, sim.R, sim.lo, sim.hi, self.walls,
-            self.bodies, self.events)
+            self.bodies, self.events, self.tracked, self.tracker_rows, self.trackers_f,
+            self.trackers_i)
         sim.loop_seconds += time.perf_counter() - start
         if done:
             self._note_events(n_events)

@@ -81,6 +81,7 @@ def test_sphere_off_centre_bit_for_bit(rotation):
     readable, compiled = _pair(scene, 1500, every=50)
     assert compiled.loop is None and compiled.loop_steps == 1500
     assert not compiled._centred
+    assert compiled._loop is not None and compiled._loop.tracked.tolist() == [0]  # the walk
     _assert_same(readable, compiled)
     assert len({e.other for e in compiled.events}) >= 3          # several walls
     if rotation == "seed":
