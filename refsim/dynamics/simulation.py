@@ -470,6 +470,29 @@ class Simulation:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             self._advance(n_steps)
 
+    def snapshot(self) -> dict:
+        """The state to come back to with :meth:`restore`: copies of ``x``,
+        ``v``, ``w``, ``R``, the boxes, ``t``, ``steps``, the contacts and
+        the number of events (frames already recorded are not part of it).
+        Steps from a restored snapshot repeat the same bits (a box tracker's
+        starting vertices may differ; its boxes do not)."""
+        if self._loop is not None:
+            self._loop.sync_set()
+        return {"x": self.x.copy(), "v": self.v.copy(), "w": self.w.copy(),
+                "R": self.R.copy(), "lo": self.lo.copy(), "hi": self.hi.copy(),
+                "t": self.t, "steps": self.steps, "events": len(self.events),
+                "touching": set(self._touching)}
+
+    def restore(self, snapshot: dict) -> None:
+        """Go back to a :meth:`snapshot` of this simulation (in place)."""
+        for name in ("x", "v", "w", "R", "lo", "hi"):
+            getattr(self, name)[...] = snapshot[name]
+        self.t, self.steps = snapshot["t"], snapshot["steps"]
+        del self.events[snapshot["events"]:]
+        self._touching = set(snapshot["touching"])
+        if self._loop is not None:
+            self._loop.touching_changed()
+
     @property
     def loop(self) -> str | None:
         """Why :meth:`run` and :meth:`advance` take one step at a time (the

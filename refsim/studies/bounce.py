@@ -642,6 +642,40 @@ def cubes_scene(count: int, rotation: str = "off", *, seed: int = BENCH_SEED,
     })
 
 
+#: The step-cost benchmark's bodies (tests/benchmarks/test_bench_dynamics.py):
+#: cubes on a grid (:func:`cubes_scene`) and one 2000-triangle sphere
+#: (:func:`sphere_scene`); rotation models; steps to a settled state.
+BENCH_BODIES = ("1 cube", "10 cubes", "40 cubes", "sphere-2k")
+BENCH_ALL_ROTATIONS = ("off", "seed", "impulse")
+SETTLE_STEPS = {"cubes": LATE_WARMUP, "sphere": 10_000}
+
+
+def sphere_scene(rotation: str = "off", *, step: float = STEP, duration: float = 20.0,
+                 solver: str = SOLVER):
+    """One 2000-triangle sphere (:data:`SPHERE`) thrown from the centre of the
+    world cube at (2, 1, -1.5) m/s, with :func:`cubes_scene`'s world (e = 0.8,
+    friction 0.1), collision level "aabb"; it rests on the floor after about
+    10 s."""
+    from refsim.scenes.loader import scene_from_dict
+
+    return scene_from_dict({
+        "world": {"half_size": HALF_SIZE, "gravity": GRAVITY, "restitution": 0.8,
+                  "friction": 0.1},
+        "integration": {"solver": solver, "step": step, "duration": duration},
+        "collision": {"level": "aabb"},
+        "dynamics": {"rotation": rotation, "body_response": "seed"},
+        "body": [{"name": "ball", "model": SPHERE, "position": [0.0, 0.0, 0.0],
+                  "velocity": [2.0, 1.0, -1.5]}],
+    })
+
+
+def bench_scene(bodies: str, rotation: str):
+    """The scene of one of :data:`BENCH_BODIES` and its settling steps."""
+    if bodies == "sphere-2k":
+        return sphere_scene(rotation), SETTLE_STEPS["sphere"]
+    return cubes_scene(int(bodies.split()[0]), rotation), SETTLE_STEPS["cubes"]
+
+
 @dataclass(frozen=True)
 class StepCost:
     """Mean seconds per step of one scene: refsim's ``Simulation.step()``
