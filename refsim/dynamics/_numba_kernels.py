@@ -135,6 +135,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
     K = np.empty((s, 2 * d))
     x0 = np.empty((B, 3))
     v0 = np.empty((B, 3))
+    w0 = np.empty((B, 3))
     R0 = np.empty((B, 3, 3))
     A = np.empty((3, 3))
     corr = np.empty(3)
@@ -151,6 +152,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
             for k in range(3):
                 x0[b, k] = x[b, k]
                 v0[b, k] = v[b, k]
+                w0[b, k] = w[b, k]
                 for j in range(3):
                     R0[b, k, j] = R[b, k, j]
 
@@ -216,7 +218,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
             total += 0.5 * (mass[b] * vv + lam[b] * ww) \
                 + mass[b] * gravity * (x[b, 1] + half_size)
         if not (total <= 0.5 * energy_limit):
-            _restore(x, v, R, x0, v0, R0)
+            _restore(x, v, w, R, x0, v0, w0, R0)
             return step, n_events, STOP_READABLE
 
         # 4. bounds: the linear scan, r_k = (R_k0 x + R_k1 y) + R_k2 z, + origin
@@ -301,7 +303,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
                         pairs[n_pairs, 1] = j
                         n_pairs += 1
             if n_pairs and body_mode == BODY_HAND_BACK:
-                _restore(x, v, R, x0, v0, R0)        # the readable step redoes this one
+                _restore(x, v, w, R, x0, v0, w0, R0)        # the readable step redoes this one
                 return step, n_events, STOP_READABLE
         # the wall contacts that began (committed only now: a hand-back above
         # leaves the previous step's flags)
@@ -367,11 +369,13 @@ def _tracker_update(row, trackers_f, trackers_i, rotation, translation, lo, hi):
 
 
 @numba.njit(cache=True, nogil=True)
-def _restore(x, v, R, x0, v0, R0):
+def _restore(x, v, w, R, x0, v0, w0, R0):
+    """The state at the start of the step (the wall stage's S9 spin changes w)."""
     for b in range(x.shape[0]):
         for k in range(3):
             x[b, k] = x0[b, k]
             v[b, k] = v0[b, k]
+            w[b, k] = w0[b, k]
             for j in range(3):
                 R[b, k, j] = R0[b, k, j]
 
