@@ -163,3 +163,24 @@ def test_bundled_scenes_bit_for_bit(name):
     assert compiled.loop is None and compiled.loop_steps > 0
     _assert_same(readable, compiled)
     assert len(compiled.events) >= 1
+
+
+@pytest.mark.parametrize("rotation", ["off", "seed"])
+def test_cubes_at_level_exact_hand_back_bit_for_bit(rotation):
+    # the 40 cubes' contacts, found exactly: every step with overlapping
+    # boxes goes back to the readable stages, walls and spin included
+    scene = cubes_scene(40, rotation, seed=9)
+    scene = replace(scene, collision=replace(scene.collision, level="exact"))
+    readable, compiled = _pair(scene, 800, every=9)
+    assert compiled.loop is None and 0 < compiled.loop_steps < 800
+    _assert_same(readable, compiled)
+    assert {e.kind for e in compiled.events} == {"wall", "body"}
+
+
+def test_box_trackers_in_the_loop_bit_for_bit():
+    # boxes="trackers": each cube's incremental walk, in the loop as in the step
+    scene = cubes_scene(10, "seed", seed=10)
+    readable, compiled = _pair(scene, 2500, every=11, boxes="trackers")
+    assert compiled._loop is not None and (compiled._loop.tracked >= 0).all()
+    _assert_same(readable, compiled)
+    assert any(e.kind == "wall" for e in compiled.events)
