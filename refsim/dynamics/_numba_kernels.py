@@ -321,6 +321,9 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
             for p in range(n_pairs):
                 a, c = pairs[p, 0], pairs[p, 1]
                 _exchange_seed(a, c, x, v)
+        # the body contacts of this step (none when the hand-back mode got
+        # here): contacts that ended are cleared, those that began noted
+        if body_mode != BODY_NONE:
             q = 0
             for i in range(B):
                 for j in range(i + 1, B):
