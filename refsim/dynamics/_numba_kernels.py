@@ -268,7 +268,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
                     corr[k] = (below if below > 0.0 else 0.0) - (above if above > 0.0 else 0.0)
             if seed_rotation:
                 _wall_spin_seed(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1],
-                                x, center, v, w, R, restitution, friction)
+                                x, center, v, w, R, lo, hi, restitution, friction)
             # wall_response_seed
             for k in range(3):
                 if corr[k] == 0.0:
@@ -384,8 +384,8 @@ def _restore(x, v, w, R, x0, v0, w0, R0):
 
 
 @numba.njit(cache=True, nogil=True)
-def _wall_spin_seed(b, corr, vertices_t, first, end, x, center, v, w, R, restitution,
-                    friction):
+def _wall_spin_seed(b, corr, vertices_t, first, end, x, center, v, w, R, lo, hi,
+                    restitution, friction):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation._wall_spin_seed`
     (the world vertices under :meth:`~refsim.dynamics.simulation.Simulation.pose`,
     origin ``x - R c`` summed left to right, also for c = 0): for each
@@ -409,15 +409,27 @@ def _wall_spin_seed(b, corr, vertices_t, first, end, x, center, v, w, R, restitu
             continue
         low = corr[k] > 0.0
         o_k = o0 if k == 0 else (o1 if k == 1 else o2)
-        # the deepest vertex: world coordinate k = r_k + origin_k, first of ties
-        best = 0.0
-        index = first
+        # The deepest vertex: the first whose world coordinate r_k + origin_k
+        # is least (greatest). The box's lo_k (hi_k) is that least value, from
+        # the same r_k and origin (rounding is monotone: min(r) + o is the
+        # least r + o; the origins differ at most in the sign of a zero, which
+        # == ignores), so the scan stops at the first vertex that reaches it.
+        target = lo[b, k] if low else hi[b, k]
+        index = -1
         for q in range(first, end):
             r = ((R[b, k, 0] * vertices_t[0, q] + R[b, k, 1] * vertices_t[1, q])
                  + R[b, k, 2] * vertices_t[2, q]) + o_k
-            if q == first or (r < best if low else r > best):
-                best = r
+            if r == target:
                 index = q
+                break
+        if index < 0:                # not reached (cannot happen): argmin / argmax
+            best = 0.0
+            for q in range(first, end):
+                r = ((R[b, k, 0] * vertices_t[0, q] + R[b, k, 1] * vertices_t[1, q])
+                     + R[b, k, 2] * vertices_t[2, q]) + o_k
+                if index < 0 or (r < best if low else r > best):
+                    best = r
+                    index = q
         P0 = (((R[b, 0, 0] * vertices_t[0, index] + R[b, 0, 1] * vertices_t[1, index])
                + R[b, 0, 2] * vertices_t[2, index]) + o0) - x[b, 0]
         P1 = (((R[b, 1, 0] * vertices_t[0, index] + R[b, 1, 1] * vertices_t[1, index])
