@@ -151,4 +151,6 @@ PAIRS: dict[str, tuple[str, str, str]] = {
                              "refsim.collision._numba_exact:triangle_vs_triangle", MIRRORS),
     "fused particle steps": ("refsim.particles.system:ParticleSystem",
                              "refsim.particles._numba_kernels:rk_steps_fused", MIRRORS),
+    "simulation loop": ("refsim.dynamics.simulation:Simulation",
+                        "refsim.dynamics._numba_kernels:advance", MIRRORS),
 }

@@ -140,6 +140,19 @@ def _particles(kernel):
     return out
 
 
+def _simulation_loop(kernel):
+    from refsim.dynamics.simulation import Simulation
+    from refsim.studies.bounce import cubes_scene
+
+    out = []
+    for rotation in ("off", "seed"):
+        sim = Simulation(cubes_scene(12, rotation, seed=8), kernel=kernel)
+        sim.advance(1500)
+        events = [(e.kind, e.step, e.time, e.body, e.other) for e in sim.events]
+        out.append((sim.x, sim.v, sim.w, sim.R, events))
+    return out
+
+
 #: The cases of each registry entry, run with each kernel.
 CASES = {
     "broad-phase sweep": _broad_phase,
@@ -155,6 +168,7 @@ CASES = {
     "exact hierarchy query": _exact_hierarchy,
     "exact triangle stage": _exact_stage,
     "fused particle steps": _particles,
+    "simulation loop": _simulation_loop,
 }
 
 

@@ -59,6 +59,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from refsim.dynamics.products import dot, norm
+
 #: Extra separation after the positional correction, relative to the bodies'
 #: size (the sum of their projection extents along n): the exact collision
 #: test counts touching as colliding, so bodies left exactly touching would
@@ -70,12 +72,15 @@ SEPARATION_SLOP = 1e-9
 def exchange_velocities_seed(c_a, c_b, v_a, v_b) -> tuple[np.ndarray, np.ndarray, bool]:
     """The seed's response: ``(v_a', v_b', approaching)``; new arrays."""
     N = np.asarray(c_a, dtype=np.float64) - c_b
-    length = np.linalg.norm(N)
+    # |N| and the dot products summed left to right (products.py), not by BLAS,
+    # whose order and fused multiply-adds depend on the processor: the same
+    # bits on every machine and in the compiled loop (_numba_kernels._exchange_seed)
+    length = float(norm(N))
     v_a, v_b = np.array(v_a, dtype=np.float64), np.array(v_b, dtype=np.float64)
     if length == 0.0:
         return v_a, v_b, False                     # no contact plane: the seed is silent
     N /= length
-    va_n, vb_n = np.dot(v_a, N), np.dot(v_b, N)
+    va_n, vb_n = float(dot(v_a, N)), float(dot(v_b, N))
     if va_n - vb_n >= 0.0:                          # moving apart (or not approaching)
         return v_a, v_b, False
     # exchange the normal components, keep the lateral ones

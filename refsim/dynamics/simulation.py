@@ -19,6 +19,14 @@ One step (:meth:`Simulation.step`), as an outline:
 7. narrow-phase the scene's collision level on the pairs that pass (S4);
 8. body-response  the seed's velocity exchange (S8) or the corrected impulse.
 
+On the compiled kernel, :meth:`Simulation.run` and :meth:`Simulation.advance`
+take their steps K at a time in one compiled call
+(:mod:`refsim.dynamics.compiled_loop`, :mod:`refsim.dynamics._numba_kernels`)
+for the choices the loop covers, and hand each step it does not take back to
+:meth:`Simulation.step`; the same state, events and frames, bit for bit. The
+loop's wall time is ``loop_seconds`` (not split into stages), its steps
+``loop_steps``.
+
 Stages 2, 6-8 run only when needed: no rotation work with ``rotation =
 "off"``; no body-body work for one body, ``collision.level = "none"`` or
 ``body_response = "off"``; no narrow phase at level "aabb" (the boxes are
@@ -69,9 +77,11 @@ from refsim.dynamics.body_response import (
     separate_bodies,
 )
 from refsim.dynamics.boxes import boxes_kernel
+from refsim.dynamics.compiled_loop import CompiledLoop, loop_support
 from refsim.dynamics.energy import EnergyParts, mechanical_energy
 from refsim.dynamics.forces import translational_rhs
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
+from refsim.dynamics.products import matvec
 from refsim.dynamics.rotation_impulse import (
     orientation_step_exact,
     wall_contacts,
@@ -118,6 +128,12 @@ DIVERGENCE_FACTOR = 1e6
 BATCH_VERTICES = 64
 
 BOXES = ("auto", "trackers", "batched")
+
+#: Steps per call of the compiled loop, at most: a call holds the interpreter
+#: (no signal handler runs until it returns), so a call lasts milliseconds
+#: (4096 steps of 40 cubes, ~20 ms), while the cost of a call (~5 us of
+#: argument passing) stays below 1 % of it for a single cube.
+LOOP_CHUNK = 4096
 
 STAGES = ("integrate", "rotation", "check", "bounds", "walls", "broad-phase", "narrow-phase",
           "body-response")
@@ -317,6 +333,13 @@ class Simulation:
         self._lambda_max = np.linalg.eigvalsh(self.I_body)[:, -1]
         self._energy_limit = DIVERGENCE_FACTOR * (self._energy_bound().sum()
                                                   + self._energy_scale())
+        # The compiled loop (many steps per call), when the kernel is compiled
+        # and the loop does this scene's choices (loop_support).
+        self.loop_seconds = 0.0
+        self.loop_steps = 0
+        self._loop: CompiledLoop | None = None
+        if self.kernel == "compiled" and loop_support(self) is None:
+            self._loop = CompiledLoop(self)
 
     # -- what the scene needs ----------------------------------------------------------
 
@@ -338,10 +361,12 @@ class Simulation:
 
     @property
     def position(self) -> np.ndarray:
-        """(B, 3) reference points (mesh origins): ``x - R c``."""
+        """(B, 3) reference points (mesh origins): ``x - R c``, ``R c`` summed
+        left to right (:func:`refsim.dynamics.products.matvec`, no einsum or
+        BLAS: the same bits on every machine and in the compiled loop)."""
         if self._centred:
             return self.x.copy()
-        return self.x - np.einsum("bij,bj->bi", self.R, self.center)
+        return self.x - matvec(self.R, self.center)
 
     @property
     def velocity(self) -> np.ndarray:
@@ -357,7 +382,7 @@ class Simulation:
 
     def pose(self, i: int) -> tuple[np.ndarray, np.ndarray]:
         """Body i's pose ``(R, origin)``, for the collision and box functions."""
-        return self.R[i], self.x[i] - self.R[i] @ self.center[i]
+        return self.R[i], self.x[i] - matvec(self.R[i], self.center[i])
 
     def world_vertices(self, i: int) -> np.ndarray:
         return transform_vertices(self.bodies[i].mesh.vertices, self.pose(i))
@@ -399,6 +424,8 @@ class Simulation:
             The state became non-finite or its energy grew without bound; the
             frames recorded so far are in ``error.partial``.
         """
+        if self._loop is not None:
+            self._loop.sync_set()     # the contacts of the loop's last step, as a set
         timer = self.timer
         timer.start()
         self._integrate()
@@ -439,10 +466,68 @@ class Simulation:
         n_steps = check_count("n_steps", n_steps, maximum=MAX_STEPS)
         every = check_count("every", every, minimum=1)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            for _ in range(n_steps):
-                self.step()
+            while n_steps:
+                stretch = min(n_steps, every - self.steps % every)   # to the next frame
+                self._advance(stretch)
+                n_steps -= stretch
                 if self.steps % every == 0:
                     self.record()
+
+    def advance(self, n_steps: int) -> None:
+        """Take ``n_steps`` steps and record no frame (:meth:`run` without
+        frames): on the compiled kernel, through the compiled loop where the
+        scene allows it (:attr:`loop`), else one :meth:`step` at a time. The
+        same state, events and frames either way, bit for bit."""
+        n_steps = check_count("n_steps", n_steps, maximum=MAX_STEPS)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            self._advance(n_steps)
+
+    def snapshot(self) -> dict:
+        """The state to come back to with :meth:`restore`: copies of ``x``,
+        ``v``, ``w``, ``R``, the boxes, ``t``, ``steps``, the contacts and
+        the number of events (frames already recorded are not part of it).
+        Steps from a restored snapshot repeat the same bits (a box tracker's
+        starting vertices may differ; its boxes do not)."""
+        if self._loop is not None:
+            self._loop.sync_set()
+        return {"x": self.x.copy(), "v": self.v.copy(), "w": self.w.copy(),
+                "R": self.R.copy(), "lo": self.lo.copy(), "hi": self.hi.copy(),
+                "t": self.t, "steps": self.steps, "events": len(self.events),
+                "touching": set(self._touching)}
+
+    def restore(self, snapshot: dict) -> None:
+        """Go back to a :meth:`snapshot` of this simulation (in place)."""
+        for name in ("x", "v", "w", "R", "lo", "hi"):
+            getattr(self, name)[...] = snapshot[name]
+        self.t, self.steps = snapshot["t"], snapshot["steps"]
+        del self.events[snapshot["events"]:]
+        self._touching = set(snapshot["touching"])
+        if self._loop is not None:
+            self._loop.touching_changed()
+
+    @property
+    def loop(self) -> str | None:
+        """Why :meth:`run` and :meth:`advance` take one step at a time (the
+        scene needs what the compiled loop does not do, or the kernel is
+        the readable one), or None when they run the compiled loop."""
+        if self.kernel != "compiled":
+            return "the readable kernel"
+        return loop_support(self)
+
+    def _advance(self, n_steps: int) -> None:
+        loop = self._loop
+        if loop is None:
+            for _ in range(n_steps):
+                self.step()
+            return
+        while n_steps:
+            # at most LOOP_CHUNK steps per call: Python runs signal handlers
+            # (Ctrl-C, SIGTERM) only between calls
+            done, stop = loop.advance(min(n_steps, LOOP_CHUNK))
+            n_steps -= done
+            if stop == loop.STOP_READABLE:
+                self.step()           # a step the loop does not take: the readable stages
+                n_steps -= 1
 
     # 1. forces and the solver, all bodies at once (S5, S6)
     def _integrate(self) -> None:
@@ -616,6 +701,8 @@ class Simulation:
             self.events.append(Event(kind=contact.kind, step=self.steps, time=self.t,
                                      body=contact.body, other=contact.other))
         self._touching = touching
+        if self._loop is not None:
+            self._loop.touching_changed()
 
     # -- frames ---------------------------------------------------------------------------
 

@@ -642,9 +642,48 @@ def cubes_scene(count: int, rotation: str = "off", *, seed: int = BENCH_SEED,
     })
 
 
+#: The step-cost benchmark's bodies (tests/benchmarks/test_bench_dynamics.py):
+#: cubes on a grid (:func:`cubes_scene`) and one 2000-triangle sphere
+#: (:func:`sphere_scene`); rotation models; steps to a settled state.
+BENCH_BODIES = ("1 cube", "10 cubes", "40 cubes", "sphere-2k")
+BENCH_ALL_ROTATIONS = ("off", "seed", "impulse")
+SETTLE_STEPS = {"cubes": LATE_WARMUP, "sphere": 10_000}
+
+
+def sphere_scene(rotation: str = "off", *, step: float = STEP, duration: float = 20.0,
+                 solver: str = SOLVER):
+    """One 2000-triangle sphere (:data:`SPHERE`) thrown from the centre of the
+    world cube at (2, 1, -1.5) m/s, with :func:`cubes_scene`'s world (e = 0.8,
+    friction 0.1), collision level "aabb"; it rests on the floor after about
+    10 s."""
+    from refsim.scenes.loader import scene_from_dict
+
+    return scene_from_dict({
+        "world": {"half_size": HALF_SIZE, "gravity": GRAVITY, "restitution": 0.8,
+                  "friction": 0.1},
+        "integration": {"solver": solver, "step": step, "duration": duration},
+        "collision": {"level": "aabb"},
+        "dynamics": {"rotation": rotation, "body_response": "seed"},
+        "body": [{"name": "ball", "model": SPHERE, "position": [0.0, 0.0, 0.0],
+                  "velocity": [2.0, 1.0, -1.5]}],
+    })
+
+
+def bench_scene(bodies: str, rotation: str):
+    """The scene of one of :data:`BENCH_BODIES` and its settling steps."""
+    if bodies == "sphere-2k":
+        return sphere_scene(rotation), SETTLE_STEPS["sphere"]
+    return cubes_scene(int(bodies.split()[0]), rotation), SETTLE_STEPS["cubes"]
+
+
+#: The "stage" of :func:`measure_step_cost`'s breakdown that is the compiled
+#: loop's time (its stages run inside one call, not timed one by one).
+LOOP_STAGE = "compiled loop"
+
+
 @dataclass(frozen=True)
 class StepCost:
-    """Mean seconds per step of one scene: refsim's ``Simulation.step()``
+    """Mean seconds per step of one scene: refsim's ``Simulation.advance``
     and pybullet's ``stepSimulation``, and their ratio (refsim / pybullet)."""
 
     bodies: int
@@ -663,6 +702,8 @@ def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: 
                       oracle=None) -> list[StepCost]:
     """Seconds per step of each cubes scene in refsim and in ``oracle`` (a
     rigid-body engine with ``step_time(scene, steps, warmup)``: pybullet's).
+    refsim's steps are ``Simulation.advance``'s: the compiled loop where the
+    scene allows it, whose time is the stage ``LOOP_STAGE`` (not split).
 
     Each engine runs the scene ``repeats`` times from its start: ``warmup``
     untimed steps (they also pay any first-call compilation), then ``steps``
@@ -679,16 +720,17 @@ def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: 
             ours, stages = math.inf, {}
             for _ in range(repeats):
                 sim = Simulation(scene)
-                for _ in range(warmup):
-                    sim.step()
+                sim.advance(warmup)
                 before = dict(sim.stage_seconds)
+                loop_before = sim.loop_seconds
                 start = time.perf_counter()
-                for _ in range(steps):
-                    sim.step()
+                sim.advance(steps)
                 mean = (time.perf_counter() - start) / steps
                 if mean < ours:
                     ours = mean
                     stages = {k: (sim.stage_seconds[k] - before[k]) / steps for k in before}
+                    if sim.loop_seconds > loop_before:
+                        stages[LOOP_STAGE] = (sim.loop_seconds - loop_before) / steps
             theirs = math.nan
             if oracle is not None:
                 theirs = min(oracle.step_time(scene, steps, warmup) for _ in range(repeats))
@@ -702,3 +744,67 @@ def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: 
 def as_dict(obj) -> dict:
     """A study's dataclass as JSON-able data."""
     return asdict(obj)
+
+
+@dataclass(frozen=True)
+class LoopCompileCost:
+    """First-call cost of the compiled simulation loop
+    (:mod:`refsim.dynamics._numba_kernels`), in seconds, and numba's cache.
+
+    ``cold_first_call``: the first ``Simulation.advance(1)`` (10 cubes,
+    rotation "seed") in a fresh process with an empty numba cache: it
+    compiles the loop and the kernels it calls and writes them to the cache.
+    ``cached_first_call``: the same in a second fresh process, which loads
+    them. ``steady_step``: a step of the same scene afterwards (mean over
+    1000). ``cold_misses``, ``cached_hits`` and ``cached_misses``: numba's
+    cache counters of the loop's kernel in the first and second process
+    (``Dispatcher.stats``): a cache hit in the second process means it did
+    not compile.
+    """
+
+    cold_first_call: float = field(metadata=TIMED)
+    cached_first_call: float = field(metadata=TIMED)
+    steady_step: float = field(metadata=TIMED)
+    cold_misses: int = 0
+    cached_hits: int = 0
+    cached_misses: int = 0
+
+
+_LOOP_PROBE = r"""
+import json, time
+from refsim.dynamics.simulation import Simulation
+from refsim.studies.bounce import cubes_scene
+sim = Simulation(cubes_scene(10, "seed"), kernel="compiled")
+t0 = time.perf_counter()
+sim.advance(1)
+t1 = time.perf_counter()
+sim.advance(1000)
+t2 = time.perf_counter()
+from refsim.dynamics._numba_kernels import advance
+stats = advance.stats
+print(json.dumps({"first": t1 - t0, "steady": (t2 - t1) / 1000,
+                  "hits": sum(stats.cache_hits.values()),
+                  "misses": sum(stats.cache_misses.values())}))
+"""
+
+
+def measure_loop_compile_cost() -> LoopCompileCost:
+    """The compiled loop's first call, cold and cached (two fresh processes
+    sharing an empty ``NUMBA_CACHE_DIR``)."""
+    import json
+    import os
+    import subprocess
+    import sys
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as cache:
+        env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+        runs = []
+        for _ in range(2):
+            out = subprocess.run([sys.executable, "-c", _LOOP_PROBE], env=env,
+                                 capture_output=True, text=True, check=True)
+            runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
+    cold, cached = runs
+    return LoopCompileCost(cold_first_call=cold["first"], cached_first_call=cached["first"],
+                           steady_step=cached["steady"], cold_misses=cold["misses"],
+                           cached_hits=cached["hits"], cached_misses=cached["misses"])

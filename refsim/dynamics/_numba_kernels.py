@@ -1,0 +1,488 @@
+"""The compiled simulation loop: many steps of :meth:`Simulation.step
+<refsim.dynamics.simulation.Simulation.step>` in one numba call.
+
+Why: the readable step costs about 50 microseconds of interpreter work
+(a few dozen numpy calls, each a few hundred nanoseconds to a few
+microseconds) whatever the number of bodies; a step of a few cubes is a few
+hundred floating-point operations. Compiling each stage separately leaves
+the calls between them; this kernel runs the whole loop, K steps per call,
+for the common choices, and hands the rest back to the readable step.
+
+What it runs (one step, the stages of the readable outline, same order):
+
+1. integrate    the scene's explicit Runge-Kutta tableau (any of the five
+                solvers) on ``y = (x, v)`` with gravity and linear or
+                quadratic drag: :func:`refsim.solvers.explicit_rk.rk_step`
+                with :func:`refsim.dynamics.forces.translational_rhs`;
+2. rotation     none (``rotation = "off"``) or the seed's Euler step of the
+                axes with Gram-Schmidt:
+                :func:`refsim.dynamics.rotation_seed.orientation_step_seed_loops`;
+3. check        the energy bound, conservatively (below);
+4. bounds       the linear scan of a body's vertices
+                (:func:`refsim.dynamics.boxes.boxes_loops`), or the
+                incremental walk for the bodies the readable step gives a
+                tracker (:meth:`Simulation._bounds`): the same boxes, bit
+                for bit, either way (``Simulation``'s ``boxes`` option);
+5. walls        :func:`refsim.bounds.world_cube.world_cube_test`'s correction,
+                then the seed's response,
+                :func:`refsim.dynamics.walls.wall_response_seed`, after S9's
+                spin change :meth:`Simulation._wall_spin_seed` (contact vertex
+                :func:`~refsim.dynamics.rotation_seed.contact_vertex_seed`,
+                :func:`~refsim.dynamics.rotation_seed.contact_spin_seed`)
+                with the seed's rotation;
+6. broad-phase  every pair of boxes, in the sorted order of
+                :func:`refsim.collision.broad_phase.overlapping_pairs_sweep`;
+8. response     at level "aabb", the seed's exchange,
+                :func:`refsim.dynamics.body_response.exchange_velocities_seed`.
+
+Each is written in the readable function's operations and order (each
+product and sum rounded once, no fused multiply-add: numba compiles without
+fast-math), so the loop and the readable step agree bit for bit;
+tests/dynamics/test_compiled_loop.py checks whole trajectories.
+
+Hand-back. The kernel returns to Python, with the state of the last whole
+step, when
+
+- ``STOP_READABLE``: a step needs what the kernel does not do (a pair of
+  boxes overlaps and the scene's level or body response is not the seed's
+  exchange at level "aabb"; or the energy bound is above half the
+  divergence limit, or not finite). The state is restored to the start of
+  that step, and the caller takes it with the readable step, which decides
+  (and raises DivergenceError where it must);
+- ``STOP_EVENTS``: the event buffer cannot hold another step's events.
+
+The energy check is conservative: the readable check sums with ``einsum``,
+whose order differs, so the kernel hands back at half the limit instead of
+deciding at the limit; a state that far beyond its scale is a divergence in
+all but name, and the readable step then decides exactly.
+
+Events: the kernel keeps the previous step's contacts as flags, ``walls``
+(B, 6) (axis k, low wall at 2k, high wall at 2k + 1) and ``bodies`` (B, B)
+(pair i < j at [i, j]), and writes one row ``(step, kind, i, j)`` per
+contact that began (kind 0: wall 2k or 2k + 1; kind 1: body j); the caller
+sorts a step's rows by names as :meth:`Simulation._note_events` does.
+
+Seed sections: S2, S3, S5-S9 (as the readable stages).
+
+Cost per step: O(s B) for s solver stages, O(sum of vertices) for the boxes,
+O(B^2) box tests for the broad phase (all pairs, compiled; cheaper than the
+sort below a few hundred bodies).
+
+This module imports numba at import time; import it only when the compiled
+kernels are chosen.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from refsim.bounds._numba_kernels import incremental_update_numba
+
+#: The kernel took every step it was asked for.
+DONE = 0
+#: The next step needs the readable step (state restored to its start).
+STOP_READABLE = 1
+#: The event buffer is nearly full; call again after reading it.
+STOP_EVENTS = 2
+
+#: Body-body modes of the loop.
+BODY_NONE = 0           # no body-body stage (one body, level "none", response "off")
+BODY_EXCHANGE = 1       # level "aabb", the seed's exchange (S8): done in the loop
+BODY_HAND_BACK = 2      # any other: a step with an overlapping pair of boxes goes back
+
+
+@numba.njit(cache=True, nogil=True)
+def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
+            restitution, friction, wall_speed_at_wall, half_size, vertices_t, first_vertex,
+            centred, center, lam, mass, energy_limit, body_mode,
+            x, v, w, R, lo, hi, walls, bodies, events, tracked, tracker_rows, trackers_f,
+            trackers_i):
+    """Mirrors :meth:`refsim.dynamics.simulation.Simulation.step`, up to
+    ``n_steps`` times, in place; returns ``(steps, events, stop)`` (module
+    docstring: the readable function of each stage, and the hand-back).
+
+    Parameters (B bodies, s solver stages; float64 unless said)
+    ----------
+    hA : (s, s) ``h * A`` of the tableau; hb : (s,) ``h * b``
+    drag_rate : (B,) ``drag / mass``; quadratic : bool
+    seed_rotation : bool (else rotation "off")
+    wall_speed_at_wall : bool (``wall_speed="wall"``, else the seed's)
+    vertices_t : (3, N) every body's body-space vertices, body b's in
+        columns ``first_vertex[b]:first_vertex[b + 1]`` (int64 (B + 1,))
+    centred : bool, every centroid at its mesh origin (mesh origin = x);
+        else the origin is ``x - R c`` for the body-space centroids ``center``
+        (B, 3), ``R c`` summed left to right
+        (:attr:`Simulation.position`, :func:`refsim.dynamics.products.matvec`)
+    lam, mass : (B,) largest principal moment, mass
+    body_mode : int (``BODY_*``)
+    x, v, w : (B, 3); R : (B, 3, 3); lo, hi : (B, 3) the state and boxes
+    walls : (B, 6) bool; bodies : (B, B) bool (the contacts, read and written)
+    events : (capacity, 4) int64
+    tracked : (B,) int64, the row of ``tracker_rows`` of a body whose box
+        comes from its incremental tracker (the walk of
+        :func:`refsim.bounds._numba_kernels.incremental_update_numba`: the
+        scan's box on a convex mesh, bit for bit), or -1 (the linear scan)
+    tracker_rows : (T, 14) int64, where each tracker's arrays start in the
+        flat ``trackers_f`` (float64) and ``trackers_i`` (int64) (``T_*``;
+        :class:`refsim.dynamics.compiled_loop.CompiledLoop` lays them out)
+    """
+    B = x.shape[0]
+    s = hb.shape[0]
+    d = 3 * B
+    y = np.empty(2 * d)
+    y_i = np.empty(2 * d)
+    K = np.empty((s, 2 * d))
+    x0 = np.empty((B, 3))
+    v0 = np.empty((B, 3))
+    w0 = np.empty((B, 3))
+    R0 = np.empty((B, 3, 3))
+    A = np.empty((3, 3))
+    corr = np.empty(3)
+    origin = np.empty((B, 3))
+    now_walls = np.zeros((B, 6), np.bool_)
+    pairs = np.empty((max(B * (B - 1) // 2, 1), 2), np.int64)
+    per_step = 6 * B + B * (B - 1) // 2
+    n_events = 0
+    k_friction = 1.0 - friction
+    for step in range(n_steps):
+        if n_events + per_step > events.shape[0]:
+            return step, n_events, STOP_EVENTS
+        for b in range(B):
+            for k in range(3):
+                x0[b, k] = x[b, k]
+                v0[b, k] = v[b, k]
+                w0[b, k] = w[b, k]
+                for j in range(3):
+                    R0[b, k, j] = R[b, k, j]
+
+        # 1. integrate: rk_step on y = (x, v), f = translational_rhs
+        for b in range(B):
+            for k in range(3):
+                y[3 * b + k] = x[b, k]
+                y[d + 3 * b + k] = v[b, k]
+        for i in range(s):
+            for e in range(2 * d):
+                y_i[e] = y[e]
+            for j in range(i):
+                if hA[i, j] != 0.0:
+                    for e in range(2 * d):
+                        y_i[e] = y_i[e] + hA[i, j] * K[j, e]
+            for b in range(B):
+                # acceleration: v (-r) (linear) or v (|v| (-r)) (quadratic), then a_y -= g
+                vx, vy, vz = y_i[d + 3 * b], y_i[d + 3 * b + 1], y_i[d + 3 * b + 2]
+                factor = -drag_rate[b]
+                if quadratic:
+                    factor = np.sqrt((vx * vx + vy * vy) + vz * vz) * factor
+                K[i, 3 * b] = vx
+                K[i, 3 * b + 1] = vy
+                K[i, 3 * b + 2] = vz
+                K[i, d + 3 * b] = vx * factor
+                K[i, d + 3 * b + 1] = vy * factor - gravity
+                K[i, d + 3 * b + 2] = vz * factor
+        for i in range(s):
+            if hb[i] != 0.0:
+                for e in range(2 * d):
+                    y[e] = y[e] + hb[i] * K[i, e]
+        for b in range(B):
+            for k in range(3):
+                x[b, k] = y[3 * b + k]
+                v[b, k] = y[d + 3 * b + k]
+
+        # 2. rotation: the seed's X += h (w x X) for each column, then Gram-Schmidt
+        if seed_rotation:
+            for b in range(B):
+                wx, wy, wz = w[b, 0], w[b, 1], w[b, 2]
+                for c in range(3):
+                    X0, X1, X2 = R[b, 0, c], R[b, 1, c], R[b, 2, c]
+                    A[0, c] = X0 + h * (wy * X2 - wz * X1)
+                    A[1, c] = X1 + h * (wz * X0 - wx * X2)
+                    A[2, c] = X2 + h * (wx * X1 - wy * X0)
+                nx = np.sqrt((A[0, 0] * A[0, 0] + A[1, 0] * A[1, 0]) + A[2, 0] * A[2, 0])
+                u0, u1, u2 = A[0, 0] / nx, A[1, 0] / nx, A[2, 0] / nx
+                dot = (A[0, 1] * u0 + A[1, 1] * u1) + A[2, 1] * u2
+                t0, t1, t2 = A[0, 1] - dot * u0, A[1, 1] - dot * u1, A[2, 1] - dot * u2
+                ny = np.sqrt((t0 * t0 + t1 * t1) + t2 * t2)
+                t0, t1, t2 = t0 / ny, t1 / ny, t2 / ny
+                R[b, 0, 0], R[b, 1, 0], R[b, 2, 0] = u0, u1, u2
+                R[b, 0, 1], R[b, 1, 1], R[b, 2, 1] = t0, t1, t2
+                R[b, 0, 2] = u1 * t2 - u2 * t1
+                R[b, 1, 2] = u2 * t0 - u0 * t2
+                R[b, 2, 2] = u0 * t1 - u1 * t0
+
+        # 3. check, conservatively (module docstring)
+        total = 0.0
+        for b in range(B):
+            vv = (v[b, 0] * v[b, 0] + v[b, 1] * v[b, 1]) + v[b, 2] * v[b, 2]
+            ww = (w[b, 0] * w[b, 0] + w[b, 1] * w[b, 1]) + w[b, 2] * w[b, 2]
+            total += 0.5 * (mass[b] * vv + lam[b] * ww) \
+                + mass[b] * gravity * (x[b, 1] + half_size)
+        if not (total <= 0.5 * energy_limit):
+            _restore(x, v, w, R, x0, v0, w0, R0)
+            return step, n_events, STOP_READABLE
+
+        # 4. bounds: the linear scan, r_k = (R_k0 x + R_k1 y) + R_k2 z, + origin
+        for b in range(B):
+            for k in range(3):
+                if centred:
+                    origin[b, k] = x[b, k]
+                else:
+                    origin[b, k] = x[b, k] - ((R[b, k, 0] * center[b, 0]
+                                               + R[b, k, 1] * center[b, 1])
+                                              + R[b, k, 2] * center[b, 2])
+            if tracked[b] >= 0:
+                _tracker_update(tracker_rows[tracked[b]], trackers_f, trackers_i, R[b],
+                                origin[b], lo[b], hi[b])
+                continue
+            for k in range(3):
+                a0, a1, a2 = R[b, k, 0], R[b, k, 1], R[b, k, 2]
+                first = first_vertex[b]
+                least = greatest = (a0 * vertices_t[0, first] + a1 * vertices_t[1, first]) \
+                    + a2 * vertices_t[2, first]
+                for q in range(first + 1, first_vertex[b + 1]):
+                    r = (a0 * vertices_t[0, q] + a1 * vertices_t[1, q]) + a2 * vertices_t[2, q]
+                    if r < least:
+                        least = r
+                    if r > greatest:
+                        greatest = r
+                lo[b, k] = least + origin[b, k]
+                hi[b, k] = greatest + origin[b, k]
+
+        # 5. walls (S3, S7; S9's spin first with the seed's rotation)
+        for b in range(B):
+            for k in range(6):
+                now_walls[b, k] = False
+            beyond = False
+            for k in range(3):
+                if lo[b, k] < -half_size or hi[b, k] > half_size:
+                    beyond = True
+            if not beyond:
+                continue
+            for k in range(3):
+                # WallCrossings.correction
+                below = -half_size - lo[b, k]
+                above = hi[b, k] - half_size
+                if below > 0.0 and above > 0.0:
+                    corr[k] = 0.5 * (below - above)
+                else:
+                    corr[k] = (below if below > 0.0 else 0.0) - (above if above > 0.0 else 0.0)
+            if seed_rotation:
+                _wall_spin_seed(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1],
+                                x, center, v, w, R, lo, hi, restitution, friction)
+            # wall_response_seed
+            for k in range(3):
+                if corr[k] == 0.0:
+                    continue
+                x[b, k] += corr[k]
+                v_k = v[b, k]
+                if wall_speed_at_wall:
+                    a_k = -gravity if k == 1 else 0.0
+                    squared = v_k * v_k + 2.0 * a_k * corr[k]
+                    if 0.0 > squared:
+                        squared = 0.0
+                    v_k = np.copysign(np.sqrt(squared), v_k)
+                v[b, k] = -restitution * v_k
+                for j in range(3):
+                    if j != k:
+                        v[b, j] = k_friction * v[b, j]
+            for k in range(3):
+                lo[b, k] += corr[k]
+                hi[b, k] += corr[k]
+                if corr[k] != 0.0:
+                    now_walls[b, 2 * k + (0 if corr[k] > 0.0 else 1)] = True
+
+        # 6. broad phase: every overlapping pair (closed boxes), rows sorted
+        n_pairs = 0
+        if body_mode != BODY_NONE:
+            for i in range(B):
+                for j in range(i + 1, B):
+                    if (lo[i, 0] <= hi[j, 0] and lo[j, 0] <= hi[i, 0]
+                            and lo[i, 1] <= hi[j, 1] and lo[j, 1] <= hi[i, 1]
+                            and lo[i, 2] <= hi[j, 2] and lo[j, 2] <= hi[i, 2]):
+                        pairs[n_pairs, 0] = i
+                        pairs[n_pairs, 1] = j
+                        n_pairs += 1
+            if n_pairs and body_mode == BODY_HAND_BACK:
+                _restore(x, v, w, R, x0, v0, w0, R0)        # the readable step redoes this one
+                return step, n_events, STOP_READABLE
+        # the wall contacts that began (committed only now: a hand-back above
+        # leaves the previous step's flags)
+        for b in range(B):
+            for k in range(6):
+                if now_walls[b, k] and not walls[b, k]:
+                    events[n_events, 0] = step
+                    events[n_events, 1] = 0
+                    events[n_events, 2] = b
+                    events[n_events, 3] = k
+                    n_events += 1
+                walls[b, k] = now_walls[b, k]
+        # 8. the seed's exchange (S8) for each pair, in order
+        if body_mode == BODY_EXCHANGE:
+            for p in range(n_pairs):
+                a, c = pairs[p, 0], pairs[p, 1]
+                _exchange_seed(a, c, x, v)
+        # the body contacts of this step (none when the hand-back mode got
+        # here): contacts that ended are cleared, those that began noted
+        if body_mode != BODY_NONE:
+            q = 0
+            for i in range(B):
+                for j in range(i + 1, B):
+                    now = q < n_pairs and pairs[q, 0] == i and pairs[q, 1] == j
+                    if now:
+                        q += 1
+                        if not bodies[i, j]:
+                            events[n_events, 0] = step
+                            events[n_events, 1] = 1
+                            events[n_events, 2] = i
+                            events[n_events, 3] = j
+                            n_events += 1
+                    bodies[i, j] = now
+    return n_steps, n_events, DONE
+
+
+#: Columns of ``tracker_rows`` (one row per tracked body): the number of
+#: vertices n, then where each of the tracker's arrays starts in the flat
+#: float (XYZ, VALUE, TIE) and int (the others) arrays.
+T_N, T_XYZ, T_VALUE, T_TIE, T_OFFSETS, T_INDICES, T_INDICES_END, T_EXTREMES, T_STAMP, \
+    T_TOUCHED, T_SEEN, T_QUEUE, T_GENERATION, T_COUNTS = range(14)
+
+
+@numba.njit(cache=True, nogil=True)
+def _tracker_update(row, trackers_f, trackers_i, rotation, translation, lo, hi):
+    """One incremental box update of a tracked body, its arrays slices of
+    the flat ones: :func:`incremental_update_numba`, which mirrors
+    :meth:`refsim.bounds.aabb_incremental.IncrementalAABB.update`."""
+    n = row[T_N]
+    f, i = trackers_f, trackers_i
+    incremental_update_numba(
+        f[row[T_XYZ]:row[T_XYZ] + 3 * n].reshape(3, n),
+        i[row[T_OFFSETS]:row[T_OFFSETS] + n + 1],
+        i[row[T_INDICES]:row[T_INDICES_END]],
+        rotation, translation,
+        i[row[T_EXTREMES]:row[T_EXTREMES] + 6].reshape(2, 3),
+        f[row[T_TIE]],
+        f[row[T_VALUE]:row[T_VALUE] + 3 * n].reshape(3, n),
+        i[row[T_STAMP]:row[T_STAMP] + 3 * n].reshape(3, n),
+        i[row[T_TOUCHED]:row[T_TOUCHED] + n],
+        i[row[T_SEEN]:row[T_SEEN] + n],
+        i[row[T_QUEUE]:row[T_QUEUE] + n],
+        i[row[T_GENERATION]:row[T_GENERATION] + 2],
+        i[row[T_COUNTS]:row[T_COUNTS] + 2],
+        lo, hi)
+
+
+@numba.njit(cache=True, nogil=True)
+def _restore(x, v, w, R, x0, v0, w0, R0):
+    """The state at the start of the step (the wall stage's S9 spin changes w)."""
+    for b in range(x.shape[0]):
+        for k in range(3):
+            x[b, k] = x0[b, k]
+            v[b, k] = v0[b, k]
+            w[b, k] = w0[b, k]
+            for j in range(3):
+                R[b, k, j] = R0[b, k, j]
+
+
+@numba.njit(cache=True, nogil=True)
+def _wall_spin_seed(b, corr, vertices_t, first, end, x, center, v, w, R, lo, hi,
+                    restitution, friction):
+    """Mirrors :meth:`refsim.dynamics.simulation.Simulation._wall_spin_seed`
+    (the world vertices under :meth:`~refsim.dynamics.simulation.Simulation.pose`,
+    origin ``x - R c`` summed left to right, also for c = 0): for each
+    crossed wall, the contact vertex
+    (:func:`refsim.dynamics.rotation_seed.contact_vertex_seed`: the first
+    deepest world vertex) and w += Pi x I
+    (:func:`refsim.dynamics.rotation_seed.contact_spin_seed`).
+
+    ``np.dot(Vi, N)`` there sums from 0.0 (BLAS, or numpy's own loop), with
+    N a signed unit axis: every product is exact, so the sum is the one
+    nonzero product in any order, written here ``((0 + p0) + p1) + p2``.
+    """
+    o0 = x[b, 0] - ((R[b, 0, 0] * center[b, 0] + R[b, 0, 1] * center[b, 1])
+                    + R[b, 0, 2] * center[b, 2])
+    o1 = x[b, 1] - ((R[b, 1, 0] * center[b, 0] + R[b, 1, 1] * center[b, 1])
+                    + R[b, 1, 2] * center[b, 2])
+    o2 = x[b, 2] - ((R[b, 2, 0] * center[b, 0] + R[b, 2, 1] * center[b, 1])
+                    + R[b, 2, 2] * center[b, 2])
+    for k in range(3):
+        if corr[k] == 0.0:
+            continue
+        low = corr[k] > 0.0
+        o_k = o0 if k == 0 else (o1 if k == 1 else o2)
+        # The deepest vertex: the first whose world coordinate r_k + origin_k
+        # is least (greatest). The box's lo_k (hi_k) is that least value, from
+        # the same r_k and origin (rounding is monotone: min(r) + o is the
+        # least r + o; the origins differ at most in the sign of a zero, which
+        # == ignores), so the scan stops at the first vertex that reaches it.
+        target = lo[b, k] if low else hi[b, k]
+        index = -1
+        for q in range(first, end):
+            r = ((R[b, k, 0] * vertices_t[0, q] + R[b, k, 1] * vertices_t[1, q])
+                 + R[b, k, 2] * vertices_t[2, q]) + o_k
+            if r == target:
+                index = q
+                break
+        if index < 0:                # not reached (cannot happen): argmin / argmax
+            best = 0.0
+            for q in range(first, end):
+                r = ((R[b, k, 0] * vertices_t[0, q] + R[b, k, 1] * vertices_t[1, q])
+                     + R[b, k, 2] * vertices_t[2, q]) + o_k
+                if index < 0 or (r < best if low else r > best):
+                    best = r
+                    index = q
+        P0 = (((R[b, 0, 0] * vertices_t[0, index] + R[b, 0, 1] * vertices_t[1, index])
+               + R[b, 0, 2] * vertices_t[2, index]) + o0) - x[b, 0]
+        P1 = (((R[b, 1, 0] * vertices_t[0, index] + R[b, 1, 1] * vertices_t[1, index])
+               + R[b, 1, 2] * vertices_t[2, index]) + o1) - x[b, 1]
+        P2 = (((R[b, 2, 0] * vertices_t[0, index] + R[b, 2, 1] * vertices_t[1, index])
+               + R[b, 2, 2] * vertices_t[2, index]) + o2) - x[b, 2]
+        N0 = N1 = N2 = 0.0
+        sign = 1.0 if low else -1.0
+        if k == 0:
+            N0 = sign
+        elif k == 1:
+            N1 = sign
+        else:
+            N2 = sign
+        w0, w1, w2 = w[b, 0], w[b, 1], w[b, 2]
+        # Vi = (w x Pi) + Vel
+        V0 = (w1 * P2 - w2 * P1) + v[b, 0]
+        V1 = (w2 * P0 - w0 * P2) + v[b, 1]
+        V2 = (w0 * P1 - w1 * P0) + v[b, 2]
+        dot = ((0.0 + V0 * N0) + V1 * N1) + V2 * N2
+        minus = -dot
+        # normal = -(Vi . N) N; I = normal kRestitution; T = Pi x I
+        I0 = (minus * N0) * restitution
+        I1 = (minus * N1) * restitution
+        I2 = (minus * N2) * restitution
+        w[b, 0] = w0 + (P1 * I2 - P2 * I1)
+        w[b, 1] = w1 + (P2 * I0 - P0 * I2)
+        w[b, 2] = w2 + (P0 * I1 - P1 * I0)
+
+
+@numba.njit(cache=True, nogil=True)
+def _exchange_seed(a, b, x, v):
+    """Mirrors :func:`refsim.dynamics.body_response.exchange_velocities_seed`
+    on ``v[a]``, ``v[b]`` in place (its sums left to right, as
+    :mod:`refsim.dynamics.products` writes them)."""
+    N0 = x[a, 0] - x[b, 0]
+    N1 = x[a, 1] - x[b, 1]
+    N2 = x[a, 2] - x[b, 2]
+    length = np.sqrt((N0 * N0 + N1 * N1) + N2 * N2)
+    if length == 0.0:
+        return
+    N0 /= length
+    N1 /= length
+    N2 /= length
+    va_n = (v[a, 0] * N0 + v[a, 1] * N1) + v[a, 2] * N2
+    vb_n = (v[b, 0] * N0 + v[b, 1] * N1) + v[b, 2] * N2
+    if va_n - vb_n >= 0.0:
+        return
+    da = vb_n - va_n
+    db = va_n - vb_n
+    v[a, 0] = v[a, 0] + da * N0
+    v[a, 1] = v[a, 1] + da * N1
+    v[a, 2] = v[a, 2] + da * N2
+    v[b, 0] = v[b, 0] + db * N0
+    v[b, 1] = v[b, 1] + db * N1
+    v[b, 2] = v[b, 2] + db * N2

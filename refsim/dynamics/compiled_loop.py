@@ -1,0 +1,232 @@
+"""Many steps per compiled call: the bridge between :class:`Simulation
+<refsim.dynamics.simulation.Simulation>` and its compiled loop
+(:func:`refsim.dynamics._numba_kernels.advance`).
+
+The readable step is the reference; the loop takes the same steps in one
+numba call, K at a time, for the choices it covers, and hands a step back
+to the readable stages whenever that step needs something it does not do
+(:func:`loop_support` says which scenes it covers;
+:mod:`refsim.dynamics._numba_kernels` says when it hands back). What this
+module adds is bookkeeping: the arrays the kernel reads (tableau, masses,
+vertices), the contacts as flags instead of a set, and the kernel's event
+rows turned into :class:`~refsim.dynamics.trajectory.Event` in the readable
+order.
+
+Why a loop and not faster stages: the readable step's cost is ~50 us of
+calls between ~1 us of arithmetic; stage kernels keep the calls, and the
+per-call cost of a numba function with many array arguments (a few
+microseconds) stays above pybullet's whole step for a few bodies. One call
+for K steps pays it once.
+
+Seed sections: as the readable step (S2, S3, S5-S9). Cost: the kernel's
+per step, plus O(B + events) per call here, plus O(B^2) when the contacts
+were changed by a readable step since the last call.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from refsim.bounds.aabb_incremental import IncrementalAABB
+from refsim.dynamics.trajectory import Event
+
+if TYPE_CHECKING:
+    from refsim.dynamics.simulation import Simulation
+
+#: Rows of the kernel's event buffer per call, at least (more for scenes
+#: with many bodies: room for several steps' worth of contacts).
+EVENT_ROWS = 4096
+WALLS = tuple("xyz"[k // 2] + "-+"[k % 2] for k in range(6))     # flag index -> wall name
+
+
+def loop_support(sim: Simulation) -> str | None:
+    """Why the compiled loop cannot run ``sim``'s scene (one line), or None.
+
+    It covers rotation "off" and "seed", the seed's wall response (either
+    wall speed), any solver,
+    linear or quadratic drag, and body-body contacts at every level but
+    "sphere" (the seed's exchange at level "aabb" in the loop; any other
+    level or response hands the steps with overlapping boxes back).
+    """
+    if sim.rotation not in ("off", "seed"):
+        return f"rotation {sim.rotation!r} (the loop does 'off' and 'seed')"
+    if sim.wall_response != "seed":
+        return f"wall response {sim.wall_response!r} (the loop does the seed's)"
+    if sim.body_body and sim.level == "sphere":
+        return "collision level 'sphere' (its broad phase is not the boxes')"
+    return None
+
+
+class CompiledLoop:
+    """The compiled loop of one simulation: its constant arrays, the contact
+    flags, and :meth:`advance`."""
+
+    def __init__(self, sim: Simulation):
+        from refsim.dynamics import _numba_kernels as kernels
+
+        self.kernels = kernels
+        self.STOP_READABLE = kernels.STOP_READABLE
+        self.sim = sim
+        B = len(sim.bodies)
+        h = sim.h
+        world = sim.scene.world
+        method = sim.method
+        self.hA = np.ascontiguousarray(h * method.A_)
+        self.hb = np.ascontiguousarray(h * method.b_)
+        # the drag rate r = k / m, as translational_rhs divides it
+        self.drag_rate = np.ascontiguousarray(world.drag / np.asarray(sim.mass, np.float64))
+        self.quadratic = world.drag_model == "quadratic"
+        vertices = [b.mesh.vertices for b in sim.bodies]
+        self.first_vertex = np.zeros(B + 1, np.int64)
+        self.first_vertex[1:] = np.cumsum([len(vs) for vs in vertices])
+        self.vertices_t = np.ascontiguousarray(np.concatenate(vertices).T)
+        self.center = np.ascontiguousarray(sim.center, dtype=np.float64)
+        self._lay_out_trackers()
+        if not sim.body_body:
+            self.body_mode = kernels.BODY_NONE
+        elif sim.level == "aabb" and sim.body_response == "seed":
+            self.body_mode = kernels.BODY_EXCHANGE
+        else:
+            self.body_mode = kernels.BODY_HAND_BACK
+        self.walls = np.zeros((B, 6), np.bool_)
+        self.bodies = np.zeros((B, B), np.bool_)
+        self.events = np.zeros((max(EVENT_ROWS, 4 * (6 * B + B * (B - 1) // 2)), 4), np.int64)
+        self._index = {name: i for i, name in enumerate(sim.names)}
+        self._flags_stale = False        # the set changed since the flags were built
+        self._set_stale = False          # the flags changed since the set was built
+
+    def _lay_out_trackers(self) -> None:
+        """The incremental trackers of the bodies that have one (the readable
+        step's ``_tracked`` bodies with a convex mesh), as slices of two flat
+        arrays (:data:`refsim.dynamics._numba_kernels.T_N` and on). The loop's
+        walks keep their own extremes and stamps: a walk from any start
+        finds the same box."""
+        sim, k = self.sim, self.kernels
+        self.tracked = np.full(len(sim.bodies), -1, np.int64)
+        rows: list[list[int]] = []
+        floats: list[np.ndarray] = []
+        ints: list[np.ndarray] = []
+        n_f = n_i = 0
+
+        def put(chunks: list[np.ndarray], array, size: int, start: int) -> int:
+            chunks.append(np.ascontiguousarray(array).ravel())
+            assert chunks[-1].size == size
+            return start + size
+
+        for b in sim._tracked:
+            tracker = sim.bodies[b].tracker
+            if not isinstance(tracker, IncrementalAABB):
+                continue                              # the linear scan, in the loop
+            mesh = sim.bodies[b].mesh
+            n = mesh.n_vertices
+            row = [0] * 14
+            row[k.T_N] = n
+            row[k.T_XYZ] = n_f
+            n_f = put(floats, mesh.vertices.T.astype(np.float64), 3 * n, n_f)
+            row[k.T_VALUE] = n_f
+            n_f = put(floats, np.zeros(3 * n), 3 * n, n_f)
+            row[k.T_TIE] = n_f
+            n_f = put(floats, np.array([tracker.tie_window], np.float64), 1, n_f)
+            row[k.T_OFFSETS] = n_i
+            n_i = put(ints, mesh.neighbor_offsets.astype(np.int64), n + 1, n_i)
+            row[k.T_INDICES] = n_i
+            n_indices = len(mesh.neighbor_indices)
+            n_i = put(ints, mesh.neighbor_indices.astype(np.int64), n_indices, n_i)
+            row[k.T_INDICES_END] = n_i
+            row[k.T_EXTREMES] = n_i
+            n_i = put(ints, np.full(6, -1, np.int64), 6, n_i)       # no frame yet
+            for column, size in ((k.T_STAMP, 3 * n), (k.T_TOUCHED, n), (k.T_SEEN, n),
+                                 (k.T_QUEUE, n), (k.T_GENERATION, 2), (k.T_COUNTS, 2)):
+                row[column] = n_i
+                n_i = put(ints, np.zeros(size, np.int64), size, n_i)
+            self.tracked[b] = len(rows)
+            rows.append(row)
+        self.tracker_rows = np.array(rows, np.int64).reshape(-1, 14)
+        self.trackers_f = np.concatenate(floats) if floats else np.zeros(1)
+        self.trackers_i = np.concatenate(ints) if ints else np.zeros(1, np.int64)
+
+    # -- contacts: the set of the readable step <-> the loop's flags -----------------------
+
+    def touching_changed(self) -> None:
+        """The readable step changed ``sim._touching``."""
+        self._flags_stale = True
+        self._set_stale = False
+
+    def sync_set(self) -> None:
+        """Bring ``sim._touching`` up to date with the flags (before a readable step)."""
+        if not self._set_stale:
+            return
+        from refsim.dynamics.simulation import Contact
+
+        names = self.sim.names
+        touching = set()
+        for i, k in zip(*np.nonzero(self.walls), strict=True):
+            touching.add(Contact("wall", names[i], WALLS[k]))
+        for i, j in zip(*np.nonzero(self.bodies), strict=True):
+            touching.add(Contact("body", names[i], names[j]))
+        self.sim._touching = touching
+        self._set_stale = False
+
+    def _sync_flags(self) -> None:
+        if not self._flags_stale:
+            return
+        self.walls[...] = False
+        self.bodies[...] = False
+        index = self._index
+        for contact in self.sim._touching:
+            i = index[contact.body]
+            if contact.kind == "wall":
+                self.walls[i, WALLS.index(contact.other)] = True
+            else:
+                j = index[contact.other]
+                self.bodies[min(i, j), max(i, j)] = True
+        self._flags_stale = False
+
+    # -- the loop ---------------------------------------------------------------------------
+
+    def advance(self, n_steps: int) -> tuple[int, int]:
+        """Up to ``n_steps`` steps in the compiled loop: ``(steps taken, stop)``,
+        ``stop`` one of the kernel's ``DONE``, ``STOP_READABLE``, ``STOP_EVENTS``."""
+        sim = self.sim
+        world = sim.scene.world
+        self._sync_flags()
+        start = time.perf_counter()
+        done, n_events, stop = self.kernels.advance(
+            n_steps, sim.h, self.hA, self.hb, world.gravity, self.drag_rate, self.quadratic,
+            sim.rotation == "seed", world.restitution, world.friction,
+            sim.wall_speed == "wall", world.half_size, self.vertices_t, self.first_vertex,
+            sim._centred, self.center, sim._lambda_max, sim.mass, sim._energy_limit,
+            self.body_mode, sim.x, sim.v, sim.w, sim.R, sim.lo, sim.hi, self.walls,
+            self.bodies, self.events, self.tracked, self.tracker_rows, self.trackers_f,
+            self.trackers_i)
+        sim.loop_seconds += time.perf_counter() - start
+        if done:
+            self._note_events(n_events)
+            sim.steps += done
+            sim.t = sim.steps * sim.h
+            sim.loop_steps += done
+            self._set_stale = True
+        return done, stop
+
+    def _note_events(self, n_events: int) -> None:
+        """The kernel's rows as Events, each step's sorted by (body, other)
+        names as :meth:`Simulation._note_events` sorts them."""
+        if not n_events:
+            return
+        sim = self.sim
+        names = sim.names
+        rows = self.events[:n_events].tolist()
+        base = sim.steps
+        found = []
+        for step, kind, i, j in rows:
+            if kind == 0:
+                found.append((step, names[i], WALLS[j], "wall"))
+            else:
+                found.append((step, names[i], names[j], "body"))
+        found.sort(key=lambda r: (r[0], r[1], r[2]))
+        for step, body, other, kind in found:
+            n = base + step + 1
+            sim.events.append(Event(kind=kind, step=n, time=n * sim.h, body=body, other=other))

@@ -1,0 +1,46 @@
+"""Dot products and matrix-vector products for one body or for B bodies at
+once, each sum written out in one order.
+
+What: for 3-vectors ``a``, ``b`` and 3x3 matrices ``M`` (shapes ``(3,)`` and
+``(3, 3)``, or ``(B, 3)`` and ``(B, 3, 3)`` for B bodies):
+
+    a . b          = (a0 b0 + a1 b1) + a2 b2
+    |a|            = sqrt(a . a)
+    (M x)_i        = (M_i0 x0 + M_i1 x1) + M_i2 x2
+
+each product and sum rounded once, left to right, as
+:mod:`refsim.bounds.aabb_linear` does for a transformed coordinate.
+
+Why not ``@``, ``np.dot``, ``np.einsum`` or ``np.linalg.norm``: numpy hands
+them to BLAS or to SIMD loops whose summation order and fused multiply-adds
+depend on the processor; on random inputs they differ from the
+left-to-right sum in the last bit in a large fraction of cases
+(docs/decisions/compiled-loop.md). Written out, the dynamics stages give
+the same bits on every machine, and the compiled simulation loop
+(:mod:`refsim.dynamics._numba_kernels`) repeats the same operations in the
+same order, so it agrees with them bit for bit.
+
+Seed sections: none of their own; used by S8 (the seed's exchange) and for
+the mesh origin ``x - R c`` of every body (S2, S9).
+
+Cost: O(1) per body, a handful of numpy calls per product.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a . b`` over the last axis: (..., 3), (..., 3) -> (...)."""
+    return (a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]) + a[..., 2] * b[..., 2]
+
+
+def norm(a: np.ndarray) -> np.ndarray:
+    """``sqrt(a . a)`` over the last axis: (..., 3) -> (...)."""
+    return np.sqrt(dot(a, a))
+
+
+def matvec(M: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``M x``: (..., 3, 3), (..., 3) -> (..., 3)."""
+    return dot(M, x[..., np.newaxis, :])

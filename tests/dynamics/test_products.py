@@ -1,0 +1,31 @@
+"""The written-out products: each sum in one order, left to right."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from refsim.dynamics.products import dot, matvec, norm
+
+
+def test_dot_and_matvec_sum_left_to_right_bit_for_bit():
+    rng = np.random.default_rng(16)
+    a, b = rng.normal(size=(500, 3)), rng.normal(size=(500, 3))
+    M = rng.normal(size=(500, 3, 3))
+    for i in range(500):
+        x, y = a[i].tolist(), b[i].tolist()
+        assert dot(a[i], b[i]) == (x[0] * y[0] + x[1] * y[1]) + x[2] * y[2]
+        assert norm(a[i]) == np.sqrt((x[0] * x[0] + x[1] * x[1]) + x[2] * x[2])
+        m = M[i].tolist()
+        expected = [(m[k][0] * x[0] + m[k][1] * x[1]) + m[k][2] * x[2] for k in range(3)]
+        assert matvec(M[i], a[i]).tolist() == expected
+    # batched: the same bits as one body at a time
+    assert matvec(M, a).tobytes() == np.array([matvec(M[i], a[i]) for i in range(500)]).tobytes()
+
+
+def test_a_unit_axis_gives_the_component_exactly():
+    v = np.array([0.1, -0.7, 1e-300])
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = 1.0
+        assert dot(v, e) == v[k]
+    assert norm(np.array([3.0, 4.0, 12.0])) == 13.0
