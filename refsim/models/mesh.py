@@ -402,7 +402,13 @@ def _weld(vertices: np.ndarray, faces: np.ndarray, tolerance: float):
                                       return_inverse=True)
         representative = first[inverse.ravel()]
     else:
-        pairs = cKDTree(vertices).query_pairs(r=tolerance, output_type="ndarray")
+        # in unit coordinates (an exact power-of-two scale), so that squared
+        # distances cannot overflow for coordinates anywhere in float64's range
+        # (unit coordinates are below 1 in magnitude: a radius of 4 already
+        # joins every pair, and caps one that would overflow)
+        e = unit_exponent(vertices)
+        radius = 4.0 if math.frexp(tolerance)[1] - e > 3 else math.ldexp(tolerance, -e)
+        pairs = cKDTree(np.ldexp(vertices, -e)).query_pairs(r=radius, output_type="ndarray")
         graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
         _, label = connected_components(graph, directed=False)
         lowest = np.full(label.max() + 1, n, dtype=np.int64)

@@ -99,6 +99,19 @@ def test_tolerance_weld_is_transitive_and_keeps_the_first_position():
     assert Mesh(v, [[0, 3, 4], [1, 3, 4], [2, 3, 4]]).n_vertices == 5
 
 
+@pytest.mark.parametrize("scale", [1e300, 1e-300, 1.0])
+def test_tolerance_weld_is_the_same_at_every_scale(scale):
+    # the same points and tolerance, scaled: the same merges (squared
+    # distances of 1e300 coordinates overflowed in the k-d tree: a fuzz finding)
+    v = np.array([[0, 0, 0], [0.6e-3, 0, 0], [1.2e-3, 0, 0], [1, 0, 0], [0, 1, 0]]) * scale
+    mesh = Mesh(v, [[0, 3, 4], [1, 3, 4], [2, 3, 4]], weld_tolerance=1e-3 * scale)
+    assert mesh.n_vertices == 3 and mesh.faces.tolist() == [[0, 1, 2]] * 3
+    apart = Mesh(v, [[0, 3, 4], [1, 3, 4], [2, 3, 4]], weld_tolerance=5e-324)
+    assert apart.n_vertices == 5                           # the smallest tolerance joins none
+    everything = Mesh(v, [[0, 3, 4]], weld_tolerance=1e308)
+    assert everything.n_vertices == 1                      # the largest joins all
+
+
 def test_unreferenced_vertices_are_dropped_in_order():
     v = np.array([[9, 9, 9], [0, 0, 0], [8, 8, 8], [1, 0, 0], [0, 1, 0], [7, 7, 7]], float)
     mesh = Mesh(v, [[1, 3, 4]])
