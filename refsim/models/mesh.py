@@ -406,9 +406,16 @@ def _weld(vertices: np.ndarray, faces: np.ndarray, tolerance: float):
         # distances cannot overflow for coordinates anywhere in float64's range
         # (unit coordinates are below 1 in magnitude: a radius of 4 already
         # joins every pair, and caps one that would overflow)
+        # The tree compares squared distances, which underflow to 0 below
+        # about 2**-537 in unit coordinates: its pairs are candidates, kept
+        # when their distance, by hypot (no overflow, no underflow to 0 of a
+        # nonzero distance), is within the radius.
         e = unit_exponent(vertices)
         radius = 4.0 if math.frexp(tolerance)[1] - e > 3 else math.ldexp(tolerance, -e)
-        pairs = cKDTree(np.ldexp(vertices, -e)).query_pairs(r=radius, output_type="ndarray")
+        unit = np.ldexp(vertices, -e)
+        pairs = cKDTree(unit).query_pairs(r=radius, output_type="ndarray")
+        d = unit[pairs[:, 0]] - unit[pairs[:, 1]]
+        pairs = pairs[np.hypot(np.hypot(d[:, 0], d[:, 1]), d[:, 2]) <= radius]
         graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
         _, label = connected_components(graph, directed=False)
         lowest = np.full(label.max() + 1, n, dtype=np.int64)

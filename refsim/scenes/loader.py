@@ -17,6 +17,7 @@ Cost: O(size of the file) plus loading the models.
 from __future__ import annotations
 
 import math
+import os
 import tomllib
 from pathlib import Path
 
@@ -284,18 +285,25 @@ def _resolve_model(name: str, scene_path: Path | None, key: str) -> Path:
     or a FIFO is then refused by the model reader as not a regular file,
     rather than reported missing); a name the system cannot look up (too
     long, behind an unsearchable directory) is refused here."""
+    shown = f"model {name[:60]!r}{'...' if len(name) > 60 else ''}"
+    if "\0" in name:
+        raise SceneError(f"{shown} cannot be looked up: it contains a NUL byte",
+                         scene_path, key)
     candidates = []
     if scene_path is not None:
         candidates.append(Path(scene_path).parent / name)
     candidates.append(models_dir() / name)
     for candidate in candidates:
+        # lexists: a dangling or looping symlink is there too (and refused
+        # by the reader), not a reason to take the bundled model instead
         try:
-            if candidate.exists():
-                return candidate.absolute()   # a symlink keeps the name (and suffix) given
-        except (OSError, ValueError) as exc:    # ValueError: a NUL byte in the name
-            reason = exc.strerror if isinstance(exc, OSError) else "it contains a NUL byte"
-            raise SceneError(f"model {name[:60]!r}{'...' if len(name) > 60 else ''} cannot "
-                             f"be looked up: {reason}", scene_path, key) from None
+            os.lstat(candidate)
+        except (FileNotFoundError, NotADirectoryError):
+            continue
+        except OSError as exc:
+            raise SceneError(f"{shown} cannot be looked up: {exc.strerror}", scene_path,
+                             key) from None
+        return candidate.absolute()           # a symlink keeps the name (and suffix) given
     looked = ", ".join(str(c) for c in candidates)
     raise SceneError(f"model {name!r} not found (looked in {looked})", scene_path, key)
 

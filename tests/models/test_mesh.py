@@ -299,3 +299,11 @@ def test_bad_input_raises_model_error(vertices, faces, kwargs, match):
     with pytest.raises(ModelError, match=match) as info:
         Mesh(vertices, faces, source="shape.obj", **kwargs)
     assert info.value.path == "shape.obj"
+
+
+def test_tolerance_weld_joins_no_points_farther_apart_than_the_tolerance():
+    # coordinates from 0 to 1e300: in unit coordinates the 1e130 distances
+    # square to 0 in the k-d tree; the distance check keeps them apart
+    v = np.array([[1e300, 0, 0], [0, 0, 0], [1e130, 0, 0], [0, 1e130, 0], [0, 0, 1e130]])
+    mesh = Mesh(v, [[1, 2, 3], [1, 3, 4], [0, 2, 3]], weld_tolerance=1e-6)
+    assert mesh.n_vertices == 5

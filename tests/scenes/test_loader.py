@@ -287,3 +287,17 @@ def test_a_body_or_particles_crossing_half_the_cube_in_one_step_are_refused(tmp_
     assert load_scene(write(tmp_path, particles.format(500.0))).particles.speed_max == 500.0
     assert_scene_error(tmp_path, particles.format(501.0), "particles.speed_max",
                        "covers 5.01 m in one step of 0.01 s")
+
+
+def test_a_dangling_symlink_beside_the_scene_is_not_replaced_by_the_bundled_model(tmp_path):
+    # cube.ac here points nowhere: refused as missing, not read from models/
+    (tmp_path / "cube.ac").symlink_to(tmp_path / "gone.ac")
+    with pytest.raises(SceneError, match="no such file") as info:
+        load_scene(write(tmp_path, MINIMAL))
+    assert info.value.key == "body[0].model"
+    assert f"{tmp_path / 'cube.ac'}: no such file" in str(info.value)
+
+
+def test_a_model_name_with_a_nul_byte_is_refused_at_its_key(tmp_path):
+    assert_scene_error(tmp_path, '[[body]]\nmodel = "cu\\u0000be.ac"\n', "body[0].model",
+                       "cannot be looked up: it contains a NUL byte")
