@@ -81,8 +81,10 @@ def _signals_deferred():
         yield
         return
     caught: list[int] = []
+    # a handler installed outside Python (getsignal gives None) is left alone:
+    # it could not be put back
     previous = {s: signal.signal(s, lambda signum, frame: caught.append(signum))
-                for s in _DEFERRED_SIGNALS}
+                for s in _DEFERRED_SIGNALS if signal.getsignal(s) is not None}
     try:
         yield
     finally:
