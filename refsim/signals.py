@@ -68,3 +68,58 @@ def signals_raise() -> Iterator[None]:
         for s, handler in previous.items():
             # None: a handler installed outside Python, not restorable from here
             signal.signal(s, signal.SIG_DFL if handler is None else handler)
+
+
+class SignalHold:
+    """Signals held by :func:`held_signals`, acted on at :meth:`check`."""
+
+    def __init__(self, signums: tuple[int, ...]):
+        self.caught: list[int] = []
+        self._previous: dict[int, object] = {}
+        self._signums = signums
+
+    def _hold(self, signum, frame) -> None:
+        self.caught.append(signum)
+
+    def _install(self) -> None:
+        self._previous = {s: signal.signal(s, self._hold) for s in self._signums}
+
+    def _restore(self) -> None:
+        for s, handler in self._previous.items():
+            signal.signal(s, handler)  # type: ignore[arg-type]  # what signal() returned
+        self._previous = {}
+
+    def check(self) -> None:
+        """At a point where the caller's state is whole: act on the first
+        signal that came while held, as its own handler would have (a
+        ``KeyboardInterrupt`` or :class:`Interrupted` raised from here); a
+        handler that returns lets the work go on, held again."""
+        if not self.caught:
+            return
+        signum = self.caught[0]
+        self.caught.clear()
+        self._restore()
+        signal.raise_signal(signum)              # runs its handler before returning
+        self._install()
+
+
+@contextmanager
+def held_signals() -> Iterator[SignalHold]:
+    """Within the body, the signals whose handler is Python code (Ctrl-C's,
+    and SIGTERM and SIGHUP under :func:`signals_raise`) are held until the
+    body calls :meth:`SignalHold.check`, so that work which moves state in
+    native code and then counts it (the compiled simulation loop) is never
+    cut between the two. A signal left to the system (SIG_DFL, SIG_IGN, or a
+    handler installed outside Python) is not touched. In threads other than
+    the main one nothing is held (Python runs handlers in the main thread)."""
+    hold = SignalHold(())
+    if threading.current_thread() is threading.main_thread():
+        signums = tuple(s for s in (signal.SIGINT, *RAISED) if callable(signal.getsignal(s)))
+        hold = SignalHold(signums)
+        hold._install()
+    try:
+        yield hold
+    finally:
+        hold._restore()
+        if hold.caught:                          # came after the last check
+            signal.raise_signal(hold.caught[0])

@@ -178,3 +178,35 @@ def test_after_the_first_signal_the_next_ones_are_ignored():
                 signal.raise_signal(signal.SIGTERM)   # ignored: the finally completes
                 finished = True
     assert finished
+
+
+def test_held_signals_wait_for_check_and_leave_the_handlers_as_they_were():
+    from refsim.signals import held_signals
+
+    before = signal.getsignal(signal.SIGINT)
+    reached = []
+    with pytest.raises(KeyboardInterrupt):
+        with held_signals() as hold:
+            signal.raise_signal(signal.SIGINT)       # held: the next line still runs
+            reached.append("after the signal")
+            hold.check()                             # acted on here
+            reached.append("after check")
+    assert reached == ["after the signal"]
+    assert signal.getsignal(signal.SIGINT) is before
+    # a signal that came after the last check is acted on when the block ends
+    with pytest.raises(KeyboardInterrupt):
+        with held_signals():
+            signal.raise_signal(signal.SIGINT)
+    assert signal.getsignal(signal.SIGINT) is before
+
+
+def test_held_signals_leave_a_signal_the_system_handles_alone():
+    from refsim.signals import held_signals
+
+    previous = signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    try:
+        with held_signals() as hold:
+            assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN
+            hold.check()
+    finally:
+        signal.signal(signal.SIGTERM, previous)

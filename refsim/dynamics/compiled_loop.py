@@ -25,9 +25,6 @@ were changed by a readable step since the last call.
 
 from __future__ import annotations
 
-import contextlib
-import signal
-import threading
 import time
 from typing import TYPE_CHECKING
 
@@ -61,37 +58,6 @@ def loop_support(sim: Simulation) -> str | None:
     if sim.body_body and sim.level == "sphere":
         return "collision level 'sphere' (its broad phase is not the boxes')"
     return None
-
-
-#: The signals a run turns into exceptions (refsim.signals, and Ctrl-C).
-_DEFERRED_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-
-
-@contextlib.contextmanager
-def _signals_deferred():
-    """Hold Ctrl-C, SIGTERM and SIGHUP while one call of the kernel and its
-    bookkeeping run, then act on the first that came, as its handler would
-    have. The kernel moves the state up to LOOP_CHUNK steps in place; a
-    handler that raised between its return and the count of steps and
-    events would leave the state ahead of ``steps``, ``t`` and ``events``.
-    The wait is at most one chunk (milliseconds). Python runs handlers in
-    the main thread only, so elsewhere (the viewer's worker) nothing is
-    held."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    caught: list[int] = []
-    # a handler installed outside Python (getsignal gives None) is left alone:
-    # it could not be put back
-    previous = {s: signal.signal(s, lambda signum, frame: caught.append(signum))
-                for s in _DEFERRED_SIGNALS if signal.getsignal(s) is not None}
-    try:
-        yield
-    finally:
-        for s, handler in previous.items():
-            signal.signal(s, handler)
-        if caught:
-            signal.raise_signal(caught[0])
 
 
 class CompiledLoop:
@@ -224,10 +190,6 @@ class CompiledLoop:
     def advance(self, n_steps: int) -> tuple[int, int]:
         """Up to ``n_steps`` steps in the compiled loop: ``(steps taken, stop)``,
         ``stop`` one of the kernel's ``DONE``, ``STOP_READABLE``, ``STOP_EVENTS``."""
-        with _signals_deferred():
-            return self._advance(n_steps)
-
-    def _advance(self, n_steps: int) -> tuple[int, int]:
         sim = self.sim
         world = sim.scene.world
         self._sync_flags()

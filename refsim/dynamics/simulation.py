@@ -107,6 +107,7 @@ from refsim.kernels import choose_kernel
 from refsim.limits import MAX_STEPS
 from refsim.models.mesh import Mesh
 from refsim.scenes.schema import Scene
+from refsim.signals import SignalHold, held_signals
 from refsim.solvers.explicit_rk import rk_step
 from refsim.solvers.integrate import resolve_method, whole_steps
 
@@ -465,13 +466,15 @@ class Simulation:
         """
         n_steps = check_count("n_steps", n_steps, maximum=MAX_STEPS)
         every = check_count("every", every, minimum=1)
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"), \
+                held_signals() as hold:
             while n_steps:
                 stretch = min(n_steps, every - self.steps % every)   # to the next frame
-                self._advance(stretch)
+                self._advance(stretch, hold)
                 n_steps -= stretch
                 if self.steps % every == 0:
                     self.record()
+                hold.check()
 
     def advance(self, n_steps: int) -> None:
         """Take ``n_steps`` steps and record no frame (:meth:`run` without
@@ -479,8 +482,9 @@ class Simulation:
         scene allows it (:attr:`loop`), else one :meth:`step` at a time. The
         same state, events and frames either way, bit for bit."""
         n_steps = check_count("n_steps", n_steps, maximum=MAX_STEPS)
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            self._advance(n_steps)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"), \
+                held_signals() as hold:
+            self._advance(n_steps, hold)
 
     def snapshot(self) -> dict:
         """The state to come back to with :meth:`restore`: copies of ``x``,
@@ -514,20 +518,25 @@ class Simulation:
             return "the readable kernel"
         return loop_support(self)
 
-    def _advance(self, n_steps: int) -> None:
+    def _advance(self, n_steps: int, hold: SignalHold) -> None:
+        """``n_steps`` steps; a held signal (Ctrl-C, SIGTERM) is acted on
+        between steps or compiled calls, where steps, time and events
+        account for the whole state (refsim.signals.held_signals)."""
         loop = self._loop
         if loop is None:
             for _ in range(n_steps):
                 self.step()
+                hold.check()
             return
         while n_steps:
-            # at most LOOP_CHUNK steps per call: Python runs signal handlers
-            # (Ctrl-C, SIGTERM) only between calls
+            # at most LOOP_CHUNK steps per call, so a held signal waits at
+            # most one call (milliseconds)
             done, stop = loop.advance(min(n_steps, LOOP_CHUNK))
             n_steps -= done
             if stop == loop.STOP_READABLE:
                 self.step()           # a step the loop does not take: the readable stages
                 n_steps -= 1
+            hold.check()
 
     # 1. forces and the solver, all bodies at once (S5, S6)
     def _integrate(self) -> None:
