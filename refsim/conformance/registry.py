@@ -33,9 +33,9 @@ rigid.determinism      rigid       two runs, the same bits
 ``--cases N`` sizes the generated sets (triangles, poses, boxes); the ODE
 problems and the rigid scenes are fixed sets.
 
-Cost: building a case set is the cost its module states (the exact answers:
-about 1 ms per triangle pair, 1 ms per pose, 20 us per box vertex; about
-17,000 rigid-body steps per engine); the registry itself is O(checks).
+Cost: building a case set is the cost its module states (the exact answers
+dominate it; measured times in docs/decisions/conformance.md); the rigid set
+is about 17,000 steps per engine; the registry itself is O(checks).
 """
 
 from __future__ import annotations
