@@ -28,3 +28,21 @@ def import_engine(module: str, package: str):
         raise OracleUnavailable(
             f"oracle engine {package!r} is not installed "
             f"(pip install -e '.[oracles]'): {exc}") from None
+
+
+def trajectory_of_frames(frames, times, names, events, step_seconds: float,
+                         total_seconds: float, settings: dict):
+    """A :class:`refsim.dynamics.trajectory.Trajectory` from an engine's
+    recorded frames, each ``(x, v, w, R)`` arrays (B, 3) or (B, 3, 3), the
+    way the rigid-body adapters (pybullet, MuJoCo) record them: two stages,
+    the engine's steps and the recording."""
+    import numpy as np
+
+    from refsim.dynamics.trajectory import Trajectory
+
+    x, v, w, r = (np.stack([f[i] for f in frames]) for i in range(4))
+    return Trajectory(t=np.asarray(times), position=x, velocity=v, angular_velocity=w,
+                      orientation=r, names=names, events=events, stages=("step", "record"),
+                      stage_seconds={"step": step_seconds,
+                                     "record": total_seconds - step_seconds},
+                      settings=settings)

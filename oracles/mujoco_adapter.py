@@ -90,7 +90,7 @@ from dataclasses import asdict, dataclass
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
-from refsim.oracles import import_engine
+from refsim.oracles import import_engine, trajectory_of_frames
 
 #: Wall names in the order of refsim's events (x-, x+, y-, y+, z-, z+).
 WALL_NAMES = ("x-", "x+", "y-", "y+", "z-", "z+")
@@ -273,7 +273,7 @@ class MujocoOracle:
         :class:`~refsim.dynamics.trajectory.Trajectory` whose events are the
         wall contacts that began in a step; ``stage_seconds`` splits the
         wall time into "step" (``mj_step`` and the drag forces) and "record"."""
-        from refsim.dynamics.trajectory import Event, Trajectory
+        from refsim.dynamics.trajectory import Event
 
         self.load(scene)
         h = scene.integration.step
@@ -297,12 +297,9 @@ class MujocoOracle:
                 frames.append(self.state())
                 times.append(k * h)
         elapsed = time.perf_counter() - start
-        x, v, w, r = (np.stack([f[i] for f in frames]) for i in range(4))
-        return Trajectory(t=np.asarray(times), position=x, velocity=v, angular_velocity=w,
-                          orientation=r, names=names, events=events, stages=("step", "record"),
-                          stage_seconds={"step": stepping, "record": elapsed - stepping},
-                          settings={"engine": "mujoco", "version": self.mujoco.__version__,
-                                    **asdict(self.settings)})
+        return trajectory_of_frames(frames, times, names, events, stepping, elapsed,
+                                    {"engine": "mujoco", "version": self.mujoco.__version__,
+                                     **asdict(self.settings)})
 
     def step_time(self, scene, steps: int, warmup: int = 0) -> float:
         """Seconds per step of ``scene`` (mean over ``steps`` steps after

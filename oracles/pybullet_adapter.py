@@ -127,7 +127,7 @@ import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from refsim.oracles import import_engine
+from refsim.oracles import import_engine, trajectory_of_frames
 
 
 @dataclass(frozen=True)
@@ -365,7 +365,7 @@ class PybulletOracle:
         whose events are the wall contacts that began in a step;
         ``stage_seconds`` splits the wall time into "step" (``stepSimulation``
         and the drag forces) and "record" (reading state and contacts)."""
-        from refsim.dynamics.trajectory import Event, Trajectory
+        from refsim.dynamics.trajectory import Event
 
         self.load(scene)
         p, c = self.p, self.client
@@ -399,11 +399,8 @@ class PybulletOracle:
                 frames.append(self.state())
                 times.append(k * h)
         elapsed = time.perf_counter() - start
-        x, v, w, r = (np.stack([f[i] for f in frames]) for i in range(4))
-        return Trajectory(t=np.asarray(times), position=x, velocity=v, angular_velocity=w,
-                          orientation=r, names=names, events=events, stages=("step", "record"),
-                          stage_seconds={"step": stepping, "record": elapsed - stepping},
-                          settings={"engine": "pybullet", **asdict(self.settings)})
+        return trajectory_of_frames(frames, times, names, events, stepping, elapsed,
+                                    {"engine": "pybullet", **asdict(self.settings)})
 
     def step_time(self, scene, steps: int, warmup: int = 0) -> float:
         """Seconds per step of ``scene`` (mean over ``steps`` steps after
