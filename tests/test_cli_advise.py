@@ -48,7 +48,7 @@ ROW_KEYS = {"solver", "step", "level", "aabb", "roles", "steps", "proxy", "force
 REFERENCE_KEYS = {"solver", "step", "check_step", "level", "aabb", "converged", "stop",
                   "horizon", "uncertainty", "position_gap", "event_gap", "resolution",
                   "energy_gap", "count_gap", "energy_spread", "count_spread", "impacts",
-                  "halvings"}
+                  "halvings", "aim"}
 
 
 @pytest.fixture(scope="module")

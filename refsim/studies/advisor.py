@@ -33,7 +33,11 @@ count allowance. The default TOL, ``DEFAULT_TOLERANCE``, is 1 cm.
    in the same step by coincidence and so agree exactly, yet both be a step
    late. Halving stops early when it does not shrink the difference by at
    least ``REDUCTION_MIN`` (the run is chaotic: more steps buy nothing), or
-   when the next run would exceed ``max_reference_steps``.
+   when the next run would exceed ``max_reference_steps``. Advice at
+   several tolerances halves for the strictest (``reference_tolerance``)
+   and takes that one reference, its horizon and its allowances past the
+   horizon for all of them: only TOL itself (and the energy allowance that
+   grows with it) differs between them.
 
    The reference has **converged** when it and its check agree within TOL
    over the whole run (positions, events, end energy) and resolves event
@@ -114,9 +118,23 @@ count allowance. The default TOL, ``DEFAULT_TOLERANCE``, is 1 cm.
    body, or ``body_response = "off"``) gives the same run at every level;
    only "none" is run.
 
+   *Confirmation.* Where contacts make the error a staircase in ``h``, and
+   where the scene is chaotic, a coarse step can land within TOL by chance
+   while steps around it do not; such a run is no advice (a user who
+   changes the step a little loses TOL), and it made the advice at a
+   stricter TOL cheaper than at a looser one. So the recommendation is the
+   cheapest run that meets TOL *and* whose next finer step on the ladder
+   (``m + 1``, same solver, level and boxes) meets it too. The runs that
+   meet TOL are confirmed in order of cost, one neighbour run each, until
+   one is confirmed; one whose neighbour misses is marked "chance". The
+   reference's check needs no neighbour (it meets TOL by construction).
+
    The scene's own settings are run and measured like any candidate, for
    the saving: the ratio of its cost to the recommendation's, and whether
-   it meets TOL at all.
+   it meets TOL at all. So are ``candidates`` given by the caller:
+   :func:`advice_by_tolerance` gives each tolerance the recommendations of
+   the stricter ones, all against one reference (the strictest's), so that
+   the recommended cost never grows as TOL loosens (see the function).
 
 4. Runs go through :func:`refsim.sweep.run_sweep` round by round (the
    reference's halvings, the search's rounds, the geometry), in-process, on
@@ -137,7 +155,8 @@ from __future__ import annotations
 
 import math
 import statistics
-from dataclasses import asdict, dataclass, field
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field, replace
 from fractions import Fraction
 from pathlib import Path
 
@@ -292,9 +311,12 @@ class RunRow:
 
     Settings: ``solver``, ``step`` (s), ``level``, ``aabb``; ``roles`` why
     it ran ("reference", "check", "reference ladder", "own", "search",
-    "geometry"). Work: ``steps``, ``proxy`` = ``force_evaluations`` +
-    ``narrow_phase_calls``, ``box_visits``; ``wall_seconds`` the median of
-    ``wall_repeats`` timings (noisy). Errors against the reference up to the
+    "geometry", "stricter": recommended at a stricter TOL, "confirmation":
+    the next finer step of a run that met TOL) and "chance" (met TOL, but
+    its next finer step did not: not recommended). Work: ``steps``,
+    ``proxy`` = ``force_evaluations`` + ``narrow_phase_calls``,
+    ``box_visits``; ``wall_seconds`` the median of ``wall_repeats``
+    timings (noisy). Errors against the reference up to the
     horizon: ``position_error`` and ``event_error`` (m), ``events``
     ("equal": paired within TOL; "late": paired, some farther apart than
     TOL; "differ": an impact missing or extra), ``event_note`` the first
@@ -352,7 +374,9 @@ class ReferenceRow:
     over the runs of the last comparison (the check, and the run at twice
     its step when the step was halved), the spread past the horizon.
     ``impacts``: the reference's, per kind. ``halvings``: ``(step,
-    uncertainty, horizon)`` for each pair compared.
+    uncertainty, horizon)`` for each pair compared. ``aim``: the tolerance
+    all of these are measured at: TOL itself, or the strictest of the
+    tolerances that share this reference (:func:`advice_by_tolerance`).
     """
 
     solver: str
@@ -373,6 +397,7 @@ class ReferenceRow:
     count_spread: dict
     impacts: dict
     halvings: tuple[tuple[float, float, float], ...]
+    aim: float
 
 
 @dataclass(frozen=True)
@@ -522,11 +547,14 @@ class _Reference:
 
 
 def _find_reference(runner: _Runner, tolerance: float, max_steps: int,
-                    first: list[tuple[Setting, str]]) -> _Reference:
+                    first: list[tuple[Setting, str]], aim: float) -> _Reference:
     """Halve the reference's step until it converges, stops converging or
-    reaches the budget (module docstring, 1). ``first``: runs to make along
-    with the first pair (the search's first round), so that one sweep runs
-    them all."""
+    reaches the budget at the tolerance ``aim`` (module docstring, 1). The
+    horizon and the allowances past it are ``aim``'s; only the energy
+    allowance grows with ``tolerance`` (>= ``aim``: advice at several
+    tolerances shares the reference of the strictest). ``first``: runs to
+    make along with the first pair (the search's first round), so that one
+    sweep runs them all."""
     ladder = runner.ladder
     m = ladder.divisions * REFERENCE_START
     if ladder.n_steps(2 * m) > max_steps:
@@ -543,22 +571,28 @@ def _find_reference(runner: _Runner, tolerance: float, max_steps: int,
                once={ref(m), ref(2 * m)})
     halvings = []
     H = float(runner.data["world"]["half_size"])
-    while True:
-        fine, coarse = runner.runs[ref(2 * m)], runner.runs[ref(m)]
-        h = ladder.step(2 * m)
-        end = runner.duration               # (a reference that diverged ends before it)
-        horizon = metrics.agreement_horizon(fine, coarse, tolerance)
+    end = runner.duration                   # (a reference that diverged ends before it)
+
+    def gaps(fine: metrics.Run, coarse: metrics.Run, h: float, scale: float, tol: float):
+        horizon = metrics.agreement_horizon(fine, coarse, tol)
         position_gap = float(metrics.distances(fine, coarse).max())
-        events = metrics.compare_events(fine, coarse, tolerance, end)
+        events = metrics.compare_events(fine, coarse, tol, end)
         event_gap = events.error if events.paired else math.inf
         fastest = max((e.speed for e in metrics.impacts(fine) if e.time <= horizon), default=0.0)
         resolution = fastest * h
-        scale = metrics.energy_scale(fine)
         energy_gap = metrics.energy_drift(coarse, scale) - metrics.energy_drift(fine, scale)
         # all four as distances: the energy's by its allowance TOL / H (fidelity_metrics)
         uncertainty = max(position_gap, event_gap, resolution, abs(energy_gap) * H)
+        return horizon, position_gap, event_gap, resolution, energy_gap, uncertainty
+
+    while True:
+        fine, coarse = runner.runs[ref(2 * m)], runner.runs[ref(m)]
+        h = ladder.step(2 * m)
+        scale = metrics.energy_scale(fine)
+        horizon, position_gap, event_gap, resolution, energy_gap, uncertainty = gaps(
+            fine, coarse, h, scale, aim)
         halvings.append((h, uncertainty, horizon))
-        if uncertainty <= REFERENCE_SHARE * tolerance and horizon >= end * (1 - 1e-12):
+        if uncertainty <= REFERENCE_SHARE * aim and horizon >= end * (1 - 1e-12):
             stop = CONVERGED
             break
         # halving did not help: the difference shrank by less than REDUCTION_MIN,
@@ -576,7 +610,7 @@ def _find_reference(runner: _Runner, tolerance: float, max_steps: int,
     reference, check = ref(2 * m), ref(m)
     runner.roles[reference] = ["reference"]
     runner.roles[check] = ["check"]
-    converged = horizon >= end * (1 - 1e-12) and uncertainty <= tolerance
+    converged = horizon >= end * (1 - 1e-12) and uncertainty <= aim
     ours, theirs = metrics.impact_counts(fine), metrics.impact_counts(coarse)
     count_gap = {k: theirs[k] - ours[k] for k in metrics.KINDS}
     # The spread past the horizon: how far the runs of the last comparison
@@ -601,7 +635,7 @@ def _find_reference(runner: _Runner, tolerance: float, max_steps: int,
         horizon=horizon, uncertainty=uncertainty, position_gap=position_gap,
         event_gap=event_gap, resolution=resolution, energy_gap=energy_gap,
         count_gap=count_gap, energy_spread=energy_spread, count_spread=count_spread,
-        impacts=ours, halvings=tuple(halvings))
+        impacts=ours, halvings=tuple(halvings), aim=aim)
     return _Reference(run=fine, setting=reference, check=check, row=row, scale=scale,
                       energy_allowance=energy_allowance, count_allowance=count_allowance)
 
@@ -717,7 +751,9 @@ def advise(scene, tolerance: float = DEFAULT_TOLERANCE, *, duration: float | Non
            backend: str = "inprocess", workers: int | None = None,
            scheduler: str | None = None, store=None, progress: bool = False,
            repeats: int = TIMING_REPEATS,
-           max_reference_steps: int = MAX_REFERENCE_STEPS) -> Advice:
+           max_reference_steps: int = MAX_REFERENCE_STEPS,
+           reference_tolerance: float | None = None,
+           candidates: Sequence[Fidelity] = ()) -> Advice:
     """The cheapest fidelity settings of ``scene`` whose run stays within
     ``tolerance`` of the reference (the module docstring explains each step).
 
@@ -740,6 +776,15 @@ def advise(scene, tolerance: float = DEFAULT_TOLERANCE, *, duration: float | Non
         Wall-time repeats of each candidate run (its median is reported).
     max_reference_steps : int
         The most steps of one reference run (module docstring, 1).
+    reference_tolerance : float, optional
+        The tolerance the reference's halving aims at and its horizon and
+        allowances past the horizon are measured at, at most ``tolerance``
+        (default: ``tolerance``). Advice at several tolerances shares the
+        reference of the strictest (:func:`advice_by_tolerance`).
+    candidates : sequence of Fidelity
+        Settings run and judged along with the search's (the
+        recommendations at stricter tolerances: module docstring, 3); each
+        step a whole number of steps per sample interval.
 
     Returns
     -------
@@ -763,6 +808,10 @@ def advise(scene, tolerance: float = DEFAULT_TOLERANCE, *, duration: float | Non
         raise StateError(f"tolerance must be a finite number of metres > 0, got {tolerance!r}")
     repeats = check_count("repeats", repeats, minimum=1)
     max_reference_steps = check_count("max_reference_steps", max_reference_steps, minimum=2)
+    aim = tolerance if reference_tolerance is None else float(reference_tolerance)
+    if not (math.isfinite(aim) and 0.0 < aim <= tolerance):
+        raise StateError(f"reference_tolerance must be a finite number of metres in "
+                         f"(0, tolerance = {tolerance!r}], got {reference_tolerance!r}")
     if not isinstance(scene, Scene):
         scene = load_scene(scene)
     if not scene.bodies:
@@ -784,9 +833,10 @@ def advise(scene, tolerance: float = DEFAULT_TOLERANCE, *, duration: float | Non
         if method.order > 1:
             first.append((Setting(name, 2 * ladder.divisions, REFERENCE_LEVEL,
                                   REFERENCE_AABB), "search"))
+    first += [(_on_ladder(ladder, fidelity), "stricter") for fidelity in candidates]
     runner.run(first[:1])            # the scene's own settings first: a scene that cannot
     #                                  run at all fails here, before the long reference runs
-    ref = _find_reference(runner, tolerance, max_reference_steps, first[1:])
+    ref = _find_reference(runner, tolerance, max_reference_steps, first[1:], aim)
 
     verdicts: dict[Setting, _Verdict] = {}
 
@@ -795,11 +845,11 @@ def advise(scene, tolerance: float = DEFAULT_TOLERANCE, *, duration: float | Non
             verdicts[setting] = _judge(runner.runs[setting], ref, tolerance)
         return verdicts[setting]
 
-    def candidates():
+    def made():
         return [s for s in runner.runs if s != ref.setting]
 
     def best_proxy() -> int:
-        meeting = [s for s in candidates() if verdict(s).meets]
+        meeting = [s for s in made() if verdict(s).meets]
         return min(runner.runs[s].proxy for s in meeting)
 
     # Integration search (module docstring, 3), at the reference's level and boxes.
@@ -808,7 +858,7 @@ def advise(scene, tolerance: float = DEFAULT_TOLERANCE, *, duration: float | Non
         best = best_proxy()
         wanted = []
         for name in SOLVERS:
-            measured = [(s.m, verdict(s).ratio, verdict(s).meets) for s in candidates()
+            measured = [(s.m, verdict(s).ratio, verdict(s).meets) for s in made()
                         if (s.solver, s.level, s.aabb) == (name, REFERENCE_LEVEL,
                                                            REFERENCE_AABB)]
             m = _propose(name, measured) if measured else None
@@ -818,7 +868,7 @@ def advise(scene, tolerance: float = DEFAULT_TOLERANCE, *, duration: float | Non
             if m * per_m >= best:
                 pruned[Setting(name, m, REFERENCE_LEVEL, REFERENCE_AABB)] = Pruned(
                     name, ladder.step(m), REFERENCE_LEVEL, REFERENCE_AABB, m * per_m, best)
-                passing = {s.m for s in candidates() if verdict(s).meets
+                passing = {s.m for s in made() if verdict(s).meets
                            and (s.level, s.aabb) == (REFERENCE_LEVEL, REFERENCE_AABB)}
                 m = _last_chance(measured, passing, (best - 1) // per_m)
                 if m is None:
@@ -829,7 +879,7 @@ def advise(scene, tolerance: float = DEFAULT_TOLERANCE, *, duration: float | Non
         runner.run(wanted)
 
     # Geometry at the best integration (module docstring, 3).
-    integration = min((s for s in candidates() if verdict(s).meets
+    integration = min((s for s in made() if verdict(s).meets
                        and (s.level, s.aabb) == (REFERENCE_LEVEL, REFERENCE_AABB)),
                       key=lambda s: _rank(s, runner.runs[s]))
     body_stage = B >= 2 and scene.dynamics.body_response != "off"
@@ -837,8 +887,21 @@ def advise(scene, tolerance: float = DEFAULT_TOLERANCE, *, duration: float | Non
     runner.run([(Setting(integration.solver, integration.m, level, CANDIDATE_AABB), "geometry")
                 for level in levels])
 
-    chosen = min((s for s in candidates() if verdict(s).meets),
-                 key=lambda s: _rank(s, runner.runs[s]))
+    # Confirmation (module docstring, 3): the cheapest run that meets TOL and
+    # whose next finer step on the ladder meets it too.
+    chosen = None
+    for s in sorted((s for s in made() if verdict(s).meets),
+                    key=lambda s: _rank(s, runner.runs[s])):
+        if s == ref.check:
+            chosen = s                  # meets by construction, against the reference
+            break
+        finer = replace(s, m=s.m + 1)
+        runner.run([(finer, "confirmation")])
+        if verdict(finer).meets:
+            chosen = s
+            break
+        runner.roles[s].append("chance")
+    assert chosen is not None           # the check is among the runs that meet TOL
     rows = {s: _row(s, runner, ref, verdict(s) if s != ref.setting else None)
             for s in runner.runs}
     recommended, own_row = rows[chosen], rows[own]
@@ -852,6 +915,15 @@ def advise(scene, tolerance: float = DEFAULT_TOLERANCE, *, duration: float | Non
         wall_saving=own_row.wall_seconds / recommended.wall_seconds,
         runs=tuple(rows.values()), pruned=tuple(pruned.values()), computed=runner.computed,
         resumed=runner.resumed)
+
+
+def _on_ladder(ladder: Ladder, fidelity: Fidelity) -> Setting:
+    """The setting of ``fidelity``, whose step must be on the ladder."""
+    m = round(ladder.interval / fidelity.step)
+    if m < 1 or ladder.step(m) != fidelity.step:
+        raise StateError(f"candidate step {fidelity.step!r} s is not a whole number of steps "
+                         f"per sample interval ({ladder.interval!r} s)")
+    return Setting(fidelity.solver, m, fidelity.level, fidelity.aabb)
 
 
 def _row(setting: Setting, runner: _Runner, ref: _Reference, v: _Verdict | None) -> RunRow:
@@ -897,14 +969,32 @@ def advice_by_tolerance(scenes=BUNDLED_RIGID_SCENES, tolerances=REPORT_TOLERANCE
     """For each scene (bundled names or paths), :func:`advise` at each
     tolerance: the report's view of how the recommendation moves with TOL.
 
+    The tolerances of a scene are advised from the strictest to the
+    loosest, all against the reference of the strictest, its horizon and
+    its allowances past the horizon (``reference_tolerance``), and each is
+    offered the recommendations of the stricter ones as candidates. Then a
+    run that meets a stricter TOL meets every looser one (each test is a
+    bound that grows with TOL), its next finer step too, so the recommended
+    cost never grows as TOL loosens: the series is one speed-accuracy
+    trade-off. A lone :func:`advise` at a loose TOL may differ from the
+    series' entry: it compares positions up to its own, later, horizon.
+
     ``store``: a directory; each scene gets its own store inside it, which
     every tolerance shares (runs common to two tolerances are made once).
     Other options go to :func:`advise` (``backend``, ``workers``,
     ``repeats``, ``duration``...). Cost: the advices', less what is shared.
+    Returns each scene's advice in the order of ``tolerances``.
     """
+    tolerances = tuple(float(t) for t in tolerances)
+    strictest = min(tolerances, default=DEFAULT_TOLERANCE)
     series = []
     for name in scenes:
         scene_store = None if store is None else Path(store) / Path(str(name)).stem
-        advice = tuple(advise(name, tol, store=scene_store, **options) for tol in tolerances)
-        series.append(ToleranceSeries(str(name), tuple(float(t) for t in tolerances), advice))
+        found: dict[float, Advice] = {}
+        for tol in sorted(set(tolerances)):
+            stricter = [a.recommended.fidelity() for a in found.values()]
+            found[tol] = advise(name, tol, store=scene_store, reference_tolerance=strictest,
+                                candidates=list(dict.fromkeys(stricter)), **options)
+        series.append(ToleranceSeries(str(name), tolerances,
+                                      tuple(found[t] for t in tolerances)))
     return tuple(series)

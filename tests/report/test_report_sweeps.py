@@ -207,6 +207,11 @@ def test_the_advisor_lists_every_bundled_scene(quick_report):
             assert row[2].startswith(f"{rec['solver']}, h = ") and str(rec["proxy"]) == row[3]
             assert a["proxy_saving"] == pytest.approx(a["own"]["proxy"] / rec["proxy"])
             assert ("converged" if a["reference"]["converged"] else "not converged") in row[8]
+        # one reference per scene; the cost never grows as TOL loosens
+        assert len({json.dumps(a["reference"], sort_keys=True) for a in scene["advice"]}) == 1
+        by_tolerance = sorted(scene["advice"], key=lambda a: a["tolerance"])
+        costs = [a["recommended"]["proxy"] for a in by_tolerance]
+        assert costs == sorted(costs, reverse=True)
     assert [s["scene"] for s in advisor["scenes"] if s["refused"]] == ["particles.toml"]
     assert [s["scene"] for s in advisor["scenes"] if s["skipped"]] == \
         list(plan.ADVISOR_QUICK_SKIP)

@@ -98,7 +98,11 @@ def build(ctx) -> Section:
                  "independent; the advisor ranks by it). A run meets TOL when its positions "
                  "stay within TOL of the reference's up to the horizon, its impacts pair "
                  "with the reference's in order with times within TOL, and its end energy "
-                 "is within the allowance; a saving below 1 means the scene's own settings "
+                 "is within the allowance; it is recommended only when its next finer step "
+                 "meets TOL too (a step that meets TOL by chance, where contacts make the "
+                 "error a staircase in h, is passed over). All tolerances of a scene are "
+                 "judged against one reference, the strictest's, and its horizon. "
+                 "A saving below 1 means the scene's own settings "
                  "are cheaper but miss TOL. Pruned: runs whose force evaluations alone "
                  "already cost more than the best run found. "
                  f"Reproduce: {CMD} (one scene: refsim advise SCENE --tolerance TOL)"))
@@ -114,7 +118,9 @@ def build(ctx) -> Section:
         svg=line_chart(series, xlabel="TOL (m)", ylabel="cost of the recommended run",
                        logx=True, logy=True),
         caption=("Each bundled rigid-body scene's cheapest run within TOL of its reference: "
-                 "how much modelling the scene needs for each accuracy. " + scope
+                 "how much modelling the scene needs for each accuracy. Each tolerance is "
+                 "offered the stricter ones' recommendations, against one reference and "
+                 "horizon, so the cost never grows as TOL loosens. " + scope
                  + f" Reproduce: {CMD}"))
     intro = ("Model no more than a scene needs: refsim advise holds a scene's physics fixed "
              "(rotation model, body response, forces) and searches its fidelity choices "
