@@ -32,7 +32,7 @@ from pathlib import Path
 from refsim.bundled import templates_dir
 from refsim.claims import CLAIMS, TERMINOLOGY
 from refsim.io import write_text_atomic
-from refsim.report.plan import REPORT_SEED, SWEEP_ENTRIES, Run
+from refsim.report.plan import PARALLEL_ENTRIES, REPORT_SEED, SWEEP_ENTRIES, Run
 from refsim.report.progress import Progress
 from refsim.report.section import Section, to_json
 
@@ -101,10 +101,11 @@ def build_report(out_dir: Path, *, quick: bool = False, stream=None,
     """Measure, render and write the report; return the path of index.html.
 
     ``workers``: run the plan's sweep entries (the conformance matrix, the
-    replays, the advisor: :data:`refsim.report.plan.SWEEP_ENTRIES`) on this
-    many local processes, started at once and measured beside the other
-    studies, which run here (:meth:`Run.prefetch`); the results are the
-    same as without workers. The engines' conformance pages and the replays
+    replays, the advisor: :data:`refsim.report.plan.SWEEP_ENTRIES`) and its
+    untimed studies (:data:`~refsim.report.plan.PARALLEL_ENTRIES`) on this
+    many local processes, started at once; the timed studies run here after
+    them (:meth:`Run.prefetch`). The results are the same as without
+    workers, timings aside. The engines' conformance pages and the replays
     are written into ``out_dir`` beside the page, each whole."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)  # fail before the long work, not after
@@ -112,7 +113,7 @@ def build_report(out_dir: Path, *, quick: bool = False, stream=None,
     with Progress(len(AREAS) + 1, stream=stream) as progress:
         run = Run(quick=quick, seed=REPORT_SEED, announce=progress.announce, out_dir=out_dir,
                   workers=workers)
-        run.prefetch(SWEEP_ENTRIES)     # with workers: their sweeps run beside the rest
+        run.prefetch(PARALLEL_ENTRIES + SWEEP_ENTRIES)   # with workers: on them, at once
         ctx = ReportContext(quick=quick, seed=REPORT_SEED, progress=progress, run=run)
         for key, title, pending in AREAS:
             progress.announce(title)

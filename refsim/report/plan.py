@@ -22,8 +22,11 @@ for the report to say so.
 Three entries run through :mod:`refsim.sweep` (:data:`SWEEP_ENTRIES`): the
 shipped engines' conformance matrix, the replays of the viewer's demos and
 the advisor on every bundled scene. A run given ``workers`` sends their
-tasks to that many local processes and starts them at once, beside the
-other entries (:meth:`Run.prefetch`); their records are the same either
+tasks to that many local processes, and with them every other entry but
+the timed ones and those that gather others' records
+(:data:`PARALLEL_ENTRIES`, one task each); it starts them at once
+(:meth:`Run.prefetch`) and measures the timed entries here once the workers
+are done, on an otherwise idle machine. The records are the same either
 way. A run given ``out_dir`` has the matrix's and the replays' pages
 written there (the report's directory).
 """
@@ -34,7 +37,7 @@ import importlib
 import math
 import threading
 from collections.abc import Callable
-from concurrent.futures import Future
+from concurrent.futures import Future, wait
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -155,39 +158,73 @@ class Run:
         return {"backend": "processes", "workers": self.workers}
 
     def prefetch(self, names) -> None:
-        """Start measuring the :data:`SWEEP_ENTRIES` among ``names`` now, one
-        after the other in a background thread, so that their sweeps run on
-        the run's workers while this thread measures the other entries;
-        :meth:`get` waits for them. Only with workers: the thread spends its
-        time waiting for the workers' answers, and the records are the same
-        as measured in order. (An entry measured here must touch nothing of
-        the run but its settings: these make no engine and read no other
-        entry.)"""
-        wanted = [n for n in names if n in SWEEP_ENTRIES and n not in self._records
-                  and n not in self._pending]
+        """Start measuring, in a background thread, the entries among
+        ``names`` that run on the workers: first the
+        :data:`PARALLEL_ENTRIES` in one sweep (a task each, in a fresh
+        :class:`Run` in the worker), then the :data:`SWEEP_ENTRIES` one after
+        the other (each its own sweep). The workers stay busy while this
+        thread measures what must run here; :meth:`get` waits for an entry's
+        records, and a timed entry waits for all of them, so that it is
+        measured on an otherwise idle machine. Only with workers: the thread
+        spends its time waiting for the workers' answers, and the records
+        are the same as measured in order. (An entry measured here must
+        touch nothing of the run but its settings: these make no engine here
+        and read no other entry.)"""
+        wanted = [n for n in names if (n in SWEEP_ENTRIES or n in PARALLEL_ENTRIES)
+                  and n not in self._records and n not in self._pending]
         if self.workers is None or not wanted:
             return
         futures: dict[str, Future] = {name: Future() for name in wanted}
         self._pending.update(futures)
+        parallel = {n: futures[n] for n in wanted if n in PARALLEL_ENTRIES}
 
         def measure() -> None:
+            if parallel:
+                self._measure_parallel(parallel)
             for name, future in futures.items():
-                if not future.set_running_or_notify_cancel():
+                if name in parallel or not future.set_running_or_notify_cancel():
                     continue
                 try:
-                    future.set_result(STUDIES[name].measure(self))
+                    future.set_result((STUDIES[name].measure(self), {}))
                 except BaseException as exc:  # noqa: BLE001 - handed to get() in the main thread
                     future.set_exception(exc)
 
         # a daemon thread: Ctrl-C in the main thread is not held up by it
         threading.Thread(target=measure, name="refsim-report-sweeps", daemon=True).start()
 
+    def _measure_parallel(self, futures: dict[str, Future]) -> None:
+        """The entries of ``futures`` as one sweep on the workers; each
+        future gets ``(records, engines missing in the worker)``."""
+        from refsim.errors import SweepError
+        from refsim.report.tasks import entry_records, measure_entry
+        from refsim.sweep import Task, run_sweep
+
+        tasks = [Task(f"entry-{name}", measure_entry,
+                      {"name": name, "quick": self.quick, "report_seed": self.seed})
+                 for name in futures]
+        try:
+            sweep = run_sweep(tasks, progress=False, seed=self.seed, **self.sweep_options())
+        except BaseException as exc:  # noqa: BLE001 - handed to get() in the main thread
+            for future in futures.values():
+                future.set_exception(exc)
+            return
+        for (name, future), result in zip(futures.items(), sweep.results, strict=True):
+            if result.status != "done":
+                future.set_exception(SweepError(f"{name}: {result.error}"))
+            else:
+                future.set_result(entry_records(result.value))
+
     def get(self, name: str):
         """The records of entry ``name`` (measured on first use)."""
         if name not in self._records and name in self._pending:
-            self._records[name] = self._pending.pop(name).result()
+            records, missing = self._pending.pop(name).result()
+            for engine, why in missing.items():
+                self.missing.setdefault(engine, why)
+            self._records[name] = records
         if name not in self._records:
             study = STUDIES[name]
+            if study.timed and self._pending:
+                wait(list(self._pending.values()))   # time it on an idle machine
             self._announce(study.title)
             self._records[name] = study.measure(self)
         return self._records[name]
@@ -236,6 +273,13 @@ class Study:
     # seed claim -> judge(records) -> ClaimResult, for the claims it backs
     claims: dict[str, Callable[[Any], ClaimResult]] = field(default_factory=dict)
     in_report: bool = True      # False: offered by ``refsim study`` only
+    #: Its records hold wall times (timing fields): with workers, it is
+    #: measured in the report's process after the workers are done, on an
+    #: otherwise idle machine, never beside them.
+    timed: bool = False
+    #: It gathers other entries' records (``run.get``): measured in the
+    #: report's process, from the records the others returned.
+    gathers: bool = False
 
 
 def command(name: str) -> str:
@@ -1058,17 +1102,18 @@ def _entries() -> dict[str, Study]:
         Study("models-facts", "models: facts of the bundled models", _models_facts),
         Study("models-agreement", "models: agreement with trimesh", _models_agreement),
         Study("bounds-cost", "bounds: cost per update (C1)", _bounds_cost,
-              {"C1": _judge("bounds.c1")}),
+              {"C1": _judge("bounds.c1")}, timed=True),
         Study("bounds-error", "bounds: incremental box on non-convex meshes (C2)",
               _bounds_error, {"C2": _judge("bounds.c2")}),
         Study("bounds-agreement", "bounds: agreement with trimesh", _bounds_agreement),
         Study("bounds-compile", "bounds: numba compile cost", _bounds_compile,
               in_report=False),
         Study("collision-levels", "collision: levels (C3)", _collision_levels,
-              {"C3": _judge("collision.c3")}),
+              {"C3": _judge("collision.c3")}, timed=True),
         Study("collision-body-oracles", "collision: body-level oracles",
               _collision_body_oracles),
-        Study("collision-speed", "collision: hierarchy against FCL", _collision_speed),
+        Study("collision-speed", "collision: hierarchy against FCL", _collision_speed,
+              timed=True),
         Study("collision-triangles", "collision: triangle pairs against FCL",
               _collision_triangles),
         Study("collision-c4", "collision: near-parallel triangles (C4)", _collision_c4,
@@ -1082,24 +1127,25 @@ def _entries() -> dict[str, Study]:
         Study("solvers-stability", "solvers: stability limits", _solvers_stability),
         Study("solvers-energy", "solvers: energy per period", _solvers_energy),
         Study("solvers-alike", "solvers: the four other solvers (C7)", _solvers_alike,
-              {"C7": _judge("solvers.c7", "orders", "limits", "jitter", "polynomials")}),
+              {"C7": _judge("solvers.c7", "orders", "limits", "jitter", "polynomials")},
+              gathers=True),
         Study("solvers-work-precision", "solvers: work-precision, Kepler",
-              _solvers_work_precision),
+              _solvers_work_precision, timed=True),
         Study("particles-work-precision", "solvers: work-precision, particle system",
-              _particles_work_precision),
+              _particles_work_precision, timed=True),
         Study("particles-work-precision-walls",
               "solvers: work-precision, particle system with walls",
-              _particles_work_precision_walls),
+              _particles_work_precision_walls, timed=True),
         Study("particles-jitter", "solvers: resting contact", _particles_jitter,
               {"C6": _judge("solvers.c6", "undamped", "damped")}),
         Study("particles-drag", "solvers: drag models", _particles_drag,
-              {"C5": _judge("solvers.c5")}),
+              {"C5": _judge("solvers.c5")}, timed=True),
         Study("particles-frame", "solvers: frame-step differences", _particles_frame),
         Study("particles-choice", "solvers: which solver (C9)", _particles_choice,
-              {"C9": _judge("solvers.c9", "rows")}),
+              {"C9": _judge("solvers.c9", "rows")}, gathers=True),
         Study("particles-rk4", "solvers: is RK4 worth its cost (C8)", _particles_rk4,
               {"C8": _judge("solvers.c8", "choice", "frame_free", "frame_walls",
-                            "wall_orders")}),
+                            "wall_orders")}, gathers=True),
         Study("particles-throughput", "particles: throughput", _particles_throughput,
               in_report=False),
         Study("particles-memory", "particles: memory per step", _particles_memory,
@@ -1108,11 +1154,11 @@ def _entries() -> dict[str, Study]:
         Study("dynamics-oblique", "dynamics: oblique bounces", _dynamics_oblique),
         Study("dynamics-rest", "dynamics: time to rest", _dynamics_rest),
         Study("dynamics-energy", "dynamics: energy over time", _dynamics_energy),
-        Study("dynamics-cost", "dynamics: error against cost", _dynamics_cost),
+        Study("dynamics-cost", "dynamics: error against cost", _dynamics_cost, timed=True),
         Study("dynamics-pybullet-settings", "dynamics: pybullet's settings",
               _dynamics_pybullet_settings),
         Study("dynamics-step-cost", "dynamics: step cost against pybullet",
-              _dynamics_step_cost),
+              _dynamics_step_cost, timed=True),
         Study("dynamics-spin", "dynamics: C12 spin", _dynamics_spin,
               {"C12": _judge("dynamics.c12")}),
         Study("dynamics-interpenetration", "dynamics: C11 interpenetration",
@@ -1134,6 +1180,13 @@ STUDIES: dict[str, Study] = _entries()
 #: The entries that run through refsim.sweep (on the run's workers, when it
 #: has them): measured beside the others by :meth:`Run.prefetch`.
 SWEEP_ENTRIES = ("replays", "conformance-matrix", "advisor")   # in the order the page needs them
+
+#: The report's other entries that a run with workers sends to them, one
+#: task each (:func:`refsim.report.tasks.measure_entry`): all but the timed
+#: ones and those that gather others' records.
+PARALLEL_ENTRIES = tuple(name for name, study in STUDIES.items()
+                         if study.in_report and not (study.timed or study.gathers)
+                         and name not in SWEEP_ENTRIES)
 
 #: The entry that backs each seed claim.
 CLAIM_STUDY: dict[str, str] = {claim: name for name, study in STUDIES.items()

@@ -1,4 +1,4 @@
-"""The report's sweep tasks: the runs of its newer sections as calls that
+"""The report's sweep tasks: its measurements as calls that
 :func:`refsim.sweep.run_sweep` can send to another process.
 
 A sweep task is a module-level function taking ``seed`` and plain
@@ -15,13 +15,26 @@ what they return. The conformance matrix's task is
   (:func:`refsim.studies.advisor.advice_by_tolerance`) on one scene at each
   tolerance.
 
-Neither uses the sweep's seed: the demos and the advisor are deterministic.
-Cost: the demo's simulations and one replay serialization; the advice's runs.
+- :func:`measure_entry`: any other entry of the plan
+  (:data:`refsim.report.plan.PARALLEL_ENTRIES`), measured in a fresh run in
+  the worker. Its records are dataclasses of arrays made for the report's
+  sections, not plain data: they travel pickled, as text (base64), and
+  :func:`entry_records` turns them back. Pickle carries every float to the
+  bit, and the report's sweeps have no store, so the plain-data rule's
+  reason (a store another version reads) does not apply to them.
+
+None uses the sweep's seed: the demos and the advisor are deterministic, and
+an entry uses the report's seed (``report_seed``), as it does when measured
+in the report's process. Cost: the demo's simulations and one replay
+serialization; the advice's runs; the entry's measurement and one pickle.
 """
 
 from __future__ import annotations
 
+import base64
+import pickle
 from pathlib import Path
+from typing import Any
 
 #: The demos :func:`write_replay_demo` knows, by name: (function of
 #: :mod:`refsim.viewer.demos`, the engine it runs beside refsim or None).
@@ -97,3 +110,21 @@ def advise_scene(*, seed: int, scene: str, tolerances: list, duration: float | N
     except StateError as exc:
         return {"refused": str(exc)}
     return {"advice": [advice.as_dict() for advice in series.advice]}
+
+
+def measure_entry(*, seed: int, name: str, quick: bool, report_seed: int) -> dict:
+    """The records of the plan's entry ``name`` measured in a fresh
+    :class:`refsim.report.plan.Run` (quick or full, ``report_seed``), in
+    this process: ``{"records": <pickle as base64 text>, "missing": {engine:
+    why}}`` (the engines it could not make)."""
+    from refsim.report.plan import Run
+
+    run = Run(quick=quick, seed=report_seed)
+    records = run.get(name)
+    text = base64.b64encode(pickle.dumps(records, protocol=pickle.HIGHEST_PROTOCOL))
+    return {"records": text.decode("ascii"), "missing": dict(run.missing)}
+
+
+def entry_records(value: dict) -> tuple[Any, dict]:
+    """``(records, missing)`` of a :func:`measure_entry` answer."""
+    return pickle.loads(base64.b64decode(value["records"])), dict(value["missing"])

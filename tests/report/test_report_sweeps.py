@@ -15,7 +15,7 @@ from refsim.claims import CLAIMS
 from refsim.conformance.matrix import conformance_matrix, run_matrix
 from refsim.conformance.results import ConformanceResult, tally
 from refsim.report import plan
-from refsim.report.build import render, section_json
+from refsim.report.build import AREAS, _build_section, claim_rows, render, section_json
 from refsim.report.section import Section, to_json
 from refsim.report.sections import advisor as advisor_section
 from refsim.report.sections import conformance as conformance_section
@@ -245,25 +245,57 @@ def _untimed(value, timings):
 
 
 def test_workers_give_the_serial_results(quick_report, tmp_path):
-    """The sweep entries measured on 2 local processes give the quick
-    report's results (built in this process), timings aside."""
+    """Every section built from a run on 2 local processes (the sweep
+    entries and the untimed studies on the workers, the timed ones here
+    after them) gives the quick report's results (built in this process),
+    timings aside."""
     _, _, results = quick_report
     run = plan.Run(quick=True, out_dir=tmp_path, workers=2)
-    run.prefetch(plan.SWEEP_ENTRIES)            # as the report does: beside this thread
-    ctx = SimpleNamespace(quick=True, run=run, seed=plan.REPORT_SEED, progress=None)
-    for key, module in (("conformance", conformance_section), ("advisor", advisor_section)):
+    run.prefetch(plan.PARALLEL_ENTRIES + plan.SWEEP_ENTRIES)   # as the report does
+    assert len(plan.PARALLEL_ENTRIES) >= 15
+    quiet = SimpleNamespace(announce=lambda text: None)
+    ctx = SimpleNamespace(quick=True, run=run, seed=plan.REPORT_SEED, progress=quiet)
+    sections = []
+    for key, title, pending in AREAS:
         timings: set = set()
-        parallel = json.loads(json.dumps(section_json(module.build(ctx), timings)))
+        sections.append(_build_section(key, title, pending, ctx))
+        parallel = json.loads(json.dumps(section_json(sections[-1], timings)))
         serial = _section(results, key)
         paths = {tuple(p[3:]) for p in results["timing_paths"] if p[1] == key} | \
             {tuple(p[3:]) for p in timings}
-        assert _untimed(parallel["results"], paths) == _untimed(serial["results"], paths)
+        assert _untimed(parallel["results"], paths) == _untimed(serial["results"], paths), key
         assert [t for t in parallel["tables"] if not t["timing"]] == \
-            [t for t in serial["tables"] if not t["timing"]]
+            [t for t in serial["tables"] if not t["timing"]], key
+    claims = json.loads(json.dumps(claim_rows(sections)))
+    assert [c for c in claims if not c["timing"]] == \
+        [c for c in results["claims"] if not c["timing"]]
+    assert run.missing == {}
     replays = json.loads(json.dumps(to_json(run.get("replays"))))
     assert replays == _section(results, "dynamics")["results"]["replays"]
     assert sorted(p.name for p in (tmp_path / "replays").iterdir()) == \
         sorted(f"{name}.html" for name, _, _ in plan.REPLAYS)
+
+
+def test_the_timed_studies_stay_in_the_reports_process():
+    """A study whose records hold timing fields is never sent to a worker
+    (it would be timed beside the others), nor one that gathers others'."""
+    for name in plan.PARALLEL_ENTRIES:
+        study = plan.STUDIES[name]
+        assert study.in_report and not study.timed and not study.gathers
+    assert {"bounds-cost", "collision-levels", "collision-speed", "particles-drag",
+            "dynamics-step-cost"} <= {n for n, s in plan.STUDIES.items() if s.timed}
+
+
+def test_an_entry_measured_in_a_worker_returns_its_records_to_the_bit():
+    from refsim.report.tasks import entry_records, measure_entry
+
+    answer = measure_entry(seed=123, name="solvers-energy", quick=True,
+                           report_seed=plan.REPORT_SEED)
+    assert json.loads(json.dumps(answer)) == answer          # plain data for the sweep
+    records, missing = entry_records(answer)
+    assert missing == {}
+    here = plan.Run(quick=True).get("solvers-energy")
+    assert json.dumps(to_json(records)) == json.dumps(to_json(here))
 
 
 def test_report_command_takes_workers(tmp_path, capsys):
