@@ -21,7 +21,8 @@ tests gate on and the report draws; nothing here prints or plots
   (:func:`classify_body_disagreement`; pairs by
   :func:`refsim.studies.triangles.classify_disagreement`).
 - :func:`measure_hierarchy_speed`: the 2k-triangle sphere and torus pairs in
-  three configurations (:data:`SPEED_CONFIGURATIONS`): all intersecting pairs
+  three configurations, and two touching pairs (cubes face to face, a cube
+  on the sphere) (:data:`SPEED_CONFIGURATIONS`): all intersecting pairs
   by the hierarchy, by the seed's path and by FCL, and the boolean query
   against FCL's, as medians and ratios measured in the same run; and the
   one-off compile cost of the numba kernels.
@@ -662,24 +663,33 @@ def measure_body_oracles(collide_engines: tuple = (), pairs_engine=None, *,
 
 @dataclass(frozen=True)
 class SpeedConfiguration:
-    """One body of ``model`` at the identity, a copy at (fixed rotation,
-    ``distance`` along ``direction``)."""
+    """One body of ``model`` at the identity, a body of ``model_b`` (None: a
+    copy of ``model``) at (``rotation_b``, ``distance`` along ``direction``)."""
 
     model: str
-    kind: str               # "separated-boxes-overlap", "grazing", "deep"
+    kind: str               # "separated-boxes-overlap", "grazing", "deep", "touching"
     direction: tuple
     distance: float
     description: str
+    model_b: str | None = None
+    rotation_b: str = "fixed"     # as Configuration.rotation_b
+
+    @property
+    def label(self) -> str:
+        """The model, or both models of a mixed pair (``"sphere-2k+cube"``)."""
+        return self.model if self.model_b is None else f"{self.model}+{self.model_b}"
 
     def as_configuration(self) -> Configuration:
-        return Configuration(f"{self.model}-{self.kind}", self.kind, self.description,
-                             self.model, self.model, direction=self.direction,
+        return Configuration(f"{self.label}-{self.kind}", self.kind, self.description,
+                             self.model, self.model_b or self.model,
+                             rotation_b=self.rotation_b, direction=self.direction,
                              distance=self.distance)
 
 
 #: The benchmark configurations: two sphere-2k (radius 1) and two torus
 #: (2000 triangles each; outer radius 1.35 in the xz plane, tube 0.35), the
-#: second body turned by the fixed rotation (FIXED_AXIS, FIXED_ANGLE).
+#: second body turned by the fixed rotation (FIXED_AXIS, FIXED_ANGLE); then
+#: the touching pairs, unturned.
 SPEED_CONFIGURATIONS: tuple[SpeedConfiguration, ...] = (
     SpeedConfiguration("sphere-2k", "separated-boxes-overlap", DIAGONAL, 2.1,
                        "centres 2.1 apart along (1,1,1): gap 0.1, boxes overlap"),
@@ -693,6 +703,14 @@ SPEED_CONFIGURATIONS: tuple[SpeedConfiguration, ...] = (
                        "centres 2.66 apart along (1,0,1)"),
     SpeedConfiguration("torus", "deep", XZ_DIAGONAL, 1.0,
                        "centres 1 apart along (1,0,1)"),
+    # issue 16's touching configurations: nearly every candidate pair touches
+    # exactly, the float filter certifies none, the exact stage answers them all
+    SpeedConfiguration("cube", "touching", (0.0, 1.0, 0.0), 1.0,
+                       "unit cubes sharing the face y = 0.5 (84 triangle-box pairs, 62 touch)",
+                       rotation_b="identity"),
+    SpeedConfiguration("sphere-2k", "touching", (0.0, 1.0, 0.0), 1.5,
+                       "a unit cube resting on the sphere's top vertex (12 of 12 pairs touch)",
+                       model_b="cube", rotation_b="identity"),
 )
 
 
@@ -835,7 +853,7 @@ def measure_hierarchy_speed(fcl=None, repeats: int = 21, *,
                                           repeats)
             fcl_bool = _median_seconds(functools.partial(fcl.bodies_collide, *arrays), repeats)
         cases.append(SpeedCase(
-            model=sc.model, kind=sc.kind, description=sc.description,
+            model=sc.label, kind=sc.kind, description=sc.description,
             candidate_pairs=len(pairs("bvh", "triangle-aabb")), exact_pairs=len(exact),
             fcl_pairs=fcl_pairs,
             bvh_seconds=_median_seconds(functools.partial(pairs, "bvh"), repeats),
