@@ -14,9 +14,13 @@ What it runs (one step, the stages of the readable outline, same order):
                 solvers) on ``y = (x, v)`` with gravity and linear or
                 quadratic drag: :func:`refsim.solvers.explicit_rk.rk_step`
                 with :func:`refsim.dynamics.forces.translational_rhs`;
-2. rotation     none (``rotation = "off"``) or the seed's Euler step of the
-                axes with Gram-Schmidt:
-                :func:`refsim.dynamics.rotation_seed.orientation_step_seed_loops`;
+2. rotation     none (``rotation = "off"``), the seed's Euler step of the
+                axes with Gram-Schmidt
+                (:func:`refsim.dynamics.rotation_seed.orientation_step_seed_loops`),
+                or the corrected exact rotation with angular momentum
+                (:func:`refsim.dynamics.rotation_impulse.orientation_step_exact`:
+                the exponential map with the C library's sine and cosine,
+                every product summed left to right);
 3. check        the energy bound, conservatively (below);
 4. bounds       the linear scan of a body's vertices
                 (:func:`refsim.dynamics.boxes.boxes_loops`), or the
@@ -29,7 +33,11 @@ What it runs (one step, the stages of the readable outline, same order):
                 spin change :meth:`Simulation._wall_spin_seed` (contact vertex
                 :func:`~refsim.dynamics.rotation_seed.contact_vertex_seed`,
                 :func:`~refsim.dynamics.rotation_seed.contact_spin_seed`)
-                with the seed's rotation;
+                with the seed's rotation; or the corrected impulses,
+                :meth:`Simulation._wall_impulse` (the vertices past the wall,
+                push-back, speed at the wall, and the contact solve
+                :func:`refsim.dynamics.impulse.solve_contacts_python`
+                compiled from its own source);
 6. broad-phase  every pair of boxes, in the sorted order of
                 :func:`refsim.collision.broad_phase.overlapping_pairs_sweep`;
 8. response     at level "aabb", the seed's exchange,
@@ -62,9 +70,12 @@ Events: the kernel keeps the previous step's contacts as flags, ``walls``
 contact that began (kind 0: wall 2k or 2k + 1; kind 1: body j); the caller
 sorts a step's rows by names as :meth:`Simulation._note_events` does.
 
-Seed sections: S2, S3, S5-S9 (as the readable stages).
+Seed sections: S2, S3, S5-S9 (as the readable stages), and their
+correction (the corrected rotation model and wall impulses).
 
-Cost per step: O(s B) for s solver stages, O(sum of vertices) for the boxes,
+Cost per step: O(s B) for s solver stages, O(sum of vertices) for the boxes
+(and per wall contact of the corrected model, for the vertices past the
+wall, plus the contact solve),
 O(B^2) box tests for the broad phase (all pairs, compiled; cheaper than the
 sort below a few hundred bodies).
 
@@ -74,10 +85,14 @@ kernels are chosen.
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 
 from refsim.bounds._numba_kernels import incremental_update_numba
+from refsim.dynamics.impulse import _matvec, solve_contacts_python
+from refsim.dynamics.rotation_impulse import SERIES_BELOW
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -91,11 +106,22 @@ BODY_NONE = 0           # no body-body stage (one body, level "none", response "
 BODY_EXCHANGE = 1       # level "aabb", the seed's exchange (S8): done in the loop
 BODY_HAND_BACK = 2      # any other: a step with an overlapping pair of boxes goes back
 
+#: Rotation models of the loop (the scene's ``dynamics.rotation``).
+ROTATION_OFF = 0
+ROTATION_SEED = 1       # S9's Euler step of the axes
+ROTATION_EXACT = 2      # "impulse": the exact rotation with angular momentum
+
+#: The contact solve of the corrected wall response, compiled from the
+#: readable source (:func:`refsim.dynamics.impulse.solve_contacts_python`,
+#: as :func:`~refsim.dynamics.impulse.solve_contacts_compiled` compiles it).
+_solve_contacts = numba.njit(cache=True, nogil=True)(solve_contacts_python)
+
 
 @numba.njit(cache=True, nogil=True)
-def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
-            restitution, friction, wall_speed_at_wall, half_size, vertices_t, first_vertex,
-            centred, center, lam, mass, energy_limit, body_mode,
+def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
+            restitution, friction, wall_speed_at_wall, wall_impulse, threshold, iterations,
+            half_size, vertices_t, first_vertex, centred, center, lam, mass, inv_mass,
+            I_body, I_body_inv, energy_limit, body_mode,
             x, v, w, R, lo, hi, walls, bodies, events, tracked, tracker_rows, trackers_f,
             trackers_i):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation.step`, up to
@@ -106,15 +132,20 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
     ----------
     hA : (s, s) ``h * A`` of the tableau; hb : (s,) ``h * b``
     drag_rate : (B,) ``drag / mass``; quadratic : bool
-    seed_rotation : bool (else rotation "off")
-    wall_speed_at_wall : bool (``wall_speed="wall"``, else the seed's)
+    rotation_mode : int (``ROTATION_*``)
+    wall_speed_at_wall : bool (``wall_speed="wall"``, else the seed's; the
+        seed's wall response)
+    wall_impulse : bool, the corrected wall response (``wall_response =
+        "impulse"``), else the seed's; threshold, iterations: its
+        restitution threshold and sweeps (:mod:`refsim.dynamics.impulse`)
     vertices_t : (3, N) every body's body-space vertices, body b's in
         columns ``first_vertex[b]:first_vertex[b + 1]`` (int64 (B + 1,))
     centred : bool, every centroid at its mesh origin (mesh origin = x);
         else the origin is ``x - R c`` for the body-space centroids ``center``
         (B, 3), ``R c`` summed left to right
         (:attr:`Simulation.position`, :func:`refsim.dynamics.products.matvec`)
-    lam, mass : (B,) largest principal moment, mass
+    lam, mass, inv_mass : (B,) largest principal moment, mass, 1 / mass
+    I_body, I_body_inv : (B, 3, 3) body-space inertia and its inverse
     body_mode : int (``BODY_*``)
     x, v, w : (B, 3); R : (B, 3, 3); lo, hi : (B, 3) the state and boxes
     walls : (B, 6) bool; bodies : (B, B) bool (the contacts, read and written)
@@ -138,7 +169,19 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
     w0 = np.empty((B, 3))
     R0 = np.empty((B, 3, 3))
     A = np.empty((3, 3))
+    E = np.empty((3, 3))            # rotation_exp of one body; then its world I^-1
     corr = np.empty(3)
+    # the wall impulses' arrays: contacts r_a, the static wall's r_b, v_b, w_b
+    # and I_inv_b (zeros), the normal n and the impulses P
+    most = 1
+    for b in range(B):
+        most = max(most, first_vertex[b + 1] - first_vertex[b])
+    r_a = np.empty((most, 3))
+    r_b = np.zeros((most, 3))
+    P = np.empty((most, 4))
+    n = np.zeros(3)
+    still = np.zeros((2, 3))
+    I_inv_wall = np.zeros((3, 3))
     origin = np.empty((B, 3))
     now_walls = np.zeros((B, 6), np.bool_)
     pairs = np.empty((max(B * (B - 1) // 2, 1), 2), np.int64)
@@ -189,8 +232,12 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
                 x[b, k] = y[3 * b + k]
                 v[b, k] = y[d + 3 * b + k]
 
-        # 2. rotation: the seed's X += h (w x X) for each column, then Gram-Schmidt
-        if seed_rotation:
+        # 2. rotation: the seed's X += h (w x X) for each column, then
+        # Gram-Schmidt; or the exact step
+        if rotation_mode == ROTATION_EXACT:
+            for b in range(B):
+                _orientation_step_exact(b, h, R, w, I_body[b], I_body_inv[b], E, A)
+        elif rotation_mode == ROTATION_SEED:
             for b in range(B):
                 wx, wy, wz = w[b, 0], w[b, 1], w[b, 2]
                 for c in range(3):
@@ -248,7 +295,8 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
                 lo[b, k] = least + origin[b, k]
                 hi[b, k] = greatest + origin[b, k]
 
-        # 5. walls (S3, S7; S9's spin first with the seed's rotation)
+        # 5. walls (S3, S7; S9's spin first with the seed's rotation; or the
+        # corrected impulses)
         for b in range(B):
             for k in range(6):
                 now_walls[b, k] = False
@@ -266,25 +314,28 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, seed_rotation,
                     corr[k] = 0.5 * (below - above)
                 else:
                     corr[k] = (below if below > 0.0 else 0.0) - (above if above > 0.0 else 0.0)
-            if seed_rotation:
-                _wall_spin_seed(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1],
-                                x, center, v, w, R, lo, hi, restitution, friction)
-            # wall_response_seed
-            for k in range(3):
-                if corr[k] == 0.0:
-                    continue
-                x[b, k] += corr[k]
-                v_k = v[b, k]
-                if wall_speed_at_wall:
-                    a_k = -gravity if k == 1 else 0.0
-                    squared = v_k * v_k + 2.0 * a_k * corr[k]
-                    if 0.0 > squared:
-                        squared = 0.0
-                    v_k = np.copysign(np.sqrt(squared), v_k)
-                v[b, k] = -restitution * v_k
-                for j in range(3):
-                    if j != k:
-                        v[b, j] = k_friction * v[b, j]
+            if wall_impulse:
+                _world_inertia(R[b], I_body_inv[b], E)
+                _wall_impulse(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1], x,
+                              center, v, w, R, half_size, gravity, restitution, friction,
+                              threshold, iterations, inv_mass[b], E, r_a, r_b, P, n, still,
+                              I_inv_wall)
+            else:
+                if rotation_mode == ROTATION_SEED:
+                    _wall_spin_seed(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1],
+                                    x, center, v, w, R, lo, hi, restitution, friction)
+                # wall_response_seed
+                for k in range(3):
+                    if corr[k] == 0.0:
+                        continue
+                    x[b, k] += corr[k]
+                    v_k = v[b, k]
+                    if wall_speed_at_wall:
+                        v_k = _wall_speed(v_k, -gravity if k == 1 else 0.0, corr[k])
+                    v[b, k] = -restitution * v_k
+                    for j in range(3):
+                        if j != k:
+                            v[b, j] = k_friction * v[b, j]
             for k in range(3):
                 lo[b, k] += corr[k]
                 hi[b, k] += corr[k]
@@ -398,12 +449,7 @@ def _wall_spin_seed(b, corr, vertices_t, first, end, x, center, v, w, R, lo, hi,
     N a signed unit axis: every product is exact, so the sum is the one
     nonzero product in any order, written here ``((0 + p0) + p1) + p2``.
     """
-    o0 = x[b, 0] - ((R[b, 0, 0] * center[b, 0] + R[b, 0, 1] * center[b, 1])
-                    + R[b, 0, 2] * center[b, 2])
-    o1 = x[b, 1] - ((R[b, 1, 0] * center[b, 0] + R[b, 1, 1] * center[b, 1])
-                    + R[b, 1, 2] * center[b, 2])
-    o2 = x[b, 2] - ((R[b, 2, 0] * center[b, 0] + R[b, 2, 1] * center[b, 1])
-                    + R[b, 2, 2] * center[b, 2])
+    o0, o1, o2 = _origin(b, x, R, center)
     for k in range(3):
         if corr[k] == 0.0:
             continue
@@ -486,3 +532,147 @@ def _exchange_seed(a, b, x, v):
     v[b, 0] = v[b, 0] + db * N0
     v[b, 1] = v[b, 1] + db * N1
     v[b, 2] = v[b, 2] + db * N2
+
+
+@numba.njit(cache=True, nogil=True)
+def _origin(b, x, R, center):
+    """Body b's mesh origin ``x - R c`` as :meth:`Simulation.pose
+    <refsim.dynamics.simulation.Simulation.pose>` computes it (``R c``
+    summed left to right, also for c = 0)."""
+    o0 = x[b, 0] - ((R[b, 0, 0] * center[b, 0] + R[b, 0, 1] * center[b, 1])
+                    + R[b, 0, 2] * center[b, 2])
+    o1 = x[b, 1] - ((R[b, 1, 0] * center[b, 0] + R[b, 1, 1] * center[b, 1])
+                    + R[b, 1, 2] * center[b, 2])
+    o2 = x[b, 2] - ((R[b, 2, 0] * center[b, 0] + R[b, 2, 1] * center[b, 1])
+                    + R[b, 2, 2] * center[b, 2])
+    return o0, o1, o2
+
+
+@numba.njit(cache=True, nogil=True)
+def _wall_speed(v_k, a_k, correction_k):
+    """Mirrors :func:`refsim.dynamics.walls.wall_speed`."""
+    squared = v_k * v_k + 2.0 * a_k * correction_k
+    if 0.0 > squared:
+        squared = 0.0
+    return np.copysign(np.sqrt(squared), v_k)
+
+
+@numba.njit(cache=True, nogil=True)
+def _rotation_exp(t0, t1, t2, E):
+    """Mirrors :func:`refsim.dynamics.rotation_impulse.rotation_exp` for one
+    rotation vector, into E (3, 3): the same series below ``SERIES_BELOW``,
+    the C library's sine and cosine (``math.sin``, ``math.cos``), each entry
+    in the same order."""
+    a2 = (t0 * t0 + t1 * t1) + t2 * t2
+    if a2 < SERIES_BELOW:
+        s = 1.0 - a2 / 6.0
+        c = 0.5 - a2 / 24.0
+        cos_a = 1.0 - 0.5 * a2
+    else:
+        a = math.sqrt(a2)
+        s = math.sin(a) / a
+        cos_a = math.cos(a)
+        c = (1.0 - cos_a) / (a * a)
+    ct0, ct1, ct2 = c * t0, c * t1, c * t2
+    st0, st1, st2 = s * t0, s * t1, s * t2
+    E[0, 0] = ct0 * t0 + cos_a
+    E[0, 1] = ct0 * t1 - st2
+    E[0, 2] = ct0 * t2 + st1
+    E[1, 0] = ct1 * t0 + st2
+    E[1, 1] = ct1 * t1 + cos_a
+    E[1, 2] = ct1 * t2 - st0
+    E[2, 0] = ct2 * t0 - st1
+    E[2, 1] = ct2 * t1 + st0
+    E[2, 2] = ct2 * t2 + cos_a
+
+
+@numba.njit(cache=True, nogil=True)
+def _matTvec(M, x0, x1, x2):
+    """``M^T x`` summed left to right (:func:`refsim.dynamics.products.matTvec`)."""
+    return ((M[0, 0] * x0 + M[1, 0] * x1) + M[2, 0] * x2,
+            (M[0, 1] * x0 + M[1, 1] * x1) + M[2, 1] * x2,
+            (M[0, 2] * x0 + M[1, 2] * x1) + M[2, 2] * x2)
+
+
+@numba.njit(cache=True, nogil=True)
+def _orientation_step_exact(b, h, R, w, I_body, I_body_inv, E, R_next):
+    """Mirrors :func:`refsim.dynamics.rotation_impulse.orientation_step_exact`
+    for body b, in place (E and R_next (3, 3) scratch)."""
+    Rb = R[b]
+    u = _matTvec(Rb, w[b, 0], w[b, 1], w[b, 2])
+    p = _matvec(I_body, u[0], u[1], u[2])
+    L = _matvec(Rb, p[0], p[1], p[2])                     # R (I_body (R^T w))
+    _rotation_exp(h * w[b, 0], h * w[b, 1], h * w[b, 2], E)
+    for i in range(3):
+        for j in range(3):
+            R_next[i, j] = (E[i, 0] * Rb[0, j] + E[i, 1] * Rb[1, j]) + E[i, 2] * Rb[2, j]
+    for i in range(3):
+        for j in range(3):
+            Rb[i, j] = R_next[i, j]
+    u = _matTvec(Rb, L[0], L[1], L[2])
+    p = _matvec(I_body_inv, u[0], u[1], u[2])
+    w[b, 0], w[b, 1], w[b, 2] = _matvec(Rb, p[0], p[1], p[2])
+
+
+@numba.njit(cache=True, nogil=True)
+def _world_inertia(Rb, I_body, out):
+    """Mirrors :func:`refsim.dynamics.rotation_impulse.world_inertia` for one
+    body: ``(R I) R^T`` into out (3, 3), each sum left to right."""
+    T = np.empty((3, 3))
+    for i in range(3):
+        for j in range(3):
+            T[i, j] = (Rb[i, 0] * I_body[0, j] + Rb[i, 1] * I_body[1, j]) \
+                + Rb[i, 2] * I_body[2, j]
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = (T[i, 0] * Rb[j, 0] + T[i, 1] * Rb[j, 1]) + T[i, 2] * Rb[j, 2]
+
+
+@numba.njit(cache=True, nogil=True)
+def _wall_impulse(b, corr, vertices_t, first, end, x, center, v, w, R, half_size, gravity,
+                  restitution, friction, threshold, iterations, inv_mass, I_inv, r_a, r_b,
+                  P, n, still, I_inv_wall):
+    """Mirrors :meth:`refsim.dynamics.simulation.Simulation._wall_impulse` for
+    body b, in place: for each crossed wall, the vertices past it
+    (:func:`refsim.dynamics.rotation_impulse.wall_contacts`, world
+    coordinates as :func:`refsim.types.transform_points` computes them), the
+    push-back, the speed at the wall (D6) and the contact solve
+    (:func:`refsim.dynamics.impulse.wall_impulses`, the wall static: zero
+    ``r_b``, ``v_b``, ``w_b`` (the rows of ``still``) and ``I_inv_wall``).
+    ``I_inv`` is the body's world inverse inertia."""
+    for k in range(3):
+        if corr[k] == 0.0:
+            continue
+        low = corr[k] > 0.0
+        wall = -half_size if low else half_size
+        o = _origin(b, x, R, center)
+        o_k = o[k]
+        count = 0
+        for q in range(first, end):
+            W_k = ((R[b, k, 0] * vertices_t[0, q] + R[b, k, 1] * vertices_t[1, q])
+                   + R[b, k, 2] * vertices_t[2, q]) + o_k
+            if W_k < wall if low else W_k > wall:
+                for j in range(3):
+                    r_a[count, j] = (((R[b, j, 0] * vertices_t[0, q]
+                                       + R[b, j, 1] * vertices_t[1, q])
+                                      + R[b, j, 2] * vertices_t[2, q]) + o[j]) - x[b, j]
+                count += 1
+        x[b, k] += corr[k]
+        # D6: the speed at the wall, only for a real bounce
+        if v[b, k] * corr[k] < -threshold * abs(corr[k]):
+            v[b, k] = _wall_speed(v[b, k], -gravity if k == 1 else 0.0, corr[k])
+        if count == 0:
+            continue
+        for j in range(3):
+            n[j] = 0.0
+            still[0, j] = 0.0
+            still[1, j] = 0.0
+            for i in range(3):
+                I_inv_wall[j, i] = 0.0
+        n[k] = 1.0 if low else -1.0
+        for i in range(count):
+            for j in range(3):
+                r_b[i, j] = 0.0
+        _solve_contacts(r_a[:count], r_b[:count], n, inv_mass, I_inv, v[b], w[b], 0.0,
+                        I_inv_wall, still[0], still[1], restitution, friction, threshold,
+                        iterations, P[:count])

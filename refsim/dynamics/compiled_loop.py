@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from refsim.bounds.aabb_incremental import IncrementalAABB
+from refsim.dynamics import impulse
 from refsim.dynamics.trajectory import Event
 
 if TYPE_CHECKING:
@@ -45,16 +46,13 @@ WALLS = tuple("xyz"[k // 2] + "-+"[k % 2] for k in range(6))     # flag index ->
 def loop_support(sim: Simulation) -> str | None:
     """Why the compiled loop cannot run ``sim``'s scene (one line), or None.
 
-    It covers rotation "off" and "seed", the seed's wall response (either
-    wall speed), any solver,
-    linear or quadratic drag, and body-body contacts at every level but
-    "sphere" (the seed's exchange at level "aabb" in the loop; any other
-    level or response hands the steps with overlapping boxes back).
+    It covers every rotation model ("off", "seed", "impulse"), both wall
+    responses (the seed's, with either wall speed, and the corrected
+    impulses), any solver, linear or quadratic drag, and body-body contacts
+    at every level but "sphere" (the seed's exchange at level "aabb" in the
+    loop; any other level or response hands the steps with overlapping
+    boxes back).
     """
-    if sim.rotation not in ("off", "seed"):
-        return f"rotation {sim.rotation!r} (the loop does 'off' and 'seed')"
-    if sim.wall_response != "seed":
-        return f"wall response {sim.wall_response!r} (the loop does the seed's)"
     if sim.body_body and sim.level == "sphere":
         return "collision level 'sphere' (its broad phase is not the boxes')"
     return None
@@ -84,6 +82,10 @@ class CompiledLoop:
         self.first_vertex[1:] = np.cumsum([len(vs) for vs in vertices])
         self.vertices_t = np.ascontiguousarray(np.concatenate(vertices).T)
         self.center = np.ascontiguousarray(sim.center, dtype=np.float64)
+        self.rotation_mode = {"off": kernels.ROTATION_OFF, "seed": kernels.ROTATION_SEED,
+                              "impulse": kernels.ROTATION_EXACT}[sim.rotation]
+        self.I_body = np.ascontiguousarray(sim.I_body, dtype=np.float64)
+        self.I_body_inv = np.ascontiguousarray(sim.I_body_inv, dtype=np.float64)
         self._lay_out_trackers()
         if not sim.body_body:
             self.body_mode = kernels.BODY_NONE
@@ -196,9 +198,11 @@ class CompiledLoop:
         start = time.perf_counter()
         done, n_events, stop = self.kernels.advance(
             n_steps, sim.h, self.hA, self.hb, world.gravity, self.drag_rate, self.quadratic,
-            sim.rotation == "seed", world.restitution, world.friction,
-            sim.wall_speed == "wall", world.half_size, self.vertices_t, self.first_vertex,
-            sim._centred, self.center, sim._lambda_max, sim.mass, sim._energy_limit,
+            self.rotation_mode, world.restitution, world.friction,
+            sim.wall_speed == "wall", sim.wall_response == "impulse",
+            impulse.RESTITUTION_THRESHOLD, impulse.ITERATIONS, world.half_size,
+            self.vertices_t, self.first_vertex, sim._centred, self.center, sim._lambda_max,
+            sim.mass, sim.inv_mass, self.I_body, self.I_body_inv, sim._energy_limit,
             self.body_mode, sim.x, sim.v, sim.w, sim.R, sim.lo, sim.hi, self.walls,
             self.bodies, self.events, self.tracked, self.tracker_rows, self.trackers_f,
             self.trackers_i)

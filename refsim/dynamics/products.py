@@ -7,6 +7,8 @@ What: for 3-vectors ``a``, ``b`` and 3x3 matrices ``M`` (shapes ``(3,)`` and
     a . b          = (a0 b0 + a1 b1) + a2 b2
     |a|            = sqrt(a . a)
     (M x)_i        = (M_i0 x0 + M_i1 x1) + M_i2 x2
+    (M^T x)_i      = (M_0i x0 + M_1i x1) + M_2i x2
+    (A B)_ij       = (A_i0 B_0j + A_i1 B_1j) + A_i2 B_2j
 
 each product and sum rounded once, left to right, as
 :mod:`refsim.bounds.aabb_linear` does for a transformed coordinate.
@@ -20,8 +22,9 @@ the same bits on every machine, and the compiled simulation loop
 (:mod:`refsim.dynamics._numba_kernels`) repeats the same operations in the
 same order, so it agrees with them bit for bit.
 
-Seed sections: none of their own; used by S8 (the seed's exchange) and for
-the mesh origin ``x - R c`` of every body (S2, S9).
+Seed sections: none of their own; used by S8 (the seed's exchange), for
+the mesh origin ``x - R c`` of every body (S2, S9), and by the corrected
+rotation model (:mod:`refsim.dynamics.rotation_impulse`).
 
 Cost: O(1) per body, a handful of numpy calls per product.
 """
@@ -44,3 +47,14 @@ def norm(a: np.ndarray) -> np.ndarray:
 def matvec(M: np.ndarray, x: np.ndarray) -> np.ndarray:
     """``M x``: (..., 3, 3), (..., 3) -> (..., 3)."""
     return dot(M, x[..., np.newaxis, :])
+
+
+def matTvec(M: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``M^T x``: (..., 3, 3), (..., 3) -> (..., 3)."""
+    return matvec(np.swapaxes(M, -1, -2), x)
+
+
+def matmul(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """``A B``: (..., 3, 3), (..., 3, 3) -> (..., 3, 3)."""
+    return ((A[..., :, 0:1] * B[..., 0:1, :] + A[..., :, 1:2] * B[..., 1:2, :])
+            + A[..., :, 2:3] * B[..., 2:3, :])

@@ -36,13 +36,40 @@ by the exponential map as in E. Hairer, C. Lubich, G. Wanner, *Geometric
 Numerical Integration*, 2nd ed., Springer 2006, section IV.8 (Lie group
 methods).
 
-Cost: O(B) per step (a few (B, 3, 3) products); O(n) per wall contact for
-the vertices, plus the contact solve.
+Arithmetic in one order: every sum of products is written out left to
+right (:mod:`refsim.dynamics.products`, not ``einsum`` or ``@``, which go
+to BLAS or SIMD loops whose order depends on the processor), and sine and
+cosine are the C library's, one call per body (:func:`sin_cos`). The
+compiled simulation loop (:mod:`refsim.dynamics._numba_kernels`) repeats
+these operations in the same order, so the two agree bit for bit, and the
+result does not depend on numpy's choice of loops for the processor.
+
+Cost: O(B) per step (a few (B, 3, 3) products, 2 B calls of sine and
+cosine); O(n) per wall contact for the vertices, plus the contact solve.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+
+from refsim.dynamics.products import dot, matmul, matTvec, matvec
+
+#: Below this ``|theta|^2`` (``|theta| < 1e-4``) :func:`rotation_exp` uses
+#: the series of ``sin(a)/a`` and ``(1 - cos(a))/a^2``, whose truncation
+#: error there (``a^4/120``) is below 1e-18.
+SERIES_BELOW = 1e-8
+
+
+def sin_cos(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(sin(a), cos(a))`` of (B,) angles, one ``math.sin`` / ``math.cos``
+    call per body: the C library's functions, which the compiled loop calls
+    too (numpy's own ``np.sin`` / ``np.cos`` may take SIMD loops of their
+    own, chosen by the processor, whose last bits differ)."""
+    values = a.tolist()
+    return (np.array([math.sin(x) for x in values], dtype=np.float64),
+            np.array([math.cos(x) for x in values], dtype=np.float64))
 
 
 def rotation_exp(theta: np.ndarray) -> np.ndarray:
@@ -51,15 +78,19 @@ def rotation_exp(theta: np.ndarray) -> np.ndarray:
     Rodrigues: ``cos(a) E + sin(a) K + (1 - cos(a)) k k^T`` with
     ``a = |theta|``, ``k = theta / a``, ``K = [k]x``; written as
     ``cos(a) E + s [theta]x + c theta theta^T`` with ``s = sin(a)/a``,
-    ``c = (1 - cos(a))/a^2``, whose series are used below ``a = 1e-4``
-    (where the truncation error, ``a^4/120``, is below 1e-18).
+    ``c = (1 - cos(a))/a^2``, whose series are used below ``SERIES_BELOW``.
+
+    Each entry in one order (the compiled loop repeats it):
+    ``((c theta_i) theta_j -+ s theta_k) + cos(a)`` (the last term on the
+    diagonal only), ``|theta|^2`` summed left to right.
     """
-    a2 = np.einsum("ij,ij->i", theta, theta)
-    small = a2 < 1e-8
+    a2 = dot(theta, theta)
+    small = a2 < SERIES_BELOW
     a = np.sqrt(np.where(small, 1.0, a2))
-    s = np.where(small, 1.0 - a2 / 6.0, np.sin(a) / a)
-    c = np.where(small, 0.5 - a2 / 24.0, (1.0 - np.cos(a)) / (a * a))
-    cos_a = np.where(small, 1.0 - 0.5 * a2, np.cos(a))
+    sin_a, cos_of_a = sin_cos(a)
+    s = np.where(small, 1.0 - a2 / 6.0, sin_a / a)
+    c = np.where(small, 0.5 - a2 / 24.0, (1.0 - cos_of_a) / (a * a))
+    cos_a = np.where(small, 1.0 - 0.5 * a2, cos_of_a)
     out = (c[:, None, None] * theta[:, :, None]) * theta[:, None, :]   # c theta theta^T
     st = s[:, None] * theta
     out[:, 0, 1] -= st[:, 2]
@@ -74,24 +105,19 @@ def rotation_exp(theta: np.ndarray) -> np.ndarray:
 
 
 def world_inertia(R: np.ndarray, I_body: np.ndarray) -> np.ndarray:
-    """``R I_body R^T`` for all bodies: (B, 3, 3), (B, 3, 3) -> (B, 3, 3)."""
-    return R @ I_body @ R.transpose(0, 2, 1)
-
-
-def _matvec(M: np.ndarray, x: np.ndarray) -> np.ndarray:
-    return np.einsum("bij,bj->bi", M, x)
-
-
-def _matTvec(M: np.ndarray, x: np.ndarray) -> np.ndarray:
-    return np.einsum("bji,bj->bi", M, x)
+    """``(R I_body) R^T`` for all bodies: (B, 3, 3), (B, 3, 3) -> (B, 3, 3),
+    each product summed left to right (:func:`refsim.dynamics.products.matmul`)."""
+    return matmul(matmul(R, I_body), np.swapaxes(R, -1, -2))
 
 
 def orientation_step_exact(R: np.ndarray, w: np.ndarray, h: float, I_body: np.ndarray,
                            I_body_inv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """One torque-free step of all bodies: ``(R', w')`` (see the module docstring)."""
-    L = _matvec(R, _matvec(I_body, _matTvec(R, w)))                  # R I_body R^T w
-    R_next = rotation_exp(h * w) @ R
-    w_next = _matvec(R_next, _matvec(I_body_inv, _matTvec(R_next, L)))
+    """One torque-free step of all bodies: ``(R', w')`` (see the module
+    docstring); each matrix-vector product a left-to-right sum
+    (:mod:`refsim.dynamics.products`), no ``einsum`` or BLAS."""
+    L = matvec(R, matvec(I_body, matTvec(R, w)))                  # R (I_body (R^T w))
+    R_next = matmul(rotation_exp(h * w), R)
+    w_next = matvec(R_next, matvec(I_body_inv, matTvec(R_next, L)))
     return R_next, w_next
 
 

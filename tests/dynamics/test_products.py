@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from refsim.dynamics.products import dot, matvec, norm
+from refsim.dynamics.products import dot, matmul, matTvec, matvec, norm
 
 
 def test_dot_and_matvec_sum_left_to_right_bit_for_bit():
@@ -29,3 +29,18 @@ def test_a_unit_axis_gives_the_component_exactly():
         e[k] = 1.0
         assert dot(v, e) == v[k]
     assert norm(np.array([3.0, 4.0, 12.0])) == 13.0
+
+
+def test_transposed_matvec_and_matmul_sum_left_to_right_bit_for_bit():
+    rng = np.random.default_rng(17)
+    a = rng.normal(size=(300, 3))
+    A, M = rng.normal(size=(300, 3, 3)), rng.normal(size=(300, 3, 3))
+    for i in range(300):
+        x, m, p = a[i].tolist(), M[i].tolist(), A[i].tolist()
+        expected = [(m[0][k] * x[0] + m[1][k] * x[1]) + m[2][k] * x[2] for k in range(3)]
+        assert matTvec(M[i], a[i]).tolist() == expected
+        product = [[(p[r][0] * m[0][c] + p[r][1] * m[1][c]) + p[r][2] * m[2][c]
+                    for c in range(3)] for r in range(3)]
+        assert matmul(A[i], M[i]).tolist() == product
+    assert matmul(A, M).tobytes() == np.array([matmul(A[i], M[i]) for i in range(300)]).tobytes()
+    assert np.allclose(matmul(A, M), A @ M, rtol=0, atol=1e-14)
