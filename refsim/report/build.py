@@ -115,10 +115,14 @@ def build_report(out_dir: Path, *, quick: bool = False, stream=None,
                   workers=workers)
         run.prefetch(PARALLEL_ENTRIES + SWEEP_ENTRIES)   # with workers: on them, at once
         ctx = ReportContext(quick=quick, seed=REPORT_SEED, progress=progress, run=run)
-        for key, title, pending in AREAS:
-            progress.announce(title)
-            sections.append(_build_section(key, title, pending, ctx))
-            progress.step(title)
+        try:
+            for key, title, pending in AREAS:
+                progress.announce(title)
+                sections.append(_build_section(key, title, pending, ctx))
+                progress.step(title)
+        except BaseException:
+            run.cancel()            # Ctrl-C, SIGTERM or an error: stop the workers now
+            raise
         environment = collect_environment()
         html = render(sections, environment, quick=quick)
         timings: set[tuple] = set()

@@ -145,6 +145,8 @@ class Run:
         self._engines: dict[str, Any] = {}
         self._claims: dict[str, ClaimResult] = {}
         self._pending: dict[str, Future] = {}    # entries measured beside this thread
+        self._cancel = threading.Event()         # stops the sweeps of that thread
+        self._thread: threading.Thread | None = None
 
     def size(self, quick, full):
         """``quick`` in a quick run, ``full`` otherwise."""
@@ -155,7 +157,16 @@ class Run:
         local processes when the run was given workers, else this process."""
         if self.workers is None:
             return {"backend": "inprocess", "workers": None}
-        return {"backend": "processes", "workers": self.workers}
+        return {"backend": "processes", "workers": self.workers, "cancel": self._cancel}
+
+    def cancel(self, timeout: float = 30.0) -> None:
+        """Stop the sweeps started by :meth:`prefetch` (their workers are
+        terminated) and wait up to ``timeout`` seconds for them to stop: a
+        report interrupted in this thread must not wait for the workers'
+        tasks to end."""
+        self._cancel.set()
+        if self._thread is not None:
+            self._thread.join(timeout)
 
     def prefetch(self, names) -> None:
         """Start measuring, in a background thread, the entries among
@@ -189,8 +200,11 @@ class Run:
                 except BaseException as exc:  # noqa: BLE001 - handed to get() in the main thread
                     future.set_exception(exc)
 
-        # a daemon thread: Ctrl-C in the main thread is not held up by it
-        threading.Thread(target=measure, name="refsim-report-sweeps", daemon=True).start()
+        # a daemon thread: Ctrl-C in the main thread is not held up by it (and
+        # cancel() stops its sweeps)
+        self._thread = threading.Thread(target=measure, name="refsim-report-sweeps",
+                                        daemon=True)
+        self._thread.start()
 
     def _measure_parallel(self, futures: dict[str, Future]) -> None:
         """The entries of ``futures`` as one sweep on the workers; each

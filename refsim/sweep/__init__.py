@@ -39,7 +39,8 @@ Design, one module per concern:
 from __future__ import annotations
 
 from refsim.sweep.backend import BACKENDS
-from refsim.sweep.run import SweepResult, TaskResult, run_sweep
+from refsim.sweep.run import SweepCancelled, SweepResult, TaskResult, run_sweep
 from refsim.sweep.tasks import Task, task_seed
 
-__all__ = ["BACKENDS", "SweepResult", "Task", "TaskResult", "run_sweep", "task_seed"]
+__all__ = ["BACKENDS", "SweepCancelled", "SweepResult", "Task", "TaskResult", "run_sweep",
+           "task_seed"]

@@ -17,10 +17,11 @@ The loop, as an outline:
               of one extra attempt, which ``attempts`` shows);
 6. return     every task's result in task order.
 
-Ctrl-C (or any error in the loop, such as a full disk) stops the backend at
-once (running calls cancelled, local workers terminated) and propagates;
-every result stored before it stays, whole. The result files are written by
-this process only, never by a worker.
+Ctrl-C (or any error in the loop, such as a full disk, or the caller's
+``cancel`` event, for a sweep run in another thread than the one Ctrl-C
+reaches) stops the backend at once (running calls cancelled, local workers
+terminated) and propagates; every result stored before it stays, whole.
+The result files are written by this process only, never by a worker.
 
 Retries are decided here for every backend, so that ``retries`` means the
 same everywhere (a Dask scheduler refsim did not start may also retry on its
@@ -33,6 +34,7 @@ Cost: the tasks' own, divided among the workers, plus a per-task overhead
 from __future__ import annotations
 
 import math
+import threading
 import time
 from collections import deque
 from collections.abc import Iterable
@@ -46,6 +48,11 @@ from refsim.sweep.progress import REFRESH_SECONDS, Progress
 from refsim.sweep.records import decode
 from refsim.sweep.store import Store
 from refsim.sweep.tasks import Task, fingerprint, task_seed
+
+
+class SweepCancelled(Exception):
+    """The caller's ``cancel`` event stopped a sweep (:func:`run_sweep`)."""
+
 
 #: TaskResult.status values.
 DONE_STATUS, FAILED_STATUS = "done", "failed"
@@ -104,7 +111,8 @@ class SweepResult:
 
 def run_sweep(tasks: Iterable[Task], *, backend: str = "inprocess", workers: int | None = None,
               scheduler: str | None = None, store=None, progress: bool = True,
-              retries: int = 3, seed: int = 0) -> SweepResult:
+              retries: int = 3, seed: int = 0,
+              cancel: threading.Event | None = None) -> SweepResult:
     """Run each task once and return their results in task order.
 
     Parameters
@@ -133,6 +141,10 @@ def run_sweep(tasks: Iterable[Task], *, backend: str = "inprocess", workers: int
     seed : int
         The sweep's seed (non-negative); each task's seed derives from it
         and the task's key only.
+    cancel : threading.Event, optional
+        Once set, the sweep stops as on Ctrl-C (within ``REFRESH_SECONDS``)
+        and raises :class:`SweepCancelled`: for a sweep run in a thread that
+        signals do not reach.
 
     Returns
     -------
@@ -149,7 +161,7 @@ def run_sweep(tasks: Iterable[Task], *, backend: str = "inprocess", workers: int
         "dask" backend without ``distributed``.
     ArgumentTypeError
         Something other than a Task among ``tasks``.
-    KeyboardInterrupt
+    KeyboardInterrupt, SweepCancelled
         After stopping the workers; the stored results stay.
     """
     start = time.perf_counter()
@@ -175,7 +187,7 @@ def run_sweep(tasks: Iterable[Task], *, backend: str = "inprocess", workers: int
             runner = open_backend(backend, workers=workers, scheduler=scheduler,
                                   calls=len(waiting))
             try:
-                _run(runner, tasks, seeds, waiting, results, saved, retries, shown)
+                _run(runner, tasks, seeds, waiting, results, saved, retries, shown, cancel)
             except BaseException:
                 runner.close(abort=True)
                 raise
@@ -186,7 +198,7 @@ def run_sweep(tasks: Iterable[Task], *, backend: str = "inprocess", workers: int
 
 
 def _run(runner, tasks, seeds, waiting: deque, results: list, saved: Store | None,
-         retries: int, shown: Progress) -> None:
+         retries: int, shown: Progress, cancel: threading.Event | None) -> None:
     """Steps 3-5 of the module docstring; fills ``results`` in place."""
     attempts = [0] * len(tasks)
     suspects: deque[int] = deque()               # lost with their worker: run next, alone
@@ -201,6 +213,8 @@ def _run(runner, tasks, seeds, waiting: deque, results: list, saved: Store | Non
         runner.submit(index, tasks[index].function, dict(tasks[index].kwargs), seeds[index])
 
     while waiting or suspects or in_flight:
+        if cancel is not None and cancel.is_set():
+            raise SweepCancelled(f"sweep cancelled with {finished} of {len(tasks)} tasks done")
         if suspects:
             if not in_flight:
                 submit(suspects.popleft())

@@ -298,6 +298,76 @@ def test_an_entry_measured_in_a_worker_returns_its_records_to_the_bit():
     assert json.dumps(to_json(records)) == json.dumps(to_json(here))
 
 
+def test_a_stopped_report_stops_its_workers_at_once(tmp_path):
+    """SIGTERM to ``refsim report --workers 2`` while its workers run: it
+    ends with one line and status 128 + 15 within seconds, and its workers
+    are gone (the quick report's tasks are short; the next test stops long
+    ones)."""
+    import os
+    import signal
+    import subprocess
+    import time
+
+    import psutil
+
+    process = subprocess.Popen(
+        [sys.executable, "-m", "refsim.cli", "report", "--quick", "--workers", "2", "-o",
+         str(tmp_path / "r")], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+        env=dict(os.environ, PYTHONWARNINGS="ignore"))
+    try:
+        me = psutil.Process(process.pid)
+        deadline = time.monotonic() + 120.0
+        while len([p for p in me.children(recursive=True)
+                   if "spawn_main" in " ".join(p.cmdline())]) < 2:
+            assert time.monotonic() < deadline and process.poll() is None
+            time.sleep(0.1)
+        workers = [p for p in me.children(recursive=True)
+                   if "spawn_main" in " ".join(p.cmdline())]
+        time.sleep(2.0)                      # the workers are inside their tasks
+        start = time.monotonic()
+        process.send_signal(signal.SIGTERM)
+        _, err = process.communicate(timeout=60.0)
+        stopped = time.monotonic() - start
+    finally:
+        process.kill()
+        process.wait(60.0)
+    assert process.returncode == 128 + signal.SIGTERM
+    assert err.decode().strip().splitlines()[-1] == "refsim: interrupted (SIGTERM)"
+    assert stopped < 30.0
+    _, alive = psutil.wait_procs(workers, timeout=30.0)
+    assert not [p for p in alive if p.status() != psutil.STATUS_ZOMBIE]
+    assert not (tmp_path / "r" / "index.html").exists()
+
+
+def test_cancel_stops_the_sweeps_of_the_background_thread(tmp_path):
+    """The advisor's sweep runs in the run's background thread, which
+    signals do not reach; cancel() terminates its workers mid-task within
+    seconds (its tasks take tens of seconds each), and the entry raises."""
+    import time
+
+    import psutil
+
+    from refsim.sweep import SweepCancelled
+
+    run = plan.Run(quick=True, out_dir=tmp_path, workers=2)
+    run.prefetch(["advisor"])
+    me = psutil.Process()
+    deadline = time.monotonic() + 120.0
+    while len([p for p in me.children(recursive=True)
+               if "spawn_main" in " ".join(p.cmdline())]) < 2:
+        assert time.monotonic() < deadline
+        time.sleep(0.1)
+    workers = [p for p in me.children(recursive=True) if "spawn_main" in " ".join(p.cmdline())]
+    time.sleep(3.0)                          # inside their first advice
+    start = time.monotonic()
+    run.cancel(timeout=60.0)
+    assert time.monotonic() - start < 6.0    # without the cancel event: 15 s here
+    _, alive = psutil.wait_procs(workers, timeout=30.0)
+    assert not [p for p in alive if p.status() != psutil.STATUS_ZOMBIE]
+    with pytest.raises(SweepCancelled, match=r"sweep cancelled with 0 of \d+ tasks done"):
+        run.get("advisor")
+
+
 def test_report_command_takes_workers(tmp_path, capsys):
     from refsim.cli import main
 

@@ -105,3 +105,41 @@ def test_ctrl_c_stops_the_workers_and_the_sweep_resumes(tmp_path):
     ran_again = {key for key in after if after[key] > before.get(key, 0)}
     assert ran_again == {r.key for r in result.results if not r.resumed}
     assert all(after[key] - before.get(key, 0) == 1 for key in ran_again)
+
+
+def test_a_cancel_event_stops_a_sweep_run_in_another_thread(tmp_path):
+    """A sweep in a thread that Ctrl-C does not reach (the report's) stops
+    when its ``cancel`` event is set: its workers are terminated mid-task,
+    and it raises SweepCancelled, long before the tasks would have ended."""
+    import threading
+
+    from refsim.sweep import SweepCancelled
+
+    markers = tmp_path / "markers"
+    markers.mkdir()
+    sweep = [Task(f"c{i}", tasks.counted, {"marker_dir": str(markers), "key": f"c{i}",
+                                           "pause": 300.0}) for i in range(4)]
+    cancel = threading.Event()
+    raised: list[BaseException] = []
+
+    def run() -> None:
+        try:
+            run_sweep(sweep, backend="processes", workers=2, progress=False, cancel=cancel)
+        except BaseException as exc:  # noqa: BLE001 - the test reads it
+            raised.append(exc)
+
+    thread = threading.Thread(target=run)
+    thread.start()
+    me = psutil.Process()
+    _wait_for(lambda: len([p for p in me.children(recursive=True)
+                           if "spawn_main" in " ".join(p.cmdline())]) >= 2, "two workers")
+    workers = [p for p in me.children(recursive=True) if "spawn_main" in " ".join(p.cmdline())]
+    start = time.monotonic()
+    cancel.set()
+    thread.join(WAIT_SECONDS)
+    assert not thread.is_alive() and time.monotonic() - start < 30.0
+    assert len(raised) == 1 and isinstance(raised[0], SweepCancelled)
+    assert "0 of 4 tasks done" in str(raised[0])
+    _, alive = psutil.wait_procs(workers, timeout=WAIT_SECONDS)
+    assert not [p for p in alive if p.status() != psutil.STATUS_ZOMBIE]
+    assert tasks.executions(markers) == {}
