@@ -604,9 +604,9 @@ def measure_engine_variants(variants, e: float = 0.8, duration: float = 9.0
 # -- step cost against pybullet ---------------------------------------------------------
 
 #: Body counts and rotation models of the step benchmarks (the seed's
-#: "1 to 40 in this simulation").
+#: "1 to 40 in this simulation"), of the report's and of ``make bench``.
 BENCH_COUNTS = (1, 10, 40)
-BENCH_ROTATIONS = ("off", "seed")
+BENCH_ROTATIONS = ("off", "seed", "impulse")
 #: Steps before timing the "late" phase: by then the cubes have settled on
 #: the floor (restitution 0.8, friction 0.1) and Bullet has many contacts.
 LATE_WARMUP = 3000
@@ -644,9 +644,8 @@ def cubes_scene(count: int, rotation: str = "off", *, seed: int = BENCH_SEED,
 
 #: The step-cost benchmark's bodies (tests/benchmarks/test_bench_dynamics.py):
 #: cubes on a grid (:func:`cubes_scene`) and one 2000-triangle sphere
-#: (:func:`sphere_scene`); rotation models; steps to a settled state.
+#: (:func:`sphere_scene`); steps to a settled state.
 BENCH_BODIES = ("1 cube", "10 cubes", "40 cubes", "sphere-2k")
-BENCH_ALL_ROTATIONS = ("off", "seed", "impulse")
 SETTLE_STEPS = {"cubes": LATE_WARMUP, "sphere": 10_000}
 
 

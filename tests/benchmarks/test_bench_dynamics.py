@@ -37,7 +37,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.studies.bounce import BENCH_ALL_ROTATIONS, BENCH_BODIES, bench_scene
+from refsim.studies.bounce import BENCH_BODIES, BENCH_ROTATIONS, bench_scene
 
 STEPS_PER_ROUND = 100
 ROUNDS = 15
@@ -125,7 +125,7 @@ def _engine(name: str, oracle):
 
 
 @pytest.mark.parametrize("state", STATES)
-@pytest.mark.parametrize("rotation", BENCH_ALL_ROTATIONS)
+@pytest.mark.parametrize("rotation", BENCH_ROTATIONS)
 @pytest.mark.parametrize("bodies", BENCH_BODIES)
 @pytest.mark.parametrize("engine", ["refsim-readable", "refsim-compiled", "pybullet",
                                     "mujoco"])
