@@ -217,7 +217,7 @@ def engine_task(*, seed: int, name: str, spec: str, cases: int, case_seed: int,
 def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=None,
                only=None, expected: dict | None = None, backend: str | None = None,
                workers: int | None = None, scheduler: str | None = None,
-               progress: bool = False) -> tuple[Matrix, dict]:
+               progress: bool = False, cancel=None) -> tuple[Matrix, dict]:
     """Run every engine of ``specs`` (name -> ``module:factory``; default the
     shipped six) with shared case sets, and write the pages under ``out_dir``
     when given (module docstring).
@@ -228,8 +228,8 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
     engine that cannot be loaded is left out and named in
     ``Matrix.unavailable``.
 
-    ``backend`` (with ``workers``, ``scheduler`` and ``progress``, as
-    :func:`refsim.sweep.run_sweep` takes them): run each engine as a sweep
+    ``backend`` (with ``workers``, ``scheduler``, ``progress`` and
+    ``cancel``, as :func:`refsim.sweep.run_sweep` takes them): run each engine as a sweep
     task (:func:`engine_task`), in this process ("inprocess"), on local
     processes or on a Dask cluster. Each task builds its own case sets from
     the same seed, so the cells are those of the shared run, on every
@@ -243,7 +243,7 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
     if backend is not None:
         return _run_matrix_sweep(specs, cases=cases, seed=seed, out_dir=out_dir, only=only,
                                  expected=expected, backend=backend, workers=workers,
-                                 scheduler=scheduler, progress=progress)
+                                 scheduler=scheduler, progress=progress, cancel=cancel)
     from refsim.conformance.expected import shipped_expected_failures
     from refsim.conformance.registry import build_cases
     from refsim.conformance.runner import check_engine, needed_case_sets
@@ -296,7 +296,8 @@ def _finish(results: dict, pages: dict, unavailable: dict, seconds: dict, out_di
 
 
 def _run_matrix_sweep(specs: dict, *, cases: int, seed: int, out_dir, only, expected,
-                      backend: str, workers, scheduler, progress: bool) -> tuple[Matrix, dict]:
+                      backend: str, workers, scheduler, progress: bool,
+                      cancel=None) -> tuple[Matrix, dict]:
     """:func:`run_matrix` with one sweep task per engine (its ``backend``)."""
     from refsim.conformance.results import ConformanceResult
     from refsim.errors import OptionError, SweepError
@@ -309,7 +310,7 @@ def _run_matrix_sweep(specs: dict, *, cases: int, seed: int, out_dir, only, expe
                                 else str(expected[name]))})
              for name, spec in specs.items()]
     sweep = run_sweep(tasks, backend=backend, workers=workers, scheduler=scheduler,
-                      progress=progress, seed=seed)
+                      progress=progress, seed=seed, cancel=cancel)
     if sweep.failures:
         raise SweepError("conformance run failed: " + "; ".join(
             f"{key}: {why}" for key, why in sweep.failures.items()))
