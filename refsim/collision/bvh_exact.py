@@ -339,24 +339,41 @@ def descend(mesh_a, pose_a, mesh_b, pose_b, *,
 
 @functools.cache
 def _compiled():
-    """The compiled ``exact_query``, or None without numba (looked up once:
-    a query costs a few microseconds, and an import statement a fraction)."""
+    """The compiled kernels module (``exact_query``, ``exact_collide``), or
+    None without numba (looked up once: a query costs a few microseconds, and
+    an import statement a fraction)."""
     try:
         from refsim.collision import _numba_kernels as nk
     except ImportError:
         return None
-    return nk.exact_query
+    return nk
 
 
-def _kernel_arrays(mesh) -> tuple:
-    """The six arrays the compiled query takes for one mesh (vertices, faces,
-    the tree's links, order, boxes, reach), gathered once and kept with the
-    mesh: twelve attribute lookups per query would be a tenth of it."""
-    def gather(m):
-        tree = frame_tree_of(m)
-        return (m.vertices, m.faces, tree.links, tree.tree.order, tree.boxes, tree.reach,
-                tree.axes_deviation)
-    return mesh.derived("frame_tree_kernel_arrays", gather)
+def pack_frame_tree(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh's constant arrays as the compiled query takes them, two in
+    all (numba unboxes each array argument at each call: few arrays, small
+    fixed cost; docs/decisions/query-fixed-cost.md):
+
+    - float64: reach, axes_deviation, then the vertices (n, 3) and the
+      :class:`FrameTree` boxes (nodes, 15), each flattened row by row;
+    - int64: the counts of vertices, faces and nodes, then the faces (m, 3),
+      the tree's links (nodes, 4) and order (m,), flattened likewise.
+
+    :func:`refsim.collision._numba_kernels.unpack` takes them apart again."""
+    tree = frame_tree_of(mesh)
+    floats = np.concatenate([[tree.reach, tree.axes_deviation], mesh.vertices.ravel(),
+                             tree.boxes.ravel()]).astype(np.float64)
+    ints = np.concatenate([[mesh.n_vertices, mesh.n_faces, tree.tree.n_nodes],
+                           mesh.faces.ravel(), tree.links.ravel(),
+                           tree.tree.order]).astype(np.int64)
+    # (left writable: numba's dispatcher types a read-only array argument
+    # by a slow path, a few hundred nanoseconds a query; nothing writes them)
+    return floats, ints
+
+
+def _kernel_arrays(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`pack_frame_tree` of the mesh, built once and kept with it."""
+    return mesh.derived("frame_tree_packed", pack_frame_tree)
 
 
 _FLOAT64 = np.dtype(np.float64)
@@ -380,6 +397,14 @@ def _pose_arrays(pose, what: str):
     return np.ascontiguousarray(rotation), np.ascontiguousarray(translation)
 
 
+def _reject(what: str, pose) -> None:
+    """Raise for the pose the compiled query found not valid."""
+    as_pose(pose, what=what)     # raises with the precise reason
+    # as_pose's Gram product rounds differently; at the tolerance's edge
+    # it may accept what the kernel rejected: reject all the same.
+    raise StateError(f"{what}: rotation is not orthonormal")
+
+
 def query_compiled(mesh_a, pose_a, mesh_b, pose_b, mode: int, *,
                    margin_rounding: float = MARGIN_ROUNDING,
                    margin_per_deviation: float = MARGIN_PER_DEVIATION):
@@ -393,19 +418,13 @@ def query_compiled(mesh_a, pose_a, mesh_b, pose_b, mode: int, *,
     """
     ra, ta = pose_a = _pose_arrays(pose_a, "pose_a")
     rb, tb = pose_b = _pose_arrays(pose_b, "pose_b")
-    va, fa, links_a, order_a, boxes_a, reach_a, dev_a = _kernel_arrays(mesh_a)
-    vb, fb, links_b, order_b, boxes_b, reach_b, dev_b = _kernel_arrays(mesh_b)
-    status, found, uncertain = _compiled()(
-        va, fa, links_a, order_a, boxes_a, reach_a, ra, ta,
-        vb, fb, links_b, order_b, boxes_b, reach_b, rb, tb,
-        dev_a if dev_a > dev_b else dev_b, mode, ORTHONORMAL_TOL, margin_rounding,
-        margin_per_deviation)
+    floats_a, ints_a = _kernel_arrays(mesh_a)
+    floats_b, ints_b = _kernel_arrays(mesh_b)
+    status, found, uncertain = _compiled().exact_query(
+        floats_a, ints_a, ra, ta, floats_b, ints_b, rb, tb, mode, ORTHONORMAL_TOL,
+        margin_rounding, margin_per_deviation)
     if status:
-        what, pose = ("pose_a", pose_a) if status == 1 else ("pose_b", pose_b)
-        as_pose(pose, what=what)     # raises with the precise reason
-        # as_pose's Gram product rounds differently; at the tolerance's edge
-        # it may accept what the kernel rejected: reject all the same.
-        raise StateError(f"{what}: rotation is not orthonormal")
+        _reject(*(("pose_a", pose_a) if status == 1 else ("pose_b", pose_b)))
     return found, uncertain
 
 
@@ -453,11 +472,38 @@ def intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> np.nd
 
 
 def collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> bool:
-    """Whether any pair of triangles intersects; stops at the first."""
+    """Whether any pair of triangles intersects; the compiled query stops at
+    the first (``exact_collide``: the float filter, else the compiled exact
+    stage, pair by pair). Only pairs that stage cannot take (degenerate
+    triangles, coordinates outside the filter's range) come back to the
+    readable exact kernel, through a second traversal."""
     if kernel == "readable":
         return len(intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)) > 0
-    found, uncertain = query_compiled(mesh_a, pose_a, mesh_b, pose_b, FIRST_HIT)
-    if len(found):
-        return True
-    return bool(len(uncertain)) and bool(_resolve(mesh_a, pose_a, mesh_b, pose_b,
-                                                   uncertain, first_only=True).any())
+    floats_a, ints_a = _kernel_arrays(mesh_a)
+    floats_b, ints_b = _kernel_arrays(mesh_b)
+    nk = _compiled()
+    try:
+        # numba checks the arrays' types (``EXACT_COLLIDE_SIGNATURE``), the
+        # kernel their shapes and values: nothing to check here first
+        (ra, ta), (rb, tb) = pose_a, pose_b
+        answer = nk.exact_collide(floats_a, ints_a, ra, ta, floats_b, ints_b, rb, tb,
+                                  ORTHONORMAL_TOL, MARGIN_ROUNDING, MARGIN_PER_DEVIATION)
+    except (TypeError, ValueError):      # not two pairs of float64 C-contiguous arrays
+        (ra, ta), (rb, tb) = pose_a, pose_b = _pose_copy(pose_a, "pose_a"), \
+            _pose_copy(pose_b, "pose_b")
+        answer = nk.exact_collide(floats_a, ints_a, ra, ta, floats_b, ints_b, rb, tb,
+                                  ORTHONORMAL_TOL, MARGIN_ROUNDING, MARGIN_PER_DEVIATION)
+    if answer == nk.APART or answer == nk.HIT:
+        return answer == nk.HIT
+    if answer == nk.BAD_POSE_A or answer == nk.BAD_POSE_B:
+        _reject(*(("pose_a", pose_a) if answer == nk.BAD_POSE_A else ("pose_b", pose_b)))
+    _, undecided = query_compiled(mesh_a, pose_a, mesh_b, pose_b, FIRST_HIT)
+    return bool(_resolve(mesh_a, pose_a, mesh_b, pose_b, undecided, first_only=True).any())
+
+
+def _pose_copy(pose, what: str):
+    """The pose checked by ``as_pose`` and copied into two new writable
+    float64 C-contiguous arrays."""
+    rotation, translation = as_pose(pose, what=what)
+    return (np.array(rotation, dtype=np.float64, order="C"),
+            np.array(translation, dtype=np.float64, order="C"))

@@ -288,3 +288,96 @@ def test_oriented_boxes_prune_the_separated_benchmark_early():
                                           config.as_configuration().poses())
     pairs, visits = bvh_exact.descend(mesh_a, as_pose(pose_a), mesh_b, as_pose(pose_b))
     assert len(pairs) == 0 and visits <= 130
+
+
+# -- the compiled query's fixed cost: packed arrays, the boolean's early exit ---------
+
+
+def test_packed_arrays_unpack_to_the_mesh_and_its_frame_tree():
+    from refsim.collision import _numba_kernels as nk
+
+    for mesh in (SPHERE, CUBE):
+        frame = bvh_exact.frame_tree_of(mesh)
+        vertices, faces, links, order, boxes, reach, axes_deviation = nk.unpack(
+            *bvh_exact.pack_frame_tree(mesh))
+        assert np.array_equal(vertices, mesh.vertices) and np.array_equal(faces, mesh.faces)
+        assert np.array_equal(links, frame.links) and np.array_equal(order, frame.tree.order)
+        assert np.array_equal(boxes, frame.boxes)
+        assert (reach, axes_deviation) == (frame.reach, frame.axes_deviation)
+
+
+def test_the_boolean_query_stops_at_the_first_pair_the_exact_stage_decides():
+    """Cubes sharing a face: the float filter certifies no pair, and the first
+    one the compiled exact stage finds touching ends the boolean query."""
+    touching = (np.eye(3), np.array([1.0, 0.0, 0.0]))
+    _, uncertain = bvh_exact.query_compiled(CUBE, IDENTITY, CUBE, touching,
+                                            bvh_exact.ALL_HITS)
+    found, undecided = bvh_exact.query_compiled(CUBE, IDENTITY, CUBE, touching,
+                                                bvh_exact.FIRST_HIT)
+    assert len(uncertain) > 1 and len(found) == 1 and len(undecided) == 0
+    _, exact = _seed_pairs(CUBE, IDENTITY, CUBE, touching)
+    assert _as_set(found) <= _as_set(exact)
+    assert bodies_collide(CUBE, IDENTITY, CUBE, touching, kernel="compiled") is True
+
+
+@pytest.mark.parametrize("kind, expected", [("grazing", True),
+                                            ("separated-boxes-overlap", False)])
+def test_pairs_the_exact_stage_cannot_take_go_to_the_readable_kernel(kind, expected):
+    """The torus benchmark poses scaled by 2^-245 (coordinates below the
+    filter's range, the geometry the same bits times a power of two): the
+    compiled boolean query answers UNDECIDED, and the readable kernel gives
+    the seed's answer (the separated pose has a candidate pair, not touching)."""
+    from refsim.collision import _numba_kernels as nk
+    from refsim.studies.levels import SPEED_CONFIGURATIONS
+
+    config = next(c for c in SPEED_CONFIGURATIONS
+                  if c.model == "torus" and c.kind == kind).as_configuration()
+    side = 2.0 ** -245
+    mesh_a, mesh_b = (mesh.scaled(side) for mesh in config.meshes())
+    (ra, ta), (rb, tb) = config.poses()
+    pose_a, pose_b = (ra, side * ta), (rb, side * tb)
+    boxes, exact = _seed_pairs(mesh_a, pose_a, mesh_b, pose_b)
+    assert len(boxes) > 0 and (len(exact) > 0) == expected
+    answer = nk.exact_collide(*bvh_exact.pack_frame_tree(mesh_a), *pose_a,
+                              *bvh_exact.pack_frame_tree(mesh_b), *pose_b, ORTHONORMAL_TOL,
+                              bvh_exact.MARGIN_ROUNDING, bvh_exact.MARGIN_PER_DEVIATION)
+    assert answer == nk.UNDECIDED
+    for kernel in ("compiled", "readable"):
+        assert bodies_collide(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel) is expected, kernel
+
+
+def _layouts(rotation, translation):
+    """The same pose as numpy and Python give it in other layouts."""
+    frozen = rotation.copy(), translation.copy()
+    for array in frozen:
+        array.flags.writeable = False
+    return {"read-only": frozen, "lists": (rotation.tolist(), translation.tolist()),
+            "float32": (rotation.astype(np.float32), translation.astype(np.float32)),
+            "Fortran order": (np.asfortranarray(rotation), translation),
+            "strided": (np.repeat(rotation, 2, axis=1)[:, ::2], np.repeat(translation, 2)[::2]),
+            "list pose": [rotation, translation]}
+
+
+@pytest.mark.parametrize("layout", list(_layouts(np.eye(3), np.zeros(3))))
+def test_the_boolean_query_takes_a_pose_in_any_layout_as_pose_takes(layout):
+    """The fast path passes poses to numba unchecked; other layouts than the
+    compiled signature's go through as_pose and give the same answers."""
+    for offset, expected in ((1.0, True), (1.5, False)):
+        pose_b = (np.eye(3), np.array([offset, 0.0, 0.0]))
+        assert bodies_collide(CUBE, _layouts(*IDENTITY)[layout], CUBE,
+                              _layouts(*pose_b)[layout]) is expected
+
+
+@pytest.mark.parametrize("pose, message", [
+    ((np.eye(4), np.zeros(3)), "pose_b: expected shapes"),
+    ((np.eye(3), np.zeros(4)), "pose_b: expected shapes"),
+    ((np.eye(3).ravel(), np.zeros(3)), "pose_b: expected shapes"),
+    ((np.eye(3), np.zeros((3, 1))), "pose_b: expected shapes"),
+    ((np.eye(3), np.array([np.nan, 0.0, 0.0])), "pose_b: non-finite"),
+    ((2.0 * np.eye(3), np.zeros(3)), "pose_b: rotation is not orthonormal"),
+    ((np.eye(3), np.zeros(3), 1.0), "pose_b: expected \\(rotation, translation\\)"),
+    (None, "pose_b: expected \\(rotation, translation\\)"),
+])
+def test_the_boolean_query_refuses_a_bad_pose_with_as_poses_message(pose, message):
+    with pytest.raises(StateError, match=message):
+        bodies_collide(CUBE, IDENTITY, CUBE, pose, kernel="compiled")
