@@ -351,7 +351,7 @@ def pose_deviation(rotation, translation, tol):
     return deviation if deviation <= tol else -1.0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def place(boxes_b, M, u, node, placed):
     """Node b's box in body a's frame, kept for the rest of the query:
     ``placed[node]`` = (M cb + u, then M Ab row by row), the part of
@@ -364,11 +364,75 @@ def place(boxes_b, M, u, node, placed):
                                            + M[i, 1] * boxes_b[node, 9 + j]
                                            + M[i, 2] * boxes_b[node, 12 + j])
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def squared_distance(x, i, y, j):
     """|x[i, :3] - y[j, :3]|^2."""
     return ((x[i, 0] - y[j, 0]) ** 2 + (x[i, 1] - y[j, 1]) ** 2
             + (x[i, 2] - y[j, 2]) ** 2)
+
+@numba.njit(cache=True, inline="always")
+def frame_row(A, i, d, P):
+    """``T[i]`` and row i of ``R`` (bvh_exact.node_pair_frame): ``T = A^T d``,
+    ``R = A^T P`` for A and P given by rows."""
+    t = A[0][i] * d[0] + A[1][i] * d[1] + A[2][i] * d[2]
+    r = (A[0][i] * P[0][0] + A[1][i] * P[1][0] + A[2][i] * P[2][0],
+         A[0][i] * P[0][1] + A[1][i] * P[1][1] + A[2][i] * P[2][1],
+         A[0][i] * P[0][2] + A[1][i] * P[1][2] + A[2][i] * P[2][2])
+    return t, r
+
+@numba.njit(cache=True, inline="always")
+def node_boxes_apart(c, h, A, p, P, g, margin):
+    """:func:`refsim.collision.bvh_exact.boxes_apart` of two node boxes, with
+    their frame (:func:`refsim.collision.bvh_exact.node_pair_frame`), on
+    tuples: node a's box has centre c, half-extents h and axes the columns
+    of A (given by rows); node b's, in a's body frame, centre p = M cb + u,
+    axes the columns of P = M Ab and half-extents g. The same formulas in
+    the same order; each row of R is computed when its face normal of a is
+    tested, and the test stops at the first separating axis. Tuples, not
+    arrays: values in registers, nothing reference-counted
+    (docs/decisions/triangle-filter-arguments.md)."""
+    d = (p[0] - c[0], p[1] - c[1], p[2] - c[2])
+    t0, r0 = frame_row(A, 0, d, P)                          # a's face normals
+    q0 = (abs(r0[0]), abs(r0[1]), abs(r0[2]))
+    if abs(t0) > h[0] + g[0] * q0[0] + g[1] * q0[1] + g[2] * q0[2] + margin:
+        return True
+    t1, r1 = frame_row(A, 1, d, P)
+    q1 = (abs(r1[0]), abs(r1[1]), abs(r1[2]))
+    if abs(t1) > h[1] + g[0] * q1[0] + g[1] * q1[1] + g[2] * q1[2] + margin:
+        return True
+    t2, r2 = frame_row(A, 2, d, P)
+    q2 = (abs(r2[0]), abs(r2[1]), abs(r2[2]))
+    if abs(t2) > h[2] + g[0] * q2[0] + g[1] * q2[1] + g[2] * q2[2] + margin:
+        return True
+    # b's face normals (M Ab)_j: projection T . R[:, j], radius h . |R[:, j]| + g[j]
+    if abs(t0 * r0[0] + t1 * r1[0] + t2 * r2[0]) > (h[0] * q0[0] + h[1] * q1[0]
+                                                    + h[2] * q2[0] + g[0]) + margin:
+        return True
+    if abs(t0 * r0[1] + t1 * r1[1] + t2 * r2[1]) > (h[0] * q0[1] + h[1] * q1[1]
+                                                    + h[2] * q2[1] + g[1]) + margin:
+        return True
+    if abs(t0 * r0[2] + t1 * r1[2] + t2 * r2[2]) > (h[0] * q0[2] + h[1] * q1[2]
+                                                    + h[2] * q2[2] + g[2]) + margin:
+        return True
+    # the nine edge-edge axes e_i x (M Ab)_j, i by i: (i1, i2) = (i+1, i+2) mod 3
+    return (edge_axes_apart(t2, r1, t1, r2, h[1], q2, h[2], q1, q0, g, margin)      # i = 0
+            or edge_axes_apart(t0, r2, t2, r0, h[2], q0, h[0], q2, q1, g, margin)   # i = 1
+            or edge_axes_apart(t1, r0, t0, r1, h[0], q1, h[1], q0, q2, g, margin))  # i = 2
+
+@numba.njit(cache=True, inline="always")
+def edge_axes_apart(t_i2, r_i1, t_i1, r_i2, h_i1, q_i2, h_i2, q_i1, q_i, g, margin):
+    """The three edge-edge axes of one i in :func:`refsim.collision.bvh_exact.boxes_apart`,
+    j = 0, 1, 2 written out (a loop over tuple indices computed mod 3 was
+    about twice as slow): projection ``T[i2] R[i1, j] - T[i1] R[i2, j]``,
+    radius ``h[i1] |R[i2, j]| + h[i2] |R[i1, j]| + g[j1] |R[i, j2]| + g[j2] |R[i, j1]|``."""
+    if abs(t_i2 * r_i1[0] - t_i1 * r_i2[0]) > (h_i1 * q_i2[0] + h_i2 * q_i1[0]
+                                               + g[1] * q_i[2] + g[2] * q_i[1]) + margin:
+        return True
+    if abs(t_i2 * r_i1[1] - t_i1 * r_i2[1]) > (h_i1 * q_i2[1] + h_i2 * q_i1[1]
+                                               + g[2] * q_i[0] + g[0] * q_i[2]) + margin:
+        return True
+    return abs(t_i2 * r_i1[2] - t_i1 * r_i2[2]) > (h_i1 * q_i2[2] + h_i2 * q_i1[2]
+                                                   + g[0] * q_i[1] + g[1] * q_i[0]) + margin
 
 @numba.njit(cache=True)
 def exact_query(floats_a, ints_a, rotation_a, translation_a,
@@ -407,13 +471,11 @@ def exact_query(floats_a, ints_a, rotation_a, translation_a,
     # Per-query state, filled lazily: node b's box in a's frame (``place``),
     # then leaf by leaf. Carved out of one float and one flag array: a
     # separate allocation for each costs more than a query far apart.
-    scratch = np.empty(36 + 12 * n_nodes_b + 3 * (n_vertices_a + n_vertices_b)
+    scratch = np.empty(12 + 12 * n_nodes_b + 3 * (n_vertices_a + n_vertices_b)
                        + 6 * (n_faces_a + n_faces_b + n_nodes_a + n_nodes_b))
     M = scratch[0:9].reshape((3, 3))
-    R = scratch[9:18].reshape((3, 3))
-    absR = scratch[18:27].reshape((3, 3))
-    u, T, d = scratch[27:30], scratch[30:33], scratch[33:36]
-    at = 36
+    u = scratch[9:12]
+    at = 12
     placed_b = scratch[at:at + 12 * n_nodes_b].reshape((n_nodes_b, 12))
     at += 12 * n_nodes_b
     world_a = scratch[at:at + 3 * n_vertices_a].reshape((n_vertices_a, 3))
@@ -428,7 +490,7 @@ def exact_query(floats_a, ints_a, rotation_a, translation_a,
     at += 6 * n_nodes_a
     leaf_box_b = scratch[at:at + 6 * n_nodes_b].reshape((n_nodes_b, 6))
     flags = np.zeros(n_vertices_a + n_vertices_b + n_faces_a + n_faces_b + n_nodes_a
-                     + n_nodes_b, dtype=np.bool_)
+                     + 2 * n_nodes_b, dtype=np.bool_)
     vertex_done_a = flags[0:n_vertices_a]
     at = n_vertices_a
     vertex_done_b = flags[at:at + n_vertices_b]
@@ -440,6 +502,8 @@ def exact_query(floats_a, ints_a, rotation_a, translation_a,
     leaf_done_a = flags[at:at + n_nodes_a]
     at += n_nodes_a
     leaf_done_b = flags[at:at + n_nodes_b]
+    at += n_nodes_b
+    placed_done_b = flags[at:at + n_nodes_b]
 
     # Body b in a's frame: x_a = M x_b + u, M = Ra^T Rb, u = Ra^T (tb - ta).
     for i in range(3):
@@ -469,53 +533,21 @@ def exact_query(floats_a, ints_a, rotation_a, translation_a,
         a = stack[top, 0]
         b = stack[top, 1]
 
-        # Node b's box in the frame of node a's box (bvh_exact.node_pair_frame):
-        # R = Aa^T (M Ab), T = Aa^T (M cb + u - ca); a node's axes are the
-        # columns of the 3x3 matrix in boxes[node, 6:15], row by row, and
-        # placed_b[b] holds M cb + u and M Ab. Then the separating-axis test
-        # of the two boxes (bvh_exact.boxes_apart), a's face normals row by
-        # row of R, as soon as the row is known.
-        for i in range(3):
-            d[i] = placed_b[b, i] - boxes_a[a, i]
-        a0, a1, a2 = boxes_a[a, 3], boxes_a[a, 4], boxes_a[a, 5]
-        b0, b1, b2 = boxes_b[b, 3], boxes_b[b, 4], boxes_b[b, 5]
-        apart = False
-        for i in range(3):                                  # a's face normals
-            T[i] = boxes_a[a, 6 + i] * d[0] + boxes_a[a, 9 + i] * d[1] + boxes_a[a, 12 + i] * d[2]
-            for j in range(3):
-                R[i, j] = (boxes_a[a, 6 + i] * placed_b[b, 3 + j]
-                           + boxes_a[a, 9 + i] * placed_b[b, 6 + j]
-                           + boxes_a[a, 12 + i] * placed_b[b, 9 + j])
-                absR[i, j] = abs(R[i, j])
-            radius = boxes_a[a, 3 + i] + b0 * absR[i, 0] + b1 * absR[i, 1] + b2 * absR[i, 2]
-            if abs(T[i]) > radius + margin:
-                apart = True
-                break
-        if apart:
-            continue
-        for j in range(3):                                  # b's face normals
-            projection = T[0] * R[0, j] + T[1] * R[1, j] + T[2] * R[2, j]
-            radius = a0 * absR[0, j] + a1 * absR[1, j] + a2 * absR[2, j] + boxes_b[b, 3 + j]
-            if abs(projection) > radius + margin:
-                apart = True
-                break
-        if apart:
-            continue
-        for i in range(3):                                  # the nine edge-edge axes
-            i1 = (i + 1) % 3
-            i2 = (i + 2) % 3
-            for j in range(3):
-                j1 = (j + 1) % 3
-                j2 = (j + 2) % 3
-                projection = T[i2] * R[i1, j] - T[i1] * R[i2, j]
-                radius = (boxes_a[a, 3 + i1] * absR[i2, j] + boxes_a[a, 3 + i2] * absR[i1, j]
-                          + boxes_b[b, 3 + j1] * absR[i, j2] + boxes_b[b, 3 + j2] * absR[i, j1])
-                if abs(projection) > radius + margin:
-                    apart = True
-                    break
-            if apart:
-                break
-        if apart:
+        # The separating-axis test of node a's box and node b's
+        # (bvh_exact.node_pair_frame, bvh_exact.boxes_apart), on values
+        # loaded once: a node's axes are the columns of the 3x3 matrix in
+        # boxes[node, 6:15], row by row; placed_b[b] holds M cb + u and M Ab.
+        if node_boxes_apart(
+                (boxes_a[a, 0], boxes_a[a, 1], boxes_a[a, 2]),
+                (boxes_a[a, 3], boxes_a[a, 4], boxes_a[a, 5]),
+                ((boxes_a[a, 6], boxes_a[a, 7], boxes_a[a, 8]),
+                 (boxes_a[a, 9], boxes_a[a, 10], boxes_a[a, 11]),
+                 (boxes_a[a, 12], boxes_a[a, 13], boxes_a[a, 14])),
+                (placed_b[b, 0], placed_b[b, 1], placed_b[b, 2]),
+                ((placed_b[b, 3], placed_b[b, 4], placed_b[b, 5]),
+                 (placed_b[b, 6], placed_b[b, 7], placed_b[b, 8]),
+                 (placed_b[b, 9], placed_b[b, 10], placed_b[b, 11])),
+                (boxes_b[b, 3], boxes_b[b, 4], boxes_b[b, 5]), margin):
             continue
 
         leaf_a = links_a[a, LEFT] < 0
@@ -632,7 +664,8 @@ def exact_query(floats_a, ints_a, rotation_a, translation_a,
             continue
         if top + 2 > stack.shape[0]:
             stack = grow(stack, top)
-        if leaf_b or (not leaf_a and a0 + a1 + a2 >= b0 + b1 + b2):
+        if leaf_b or (not leaf_a and (boxes_a[a, 3] + boxes_a[a, 4] + boxes_a[a, 5]
+                                      >= boxes_b[b, 3] + boxes_b[b, 4] + boxes_b[b, 5])):
             near, far = links_a[a, LEFT], links_a[a, RIGHT]     # open the bigger node
             if mode == FIRST_HIT and (squared_distance(boxes_a, far, placed_b, b)
                                       < squared_distance(boxes_a, near, placed_b, b)):
@@ -643,8 +676,10 @@ def exact_query(floats_a, ints_a, rotation_a, translation_a,
             stack[top + 1, 1] = b
         else:
             near, far = links_b[b, LEFT], links_b[b, RIGHT]
-            place(boxes_b, M, u, near, placed_b)
-            place(boxes_b, M, u, far, placed_b)
+            if not placed_done_b[near]:                   # (the two children together)
+                place(boxes_b, M, u, near, placed_b)
+                place(boxes_b, M, u, far, placed_b)
+                placed_done_b[near] = True
             if mode == FIRST_HIT and (squared_distance(boxes_a, a, placed_b, far)
                                       < squared_distance(boxes_a, a, placed_b, near)):
                 near, far = far, near
