@@ -10,13 +10,17 @@ M. C. Lin, D. Manocha, "OBBTree: A Hierarchical Structure for Rapid
 Interference Detection", SIGGRAPH 1996):
 
 1. Node volumes are oriented boxes in body space, computed once per mesh
-   (:class:`FrameTree`: the topology of :func:`refsim.collision.bvh.tree_of`;
-   each node's box along the principal axes of its vertices,
-   :func:`oriented_box`, :func:`principal_axes`). On a curved surface such a box is about as thin
+   (:class:`FrameTree`: a tree of :func:`refsim.collision.bvh.build_tree`
+   split across the one of each node's principal axes whose halves have
+   the least total box volume, :func:`least_volume_split`; each node's box
+   along the principal axes of its vertices, :func:`oriented_box`,
+   :func:`principal_axes`). On a curved surface such a box is about as thin
    as the patch is bent, where the axis-aligned box of a tilted patch is as
    thick as the patch is wide: on the separated sphere benchmark the query
-   visits 117 node pairs against 751 with axis-aligned node boxes, 2185
-   against 4025 on the deep one.
+   visited 117 node pairs against 751 with axis-aligned node boxes, 2185
+   against 4025 on the deep one (both over the least-area tree of
+   :mod:`refsim.collision.bvh`; the least-volume split visits 121 and 2209
+   there, and 73 instead of 247 on two linked tori).
 2. A query expresses body b in a's frame, ``x_a = M x_b + u`` with
    ``M = Ra^T Rb`` and ``u = Ra^T (tb - ta)``, and a pair of nodes in the
    frame of node a's box (:func:`node_pair_frame`: ``R = Aa^T M Ab``,
@@ -107,7 +111,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.boxes import triangle_boxes, world_vertices
-from refsim.collision.bvh import TriangleTree, tree_of
+from refsim.collision.bvh import TriangleTree, build_tree
 from refsim.collision.seed_levels import exact_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_numba import compiled_exact_kernels
@@ -195,10 +199,47 @@ def oriented_box(points: np.ndarray, axes: np.ndarray | None = None):
     return centre, half, axes
 
 
+def box_volume(points: np.ndarray) -> float:
+    """Volume of the box about ``points`` (k, 3) along their principal axes."""
+    projected = points @ principal_axes(points)
+    return float(np.prod(projected.max(axis=0) - projected.min(axis=0)))
+
+
+def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int) -> np.ndarray:
+    """``members`` ranked by centroid along the one of the node's three
+    principal axes whose halves ``[:mid]`` and ``[mid:]`` have the least
+    total oriented-box volume (a split rule for
+    :func:`refsim.collision.bvh.build_tree`; the triangles' vertices stand
+    for the points, shared ones counted once per triangle).
+
+    Splitting across the longest principal axis (OBBTree's rule) keeps a
+    tube's segments short, which the least-area split of axis-aligned boxes
+    does not, but it cuts a sphere's caps badly; choosing among the three
+    axes by the children's volumes does well on both
+    (docs/decisions/query-fixed-cost.md)."""
+    points = triangles[members]
+    centroids = points.mean(axis=1) @ principal_axes(points.reshape(-1, 3))
+    best_volume = np.inf
+    for axis in range(3):
+        # stable tie-break by index, so the same mesh always gives the same tree
+        ranked = np.lexsort((members, centroids[:, axis]))
+        volume = (box_volume(points[ranked[:mid]].reshape(-1, 3))
+                  + box_volume(points[ranked[mid:]].reshape(-1, 3)))
+        if volume < best_volume:              # ties keep the lower axis
+            best_volume, best = volume, ranked
+    return members[best]
+
+
+def frame_topology_of(mesh) -> TriangleTree:
+    """The exact level's tree (:func:`least_volume_split`), built once per mesh."""
+    return mesh.derived("frame_topology", lambda m: build_tree(
+        m.vertices, m.faces, split=least_volume_split))
+
+
 def build_frame_tree(mesh, choose_axes=principal_axes) -> FrameTree:
     """The mesh's :class:`FrameTree`, each node's box along
     ``choose_axes(points)`` (the tests pass axes off orthonormal)."""
-    tree = tree_of(mesh)
+    tree = frame_topology_of(mesh)
     boxes = np.empty((tree.n_nodes, 15))
     axes_deviation = 0.0
     for node in range(tree.n_nodes):

@@ -256,7 +256,7 @@ def test_frame_tree_boxes_contain_their_triangles():
 def test_oriented_boxes_follow_the_surface():
     """A flat set of points gets a box of zero thickness; a tilted patch of
     the sphere a box thinner than its axis-aligned one (why the separated
-    benchmark visits 117 node pairs, not 751 as with axis-aligned boxes)."""
+    benchmark visits about 120 node pairs, not 751 as with axis-aligned boxes)."""
     rng = np.random.default_rng(3)
     rotation = random_rotation(rng)
     flat = np.column_stack([rng.uniform(-1, 1, (20, 2)), np.zeros(20)]) @ rotation.T
@@ -277,8 +277,9 @@ def test_oriented_boxes_follow_the_surface():
 
 def test_oriented_boxes_prune_the_separated_benchmark_early():
     """The separated sphere benchmark pose: 751 node pairs visited with
-    axis-aligned node boxes (commit 762e5f1), 117 with oriented ones here,
-    and no candidate pair left for the exact test."""
+    axis-aligned node boxes (commit 762e5f1), 117 with oriented ones over
+    the least-area tree, 121 over the least-volume tree used now, and no
+    candidate pair left for the exact test."""
     from refsim.studies.levels import SPEED_CONFIGURATIONS
     from refsim.types import as_pose
 
@@ -320,30 +321,38 @@ def test_the_boolean_query_stops_at_the_first_pair_the_exact_stage_decides():
     assert bodies_collide(CUBE, IDENTITY, CUBE, touching, kernel="compiled") is True
 
 
-@pytest.mark.parametrize("kind, expected", [("grazing", True),
-                                            ("separated-boxes-overlap", False)])
-def test_pairs_the_exact_stage_cannot_take_go_to_the_readable_kernel(kind, expected):
-    """The torus benchmark poses scaled by 2^-245 (coordinates below the
-    filter's range, the geometry the same bits times a power of two): the
-    compiled boolean query answers UNDECIDED, and the readable kernel gives
-    the seed's answer (the separated pose has a candidate pair, not touching)."""
-    from refsim.collision import _numba_kernels as nk
+def _torus_grazing():
     from refsim.studies.levels import SPEED_CONFIGURATIONS
 
     config = next(c for c in SPEED_CONFIGURATIONS
-                  if c.model == "torus" and c.kind == kind).as_configuration()
+                  if c.model == "torus" and c.kind == "grazing").as_configuration()
+    return config.poses()
+
+
+@pytest.mark.parametrize("poses, expected", [
+    (_torus_grazing, True),
+    (lambda: _poses(3, 14, 2.5)[13], False),    # 87 candidate pairs, none touching
+], ids=["grazing benchmark pose", "close, not touching"])
+def test_pairs_the_exact_stage_cannot_take_go_to_the_readable_kernel(poses, expected):
+    """Two tori scaled by 2^-245 (coordinates below the filter's range, the
+    geometry the same bits times a power of two) with candidate pairs: the
+    compiled boolean query answers UNDECIDED, and the readable kernel gives
+    the seed's answer."""
+    from refsim.collision import _numba_kernels as nk
+
     side = 2.0 ** -245
-    mesh_a, mesh_b = (mesh.scaled(side) for mesh in config.meshes())
-    (ra, ta), (rb, tb) = config.poses()
+    tiny = TORUS.scaled(side)
+    (ra, ta), (rb, tb) = poses()
     pose_a, pose_b = (ra, side * ta), (rb, side * tb)
-    boxes, exact = _seed_pairs(mesh_a, pose_a, mesh_b, pose_b)
+    boxes, exact = _seed_pairs(tiny, pose_a, tiny, pose_b)
     assert len(boxes) > 0 and (len(exact) > 0) == expected
-    answer = nk.exact_collide(*bvh_exact.pack_frame_tree(mesh_a), *pose_a,
-                              *bvh_exact.pack_frame_tree(mesh_b), *pose_b, ORTHONORMAL_TOL,
+    assert len(bvh_exact.candidate_pairs(tiny, pose_a, tiny, pose_b)) > 0
+    packed = bvh_exact.pack_frame_tree(tiny)
+    answer = nk.exact_collide(*packed, *pose_a, *packed, *pose_b, ORTHONORMAL_TOL,
                               bvh_exact.MARGIN_ROUNDING, bvh_exact.MARGIN_PER_DEVIATION)
     assert answer == nk.UNDECIDED
     for kernel in ("compiled", "readable"):
-        assert bodies_collide(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel) is expected, kernel
+        assert bodies_collide(tiny, pose_a, tiny, pose_b, kernel=kernel) is expected, kernel
 
 
 def _layouts(rotation, translation):
@@ -381,3 +390,18 @@ def test_the_boolean_query_takes_a_pose_in_any_layout_as_pose_takes(layout):
 def test_the_boolean_query_refuses_a_bad_pose_with_as_poses_message(pose, message):
     with pytest.raises(StateError, match=message):
         bodies_collide(CUBE, IDENTITY, CUBE, pose, kernel="compiled")
+
+
+def test_the_least_volume_split_separates_linked_tori_in_few_node_pairs():
+    """Two tori linked like a chain (overlapping boxes, no contact): the exact
+    level's own split (bvh_exact.least_volume_split) proves them apart in
+    73 node pairs; over the least-area tree of the triangle-aabb level it
+    took 247."""
+    from refsim.collision.bvh import tree_of
+
+    turn_x = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+    pose_b = (turn_x, np.array([1.0, 0.0, 0.0]))
+    pairs, visits = bvh_exact.descend(TORUS, IDENTITY, TORUS, pose_b)
+    assert len(pairs) == 0 and visits <= 80
+    assert not np.array_equal(bvh_exact.frame_tree_of(TORUS).tree.order, tree_of(TORUS).order)
+    assert bodies_collide(TORUS, IDENTITY, TORUS, pose_b) is False
