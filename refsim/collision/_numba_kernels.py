@@ -295,6 +295,11 @@ def grow(rows, used):
 # once per mesh): numba unboxes every array argument at every call, and a
 # query that passed each array on its own spent about a third of its fixed
 # cost doing so (docs/decisions/query-fixed-cost.md).
+#
+# Caveat: the boolean mode calls the exact stage of _numba_exact, and numba's
+# cache keys a kernel by its own source file only: after an edit to
+# _numba_exact.py alone, clear __pycache__ (or touch this file) so that the
+# cached exact_query is compiled again.
 
 #: Query modes of ``exact_query``.
 ALL_HITS, FIRST_HIT, CANDIDATES = 0, 1, 2
@@ -312,21 +317,23 @@ LEFT, RIGHT, START, COUNT = 0, 1, 2, 3
 FLOAT_HEADER, INT_HEADER = 2, 3
 
 
+@numba.njit(cache=True, inline="always")
+def carve(block, at, rows, columns):
+    """``(view, end)``: ``block[at:end]`` as a (rows, columns) array, ``end =
+    at + rows columns``."""
+    end = at + rows * columns
+    return block[at:end].reshape((rows, columns)), end
+
 @numba.njit(cache=True)
 def unpack(floats, ints):
     """The arrays of :func:`refsim.collision.bvh_exact.pack_frame_tree` as
     views: ``(vertices, faces, links, order, boxes, reach, axes_deviation)``."""
     n_vertices, n_faces, n_nodes = ints[0], ints[1], ints[2]
-    at = INT_HEADER
-    faces = ints[at:at + 3 * n_faces].reshape((n_faces, 3))
-    at += 3 * n_faces
-    links = ints[at:at + 4 * n_nodes].reshape((n_nodes, 4))
-    at += 4 * n_nodes
+    faces, at = carve(ints, INT_HEADER, n_faces, 3)
+    links, at = carve(ints, at, n_nodes, 4)
     order = ints[at:at + n_faces]
-    at = FLOAT_HEADER
-    vertices = floats[at:at + 3 * n_vertices].reshape((n_vertices, 3))
-    at += 3 * n_vertices
-    boxes = floats[at:at + 15 * n_nodes].reshape((n_nodes, 15))
+    vertices, at = carve(floats, FLOAT_HEADER, n_vertices, 3)
+    boxes, _ = carve(floats, at, n_nodes, 15)
     return vertices, faces, links, order, boxes, floats[0], floats[1]
 
 @numba.njit(cache=True)
@@ -473,22 +480,15 @@ def exact_query(floats_a, ints_a, rotation_a, translation_a,
     # separate allocation for each costs more than a query far apart.
     scratch = np.empty(12 + 12 * n_nodes_b + 3 * (n_vertices_a + n_vertices_b)
                        + 6 * (n_faces_a + n_faces_b + n_nodes_a + n_nodes_b))
-    M = scratch[0:9].reshape((3, 3))
+    M, at = carve(scratch, 0, 3, 3)
     u = scratch[9:12]
-    at = 12
-    placed_b = scratch[at:at + 12 * n_nodes_b].reshape((n_nodes_b, 12))
-    at += 12 * n_nodes_b
-    world_a = scratch[at:at + 3 * n_vertices_a].reshape((n_vertices_a, 3))
-    at += 3 * n_vertices_a
-    world_b = scratch[at:at + 3 * n_vertices_b].reshape((n_vertices_b, 3))
-    at += 3 * n_vertices_b
-    tri_box_a = scratch[at:at + 6 * n_faces_a].reshape((n_faces_a, 6))
-    at += 6 * n_faces_a
-    tri_box_b = scratch[at:at + 6 * n_faces_b].reshape((n_faces_b, 6))
-    at += 6 * n_faces_b
-    leaf_box_a = scratch[at:at + 6 * n_nodes_a].reshape((n_nodes_a, 6))
-    at += 6 * n_nodes_a
-    leaf_box_b = scratch[at:at + 6 * n_nodes_b].reshape((n_nodes_b, 6))
+    placed_b, at = carve(scratch, 12, n_nodes_b, 12)
+    world_a, at = carve(scratch, at, n_vertices_a, 3)
+    world_b, at = carve(scratch, at, n_vertices_b, 3)
+    tri_box_a, at = carve(scratch, at, n_faces_a, 6)
+    tri_box_b, at = carve(scratch, at, n_faces_b, 6)
+    leaf_box_a, at = carve(scratch, at, n_nodes_a, 6)
+    leaf_box_b, at = carve(scratch, at, n_nodes_b, 6)
     flags = np.zeros(n_vertices_a + n_vertices_b + n_faces_a + n_faces_b + n_nodes_a
                      + 2 * n_nodes_b, dtype=np.bool_)
     vertex_done_a = flags[0:n_vertices_a]

@@ -94,8 +94,16 @@ The pairs the compiled filter cannot certify (on touching bodies, nearly
 all of them) are answered by the compiled exact stage
 (:mod:`refsim.collision._numba_exact`: the readable triangle test over exact
 expansion predicates), and the few it does not take (degenerate triangles,
-coordinates outside the filter's range) by the readable exact kernel.
+coordinates outside the filter's range) by the readable exact kernel. The
+boolean query (:func:`collide_bvh`) runs that stage inside the traversal,
+pair by pair, and stops at the first pair either decides intersecting; the
+all-pairs query collects the open pairs and answers them after.
 
+A query's fixed cost (docs/decisions/query-fixed-cost.md): each mesh's
+constant arrays travel packed in two (:func:`pack_frame_tree`, built once),
+since numba unboxes every array argument at every call; the boolean query's
+kernel returns one number, and its poses go to numba unchecked, its one
+compiled signature refusing any other layout (then :func:`as_pose` converts).
 Cost: O(m log m) once per mesh for the boxes (a 3x3 eigenproblem per node);
 per query about O(k log m) node
 tests for k overlapping node pairs, plus O(1) per vertex and triangle of the
