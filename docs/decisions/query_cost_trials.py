@@ -2,19 +2,21 @@
 
     .venv/bin/python docs/decisions/query_cost_trials.py calls
     .venv/bin/python docs/decisions/query_cost_trials.py splits
-    .venv/bin/python docs/decisions/query_cost_trials.py table bench.json
+    .venv/bin/python docs/decisions/query_cost_trials.py table before.json after.json
 
 ``calls`` times what a compiled query pays around its work: numba's
 dispatch per argument (writable and read-only arrays, floats), boxing what
-it returns, reshaping a slice, allocating per-query arrays, and reading an
-unset environment variable (best of 9 repeats, nanoseconds a call).
+it returns, reshaping a slice, allocating per-query arrays, packing two
+poses into one array in Python, and reading an unset environment variable
+(best of 9 repeats, nanoseconds a call).
 ``splits`` counts the node pairs the readable exact traversal visits on the
 benchmark poses over the least-area tree and the least-volume tree.
-``table`` prints the refsim/FCL table from the JSON of
+``table`` prints the refsim/FCL medians and ratios of one or more JSON
+files (say, before and after a change) of
 
     .venv/bin/python -m pytest tests/benchmarks/test_bench_collision.py \
         -k "fixed_cost or test_boolean or test_all_pairs or touching" \
-        --benchmark-only -p no:randomly --benchmark-json=bench.json
+        --benchmark-only -p no:randomly --benchmark-json=before.json
 """
 
 from __future__ import annotations
@@ -105,6 +107,16 @@ def calls() -> None:
         print(f"{f.__name__} (2k-triangle meshes): "
               f"{best_ns(lambda f=f: f(1002, 2000, 1023)):.0f} ns")
 
+    rotation, translation = np.eye(3), np.zeros(3)
+    pair = np.empty(24)
+
+    def by_slices():
+        pair[:9], pair[9:12] = rotation.ravel(), translation
+        pair[12:21], pair[21:] = rotation.ravel(), translation
+
+    print(f"two poses packed into one array by slices: {best_ns(by_slices):.0f} ns, by "
+          f"np.concatenate: {best_ns(lambda: np.concatenate((rotation.ravel(), translation, rotation.ravel(), translation))):.0f} ns")  # noqa: E501
+
     from refsim.kernels import KERNELS_ENV, _environment_kernel
 
     os.environ.pop(KERNELS_ENV, None)
@@ -142,20 +154,30 @@ def splits() -> None:
         print(f"{name} | {counts[0]} | {counts[1]}")
 
 
-def table(path: str) -> None:
+def medians(path: str) -> dict[str, dict[str, float]]:
+    """Median microseconds of each benchmark group, by engine."""
     with open(path) as f:
         data = json.load(f)
     groups: dict[str, dict[str, float]] = defaultdict(dict)
     for bench in data["benchmarks"]:
         groups[bench["group"]][bench["params"]["engine"]] = bench["stats"]["median"] * 1e6
-    print("| query | configuration | refsim (us) | FCL (us) | refsim / FCL |")
-    print("| --- | --- | ---: | ---: | ---: |")
-    for group, us in groups.items():
-        refsim_us = us["refsim-bvh"]
-        fcl_us = us.get("fcl-posed", us.get("fcl"))
+    return groups
+
+
+def table(*paths: str) -> None:
+    """One row a benchmark group: refsim, FCL and their ratio from each JSON
+    file in turn (before, after)."""
+    runs = [medians(path) for path in paths]
+    print("| query | configuration |" + " refsim (us) | FCL (us) | ratio |" * len(runs))
+    print("| --- | --- |" + " ---: | ---: | ---: |" * len(runs))
+    for group in runs[0]:
         query, configuration = group.split(": ", 1)
-        print(f"| {query} | {configuration} | {refsim_us:.1f} | {fcl_us:.1f} "
-              f"| {refsim_us / fcl_us:.2f} |")
+        cells = []
+        for run in runs:
+            us = run[group]
+            refsim_us, fcl_us = us["refsim-bvh"], us.get("fcl-posed", us.get("fcl"))
+            cells.append(f" {refsim_us:.1f} | {fcl_us:.1f} | {refsim_us / fcl_us:.2f} |")
+        print(f"| {query} | {configuration} |" + "".join(cells))
 
 
 if __name__ == "__main__":
