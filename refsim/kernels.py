@@ -73,7 +73,7 @@ def choose_kernel(kernel: str | None) -> str:
         An unknown kernel, or ``"compiled"`` where numba does not work.
     """
     if kernel is None:
-        kernel = os.environ.get(KERNELS_ENV) or None
+        kernel = _environment_kernel()
         if kernel is not None:
             check_option(KERNELS_ENV, kernel, KERNELS)
     if kernel is None:
@@ -86,6 +86,23 @@ def choose_kernel(kernel: str | None) -> str:
         raise OptionError(f"kernel 'compiled' needs numba, which does not work here: "
                           f"{numba_error()}")
     return kernel
+
+
+def _environment_kernel() -> str | None:
+    """``REFSIM_KERNELS``'s value, or None when it is unset or empty; read
+    at every call (a test or a user may set it mid-run). Looked up in
+    ``os.environ``'s own mapping where it has one: ``os.environ.get`` raises
+    and catches a KeyError inside when the variable is unset, which made the
+    lookup a sixth of a small collision query
+    (docs/decisions/query-fixed-cost.md)."""
+    encodekey = getattr(os.environ, "encodekey", None)
+    data = getattr(os.environ, "_data", None)
+    if encodekey is None or data is None:                 # not CPython's os._Environ
+        return os.environ.get(KERNELS_ENV) or None
+    value = data.get(encodekey(KERNELS_ENV))
+    if value is None:
+        return None
+    return os.environ.decodevalue(value) or None
 
 
 @functools.cache

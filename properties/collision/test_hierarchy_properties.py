@@ -16,6 +16,7 @@ from hypothesis import given
 from refsim.oracles import OracleUnavailable
 
 from properties.collision.strategies import posed_model_pairs
+from refsim.collision import bvh_exact
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
 from refsim.studies.triangles import classify_disagreement
@@ -47,6 +48,22 @@ def test_boolean_query_matches_pairs(case):
     for level in ("triangle-aabb", "exact"):
         pairs = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level=level)
         assert bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level=level) == (len(pairs) > 0)
+
+
+@given(posed_model_pairs())
+def test_the_boolean_query_stops_at_an_intersecting_pair(case):
+    """The compiled boolean query's early exit (bvh_exact's FIRST_HIT, the
+    exact stage answering each pair the filter leaves open as it is met):
+    the pair it stops at is one of the all-pairs query's, and it finds one
+    exactly when that query finds any (unless pairs are left undecided for
+    the readable kernel, which these models' coordinates never need)."""
+    mesh_a, pose_a, mesh_b, pose_b, _ = case
+    pairs = as_set(intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, kernel="compiled"))
+    found, undecided = bvh_exact.query_compiled(mesh_a, pose_a, mesh_b, pose_b,
+                                                bvh_exact.FIRST_HIT)
+    assert len(undecided) == 0
+    assert len(found) == (1 if pairs else 0) and as_set(found) <= pairs
+    assert bodies_collide(mesh_a, pose_a, mesh_b, pose_b, kernel="compiled") == bool(pairs)
 
 
 @pytest.mark.parametrize("kernel", ["compiled", "readable"])

@@ -23,6 +23,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from refsim.collision._numba_exact import triangles_intersect_exact
 from refsim.collision.predicates import (
     FILTER_MAX_ABS,
     FILTER_MIN_ABS,
@@ -289,20 +290,59 @@ def grow(rows, used):
 # loops over a leaf pair are written out in the main loop: a helper taking a
 # dozen arrays made the whole query measurably slower on the separated
 # benchmarks (docs/decisions/triangle-filter-arguments.md).
+#
+# A mesh's constant arrays come packed in two (bvh_exact.pack_frame_tree, built
+# once per mesh): numba unboxes every array argument at every call, and a
+# query that passed each array on its own spent about a third of its fixed
+# cost doing so (docs/decisions/query-fixed-cost.md).
+#
+# Caveat: the boolean mode calls the exact stage of _numba_exact, and numba's
+# cache keys a kernel by its own source file only: after an edit to
+# _numba_exact.py alone, clear __pycache__ (or touch this file) so that the
+# cached exact_query is compiled again.
 
 #: Query modes of ``exact_query``.
 ALL_HITS, FIRST_HIT, CANDIDATES = 0, 1, 2
+
+#: Answers of ``exact_collide``: no pair intersects, one does, some pairs are
+#: left to the readable exact kernel, pose a / pose b is not valid.
+APART, HIT, UNDECIDED, BAD_POSE_A, BAD_POSE_B = 0, 1, 2, 3, 4
 
 #: Columns of a hierarchy's ``links`` (bvh_exact.FrameTree); its ``boxes``
 #: hold a node's centre in columns 0-2, half-extents in 3-5 and axes in 6-14.
 LEFT, RIGHT, START, COUNT = 0, 1, 2, 3
 
+#: Leading entries of the packed arrays: (reach, axes deviation) of the
+#: floats, (vertices, faces, nodes) of the integers.
+FLOAT_HEADER, INT_HEADER = 2, 3
+
+
+@numba.njit(cache=True, inline="always")
+def carve(block, at, rows, columns):
+    """``(view, end)``: ``block[at:end]`` as a (rows, columns) array, ``end =
+    at + rows columns``."""
+    end = at + rows * columns
+    return block[at:end].reshape((rows, columns)), end
+
+@numba.njit(cache=True)
+def unpack(floats, ints):
+    """The arrays of :func:`refsim.collision.bvh_exact.pack_frame_tree` as
+    views: ``(vertices, faces, links, order, boxes, reach, axes_deviation)``."""
+    n_vertices, n_faces, n_nodes = ints[0], ints[1], ints[2]
+    faces, at = carve(ints, INT_HEADER, n_faces, 3)
+    links, at = carve(ints, at, n_nodes, 4)
+    order = ints[at:at + n_faces]
+    vertices, at = carve(floats, FLOAT_HEADER, n_vertices, 3)
+    boxes, _ = carve(floats, at, n_nodes, 15)
+    return vertices, faces, links, order, boxes, floats[0], floats[1]
 
 @numba.njit(cache=True)
 def pose_deviation(rotation, translation, tol):
     """max |R^T R - I| of a valid pose, or -1.0 if the pose is not valid (a
     non-finite value, an entry of R above 1 + tol, or R^T R further than tol
-    from I: the conditions of refsim.types.as_pose)."""
+    from I: the conditions of refsim.types.as_pose), or of the wrong shape."""
+    if rotation.shape[0] != 3 or rotation.shape[1] != 3 or translation.shape[0] != 3:
+        return -1.0
     for k in range(3):
         if not abs(translation[k]) < np.inf:
             return -1.0
@@ -317,35 +357,155 @@ def pose_deviation(rotation, translation, tol):
             deviation = max(deviation, abs(gram - (1.0 if i == j else 0.0)))
     return deviation if deviation <= tol else -1.0
 
+
+@numba.njit(cache=True, inline="always")
+def place(boxes_b, M, u, node, placed):
+    """Node b's box in body a's frame, kept for the rest of the query:
+    ``placed[node]`` = (M cb + u, then M Ab row by row), the part of
+    bvh_exact.node_pair_frame that depends on node b alone."""
+    for i in range(3):
+        placed[node, i] = (M[i, 0] * boxes_b[node, 0] + M[i, 1] * boxes_b[node, 1]
+                           + M[i, 2] * boxes_b[node, 2] + u[i])
+        for j in range(3):
+            placed[node, 3 + 3 * i + j] = (M[i, 0] * boxes_b[node, 6 + j]
+                                           + M[i, 1] * boxes_b[node, 9 + j]
+                                           + M[i, 2] * boxes_b[node, 12 + j])
+
+@numba.njit(cache=True, inline="always")
+def squared_distance(x, i, y, j):
+    """|x[i, :3] - y[j, :3]|^2."""
+    return ((x[i, 0] - y[j, 0]) ** 2 + (x[i, 1] - y[j, 1]) ** 2
+            + (x[i, 2] - y[j, 2]) ** 2)
+
+@numba.njit(cache=True, inline="always")
+def frame_row(A, i, d, P):
+    """``T[i]`` and row i of ``R`` (bvh_exact.node_pair_frame): ``T = A^T d``,
+    ``R = A^T P`` for A and P given by rows."""
+    t = A[0][i] * d[0] + A[1][i] * d[1] + A[2][i] * d[2]
+    r = (A[0][i] * P[0][0] + A[1][i] * P[1][0] + A[2][i] * P[2][0],
+         A[0][i] * P[0][1] + A[1][i] * P[1][1] + A[2][i] * P[2][1],
+         A[0][i] * P[0][2] + A[1][i] * P[1][2] + A[2][i] * P[2][2])
+    return t, r
+
+@numba.njit(cache=True, inline="always")
+def node_boxes_apart(c, h, A, p, P, g, margin):
+    """:func:`refsim.collision.bvh_exact.boxes_apart` of two node boxes, with
+    their frame (:func:`refsim.collision.bvh_exact.node_pair_frame`), on
+    tuples: node a's box has centre c, half-extents h and axes the columns
+    of A (given by rows); node b's, in a's body frame, centre p = M cb + u,
+    axes the columns of P = M Ab and half-extents g. The same formulas in
+    the same order; each row of R is computed when its face normal of a is
+    tested, and the test stops at the first separating axis. Tuples, not
+    arrays: values in registers, nothing reference-counted
+    (docs/decisions/triangle-filter-arguments.md)."""
+    d = (p[0] - c[0], p[1] - c[1], p[2] - c[2])
+    t0, r0 = frame_row(A, 0, d, P)                          # a's face normals
+    q0 = (abs(r0[0]), abs(r0[1]), abs(r0[2]))
+    if abs(t0) > h[0] + g[0] * q0[0] + g[1] * q0[1] + g[2] * q0[2] + margin:
+        return True
+    t1, r1 = frame_row(A, 1, d, P)
+    q1 = (abs(r1[0]), abs(r1[1]), abs(r1[2]))
+    if abs(t1) > h[1] + g[0] * q1[0] + g[1] * q1[1] + g[2] * q1[2] + margin:
+        return True
+    t2, r2 = frame_row(A, 2, d, P)
+    q2 = (abs(r2[0]), abs(r2[1]), abs(r2[2]))
+    if abs(t2) > h[2] + g[0] * q2[0] + g[1] * q2[1] + g[2] * q2[2] + margin:
+        return True
+    # b's face normals (M Ab)_j: projection T . R[:, j], radius h . |R[:, j]| + g[j]
+    if abs(t0 * r0[0] + t1 * r1[0] + t2 * r2[0]) > (h[0] * q0[0] + h[1] * q1[0]
+                                                    + h[2] * q2[0] + g[0]) + margin:
+        return True
+    if abs(t0 * r0[1] + t1 * r1[1] + t2 * r2[1]) > (h[0] * q0[1] + h[1] * q1[1]
+                                                    + h[2] * q2[1] + g[1]) + margin:
+        return True
+    if abs(t0 * r0[2] + t1 * r1[2] + t2 * r2[2]) > (h[0] * q0[2] + h[1] * q1[2]
+                                                    + h[2] * q2[2] + g[2]) + margin:
+        return True
+    # the nine edge-edge axes e_i x (M Ab)_j, i by i: (i1, i2) = (i+1, i+2) mod 3
+    return (edge_axes_apart(t2, r1, t1, r2, h[1], q2, h[2], q1, q0, g, margin)      # i = 0
+            or edge_axes_apart(t0, r2, t2, r0, h[2], q0, h[0], q2, q1, g, margin)   # i = 1
+            or edge_axes_apart(t1, r0, t0, r1, h[0], q1, h[1], q0, q2, g, margin))  # i = 2
+
+@numba.njit(cache=True, inline="always")
+def edge_axes_apart(t_i2, r_i1, t_i1, r_i2, h_i1, q_i2, h_i2, q_i1, q_i, g, margin):
+    """The three edge-edge axes of one i in :func:`refsim.collision.bvh_exact.boxes_apart`,
+    j = 0, 1, 2 written out (a loop over tuple indices computed mod 3 was
+    about twice as slow): projection ``T[i2] R[i1, j] - T[i1] R[i2, j]``,
+    radius ``h[i1] |R[i2, j]| + h[i2] |R[i1, j]| + g[j1] |R[i, j2]| + g[j2] |R[i, j1]|``."""
+    if abs(t_i2 * r_i1[0] - t_i1 * r_i2[0]) > (h_i1 * q_i2[0] + h_i2 * q_i1[0]
+                                               + g[1] * q_i[2] + g[2] * q_i[1]) + margin:
+        return True
+    if abs(t_i2 * r_i1[1] - t_i1 * r_i2[1]) > (h_i1 * q_i2[1] + h_i2 * q_i1[1]
+                                               + g[2] * q_i[0] + g[0] * q_i[2]) + margin:
+        return True
+    return abs(t_i2 * r_i1[2] - t_i1 * r_i2[2]) > (h_i1 * q_i2[2] + h_i2 * q_i1[2]
+                                                   + g[0] * q_i[1] + g[1] * q_i[0]) + margin
+
 @numba.njit(cache=True)
-def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotation_a,
-                translation_a,
-                vertices_b, faces_b, links_b, order_b, boxes_b, reach_b, rotation_b,
-                translation_b,
-                axes_deviation, mode, tol, margin_rounding, margin_per_deviation):
+def exact_query(floats_a, ints_a, rotation_a, translation_a,
+                floats_b, ints_b, rotation_b, translation_b,
+                mode, tol, margin_rounding, margin_per_deviation):
     """Mirrors :func:`refsim.collision.bvh_exact.descend` with the filter of :func:`certified`.
 
-    Returns ``(status, found, uncertain)``.
-
-    axes_deviation: the larger ``FrameTree.axes_deviation`` of the two meshes.
+    Returns ``(status, found, uncertain)``. Each mesh comes as the two arrays
+    of :func:`refsim.collision.bvh_exact.pack_frame_tree`.
 
     status: 0, or 1 / 2 when pose a / b is not valid (nothing else computed).
     found: the pairs certified to intersect (ALL_HITS; at most one for
     FIRST_HIT), or every candidate pair (CANDIDATES: node boxes not separated,
     triangle boxes overlap; nothing certified).
-    uncertain: the candidate pairs the float filter could not decide.
+    uncertain: the candidate pairs the float filter could not decide; with
+    FIRST_HIT, only those the compiled exact stage could not decide either.
+
+    FIRST_HIT answers each pair the filter leaves open with the compiled exact
+    stage on the spot (:func:`refsim.collision._numba_exact.triangles_intersect_exact`),
+    so it stops at the first intersecting pair whichever decides it, and
+    descends into the nearer child first (centre to centre), where a hit is
+    likelier. The other modes descend as the readable traversal does.
     """
-    none = np.empty((0, 2), dtype=np.int64)
     deviation_a = pose_deviation(rotation_a, translation_a, tol)
-    if deviation_a < 0.0:
-        return 1, none, none
     deviation_b = pose_deviation(rotation_b, translation_b, tol)
-    if deviation_b < 0.0:
-        return 2, none, none
+    if deviation_a < 0.0 or deviation_b < 0.0:
+        none = np.empty((0, 2), dtype=np.int64)
+        return (1 if deviation_a < 0.0 else 2), none, none
+    vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, axes_deviation_a = \
+        unpack(floats_a, ints_a)
+    vertices_b, faces_b, links_b, order_b, boxes_b, reach_b, axes_deviation_b = \
+        unpack(floats_b, ints_b)
+    n_vertices_a, n_faces_a, n_nodes_a = vertices_a.shape[0], faces_a.shape[0], links_a.shape[0]
+    n_vertices_b, n_faces_b, n_nodes_b = vertices_b.shape[0], faces_b.shape[0], links_b.shape[0]
+
+    # Per-query state, filled lazily: node b's box in a's frame (``place``),
+    # then leaf by leaf. Carved out of one float and one flag array: a
+    # separate allocation for each costs more than a query far apart.
+    scratch = np.empty(12 + 12 * n_nodes_b + 3 * (n_vertices_a + n_vertices_b)
+                       + 6 * (n_faces_a + n_faces_b + n_nodes_a + n_nodes_b))
+    M, at = carve(scratch, 0, 3, 3)
+    u = scratch[9:12]
+    placed_b, at = carve(scratch, 12, n_nodes_b, 12)
+    world_a, at = carve(scratch, at, n_vertices_a, 3)
+    world_b, at = carve(scratch, at, n_vertices_b, 3)
+    tri_box_a, at = carve(scratch, at, n_faces_a, 6)
+    tri_box_b, at = carve(scratch, at, n_faces_b, 6)
+    leaf_box_a, at = carve(scratch, at, n_nodes_a, 6)
+    leaf_box_b, at = carve(scratch, at, n_nodes_b, 6)
+    flags = np.zeros(n_vertices_a + n_vertices_b + n_faces_a + n_faces_b + n_nodes_a
+                     + 2 * n_nodes_b, dtype=np.bool_)
+    vertex_done_a = flags[0:n_vertices_a]
+    at = n_vertices_a
+    vertex_done_b = flags[at:at + n_vertices_b]
+    at += n_vertices_b
+    tri_ok_a = flags[at:at + n_faces_a]
+    at += n_faces_a
+    tri_ok_b = flags[at:at + n_faces_b]
+    at += n_faces_b
+    leaf_done_a = flags[at:at + n_nodes_a]
+    at += n_nodes_a
+    leaf_done_b = flags[at:at + n_nodes_b]
+    at += n_nodes_b
+    placed_done_b = flags[at:at + n_nodes_b]
 
     # Body b in a's frame: x_a = M x_b + u, M = Ra^T Rb, u = Ra^T (tb - ta).
-    M = np.empty((3, 3))
-    u = np.empty(3)
     for i in range(3):
         for j in range(3):
             M[i, j] = (rotation_a[0, i] * rotation_b[0, j] + rotation_a[1, i] * rotation_b[1, j]
@@ -356,91 +516,38 @@ def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotatio
     scale = reach_a + reach_b
     for k in range(3):
         scale = max(scale, reach_a + reach_b + abs(translation_a[k]) + abs(translation_b[k]))
-    deviation = max(max(deviation_a, deviation_b), axes_deviation)
+    deviation = max(max(deviation_a, deviation_b), max(axes_deviation_a, axes_deviation_b))
     margin = (margin_rounding + margin_per_deviation * deviation) * scale
-
-    # Per-query state, filled lazily, leaf by leaf.
-    world_a = np.empty((vertices_a.shape[0], 3))
-    world_b = np.empty((vertices_b.shape[0], 3))
-    vertex_done_a = np.zeros(vertices_a.shape[0], dtype=np.bool_)
-    vertex_done_b = np.zeros(vertices_b.shape[0], dtype=np.bool_)
-    tri_box_a = np.empty((faces_a.shape[0], 6))
-    tri_box_b = np.empty((faces_b.shape[0], 6))
-    tri_ok_a = np.empty(faces_a.shape[0], dtype=np.bool_)
-    tri_ok_b = np.empty(faces_b.shape[0], dtype=np.bool_)
-    leaf_box_a = np.empty((links_a.shape[0], 6))
-    leaf_box_b = np.empty((links_b.shape[0], 6))
-    leaf_done_a = np.zeros(links_a.shape[0], dtype=np.bool_)
-    leaf_done_b = np.zeros(links_b.shape[0], dtype=np.bool_)
 
     found = np.empty((64, 2), dtype=np.int64)
     n_found = 0
     uncertain = np.empty((64, 2), dtype=np.int64)
     n_uncertain = 0
-    T = np.empty(3)
-    R = np.empty((3, 3))
-    absR = np.empty((3, 3))
-    d = np.empty(3)
-    MB = np.empty((3, 3))
     stack = np.empty((256, 2), dtype=np.int64)
     stack[0, 0] = 0
     stack[0, 1] = 0
     top = 1
+    place(boxes_b, M, u, 0, placed_b)                   # every pushed node b is placed
     while top > 0:
         top -= 1
         a = stack[top, 0]
         b = stack[top, 1]
 
-        # Node b's box in the frame of node a's box (bvh_exact.node_pair_frame):
-        # R = Aa^T M Ab, T = Aa^T (M cb + u - ca); a node's axes are the
-        # columns of the 3x3 matrix in boxes[node, 6:15], row by row.
-        for i in range(3):
-            d[i] = (M[i, 0] * boxes_b[b, 0] + M[i, 1] * boxes_b[b, 1]
-                    + M[i, 2] * boxes_b[b, 2] + u[i] - boxes_a[a, i])
-            for j in range(3):
-                MB[i, j] = (M[i, 0] * boxes_b[b, 6 + j] + M[i, 1] * boxes_b[b, 9 + j]
-                            + M[i, 2] * boxes_b[b, 12 + j])
-        for i in range(3):
-            T[i] = boxes_a[a, 6 + i] * d[0] + boxes_a[a, 9 + i] * d[1] + boxes_a[a, 12 + i] * d[2]
-            for j in range(3):
-                R[i, j] = (boxes_a[a, 6 + i] * MB[0, j] + boxes_a[a, 9 + i] * MB[1, j]
-                           + boxes_a[a, 12 + i] * MB[2, j])
-                absR[i, j] = abs(R[i, j])
-
-        # Separating-axis test of the two boxes (bvh_exact.boxes_apart).
-        a0, a1, a2 = boxes_a[a, 3], boxes_a[a, 4], boxes_a[a, 5]
-        b0, b1, b2 = boxes_b[b, 3], boxes_b[b, 4], boxes_b[b, 5]
-        apart = False
-        for i in range(3):                                  # a's face normals
-            radius = boxes_a[a, 3 + i] + b0 * absR[i, 0] + b1 * absR[i, 1] + b2 * absR[i, 2]
-            if abs(T[i]) > radius + margin:
-                apart = True
-                break
-        if apart:
-            continue
-        for j in range(3):                                  # b's face normals
-            projection = T[0] * R[0, j] + T[1] * R[1, j] + T[2] * R[2, j]
-            radius = a0 * absR[0, j] + a1 * absR[1, j] + a2 * absR[2, j] + boxes_b[b, 3 + j]
-            if abs(projection) > radius + margin:
-                apart = True
-                break
-        if apart:
-            continue
-        for i in range(3):                                  # the nine edge-edge axes
-            i1 = (i + 1) % 3
-            i2 = (i + 2) % 3
-            for j in range(3):
-                j1 = (j + 1) % 3
-                j2 = (j + 2) % 3
-                projection = T[i2] * R[i1, j] - T[i1] * R[i2, j]
-                radius = (boxes_a[a, 3 + i1] * absR[i2, j] + boxes_a[a, 3 + i2] * absR[i1, j]
-                          + boxes_b[b, 3 + j1] * absR[i, j2] + boxes_b[b, 3 + j2] * absR[i, j1])
-                if abs(projection) > radius + margin:
-                    apart = True
-                    break
-            if apart:
-                break
-        if apart:
+        # The separating-axis test of node a's box and node b's
+        # (bvh_exact.node_pair_frame, bvh_exact.boxes_apart), on values
+        # loaded once: a node's axes are the columns of the 3x3 matrix in
+        # boxes[node, 6:15], row by row; placed_b[b] holds M cb + u and M Ab.
+        if node_boxes_apart(
+                (boxes_a[a, 0], boxes_a[a, 1], boxes_a[a, 2]),
+                (boxes_a[a, 3], boxes_a[a, 4], boxes_a[a, 5]),
+                ((boxes_a[a, 6], boxes_a[a, 7], boxes_a[a, 8]),
+                 (boxes_a[a, 9], boxes_a[a, 10], boxes_a[a, 11]),
+                 (boxes_a[a, 12], boxes_a[a, 13], boxes_a[a, 14])),
+                (placed_b[b, 0], placed_b[b, 1], placed_b[b, 2]),
+                ((placed_b[b, 3], placed_b[b, 4], placed_b[b, 5]),
+                 (placed_b[b, 6], placed_b[b, 7], placed_b[b, 8]),
+                 (placed_b[b, 9], placed_b[b, 10], placed_b[b, 11])),
+                (boxes_b[b, 3], boxes_b[b, 4], boxes_b[b, 5]), margin):
             continue
 
         leaf_a = links_a[a, LEFT] < 0
@@ -524,18 +631,21 @@ def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotatio
                         continue                            # triangle boxes apart
                     if mode == CANDIDATES:
                         answer, certain = True, True
-                    elif tri_ok_a[i] and tri_ok_b[j]:
+                    else:
                         p0, p1, p2 = faces_a[i, 0], faces_a[i, 1], faces_a[i, 2]
                         q0, q1, q2 = faces_b[j, 0], faces_b[j, 1], faces_b[j, 2]
-                        answer, certain = certify_filtered(
-                            ((world_a[p0, 0], world_a[p0, 1], world_a[p0, 2]),
-                             (world_a[p1, 0], world_a[p1, 1], world_a[p1, 2]),
-                             (world_a[p2, 0], world_a[p2, 1], world_a[p2, 2])),
-                            ((world_b[q0, 0], world_b[q0, 1], world_b[q0, 2]),
-                             (world_b[q1, 0], world_b[q1, 1], world_b[q1, 2]),
-                             (world_b[q2, 0], world_b[q2, 1], world_b[q2, 2])))
-                    else:
-                        answer, certain = False, False
+                        tri_a = ((world_a[p0, 0], world_a[p0, 1], world_a[p0, 2]),
+                                 (world_a[p1, 0], world_a[p1, 1], world_a[p1, 2]),
+                                 (world_a[p2, 0], world_a[p2, 1], world_a[p2, 2]))
+                        tri_b = ((world_b[q0, 0], world_b[q0, 1], world_b[q0, 2]),
+                                 (world_b[q1, 0], world_b[q1, 1], world_b[q1, 2]),
+                                 (world_b[q2, 0], world_b[q2, 1], world_b[q2, 2]))
+                        if tri_ok_a[i] and tri_ok_b[j]:
+                            answer, certain = certify_filtered(tri_a, tri_b)
+                        else:
+                            answer, certain = False, False
+                        if not certain and mode == FIRST_HIT:
+                            answer, certain = triangles_intersect_exact(tri_a, tri_b)
                     if certain:
                         if answer:
                             if n_found == found.shape[0]:
@@ -554,15 +664,55 @@ def exact_query(vertices_a, faces_a, links_a, order_a, boxes_a, reach_a, rotatio
             continue
         if top + 2 > stack.shape[0]:
             stack = grow(stack, top)
-        if leaf_b or (not leaf_a and a0 + a1 + a2 >= b0 + b1 + b2):
-            stack[top, 0] = links_a[a, RIGHT]               # open the bigger node
+        if leaf_b or (not leaf_a and (boxes_a[a, 3] + boxes_a[a, 4] + boxes_a[a, 5]
+                                      >= boxes_b[b, 3] + boxes_b[b, 4] + boxes_b[b, 5])):
+            near, far = links_a[a, LEFT], links_a[a, RIGHT]     # open the bigger node
+            if mode == FIRST_HIT and (squared_distance(boxes_a, far, placed_b, b)
+                                      < squared_distance(boxes_a, near, placed_b, b)):
+                near, far = far, near
+            stack[top, 0] = far
             stack[top, 1] = b
-            stack[top + 1, 0] = links_a[a, LEFT]
+            stack[top + 1, 0] = near
             stack[top + 1, 1] = b
         else:
+            near, far = links_b[b, LEFT], links_b[b, RIGHT]
+            if not placed_done_b[near]:                   # (the two children together)
+                place(boxes_b, M, u, near, placed_b)
+                place(boxes_b, M, u, far, placed_b)
+                placed_done_b[near] = True
+            if mode == FIRST_HIT and (squared_distance(boxes_a, a, placed_b, far)
+                                      < squared_distance(boxes_a, a, placed_b, near)):
+                near, far = far, near
             stack[top, 0] = a
-            stack[top, 1] = links_b[b, RIGHT]
+            stack[top, 1] = far
             stack[top + 1, 0] = a
-            stack[top + 1, 1] = links_b[b, LEFT]
+            stack[top + 1, 1] = near
         top += 2
     return 0, found[:n_found], uncertain[:n_uncertain]
+
+
+#: The one signature ``exact_collide`` is compiled for: packed mesh arrays,
+#: float64 C-contiguous poses. numba refuses any other argument types with a
+#: TypeError instead of compiling for them, so the caller need not check a
+#: pose's layout before the call (bvh_exact.collide_bvh).
+EXACT_COLLIDE_SIGNATURE = numba.int64(
+    numba.float64[::1], numba.int64[::1], numba.float64[:, ::1], numba.float64[::1],
+    numba.float64[::1], numba.int64[::1], numba.float64[:, ::1], numba.float64[::1],
+    numba.float64, numba.float64, numba.float64)
+
+
+@numba.njit(EXACT_COLLIDE_SIGNATURE, cache=True)
+def exact_collide(floats_a, ints_a, rotation_a, translation_a,
+                  floats_b, ints_b, rotation_b, translation_b,
+                  tol, margin_rounding, margin_per_deviation):
+    """:func:`exact_query` in mode FIRST_HIT, answered as one code (APART,
+    HIT, UNDECIDED, BAD_POSE_A, BAD_POSE_B): returning a number instead of
+    two arrays spares the caller numba's boxing of the arrays."""
+    status, found, uncertain = exact_query(
+        floats_a, ints_a, rotation_a, translation_a, floats_b, ints_b, rotation_b,
+        translation_b, FIRST_HIT, tol, margin_rounding, margin_per_deviation)
+    if status:
+        return BAD_POSE_A if status == 1 else BAD_POSE_B
+    if found.shape[0]:
+        return HIT
+    return UNDECIDED if uncertain.shape[0] else APART

@@ -30,8 +30,9 @@ loops, the reference) and a numba-compiled mirror of them
 
 This path serves level "triangle-aabb", whose answer is test 2's pairs. The
 exact level only needs a superset of the intersecting pairs and uses the
-cheaper traversal of :mod:`refsim.collision.bvh_exact`, which shares this
-module's tree.
+cheaper traversal of :mod:`refsim.collision.bvh_exact`, over a tree built by
+this module's :func:`build_tree` with a split of its own (oriented node
+boxes want another split than axis-aligned ones).
 
 Cost: build O(m log m) once; transform, boxes and refit O(n + m) per query;
 traversal about O(k log m) for k overlapping node pairs in practice, against
@@ -81,17 +82,34 @@ def _surface_area(lo: np.ndarray, hi: np.ndarray) -> float:
     return float(d[0] * d[1] + d[1] * d[2] + d[2] * d[0])
 
 
-def build_tree(vertices: np.ndarray, faces: np.ndarray, leaf_size: int = LEAF_SIZE) -> TriangleTree:
-    """Top-down median split of the triangles' centroids, on the axis whose
-    halves have the least total box area."""
+def least_area_split(triangles: np.ndarray, members: np.ndarray, mid: int) -> np.ndarray:
+    """``members`` (triangle indices, k > 1) ranked by centroid along the axis
+    whose halves ``[:mid]`` and ``[mid:]`` have the least total box surface
+    area; ``triangles`` (m, 3, 3) as :func:`build_tree` scales them."""
+    centroids = triangles[members].mean(axis=1)
+    tri_lo, tri_hi = triangles[members].min(axis=1), triangles[members].max(axis=1)
+    best_area = np.inf
+    for axis in range(3):
+        # stable tie-break by index, so the same mesh always gives the same tree
+        ranked = np.lexsort((members, centroids[:, axis]))
+        first, second = ranked[:mid], ranked[mid:]
+        area = (_surface_area(tri_lo[first], tri_hi[first])
+                + _surface_area(tri_lo[second], tri_hi[second]))
+        if area < best_area:                  # ties keep the lower axis
+            best_area, best = area, ranked
+    return members[best]
+
+
+def build_tree(vertices: np.ndarray, faces: np.ndarray, leaf_size: int = LEAF_SIZE,
+               split=least_area_split) -> TriangleTree:
+    """Top-down median split: each node's triangles ranked by ``split``
+    (by default :func:`least_area_split`), the first half to the left child."""
     # The split is chosen on coordinates times 2**-e (every one below 1): the
     # areas of boxes of a mesh with coordinates near 1e154 would overflow to
     # inf (and inf - inf to nan), leaving no axis "best". The tree's
     # topology is all that is built here, and scaling by a power of two
     # changes no comparison.
     triangles = np.ldexp(vertices, -unit_exponent(vertices))[faces]
-    centroids = triangles.mean(axis=1)
-    tri_lo, tri_hi = triangles.min(axis=1), triangles.max(axis=1)
     order = np.arange(len(faces), dtype=np.int64)
     left, right, start, count = [], [], [], []
 
@@ -107,18 +125,8 @@ def build_tree(vertices: np.ndarray, faces: np.ndarray, leaf_size: int = LEAF_SI
         node, lo, hi = stack.pop()
         if hi - lo <= leaf_size:
             continue
-        members = order[lo:hi]
         mid = (hi - lo) // 2
-        best_area = np.inf
-        for axis in range(3):
-            # stable tie-break by index, so the same mesh always gives the same tree
-            ranked = members[np.lexsort((members, centroids[members, axis]))]
-            first, second = ranked[:mid], ranked[mid:]
-            area = (_surface_area(tri_lo[first], tri_hi[first])
-                    + _surface_area(tri_lo[second], tri_hi[second]))
-            if area < best_area:                  # ties keep the lower axis
-                best_area, best = area, ranked
-        order[lo:hi] = best
+        order[lo:hi] = split(triangles, order[lo:hi], mid)
         a = new_node(lo, lo + mid)
         b = new_node(lo + mid, hi)
         left[node], right[node] = a, b

@@ -10,13 +10,17 @@ M. C. Lin, D. Manocha, "OBBTree: A Hierarchical Structure for Rapid
 Interference Detection", SIGGRAPH 1996):
 
 1. Node volumes are oriented boxes in body space, computed once per mesh
-   (:class:`FrameTree`: the topology of :func:`refsim.collision.bvh.tree_of`;
-   each node's box along the principal axes of its vertices,
-   :func:`oriented_box`, :func:`principal_axes`). On a curved surface such a box is about as thin
+   (:class:`FrameTree`: a tree of :func:`refsim.collision.bvh.build_tree`
+   split across the one of each node's principal axes whose halves have
+   the least total box volume, :func:`least_volume_split`; each node's box
+   along the principal axes of its vertices, :func:`oriented_box`,
+   :func:`principal_axes`). On a curved surface such a box is about as thin
    as the patch is bent, where the axis-aligned box of a tilted patch is as
    thick as the patch is wide: on the separated sphere benchmark the query
-   visits 117 node pairs against 751 with axis-aligned node boxes, 2185
-   against 4025 on the deep one.
+   visited 117 node pairs against 751 with axis-aligned node boxes, 2185
+   against 4025 on the deep one (both over the least-area tree of
+   :mod:`refsim.collision.bvh`; the least-volume split visits 121 and 2209
+   there, and 73 instead of 247 on two linked tori).
 2. A query expresses body b in a's frame, ``x_a = M x_b + u`` with
    ``M = Ra^T Rb`` and ``u = Ra^T (tb - ta)``, and a pair of nodes in the
    frame of node a's box (:func:`node_pair_frame`: ``R = Aa^T M Ab``,
@@ -90,8 +94,16 @@ The pairs the compiled filter cannot certify (on touching bodies, nearly
 all of them) are answered by the compiled exact stage
 (:mod:`refsim.collision._numba_exact`: the readable triangle test over exact
 expansion predicates), and the few it does not take (degenerate triangles,
-coordinates outside the filter's range) by the readable exact kernel.
+coordinates outside the filter's range) by the readable exact kernel. The
+boolean query (:func:`collide_bvh`) runs that stage inside the traversal,
+pair by pair, and stops at the first pair either decides intersecting; the
+all-pairs query collects the open pairs and answers them after.
 
+A query's fixed cost (docs/decisions/query-fixed-cost.md): each mesh's
+constant arrays travel packed in two (:func:`pack_frame_tree`, built once),
+since numba unboxes every array argument at every call; the boolean query's
+kernel returns one number, and its poses go to numba unchecked, its one
+compiled signature refusing any other layout (then :func:`as_pose` converts).
 Cost: O(m log m) once per mesh for the boxes (a 3x3 eigenproblem per node);
 per query about O(k log m) node
 tests for k overlapping node pairs, plus O(1) per vertex and triangle of the
@@ -107,7 +119,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.boxes import triangle_boxes, world_vertices
-from refsim.collision.bvh import TriangleTree, tree_of
+from refsim.collision.bvh import TriangleTree, build_tree
 from refsim.collision.seed_levels import exact_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_numba import compiled_exact_kernels
@@ -195,10 +207,47 @@ def oriented_box(points: np.ndarray, axes: np.ndarray | None = None):
     return centre, half, axes
 
 
+def box_volume(points: np.ndarray) -> float:
+    """Volume of the box about ``points`` (k, 3) along their principal axes."""
+    projected = points @ principal_axes(points)
+    return float(np.prod(projected.max(axis=0) - projected.min(axis=0)))
+
+
+def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int) -> np.ndarray:
+    """``members`` ranked by centroid along the one of the node's three
+    principal axes whose halves ``[:mid]`` and ``[mid:]`` have the least
+    total oriented-box volume (a split rule for
+    :func:`refsim.collision.bvh.build_tree`; the triangles' vertices stand
+    for the points, shared ones counted once per triangle).
+
+    Splitting across the longest principal axis (OBBTree's rule) keeps a
+    tube's segments short, which the least-area split of axis-aligned boxes
+    does not, but it cuts a sphere's caps badly; choosing among the three
+    axes by the children's volumes does well on both
+    (docs/decisions/query-fixed-cost.md)."""
+    points = triangles[members]
+    centroids = points.mean(axis=1) @ principal_axes(points.reshape(-1, 3))
+    best_volume = np.inf
+    for axis in range(3):
+        # stable tie-break by index, so the same mesh always gives the same tree
+        ranked = np.lexsort((members, centroids[:, axis]))
+        volume = (box_volume(points[ranked[:mid]].reshape(-1, 3))
+                  + box_volume(points[ranked[mid:]].reshape(-1, 3)))
+        if volume < best_volume:              # ties keep the lower axis
+            best_volume, best = volume, ranked
+    return members[best]
+
+
+def frame_topology_of(mesh) -> TriangleTree:
+    """The exact level's tree (:func:`least_volume_split`), built once per mesh."""
+    return mesh.derived("frame_topology", lambda m: build_tree(
+        m.vertices, m.faces, split=least_volume_split))
+
+
 def build_frame_tree(mesh, choose_axes=principal_axes) -> FrameTree:
     """The mesh's :class:`FrameTree`, each node's box along
     ``choose_axes(points)`` (the tests pass axes off orthonormal)."""
-    tree = tree_of(mesh)
+    tree = frame_topology_of(mesh)
     boxes = np.empty((tree.n_nodes, 15))
     axes_deviation = 0.0
     for node in range(tree.n_nodes):
@@ -339,24 +388,41 @@ def descend(mesh_a, pose_a, mesh_b, pose_b, *,
 
 @functools.cache
 def _compiled():
-    """The compiled ``exact_query``, or None without numba (looked up once:
-    a query costs a few microseconds, and an import statement a fraction)."""
+    """The compiled kernels module (``exact_query``, ``exact_collide``), or
+    None without numba (looked up once: a query costs a few microseconds, and
+    an import statement a fraction)."""
     try:
         from refsim.collision import _numba_kernels as nk
     except ImportError:
         return None
-    return nk.exact_query
+    return nk
 
 
-def _kernel_arrays(mesh) -> tuple:
-    """The six arrays the compiled query takes for one mesh (vertices, faces,
-    the tree's links, order, boxes, reach), gathered once and kept with the
-    mesh: twelve attribute lookups per query would be a tenth of it."""
-    def gather(m):
-        tree = frame_tree_of(m)
-        return (m.vertices, m.faces, tree.links, tree.tree.order, tree.boxes, tree.reach,
-                tree.axes_deviation)
-    return mesh.derived("frame_tree_kernel_arrays", gather)
+def pack_frame_tree(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """The mesh's constant arrays as the compiled query takes them, two in
+    all (numba unboxes each array argument at each call: few arrays, small
+    fixed cost; docs/decisions/query-fixed-cost.md):
+
+    - float64: reach, axes_deviation, then the vertices (n, 3) and the
+      :class:`FrameTree` boxes (nodes, 15), each flattened row by row;
+    - int64: the counts of vertices, faces and nodes, then the faces (m, 3),
+      the tree's links (nodes, 4) and order (m,), flattened likewise.
+
+    :func:`refsim.collision._numba_kernels.unpack` takes them apart again."""
+    tree = frame_tree_of(mesh)
+    floats = np.concatenate([[tree.reach, tree.axes_deviation], mesh.vertices.ravel(),
+                             tree.boxes.ravel()]).astype(np.float64)
+    ints = np.concatenate([[mesh.n_vertices, mesh.n_faces, tree.tree.n_nodes],
+                           mesh.faces.ravel(), tree.links.ravel(),
+                           tree.tree.order]).astype(np.int64)
+    # (left writable: numba's dispatcher types a read-only array argument
+    # by a slow path, a few hundred nanoseconds a query; nothing writes them)
+    return floats, ints
+
+
+def _kernel_arrays(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`pack_frame_tree` of the mesh, built once and kept with it."""
+    return mesh.derived("frame_tree_packed", pack_frame_tree)
 
 
 _FLOAT64 = np.dtype(np.float64)
@@ -380,6 +446,14 @@ def _pose_arrays(pose, what: str):
     return np.ascontiguousarray(rotation), np.ascontiguousarray(translation)
 
 
+def _reject(what: str, pose) -> None:
+    """Raise for the pose the compiled query found not valid."""
+    as_pose(pose, what=what)     # raises with the precise reason
+    # as_pose's Gram product rounds differently; at the tolerance's edge
+    # it may accept what the kernel rejected: reject all the same.
+    raise StateError(f"{what}: rotation is not orthonormal")
+
+
 def query_compiled(mesh_a, pose_a, mesh_b, pose_b, mode: int, *,
                    margin_rounding: float = MARGIN_ROUNDING,
                    margin_per_deviation: float = MARGIN_PER_DEVIATION):
@@ -393,19 +467,13 @@ def query_compiled(mesh_a, pose_a, mesh_b, pose_b, mode: int, *,
     """
     ra, ta = pose_a = _pose_arrays(pose_a, "pose_a")
     rb, tb = pose_b = _pose_arrays(pose_b, "pose_b")
-    va, fa, links_a, order_a, boxes_a, reach_a, dev_a = _kernel_arrays(mesh_a)
-    vb, fb, links_b, order_b, boxes_b, reach_b, dev_b = _kernel_arrays(mesh_b)
-    status, found, uncertain = _compiled()(
-        va, fa, links_a, order_a, boxes_a, reach_a, ra, ta,
-        vb, fb, links_b, order_b, boxes_b, reach_b, rb, tb,
-        dev_a if dev_a > dev_b else dev_b, mode, ORTHONORMAL_TOL, margin_rounding,
-        margin_per_deviation)
+    floats_a, ints_a = _kernel_arrays(mesh_a)
+    floats_b, ints_b = _kernel_arrays(mesh_b)
+    status, found, uncertain = _compiled().exact_query(
+        floats_a, ints_a, ra, ta, floats_b, ints_b, rb, tb, mode, ORTHONORMAL_TOL,
+        margin_rounding, margin_per_deviation)
     if status:
-        what, pose = ("pose_a", pose_a) if status == 1 else ("pose_b", pose_b)
-        as_pose(pose, what=what)     # raises with the precise reason
-        # as_pose's Gram product rounds differently; at the tolerance's edge
-        # it may accept what the kernel rejected: reject all the same.
-        raise StateError(f"{what}: rotation is not orthonormal")
+        _reject(*(("pose_a", pose_a) if status == 1 else ("pose_b", pose_b)))
     return found, uncertain
 
 
@@ -453,11 +521,38 @@ def intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> np.nd
 
 
 def collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> bool:
-    """Whether any pair of triangles intersects; stops at the first."""
+    """Whether any pair of triangles intersects; the compiled query stops at
+    the first (``exact_collide``: the float filter, else the compiled exact
+    stage, pair by pair). Only pairs that stage cannot take (degenerate
+    triangles, coordinates outside the filter's range) come back to the
+    readable exact kernel, through a second traversal."""
     if kernel == "readable":
         return len(intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)) > 0
-    found, uncertain = query_compiled(mesh_a, pose_a, mesh_b, pose_b, FIRST_HIT)
-    if len(found):
-        return True
-    return bool(len(uncertain)) and bool(_resolve(mesh_a, pose_a, mesh_b, pose_b,
-                                                   uncertain, first_only=True).any())
+    floats_a, ints_a = _kernel_arrays(mesh_a)
+    floats_b, ints_b = _kernel_arrays(mesh_b)
+    nk = _compiled()
+    try:
+        # numba checks the arrays' types (``EXACT_COLLIDE_SIGNATURE``), the
+        # kernel their shapes and values: nothing to check here first
+        (ra, ta), (rb, tb) = pose_a, pose_b
+        answer = nk.exact_collide(floats_a, ints_a, ra, ta, floats_b, ints_b, rb, tb,
+                                  ORTHONORMAL_TOL, MARGIN_ROUNDING, MARGIN_PER_DEVIATION)
+    except (TypeError, ValueError):      # not two pairs of float64 C-contiguous arrays
+        (ra, ta), (rb, tb) = pose_a, pose_b = _pose_copy(pose_a, "pose_a"), \
+            _pose_copy(pose_b, "pose_b")
+        answer = nk.exact_collide(floats_a, ints_a, ra, ta, floats_b, ints_b, rb, tb,
+                                  ORTHONORMAL_TOL, MARGIN_ROUNDING, MARGIN_PER_DEVIATION)
+    if answer == nk.APART or answer == nk.HIT:
+        return answer == nk.HIT
+    if answer == nk.BAD_POSE_A or answer == nk.BAD_POSE_B:
+        _reject(*(("pose_a", pose_a) if answer == nk.BAD_POSE_A else ("pose_b", pose_b)))
+    _, undecided = query_compiled(mesh_a, pose_a, mesh_b, pose_b, FIRST_HIT)
+    return bool(_resolve(mesh_a, pose_a, mesh_b, pose_b, undecided, first_only=True).any())
+
+
+def _pose_copy(pose, what: str):
+    """The pose checked by ``as_pose`` and copied into two new writable
+    float64 C-contiguous arrays."""
+    rotation, translation = as_pose(pose, what=what)
+    return (np.array(rotation, dtype=np.float64, order="C"),
+            np.array(translation, dtype=np.float64, order="C"))

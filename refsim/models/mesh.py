@@ -149,10 +149,12 @@ class Mesh:
         """A structure derived from this mesh (e.g. a triangle hierarchy),
         built by ``build(mesh)`` on first use and kept: the mesh is immutable,
         so the structure stays valid for the mesh's lifetime."""
-        cache = self.__dict__.setdefault("_derived", {})
-        if key not in cache:
-            cache[key] = build(self)
-        return cache[key]
+        try:
+            return self.__dict__["_derived"][key]     # the common case, kept cheap
+        except KeyError:
+            cache = self.__dict__.setdefault("_derived", {})
+            cache[key] = structure = build(self)
+            return structure
 
     def scaled(self, factor: float) -> Mesh:
         """This mesh with every vertex times ``factor`` (> 0), kept with the

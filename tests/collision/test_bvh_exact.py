@@ -256,7 +256,7 @@ def test_frame_tree_boxes_contain_their_triangles():
 def test_oriented_boxes_follow_the_surface():
     """A flat set of points gets a box of zero thickness; a tilted patch of
     the sphere a box thinner than its axis-aligned one (why the separated
-    benchmark visits 117 node pairs, not 751 as with axis-aligned boxes)."""
+    benchmark visits about 120 node pairs, not 751 as with axis-aligned boxes)."""
     rng = np.random.default_rng(3)
     rotation = random_rotation(rng)
     flat = np.column_stack([rng.uniform(-1, 1, (20, 2)), np.zeros(20)]) @ rotation.T
@@ -277,8 +277,9 @@ def test_oriented_boxes_follow_the_surface():
 
 def test_oriented_boxes_prune_the_separated_benchmark_early():
     """The separated sphere benchmark pose: 751 node pairs visited with
-    axis-aligned node boxes (commit 762e5f1), 117 with oriented ones here,
-    and no candidate pair left for the exact test."""
+    axis-aligned node boxes (commit 762e5f1), 117 with oriented ones over
+    the least-area tree, 121 over the least-volume tree used now, and no
+    candidate pair left for the exact test."""
     from refsim.studies.levels import SPEED_CONFIGURATIONS
     from refsim.types import as_pose
 
@@ -288,3 +289,119 @@ def test_oriented_boxes_prune_the_separated_benchmark_early():
                                           config.as_configuration().poses())
     pairs, visits = bvh_exact.descend(mesh_a, as_pose(pose_a), mesh_b, as_pose(pose_b))
     assert len(pairs) == 0 and visits <= 130
+
+
+# -- the compiled query's fixed cost: packed arrays, the boolean's early exit ---------
+
+
+def test_packed_arrays_unpack_to_the_mesh_and_its_frame_tree():
+    from refsim.collision import _numba_kernels as nk
+
+    for mesh in (SPHERE, CUBE):
+        frame = bvh_exact.frame_tree_of(mesh)
+        vertices, faces, links, order, boxes, reach, axes_deviation = nk.unpack(
+            *bvh_exact.pack_frame_tree(mesh))
+        assert np.array_equal(vertices, mesh.vertices) and np.array_equal(faces, mesh.faces)
+        assert np.array_equal(links, frame.links) and np.array_equal(order, frame.tree.order)
+        assert np.array_equal(boxes, frame.boxes)
+        assert (reach, axes_deviation) == (frame.reach, frame.axes_deviation)
+
+
+def test_the_boolean_query_stops_at_the_first_pair_the_exact_stage_decides():
+    """Cubes sharing a face: the float filter certifies no pair, and the first
+    one the compiled exact stage finds touching ends the boolean query."""
+    touching = (np.eye(3), np.array([1.0, 0.0, 0.0]))
+    _, uncertain = bvh_exact.query_compiled(CUBE, IDENTITY, CUBE, touching,
+                                            bvh_exact.ALL_HITS)
+    found, undecided = bvh_exact.query_compiled(CUBE, IDENTITY, CUBE, touching,
+                                                bvh_exact.FIRST_HIT)
+    assert len(uncertain) > 1 and len(found) == 1 and len(undecided) == 0
+    _, exact = _seed_pairs(CUBE, IDENTITY, CUBE, touching)
+    assert _as_set(found) <= _as_set(exact)
+    assert bodies_collide(CUBE, IDENTITY, CUBE, touching, kernel="compiled") is True
+
+
+def _torus_grazing():
+    from refsim.studies.levels import SPEED_CONFIGURATIONS
+
+    config = next(c for c in SPEED_CONFIGURATIONS
+                  if c.model == "torus" and c.kind == "grazing").as_configuration()
+    return config.poses()
+
+
+@pytest.mark.parametrize("poses, expected", [
+    (_torus_grazing, True),
+    (lambda: _poses(3, 14, 2.5)[13], False),    # 87 candidate pairs, none touching
+], ids=["grazing benchmark pose", "close, not touching"])
+def test_pairs_the_exact_stage_cannot_take_go_to_the_readable_kernel(poses, expected):
+    """Two tori scaled by 2^-245 (coordinates below the filter's range, the
+    geometry the same bits times a power of two) with candidate pairs: the
+    compiled boolean query answers UNDECIDED, and the readable kernel gives
+    the seed's answer."""
+    from refsim.collision import _numba_kernels as nk
+
+    side = 2.0 ** -245
+    tiny = TORUS.scaled(side)
+    (ra, ta), (rb, tb) = poses()
+    pose_a, pose_b = (ra, side * ta), (rb, side * tb)
+    boxes, exact = _seed_pairs(tiny, pose_a, tiny, pose_b)
+    assert len(boxes) > 0 and (len(exact) > 0) == expected
+    assert len(bvh_exact.candidate_pairs(tiny, pose_a, tiny, pose_b)) > 0
+    packed = bvh_exact.pack_frame_tree(tiny)
+    answer = nk.exact_collide(*packed, *pose_a, *packed, *pose_b, ORTHONORMAL_TOL,
+                              bvh_exact.MARGIN_ROUNDING, bvh_exact.MARGIN_PER_DEVIATION)
+    assert answer == nk.UNDECIDED
+    for kernel in ("compiled", "readable"):
+        assert bodies_collide(tiny, pose_a, tiny, pose_b, kernel=kernel) is expected, kernel
+
+
+def _layouts(rotation, translation):
+    """The same pose as numpy and Python give it in other layouts."""
+    frozen = rotation.copy(), translation.copy()
+    for array in frozen:
+        array.flags.writeable = False
+    return {"read-only": frozen, "lists": (rotation.tolist(), translation.tolist()),
+            "float32": (rotation.astype(np.float32), translation.astype(np.float32)),
+            "Fortran order": (np.asfortranarray(rotation), translation),
+            "strided": (np.repeat(rotation, 2, axis=1)[:, ::2], np.repeat(translation, 2)[::2]),
+            "list pose": [rotation, translation]}
+
+
+@pytest.mark.parametrize("layout", list(_layouts(np.eye(3), np.zeros(3))))
+def test_the_boolean_query_takes_a_pose_in_any_layout_as_pose_takes(layout):
+    """The fast path passes poses to numba unchecked; other layouts than the
+    compiled signature's go through as_pose and give the same answers."""
+    for offset, expected in ((1.0, True), (1.5, False)):
+        pose_b = (np.eye(3), np.array([offset, 0.0, 0.0]))
+        assert bodies_collide(CUBE, _layouts(*IDENTITY)[layout], CUBE,
+                              _layouts(*pose_b)[layout]) is expected
+
+
+@pytest.mark.parametrize("pose, message", [
+    ((np.eye(4), np.zeros(3)), "pose_b: expected shapes"),
+    ((np.eye(3), np.zeros(4)), "pose_b: expected shapes"),
+    ((np.eye(3).ravel(), np.zeros(3)), "pose_b: expected shapes"),
+    ((np.eye(3), np.zeros((3, 1))), "pose_b: expected shapes"),
+    ((np.eye(3), np.array([np.nan, 0.0, 0.0])), "pose_b: non-finite"),
+    ((2.0 * np.eye(3), np.zeros(3)), "pose_b: rotation is not orthonormal"),
+    ((np.eye(3), np.zeros(3), 1.0), "pose_b: expected \\(rotation, translation\\)"),
+    (None, "pose_b: expected \\(rotation, translation\\)"),
+])
+def test_the_boolean_query_refuses_a_bad_pose_with_as_poses_message(pose, message):
+    with pytest.raises(StateError, match=message):
+        bodies_collide(CUBE, IDENTITY, CUBE, pose, kernel="compiled")
+
+
+def test_the_least_volume_split_separates_linked_tori_in_few_node_pairs():
+    """Two tori linked like a chain (overlapping boxes, no contact): the exact
+    level's own split (bvh_exact.least_volume_split) proves them apart in
+    73 node pairs; over the least-area tree of the triangle-aabb level it
+    took 247."""
+    from refsim.collision.bvh import tree_of
+
+    turn_x = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+    pose_b = (turn_x, np.array([1.0, 0.0, 0.0]))
+    pairs, visits = bvh_exact.descend(TORUS, IDENTITY, TORUS, pose_b)
+    assert len(pairs) == 0 and visits <= 80
+    assert not np.array_equal(bvh_exact.frame_tree_of(TORUS).tree.order, tree_of(TORUS).order)
+    assert bodies_collide(TORUS, IDENTITY, TORUS, pose_b) is False
