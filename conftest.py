@@ -4,13 +4,30 @@ In CI a skipped test is a check that silently did not run (a missing
 optional engine, numba or Chromium), so there every skip fails instead:
 ``.ci/run`` sets ``REFSIM_NO_SKIPS=1``, as does ``CI=true``. Locally a skip
 stays a skip, with its reason in the summary (``pytest -rs``).
+
+The signal tests expect the dispositions a terminal gives: a suite started
+by ``nohup`` or as a background job of a non-interactive shell inherits
+SIGHUP, SIGINT and SIGQUIT ignored, and so would every process it starts,
+which then cannot be stopped by the signals the tests send. Each test
+process puts them back as an interactive shell would have them
+(:func:`pytest_configure`).
 """
 
 from __future__ import annotations
 
 import os
+import signal
 
 import pytest
+
+
+def pytest_configure(config) -> None:
+    """Signals the suite's launcher left ignored get their usual handling:
+    Python's KeyboardInterrupt for SIGINT, the system's default for the rest."""
+    for signum in (signal.SIGINT, signal.SIGHUP, signal.SIGQUIT, signal.SIGTERM):
+        if signal.getsignal(signum) is signal.SIG_IGN:
+            signal.signal(signum, signal.default_int_handler if signum == signal.SIGINT
+                          else signal.SIG_DFL)
 
 #: pytester runs a small suite in a temporary directory (tests/test_no_skips_in_ci.py).
 pytest_plugins = ["pytester"]

@@ -31,3 +31,19 @@ def assert_scene_error(tmp_path, text: str, key: str, phrase: str) -> None:
     assert err.key == key
     assert phrase in err.message
     assert str(path) in str(err) and key in str(err)
+
+
+def new_workers(process, before: set[int]) -> list:
+    """The spawned worker processes (``multiprocessing``'s spawn) below
+    ``process`` (a ``psutil.Process``) whose pids are not in ``before``:
+    a sweep's, told apart from those of a fixture started earlier."""
+    import psutil
+
+    found = []
+    for child in process.children(recursive=True):
+        try:
+            if child.pid not in before and "spawn_main" in " ".join(child.cmdline()):
+                found.append(child)
+        except psutil.NoSuchProcess:
+            continue
+    return found

@@ -314,15 +314,15 @@ def test_a_stopped_report_stops_its_workers_at_once(tmp_path):
         [sys.executable, "-m", "refsim.cli", "report", "--quick", "--workers", "2", "-o",
          str(tmp_path / "r")], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
         env=dict(os.environ, PYTHONWARNINGS="ignore"))
+    from tests.helpers import new_workers
+
     try:
         me = psutil.Process(process.pid)
         deadline = time.monotonic() + 120.0
-        while len([p for p in me.children(recursive=True)
-                   if "spawn_main" in " ".join(p.cmdline())]) < 2:
+        while len(new_workers(me, set())) < 2:
             assert time.monotonic() < deadline and process.poll() is None
             time.sleep(0.1)
-        workers = [p for p in me.children(recursive=True)
-                   if "spawn_main" in " ".join(p.cmdline())]
+        workers = new_workers(me, set())
         time.sleep(2.0)                      # the workers are inside their tasks
         start = time.monotonic()
         process.send_signal(signal.SIGTERM)
@@ -348,16 +348,17 @@ def test_cancel_stops_the_sweeps_of_the_background_thread(tmp_path):
     import psutil
 
     from refsim.sweep import SweepCancelled
+    from tests.helpers import new_workers
 
+    me = psutil.Process()
+    before = {p.pid for p in me.children(recursive=True)}   # e.g. a Dask fixture's
     run = plan.Run(quick=True, out_dir=tmp_path, workers=2)
     run.prefetch(["advisor"])
-    me = psutil.Process()
     deadline = time.monotonic() + 120.0
-    while len([p for p in me.children(recursive=True)
-               if "spawn_main" in " ".join(p.cmdline())]) < 2:
+    while len(new_workers(me, before)) < 2:
         assert time.monotonic() < deadline
         time.sleep(0.1)
-    workers = [p for p in me.children(recursive=True) if "spawn_main" in " ".join(p.cmdline())]
+    workers = new_workers(me, before)
     time.sleep(3.0)                          # inside their first advice
     start = time.monotonic()
     run.cancel(timeout=60.0)

@@ -14,6 +14,7 @@ import psutil
 
 from refsim.sweep import Task, run_sweep
 from refsim.sweep.records import encode
+from tests.helpers import new_workers
 from tests.sweep import tasks
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -53,6 +54,7 @@ def test_a_task_that_always_kills_its_worker_fails_after_its_retries(tmp_path):
 SCRIPT = """
 import sys
 from refsim.sweep import Task, run_sweep
+from tests.helpers import new_workers
 from tests.sweep import tasks
 
 if __name__ == "__main__":
@@ -128,12 +130,12 @@ def test_a_cancel_event_stops_a_sweep_run_in_another_thread(tmp_path):
         except BaseException as exc:  # noqa: BLE001 - the test reads it
             raised.append(exc)
 
+    me = psutil.Process()
+    before = {p.pid for p in me.children(recursive=True)}   # e.g. a Dask fixture's
     thread = threading.Thread(target=run)
     thread.start()
-    me = psutil.Process()
-    _wait_for(lambda: len([p for p in me.children(recursive=True)
-                           if "spawn_main" in " ".join(p.cmdline())]) >= 2, "two workers")
-    workers = [p for p in me.children(recursive=True) if "spawn_main" in " ".join(p.cmdline())]
+    _wait_for(lambda: len(new_workers(me, before)) >= 2, "two workers")
+    workers = new_workers(me, before)
     start = time.monotonic()
     cancel.set()
     thread.join(WAIT_SECONDS)
