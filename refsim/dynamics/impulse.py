@@ -202,13 +202,18 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
     if approaching == 0:
         return 0
     # Phase 1, compression: v_n -> 0 with P_n >= 0, then friction in the cone.
+    # A sweep whose every increment is exactly zero changed no value, so each
+    # later sweep would start from the same numbers and change none either:
+    # the solve stops there, with the values all ``iterations`` sweeps give.
     dE1 = 0.0
     for _ in range(iterations):
+        moved = False
         for i in range(c):
             vr = _relative_velocity(i, r_a, r_b, v_a, w_a, v_b, w_b)
             vn = vr[0] * n0 + vr[1] * n1 + vr[2] * n2
             Pn = max(P[i, 0] - vn / Kn[i], 0.0)           # accumulated, clamped
             dPn = Pn - P[i, 0]
+            moved = moved or dPn != 0.0
             P[i, 0] = Pn
             dE1 += _apply(i, dPn * n0, dPn * n1, dPn * n2, r_a, r_b, m_inv_a, I_inv_a,
                           m_inv_b, I_inv_b, v_a, w_a, v_b, w_b)
@@ -230,9 +235,12 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
                 scale = limit / size
                 q0, q1, q2 = q0 * scale, q1 * scale, q2 * scale
             dP0, dP1, dP2 = q0 - P[i, 1], q1 - P[i, 2], q2 - P[i, 3]
+            moved = moved or dP0 != 0.0 or dP1 != 0.0 or dP2 != 0.0
             P[i, 1], P[i, 2], P[i, 3] = q0, q1, q2
             dE1 += _apply(i, dP0, dP1, dP2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b,
                           I_inv_b, v_a, w_a, v_b, w_b)
+        if not moved:
+            break
     # Phase 2, restitution (Poisson): e times the compression impulse,
     # limited so that the collision as a whole adds no energy.
     # DEVIATION (D8): at several contacts with friction, Poisson's
