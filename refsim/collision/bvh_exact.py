@@ -19,8 +19,8 @@ Interference Detection", SIGGRAPH 1996):
    thick as the patch is wide: on the separated sphere benchmark the query
    visited 117 node pairs against 751 with axis-aligned node boxes, 2185
    against 4025 on the deep one (both over the least-area tree of
-   :mod:`refsim.collision.bvh`; the least-volume split visits 121 and 2209
-   there, and 73 instead of 247 on two linked tori).
+   :mod:`refsim.collision.bvh`; the least-volume split visits 151 and 2307
+   there, and 25 instead of 247 on two linked tori).
 2. A query expresses body b in a's frame, ``x_a = M x_b + u`` with
    ``M = Ra^T Rb`` and ``u = Ra^T (tb - ta)``, and a pair of nodes in the
    frame of node a's box (:func:`node_pair_frame`: ``R = Aa^T M Ab``,
@@ -65,7 +65,7 @@ bounds):
   ``|R^T R - I| <= 12g``: off by <= 36g reach_b and <= 104g reach_b. (Node
   a's extents and the projections of T are right for any R; node a's box is
   exact in its own frame, since T is the very expression it is defined by.
-  Axes with determinant -1, which eigh returns for about 40% of the nodes,
+  Axes with determinant -1 (about 40% of the nodes' principal axes)
   change nothing: the extents take absolute values and the boxes are
   symmetric.) Under 120 g S in all.
 
@@ -114,6 +114,7 @@ leaves reached. The speed against FCL is measured in
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -184,14 +185,73 @@ def principal_axes(points: np.ndarray) -> np.ndarray:
     """(3, 3), columns the principal axes of the points' covariance
     (Gottschalk et al. 1996 take the covariance of the triangles' hull; of
     the vertices is simpler and, on the benchmark meshes, visits about as
-    many node pairs): the eigenvectors from ``numpy.linalg.eigh``,
-    orthonormal up to a few roundoffs whatever the points. The covariance is
-    taken of the points times ``2**-e`` (:func:`refsim.types.unit_exponent`):
-    the axes do not change with the scale, and squares of coordinates near
-    1e154 would overflow."""
+    many node pairs), in order of increasing variance, orthonormal up to a
+    few roundoffs whatever the points. The covariance is taken of the points
+    times ``2**-e`` (:func:`refsim.types.unit_exponent`): the axes do not
+    change with the scale, and squares of coordinates near 1e154 would
+    overflow.
+
+    No BLAS or LAPACK: the covariance is sums of element-wise products and
+    the eigenvectors come from :func:`symmetric_eigenvectors`, so a mesh has
+    the same tree on every machine (with ``numpy.cov`` and
+    ``numpy.linalg.eigh`` the tree, and the node pairs a query visits,
+    changed with ``OPENBLAS_CORETYPE``)."""
     points = np.ldexp(points, -unit_exponent(points))
-    covariance = np.cov(points.T) if len(points) > 1 else np.zeros((3, 3))
-    return np.linalg.eigh(covariance)[1]
+    if len(points) < 2:
+        return np.eye(3)
+    centred = points - points.mean(axis=0)
+    covariance = [[float(np.sum(centred[:, i] * centred[:, j])) for j in range(3)]
+                  for i in range(3)]
+    return symmetric_eigenvectors(covariance)
+
+
+#: Most sweeps of :func:`symmetric_eigenvectors` (three converge a 3 x 3
+#: matrix to rounding; the bound only guards against a cycle).
+JACOBI_SWEEPS = 50
+
+
+def symmetric_eigenvectors(a: list[list[float]]) -> np.ndarray:
+    """Eigenvectors (columns, orthonormal, by increasing eigenvalue) of the
+    symmetric 3 x 3 matrix ``a``, by cyclic Jacobi rotations in a fixed order
+    (Golub and Van Loan, *Matrix Computations*, 4th ed., section 8.5.2): plain
+    floating-point arithmetic, the same bits on every machine. Each column's
+    largest component is made positive."""
+    a = [row[:] for row in a]
+    v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    for _ in range(JACOBI_SWEEPS):
+        if abs(a[0][1]) + abs(a[0][2]) + abs(a[1][2]) == 0.0:
+            break
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            if a[p][q] == 0.0:
+                continue
+            # the rotation that zeroes a[p][q]: t = tan(theta), the smaller root
+            tau = (a[q][q] - a[p][p]) / (2.0 * a[p][q])
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            c = 1.0 / math.sqrt(1.0 + t * t)
+            s = t * c
+            for k in range(3):                        # a <- a J (columns p, q)
+                akp, akq = a[k][p], a[k][q]
+                a[k][p], a[k][q] = c * akp - s * akq, s * akp + c * akq
+            for k in range(3):                        # a <- J^T a (rows p, q)
+                apk, aqk = a[p][k], a[q][k]
+                a[p][k], a[q][k] = c * apk - s * aqk, s * apk + c * aqk
+            a[p][q] = a[q][p] = 0.0
+            for k in range(3):                        # v <- v J
+                vkp, vkq = v[k][p], v[k][q]
+                v[k][p], v[k][q] = c * vkp - s * vkq, s * vkp + c * vkq
+    order = sorted(range(3), key=lambda i: (a[i][i], i))
+    axes = np.array([[v[k][i] for i in order] for k in range(3)])
+    for i in range(3):
+        column = axes[:, i]
+        if column[int(np.argmax(np.abs(column)))] < 0.0:
+            axes[:, i] = -column
+    return axes
+
+
+def project(points: np.ndarray, axes: np.ndarray) -> np.ndarray:
+    """``points @ axes`` without BLAS: (k, 3), each entry
+    ``(p0 a0j + p1 a1j) + p2 a2j``."""
+    return (points[:, 0:1] * axes[0] + points[:, 1:2] * axes[1]) + points[:, 2:3] * axes[2]
 
 
 def oriented_box(points: np.ndarray, axes: np.ndarray | None = None):
@@ -201,15 +261,16 @@ def oriented_box(points: np.ndarray, axes: np.ndarray | None = None):
     that expression, so it holds the points for any axes (a flat or a
     one-point set gives a box of zero thickness)."""
     axes = principal_axes(points) if axes is None else axes
-    projected = points @ axes
-    centre = axes @ ((projected.min(axis=0) + projected.max(axis=0)) / 2)
-    half = np.abs((points - centre) @ axes).max(axis=0)
+    projected = project(points, axes)
+    mid = (projected.min(axis=0) + projected.max(axis=0)) / 2
+    centre = (axes[:, 0] * mid[0] + axes[:, 1] * mid[1]) + axes[:, 2] * mid[2]
+    half = np.abs(project(points - centre, axes)).max(axis=0)
     return centre, half, axes
 
 
 def box_volume(points: np.ndarray) -> float:
     """Volume of the box about ``points`` (k, 3) along their principal axes."""
-    projected = points @ principal_axes(points)
+    projected = project(points, principal_axes(points))
     return float(np.prod(projected.max(axis=0) - projected.min(axis=0)))
 
 
@@ -226,7 +287,7 @@ def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int) -> 
     axes by the children's volumes does well on both
     (docs/decisions/query-fixed-cost.md)."""
     points = triangles[members]
-    centroids = points.mean(axis=1) @ principal_axes(points.reshape(-1, 3))
+    centroids = project(points.mean(axis=1), principal_axes(points.reshape(-1, 3)))
     best_volume = np.inf
     for axis in range(3):
         # stable tie-break by index, so the same mesh always gives the same tree

@@ -41,15 +41,10 @@ APART = {
 }
 
 
-#: Issue 16's touching configurations, where nearly every candidate pair is
-#: exactly touching and the float filter certifies none: the exact stage
-#: answers them all (model a, model b, pose of b; a at the identity).
-TOUCHING = {
-    # unit cubes sharing the face y = 0.5: 79 candidate pairs, 62 touch
-    "cubes-face-to-face": ("cube.ac", "cube.ac", (np.eye(3), np.array([0.0, 1.0, 0.0]))),
-    # a unit cube resting on the sphere of radius 1 at its top vertex: 12 of 12
-    "cube-on-sphere": ("sphere-2k.ac", "cube.ac", (np.eye(3), np.array([0.0, 1.5, 0.0]))),
-}
+#: Issue 16's touching configurations (cubes face to face, a cube resting on
+#: the sphere), where nearly every candidate pair is exactly touching and the
+#: float filter certifies none: the exact stage answers them all.
+TOUCHING = [name for name, config in CASES.items() if config.kind == "touching"]
 
 
 class PosedFCL:
@@ -81,15 +76,11 @@ class PosedFCL:
         return np.unique(pairs.reshape(-1, 2), axis=0)
 
 
-@pytest.mark.parametrize("name", list(TOUCHING))
+@pytest.mark.parametrize("name", TOUCHING)
 @pytest.mark.parametrize("query", ["boolean", "all pairs"])
 @pytest.mark.parametrize("engine", ["refsim-bvh", "fcl-posed"])
 def test_touching(benchmark, fcl, name, query, engine):
-    model_a, model_b, pose_b = TOUCHING[name]
-    mesh_a, mesh_b = refsim.load_model(model_a), refsim.load_model(model_b)
-    pose_a = (np.eye(3), np.zeros(3))
-    expected = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, method="seed",
-                                  kernel="readable")
+    mesh_a, pose_a, mesh_b, pose_b, expected = _setup(name)
     benchmark.group = f"touching, poses set per query: {name}, {query}"
     if engine == "fcl-posed":
         posed = PosedFCL(fcl, mesh_a, mesh_b)
