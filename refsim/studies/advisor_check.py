@@ -26,7 +26,9 @@ every step (:class:`refsim.Trajectory`), and measures
   advisor states.
 
 ``python -m refsim.studies.advisor_check`` advises every bundled rigid-body
-scene at two tolerances, checks each answer and prints one row per answer.
+scene at the tolerances given as the report does (one series per scene,
+:func:`refsim.studies.advisor.advice_by_tolerance`), checks each answer and
+prints one row per answer.
 
 Cost: two simulations recorded at every step (memory: 19 float64 per body
 per step of the reference), plus O(steps) to compare.
@@ -165,9 +167,10 @@ def check_advice(scene, advice) -> AdviceCheck:
 
 
 def main(argv: list[str] | None = None) -> None:
-    """Advise and check every bundled rigid-body scene at the tolerances given."""
+    """Advise and check every bundled rigid-body scene at the tolerances given
+    (a series per scene, as the report's advisor section)."""
     from refsim.scenes.loader import load_scene
-    from refsim.studies.advisor import BUNDLED_RIGID_SCENES, advise
+    from refsim.studies.advisor import BUNDLED_RIGID_SCENES, advice_by_tolerance
 
     parser = argparse.ArgumentParser(prog="python -m refsim.studies.advisor_check")
     parser.add_argument("scenes", nargs="*", default=list(BUNDLED_RIGID_SCENES))
@@ -181,10 +184,10 @@ def main(argv: list[str] | None = None) -> None:
           "  | check: pos err (samples, every step) m  events  energy gap  meets")
     for name in args.scenes:
         scene = load_scene(name)
-        for tol in args.tolerances:
-            store = None if args.store is None else f"{args.store}/{name.rsplit('.', 1)[0]}"
-            advice = advise(scene, tol, backend=backend, workers=args.workers, store=store,
-                            repeats=args.repeats, progress=False)
+        (series,) = advice_by_tolerance((name,), tuple(args.tolerances), store=args.store,
+                                        backend=backend, workers=args.workers,
+                                        repeats=args.repeats, progress=False)
+        for tol, advice in zip(series.tolerances, series.advice, strict=True):
             check = check_advice(scene, advice)
             rec, own = advice.recommended, advice.own
             print(f"{name}  {tol:g}  {advice.reference.converged}  {advice.reference.horizon:g}"

@@ -551,3 +551,18 @@ def test_the_horizon_is_the_last_sample_before_the_runs_part():
     b = _run(t, np.where(t > 0.55, 0.5, 0.0))
     assert metrics.agreement_horizon(a, b, 1e-2) == pytest.approx(0.5)
     assert metrics.agreement_horizon(a, a, 1e-2) == 1.0
+
+
+def test_the_check_command_checks_each_answer_of_a_series(tmp_path, capsys):
+    """``python -m refsim.studies.advisor_check``: the report's series for a
+    scene, each answer re-run independently, one row per tolerance."""
+    from refsim.studies.advisor_check import main
+
+    path = tmp_path / "drop.toml"
+    path.write_text(DROP)
+    main([str(path), "--tolerances", str(2 * TOL), str(TOL), "--repeats", "1",
+          "--store", str(tmp_path / "stores")])
+    rows = capsys.readouterr().out.splitlines()[1:]
+    assert [row.split()[1] for row in rows] == [f"{2 * TOL:g}", f"{TOL:g}"]
+    assert all(row.split()[-1] == "True" and " equal " in row for row in rows)
+    assert (tmp_path / "stores" / "drop").is_dir()
