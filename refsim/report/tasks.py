@@ -116,11 +116,20 @@ def measure_entry(*, seed: int, name: str, quick: bool, report_seed: int) -> dic
     """The records of the plan's entry ``name`` measured in a fresh
     :class:`refsim.report.plan.Run` (quick or full, ``report_seed``), in
     this process: ``{"records": <pickle as base64 text>, "missing": {engine:
-    why}}`` (the engines it could not make)."""
+    why}}`` (the engines it could not make). An entry whose records hold
+    timing fields is refused: it must run alone (``Study.timed``), and this
+    check keeps that flag true."""
+    from refsim.errors import SweepError
     from refsim.report.plan import Run
+    from refsim.report.section import to_json
 
     run = Run(quick=quick, seed=report_seed)
     records = run.get(name)
+    timings: set = set()
+    to_json(records, (), timings)
+    if timings:      # measured beside other work: its timings would be disturbed
+        raise SweepError(f"entry {name!r} holds timings ({sorted(timings)[0]}, ...): "
+                         "mark its Study timed=True so that the report measures it alone")
     text = base64.b64encode(pickle.dumps(records, protocol=pickle.HIGHEST_PROTOCOL))
     return {"records": text.decode("ascii"), "missing": dict(run.missing)}
 

@@ -286,6 +286,17 @@ def test_the_timed_studies_stay_in_the_reports_process():
             "dynamics-step-cost"} <= {n for n, s in plan.STUDIES.items() if s.timed}
 
 
+def test_a_timed_entry_is_refused_by_the_worker_task():
+    """A study whose records hold timings, sent to a worker by mistake (its
+    ``timed`` flag forgotten), fails with a line naming the flag."""
+    from refsim.errors import SweepError
+    from refsim.report.tasks import measure_entry
+
+    with pytest.raises(SweepError, match="'particles-drag' holds timings .*timed=True"):
+        measure_entry(seed=0, name="particles-drag", quick=True,
+                      report_seed=plan.REPORT_SEED)
+
+
 def test_an_entry_measured_in_a_worker_returns_its_records_to_the_bit():
     from refsim.report.tasks import entry_records, measure_entry
 
