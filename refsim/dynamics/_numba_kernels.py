@@ -35,9 +35,11 @@ What it runs (one step, the stages of the readable outline, same order):
                 :func:`~refsim.dynamics.rotation_seed.contact_spin_seed`)
                 with the seed's rotation; or the corrected impulses,
                 :meth:`Simulation._wall_impulse` (the vertices past the wall,
-                push-back, speed at the wall, and the contact solve
+                found without testing the groups of vertices that cannot
+                be past it, :func:`_vertices_past_wall`; push-back, speed
+                at the wall, and the contact solve
                 :func:`refsim.dynamics.impulse.solve_contacts_python`
-                compiled from its own source);
+                compiled from its own source, the wall static);
 6. broad-phase  every pair of boxes, in the sorted order of
                 :func:`refsim.collision.broad_phase.overlapping_pairs_sweep`;
 8. response     at level "aabb", the seed's exchange,
@@ -75,7 +77,8 @@ correction (the corrected rotation model and wall impulses).
 
 Cost per step: O(s B) for s solver stages, O(sum of vertices) for the boxes
 (and per wall contact of the corrected model, for the vertices past the
-wall, plus the contact solve),
+wall: O(leaves + the vertices of the leaves near the wall), plus the
+contact solve),
 O(B^2) box tests for the broad phase (all pairs, compiled; cheaper than the
 sort below a few hundred bodies).
 
@@ -121,7 +124,8 @@ _solve_contacts = numba.njit(cache=True, nogil=True)(solve_contacts_python)
 def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
             restitution, friction, wall_speed_at_wall, wall_impulse, threshold, iterations,
             half_size, vertices_t, first_vertex, centred, center, lam, mass, inv_mass,
-            I_body, I_body_inv, energy_limit, body_mode,
+            I_body, I_body_inv, energy_limit, leaf_order, leaf_start, leaf_spheres,
+            first_leaf, body_mode,
             x, v, w, R, lo, hi, walls, bodies, events, tracked, tracker_rows, trackers_f,
             trackers_i):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation.step`, up to
@@ -146,6 +150,10 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
         (:attr:`Simulation.position`, :func:`refsim.dynamics.products.matvec`)
     lam, mass, inv_mass : (B,) largest principal moment, mass, 1 / mass
     I_body, I_body_inv : (B, 3, 3) body-space inertia and its inverse
+    leaf_order, leaf_start, leaf_spheres, first_leaf : every body's groups
+        of vertices (:func:`refsim.dynamics.compiled_loop.vertex_leaves`,
+        laid out by ``CompiledLoop._lay_out_leaves``), for the wall stage of
+        the corrected response (:func:`_vertices_past_wall`)
     body_mode : int (``BODY_*``)
     x, v, w : (B, 3); R : (B, 3, 3); lo, hi : (B, 3) the state and boxes
     walls : (B, 6) bool; bodies : (B, B) bool (the contacts, read and written)
@@ -171,17 +179,15 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
     A = np.empty((3, 3))
     E = np.empty((3, 3))            # rotation_exp of one body; then its world I^-1
     corr = np.empty(3)
-    # the wall impulses' arrays: contacts r_a, the static wall's r_b, v_b, w_b
-    # and I_inv_b (zeros), the normal n and the impulses P
+    # the wall impulses' arrays: the vertices past a wall, contacts r_a, the
+    # normal n and the impulses P
     most = 1
     for b in range(B):
         most = max(most, first_vertex[b + 1] - first_vertex[b])
+    past = np.empty(most, np.int64)
     r_a = np.empty((most, 3))
-    r_b = np.zeros((most, 3))
     P = np.empty((most, 4))
     n = np.zeros(3)
-    still = np.zeros((2, 3))
-    I_inv_wall = np.zeros((3, 3))
     origin = np.empty((B, 3))
     now_walls = np.zeros((B, 6), np.bool_)
     pairs = np.empty((max(B * (B - 1) // 2, 1), 2), np.int64)
@@ -316,10 +322,10 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
                     corr[k] = (below if below > 0.0 else 0.0) - (above if above > 0.0 else 0.0)
             if wall_impulse:
                 _world_inertia(R[b], I_body_inv[b], E)
-                _wall_impulse(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1], x,
-                              center, v, w, R, half_size, gravity, restitution, friction,
-                              threshold, iterations, inv_mass[b], E, r_a, r_b, P, n, still,
-                              I_inv_wall)
+                _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres,
+                              first_leaf, x, center, v, w, R, half_size, gravity,
+                              restitution, friction, threshold, iterations, inv_mass[b], E,
+                              past, r_a, P, n)
             else:
                 if rotation_mode == ROTATION_SEED:
                     _wall_spin_seed(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1],
@@ -628,35 +634,80 @@ def _world_inertia(Rb, I_body, out):
             out[i, j] = (T[i, 0] * Rb[j, 0] + T[i, 1] * Rb[j, 1]) + T[i, 2] * Rb[j, 2]
 
 
+#: Relative slack of :func:`_vertices_past_wall`'s test (far above the
+#: rounding it covers, about 1e-15 relative).
+CULL_SLACK = 1e-9
+
+
 @numba.njit(cache=True, nogil=True)
-def _wall_impulse(b, corr, vertices_t, first, end, x, center, v, w, R, half_size, gravity,
-                  restitution, friction, threshold, iterations, inv_mass, I_inv, r_a, r_b,
-                  P, n, still, I_inv_wall):
+def _vertices_past_wall(b, k, low, wall, o_k, R, vertices_t, leaf_order, leaf_start,
+                        leaf_spheres, first_leaf, past):
+    """The columns q of ``vertices_t`` (body b's vertices) whose world
+    coordinate ``W_q = ((R_k0 X_q + R_k1 Y_q) + R_k2 Z_q) + o_k`` is past the
+    wall (``W_q < wall`` for a low wall, ``> wall`` for a high one), in
+    increasing order, into ``past``; returns how many. The same list as
+    testing every vertex (as :func:`refsim.dynamics.rotation_impulse.wall_contacts`
+    does), without looking at the leaves that cannot hold one.
+
+    Why a leaf can be passed over. With ``a = R[b, k]`` and a leaf's sphere
+    ``(c, rho)`` (:func:`refsim.dynamics.compiled_loop.vertex_leaves`), every
+    vertex v of the leaf has ``|a . (v - c)| <= |a| rho``, so
+    ``a . v + o_k`` lies within ``|a| rho`` of ``s = a . c + o_k``. The
+    computed ``W_q`` and ``s`` differ from these exact values by a few
+    rounding errors, each below ``4 u (|a| (|c| + rho) + |o_k|)`` (u =
+    2^-53; ``|c| + rho`` bounds ``|v|``); the slack ``CULL_SLACK (|a| (|c| +
+    rho) + |o_k| + |wall|)`` covers them and the rounding of the test itself
+    many times over. So when ``s - (|a| rho + slack) > wall`` every
+    computed ``W_q`` of the leaf is above the wall (below it for a high
+    wall, mirrored), and no vertex of the leaf is past it. A non-finite
+    value makes the test false, and the leaf is tested vertex by vertex.
+    """
+    a0, a1, a2 = R[b, k, 0], R[b, k, 1], R[b, k, 2]
+    norm = math.sqrt((a0 * a0 + a1 * a1) + a2 * a2)
+    count = 0
+    for leaf in range(first_leaf[b], first_leaf[b + 1]):
+        s = ((a0 * leaf_spheres[leaf, 0] + a1 * leaf_spheres[leaf, 1])
+             + a2 * leaf_spheres[leaf, 2]) + o_k
+        reach = norm * leaf_spheres[leaf, 3] \
+            + CULL_SLACK * ((norm * leaf_spheres[leaf, 4] + abs(o_k)) + abs(wall))
+        if (s - reach > wall) if low else (s + reach < wall):
+            continue
+        for p in range(leaf_start[leaf], leaf_start[leaf + 1]):
+            q = leaf_order[p]
+            W_k = ((a0 * vertices_t[0, q] + a1 * vertices_t[1, q]) + a2 * vertices_t[2, q]) \
+                + o_k
+            if W_k < wall if low else W_k > wall:
+                past[count] = q
+                count += 1
+    past[:count].sort()
+    return count
+
+
+@numba.njit(cache=True, nogil=True)
+def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, first_leaf, x,
+                  center, v, w, R, half_size, gravity, restitution, friction, threshold,
+                  iterations, inv_mass, I_inv, past, r_a, P, n):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation._wall_impulse` for
     body b, in place: for each crossed wall, the vertices past it
-    (:func:`refsim.dynamics.rotation_impulse.wall_contacts`, world
-    coordinates as :func:`refsim.types.transform_points` computes them), the
-    push-back, the speed at the wall (D6) and the contact solve
-    (:func:`refsim.dynamics.impulse.wall_impulses`, the wall static: zero
-    ``r_b``, ``v_b``, ``w_b`` (the rows of ``still``) and ``I_inv_wall``).
-    ``I_inv`` is the body's world inverse inertia."""
+    (:func:`refsim.dynamics.rotation_impulse.wall_contacts`, found by
+    :func:`_vertices_past_wall`, world coordinates as
+    :func:`refsim.types.transform_points` computes them), the push-back, the
+    speed at the wall (D6) and the contact solve
+    (:func:`refsim.dynamics.impulse.wall_impulses`, the wall static: B's
+    arrays None). ``I_inv`` is the body's world inverse inertia."""
     for k in range(3):
         if corr[k] == 0.0:
             continue
         low = corr[k] > 0.0
         wall = -half_size if low else half_size
         o = _origin(b, x, R, center)
-        o_k = o[k]
-        count = 0
-        for q in range(first, end):
-            W_k = ((R[b, k, 0] * vertices_t[0, q] + R[b, k, 1] * vertices_t[1, q])
-                   + R[b, k, 2] * vertices_t[2, q]) + o_k
-            if W_k < wall if low else W_k > wall:
-                for j in range(3):
-                    r_a[count, j] = (((R[b, j, 0] * vertices_t[0, q]
-                                       + R[b, j, 1] * vertices_t[1, q])
-                                      + R[b, j, 2] * vertices_t[2, q]) + o[j]) - x[b, j]
-                count += 1
+        count = _vertices_past_wall(b, k, low, wall, o[k], R, vertices_t, leaf_order,
+                                    leaf_start, leaf_spheres, first_leaf, past)
+        for i in range(count):
+            q = past[i]
+            for j in range(3):
+                r_a[i, j] = (((R[b, j, 0] * vertices_t[0, q] + R[b, j, 1] * vertices_t[1, q])
+                              + R[b, j, 2] * vertices_t[2, q]) + o[j]) - x[b, j]
         x[b, k] += corr[k]
         # D6: the speed at the wall, only for a real bounce
         if v[b, k] * corr[k] < -threshold * abs(corr[k]):
@@ -665,14 +716,6 @@ def _wall_impulse(b, corr, vertices_t, first, end, x, center, v, w, R, half_size
             continue
         for j in range(3):
             n[j] = 0.0
-            still[0, j] = 0.0
-            still[1, j] = 0.0
-            for i in range(3):
-                I_inv_wall[j, i] = 0.0
         n[k] = 1.0 if low else -1.0
-        for i in range(count):
-            for j in range(3):
-                r_b[i, j] = 0.0
-        _solve_contacts(r_a[:count], r_b[:count], n, inv_mass, I_inv, v[b], w[b], 0.0,
-                        I_inv_wall, still[0], still[1], restitution, friction, threshold,
-                        iterations, P[:count])
+        _solve_contacts(r_a[:count], None, n, inv_mass, I_inv, v[b], w[b], 0.0, None, None,
+                        None, restitution, friction, threshold, iterations, P[:count])

@@ -40,6 +40,8 @@ if TYPE_CHECKING:
 #: Rows of the kernel's event buffer per call, at least (more for scenes
 #: with many bodies: room for several steps' worth of contacts).
 EVENT_ROWS = 4096
+#: Vertices per leaf of :func:`vertex_leaves`, at most.
+LEAF_VERTICES = 16
 WALLS = tuple("xyz"[k // 2] + "-+"[k % 2] for k in range(6))     # flag index -> wall name
 
 
@@ -56,6 +58,53 @@ def loop_support(sim: Simulation) -> str | None:
     if sim.body_body and sim.level == "sphere":
         return "collision level 'sphere' (its broad phase is not the boxes')"
     return None
+
+
+def vertex_leaves(vertices: np.ndarray, size: int = LEAF_VERTICES):
+    """Groups of at most ``size`` nearby vertices of one mesh and a sphere
+    around each, for the kernel's wall stage: a leaf whose sphere is clear
+    of a wall has no vertex past it, and its vertices are not looked at
+    (:func:`refsim.dynamics._numba_kernels._vertices_past_wall`).
+
+    The groups come from halving: a group of more than ``size`` vertices is
+    split at the median of its widest coordinate (a stable sort, so the
+    same mesh always gives the same leaves). Each leaf's sphere is centred
+    on its box's midpoint ``c``, with radius ``rho`` the largest distance to
+    a vertex. Rounding in ``rho`` does not matter: the kernel's test has a
+    slack far above it.
+
+    Returns ``order`` (n,) int64, the vertex indices leaf by leaf;
+    ``start`` (L + 1,) int64, leaf l's indices are ``order[start[l]:
+    start[l + 1]]``; and ``spheres`` (L, 5) float64, the rows ``(c_x, c_y,
+    c_z, rho, |c| + rho)`` (the last bounds every vertex's distance from
+    the mesh origin).
+    """
+    vertices = np.asarray(vertices, dtype=np.float64)
+    groups = [np.arange(len(vertices), dtype=np.int64)]
+    leaves = []
+    while groups:
+        group = groups.pop()
+        points = vertices[group]
+        if len(group) <= size:
+            leaves.append(group)
+            continue
+        widest = int(np.argmax(points.max(axis=0) - points.min(axis=0)))
+        ranked = group[np.argsort(points[:, widest], kind="stable")]
+        half = len(ranked) // 2
+        groups += [ranked[half:], ranked[:half]]       # the lower half becomes a leaf first
+    order = np.concatenate(leaves)
+    start = np.zeros(len(leaves) + 1, np.int64)
+    start[1:] = np.cumsum([len(leaf) for leaf in leaves])
+    spheres = np.empty((len(leaves), 5))
+    for l, leaf in enumerate(leaves):
+        points = vertices[leaf]
+        c = 0.5 * (points.max(axis=0) + points.min(axis=0))
+        d = points - c
+        rho = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] + d[:, 2] * d[:, 2]).max()
+        spheres[l, :3] = c
+        spheres[l, 3] = rho
+        spheres[l, 4] = np.sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) + rho
+    return order, start, spheres
 
 
 class CompiledLoop:
@@ -87,6 +136,7 @@ class CompiledLoop:
         self.I_body = np.ascontiguousarray(sim.I_body, dtype=np.float64)
         self.I_body_inv = np.ascontiguousarray(sim.I_body_inv, dtype=np.float64)
         self._lay_out_trackers()
+        self._lay_out_leaves(vertices)
         if not sim.body_body:
             self.body_mode = kernels.BODY_NONE
         elif sim.level == "aabb" and sim.body_response == "seed":
@@ -150,6 +200,29 @@ class CompiledLoop:
         self.trackers_f = np.concatenate(floats) if floats else np.zeros(1)
         self.trackers_i = np.concatenate(ints) if ints else np.zeros(1, np.int64)
 
+    def _lay_out_leaves(self, vertices: list[np.ndarray]) -> None:
+        """Every body's :func:`vertex_leaves`, concatenated: body b's leaves
+        are ``first_leaf[b]:first_leaf[b + 1]``, their vertex indices count
+        from ``first_vertex[b]`` (columns of ``vertices_t``). Bodies of one
+        mesh share its leaves' layout."""
+        made: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
+        orders, starts, spheres = [], [np.zeros(1, np.int64)], []
+        self.first_leaf = np.zeros(len(vertices) + 1, np.int64)
+        n_leaves = 0
+        for b, vs in enumerate(vertices):
+            key = id(self.sim.bodies[b].mesh)
+            if key not in made:
+                made[key] = vertex_leaves(vs)
+            order, start, sphere = made[key]
+            orders.append(order + self.first_vertex[b])
+            starts.append(start[1:] + starts[-1][-1])
+            spheres.append(sphere)
+            n_leaves += len(sphere)
+            self.first_leaf[b + 1] = n_leaves
+        self.leaf_order = np.concatenate(orders)
+        self.leaf_start = np.concatenate(starts)
+        self.leaf_spheres = np.ascontiguousarray(np.concatenate(spheres))
+
     # -- contacts: the set of the readable step <-> the loop's flags -----------------------
 
     def touching_changed(self) -> None:
@@ -203,6 +276,7 @@ class CompiledLoop:
             impulse.RESTITUTION_THRESHOLD, impulse.ITERATIONS, world.half_size,
             self.vertices_t, self.first_vertex, sim._centred, self.center, sim._lambda_max,
             sim.mass, sim.inv_mass, self.I_body, self.I_body_inv, sim._energy_limit,
+            self.leaf_order, self.leaf_start, self.leaf_spheres, self.first_leaf,
             self.body_mode, sim.x, sim.v, sim.w, sim.R, sim.lo, sim.hi, self.walls,
             self.bodies, self.events, self.tracked, self.tracker_rows, self.trackers_f,
             self.trackers_i)

@@ -107,22 +107,32 @@ def _matvec(M, x0, x1, x2):
 
 @_jitable
 def _relative_velocity(i, r_a, r_b, v_a, w_a, v_b, w_b):
-    """v_rel at contact i: (v_a + w_a x r_a) - (v_b + w_b x r_b)."""
+    """v_rel at contact i: (v_a + w_a x r_a) - (v_b + w_b x r_b); B static
+    (``r_b is None``): v_a + w_a x r_a."""
     ca = _cross(w_a[0], w_a[1], w_a[2], r_a[i, 0], r_a[i, 1], r_a[i, 2])
+    if r_b is None:
+        return v_a[0] + ca[0], v_a[1] + ca[1], v_a[2] + ca[2]
     cb = _cross(w_b[0], w_b[1], w_b[2], r_b[i, 0], r_b[i, 1], r_b[i, 2])
     return (v_a[0] + ca[0] - v_b[0] - cb[0], v_a[1] + ca[1] - v_b[1] - cb[1],
             v_a[2] + ca[2] - v_b[2] - cb[2])
 
 
 @_jitable
+def _angular_inverse_mass(i, d0, d1, d2, r, I_inv):
+    """d . ((I^-1 (r x d)) x r) = (r x d) . I^-1 (r x d) at contact i."""
+    c = _cross(r[i, 0], r[i, 1], r[i, 2], d0, d1, d2)
+    q = _matvec(I_inv, c[0], c[1], c[2])
+    return c[0] * q[0] + c[1] * q[1] + c[2] * q[2]
+
+
+@_jitable
 def _effective_inverse_mass(i, d0, d1, d2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b, I_inv_b):
-    """K_d = 1/m_a + 1/m_b + d . ((I_a^-1 (r_a x d)) x r_a + (I_b^-1 (r_b x d)) x r_b)."""
+    """K_d = 1/m_a + 1/m_b + d . ((I_a^-1 (r_a x d)) x r_a + (I_b^-1 (r_b x d)) x r_b);
+    B static (``r_b is None``): without B's angular term."""
     k = m_inv_a + m_inv_b
-    for r, I_inv in ((r_a, I_inv_a), (r_b, I_inv_b)):
-        c = _cross(r[i, 0], r[i, 1], r[i, 2], d0, d1, d2)
-        q = _matvec(I_inv, c[0], c[1], c[2])
-        # d . (q x r) = (r x d) . q
-        k += c[0] * q[0] + c[1] * q[1] + c[2] * q[2]
+    k += _angular_inverse_mass(i, d0, d1, d2, r_a, I_inv_a)
+    if r_b is not None:
+        k += _angular_inverse_mass(i, d0, d1, d2, r_b, I_inv_b)
     return k
 
 
@@ -133,7 +143,7 @@ def _apply(i, P0, P1, P2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b, I_inv_b, v_a, w_a
     Returns the change of kinetic energy, from the velocities before:
     ``P . v + |P|^2 / (2 m) + w . (r x P) + (r x P) . I^-1 (r x P) / 2``
     for A, the same with -P for B (no inertia tensor needed, only its
-    inverse)."""
+    inverse); nothing for a static B (``r_b is None``)."""
     dE = 0.0
     c = _cross(r_a[i, 0], r_a[i, 1], r_a[i, 2], P0, P1, P2)
     q = _matvec(I_inv_a, c[0], c[1], c[2])
@@ -147,6 +157,8 @@ def _apply(i, P0, P1, P2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b, I_inv_b, v_a, w_a
     w_a[0] += q[0]
     w_a[1] += q[1]
     w_a[2] += q[2]
+    if r_b is None:
+        return dE
     c = _cross(r_b[i, 0], r_b[i, 1], r_b[i, 2], P0, P1, P2)
     q = _matvec(I_inv_b, c[0], c[1], c[2])
     dE += (-(P0 * v_b[0] + P1 * v_b[1] + P2 * v_b[2])
@@ -172,8 +184,18 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
         Contact points relative to A's and B's centres of mass.
     n : (3,) unit normal from B into A.
     m_inv_a, m_inv_b : float; I_inv_a, I_inv_b : (3, 3) world-frame inverse
-        inertia (zeros for a static B, or for a body whose rotation is off).
+        inertia (zeros for a body whose rotation is off).
     v_a, w_a, v_b, w_b : (3,) float64, updated in place.
+    A static B (a wall): ``r_b``, ``I_inv_b``, ``v_b`` and ``w_b`` None and
+    ``m_inv_b = 0``. B's terms are then left out, which gives the values
+    that zero arrays would (+0.0 everywhere): with ``m_inv_b``, ``I_inv_b``,
+    ``v_b``, ``w_b`` and ``r_b`` zero, B's velocity at the contact is +0
+    and ``x - (+0) = x`` for every float; B's inverse mass terms are +-0
+    added to a positive ``K``; B's velocities stay +0 (``+0 - (+-0) =
+    +0``); and B's energy terms are +-0 added to ``dE``, which can change
+    only the sign of a zero ``dE``, which no result depends on (it enters
+    only comparisons and ``1 - lam`` with ``lam = -dE1 / G`` clamped to
+    ``[0, 1]``). (Numba compiles the ``is None`` branches away.)
     e, mu, threshold : restitution, Coulomb coefficient, restitution threshold.
     iterations : int, sweeps of phase 1.
     P : (c, 4) float64 output: accumulated normal impulse and friction impulse
@@ -293,14 +315,12 @@ def wall_impulses(r_a, n, inv_mass: float, I_inv, v, w, restitution: float,
                   friction: float, *, kernel: str | None = None) -> np.ndarray:
     """Impulses of one body against a wall at contacts ``r_a`` (k, 3) (from
     its centre of mass), wall normal ``n`` (into the body); ``v``, ``w`` (3,)
-    updated in place. The wall is body B of the solve: static, so no mass
-    (``m_inv_b = 0``), no inertia (``I_inv_b = 0``) and at rest (``v_b =
-    w_b = 0``), and ``r_b`` does not matter. Returns the (k, 4) impulses."""
+    updated in place. The wall is body B of the solve: static (no mass, no
+    inertia, at rest), passed as None. Returns the (k, 4) impulses."""
     r_a = np.ascontiguousarray(r_a, dtype=np.float64)
     P = np.empty((len(r_a), 4))
-    solve_contacts(r_a, np.zeros_like(r_a), n, inv_mass, I_inv, v, w, 0.0,
-                   np.zeros((3, 3)), np.zeros(3), np.zeros(3), restitution, friction,
-                   RESTITUTION_THRESHOLD, ITERATIONS, P, kernel=kernel)
+    solve_contacts(r_a, None, n, inv_mass, I_inv, v, w, 0.0, None, None, None, restitution,
+                   friction, RESTITUTION_THRESHOLD, ITERATIONS, P, kernel=kernel)
     return P
 
 

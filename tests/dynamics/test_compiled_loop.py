@@ -333,3 +333,106 @@ def test_impulse_body_contacts_are_handed_back_bit_for_bit(level):
     assert compiled.loop is None and 0 < compiled.loop_steps < 800
     _assert_same(readable, compiled)
     assert {e.kind for e in compiled.events} == {"wall", "body"}
+
+
+# -- the wall stage's leaves (vertex_leaves, _vertices_past_wall) -----------------------------
+
+
+def _model_vertices(model: str) -> np.ndarray:
+    from refsim.bundled import models_dir
+    from refsim.models.loading import load_model
+
+    return load_model(models_dir() / model).vertices
+
+
+def test_vertex_leaves_partition_the_mesh_into_small_groups_inside_their_spheres():
+    from refsim.dynamics.compiled_loop import LEAF_VERTICES, vertex_leaves
+
+    for model in ("sphere-2k.ac", "cube.ac", "l-beam.ac"):
+        vertices = _model_vertices(model)
+        order, start, spheres = vertex_leaves(vertices)
+        assert sorted(order.tolist()) == list(range(len(vertices)))      # each vertex once
+        sizes = np.diff(start)
+        assert start[0] == 0 and start[-1] == len(vertices)
+        assert sizes.min() >= 1 and sizes.max() <= LEAF_VERTICES
+        for leaf, sphere in enumerate(spheres):
+            points = vertices[order[start[leaf]:start[leaf + 1]]]
+            distance = np.linalg.norm(points - sphere[:3], axis=1)
+            assert distance.max() <= sphere[3] * (1 + 1e-12)
+            assert np.linalg.norm(points, axis=1).max() <= sphere[4] * (1 + 1e-12)
+        again = vertex_leaves(vertices)                                   # deterministic
+        assert all(np.array_equal(a, b) for a, b in zip(again, (order, start, spheres),
+                                                        strict=True))
+    order, start, spheres = vertex_leaves(_model_vertices("sphere-2k.ac"))
+    assert len(spheres) == 64 and spheres[:, 3].max() < 0.35    # local groups (radius 1)
+
+
+def _past_by_testing_every_vertex(a, X, o_k, wall, low):
+    W = ((a[0] * X[0] + a[1] * X[1]) + a[2] * X[2]) + o_k     # numpy rounds each op once
+    return np.flatnonzero(W < wall if low else W > wall)
+
+
+def test_the_vertices_past_a_wall_are_those_of_testing_every_vertex():
+    # the leaves are only passed over when no vertex can be past: the list is
+    # the full scan's, in the same order, also for walls through a vertex
+    from refsim.dynamics import _numba_kernels as kernels
+    from refsim.dynamics.compiled_loop import vertex_leaves
+    from refsim.types import random_rotation
+
+    rng = np.random.default_rng(314)
+    checked = hits = 0
+    for model in ("sphere-2k.ac", "l-beam.ac", "cube.ac"):
+        vertices = _model_vertices(model)
+        X = np.ascontiguousarray(vertices.T)
+        order, start, spheres = vertex_leaves(vertices)
+        first_leaf = np.array([0, len(spheres)], np.int64)
+        past = np.empty(len(vertices), np.int64)
+        for trial in range(300):
+            R = random_rotation(rng)[None]
+            k = trial % 3
+            low = trial % 2 == 0
+            wall = float(rng.choice([-2.0, 2.0, -1e3, 7.5]))
+            a = R[0, k]
+            r = ((a[0] * X[0] + a[1] * X[1]) + a[2] * X[2])
+            # a wall through a vertex (to rounding), or at a random depth
+            target = r[rng.integers(len(r))] if trial % 4 else rng.uniform(r.min(), r.max())
+            for o_k in (wall - target, np.nextafter(wall - target, np.inf),
+                        np.nextafter(wall - target, -np.inf)):
+                expected = _past_by_testing_every_vertex(a, X, o_k, wall, low)
+                count = kernels._vertices_past_wall(0, k, low, wall, o_k, R, X, order, start,
+                                                    spheres, first_leaf, past)
+                assert past[:count].tolist() == expected.tolist()
+                checked += 1
+                hits += count > 0
+    assert checked == 2700 and hits > 1000
+
+
+def test_impulse_sphere_rolling_on_the_floor_bit_for_bit(monkeypatch):
+    # the benchmark's settled sphere: rolling on the floor, a few of its 1002
+    # vertices past it in almost every step (the leaves passed over, the
+    # contact solve with a static wall), from the same state on both kernels
+    from refsim.dynamics import impulse
+    from refsim.studies.bounce import SETTLE_STEPS, sphere_scene
+
+    scene = sphere_scene("impulse")
+    compiled = Simulation(scene, kernel="compiled")
+    compiled.advance(SETTLE_STEPS["sphere"])
+    start = compiled.snapshot()
+    compiled.events.clear()                   # the settling's; the readable one has none
+    readable = Simulation(scene, kernel="readable")
+    readable.restore(start)
+    contacts = []
+    solve = impulse.solve_contacts
+
+    def counted(r_a, *args, **options):
+        contacts.append(len(r_a))
+        return solve(r_a, *args, **options)
+
+    monkeypatch.setattr(impulse, "solve_contacts", counted)
+    for sim in (readable, compiled):
+        sim.record()
+        sim.run(400, every=7)
+    _assert_same(readable, compiled)
+    assert compiled.loop_steps == SETTLE_STEPS["sphere"] + 400
+    assert len(contacts) >= 390 and max(contacts) >= 2          # touching nearly every step
+    assert np.abs(compiled.w).max() > 0.05                        # rolling, not at rest

@@ -43,9 +43,14 @@ def _solve(kernel, ma, Ia, xa, va, wa, mb, Ib, xb, vb, wb, p, n, e, mu):
     return va, wa, vb, wb, P
 
 
+def _solve_on(kernel: str):
+    """The solve on kernel "readable" (the plain function) or "compiled"."""
+    return impulse.solve_contacts_python if kernel == "readable" else impulse.solve_contacts
+
+
 @pytest.mark.parametrize("kernel", ["readable", "compiled"])
 def test_momentum_conserved_and_energy_not_increased(kernel):
-    solve = impulse.solve_contacts_python if kernel == "readable" else impulse.solve_contacts
+    solve = _solve_on(kernel)
     rng = np.random.default_rng(2024)
     hits = 0
     for _ in range(200):
@@ -105,3 +110,41 @@ def test_four_corners_of_a_falling_cube_stop_it_and_bounce_by_e():
                                   impulse.ITERATIONS, P)
     assert v[1] == pytest.approx(1.5, rel=1e-9)          # converged: see ITERATIONS
     assert np.abs(w).max() < 1e-6                          # symmetric: no spin
+
+
+@pytest.mark.parametrize("kernel", ["readable", "compiled"])
+def test_a_static_b_given_as_none_gives_the_values_of_zero_arrays(kernel):
+    # wall_impulses passes the wall's arrays as None (B's terms left out);
+    # the general solve with B's arrays +0.0 must give the same bits: the
+    # velocities, the impulses, signs of zero included
+    solve = _solve_on(kernel)
+    rng = np.random.default_rng(77)
+    solved = 0
+    for trial in range(300):
+        c = 1 + trial % 4
+        n = np.zeros(3)
+        n[trial % 3] = 1.0 if trial % 2 else -1.0
+        r = rng.normal(size=(c, 3))
+        r -= 0.8 * np.outer(r @ n, n)                        # mostly on the contact side
+        m_inv = rng.uniform(0.1, 2.0)
+        M = rng.normal(size=(3, 3))
+        I_inv = np.linalg.inv(M @ M.T + np.eye(3))
+        v0, w0 = rng.normal(size=3), rng.normal(size=3)
+        v0 -= 2.0 * n * rng.uniform(0, 1)                    # approaching, most of the time
+        e, mu = rng.uniform(0, 1), rng.choice([0.0, rng.uniform(0, 1)])
+        out = []
+        for static in (None, "zeros"):
+            v, w, P = v0.copy(), w0.copy(), np.empty((c, 4))
+            if static is None:
+                b_arrays = (None, None, None, None)
+            else:
+                b_arrays = (np.zeros((c, 3)), np.zeros((3, 3)), np.zeros(3), np.zeros(3))
+            r_b, I_b, v_b, w_b = b_arrays
+            approaching = solve(r, r_b, n, m_inv, I_inv, v, w, 0.0, I_b, v_b, w_b, e, mu,
+                                impulse.RESTITUTION_THRESHOLD, impulse.ITERATIONS, P)
+            out.append((approaching, v.tobytes(), w.tobytes(), P.tobytes()))
+            if static is not None:
+                assert not (v_b.any() or w_b.any())          # the zero wall stays at rest
+        assert out[0] == out[1]
+        solved += out[0][0] > 0
+    assert solved > 150                                      # impulses, not only no-ops
