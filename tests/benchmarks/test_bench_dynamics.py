@@ -162,6 +162,42 @@ def test_step(benchmark, oracle, engine, bodies, rotation, state):
             runner.close()
 
 
+def _one_step_per_call(runner, steps: int) -> None:
+    for _ in range(steps):
+        runner.advance(1)
+
+
+@pytest.mark.parametrize("bodies", ["1 cube", "10 cubes", "sphere-2k"])
+@pytest.mark.parametrize("engine", ["refsim-readable", "refsim-compiled", "pybullet",
+                                    "mujoco"])
+def test_one_step_per_call(benchmark, oracle, engine, bodies):
+    # A caller that steps once per call (a control loop, a viewer's frame):
+    # refsim pays its per-call cost (signal hold, the kernel's dispatch) at
+    # every step, where test_step spreads it over STEPS_PER_ROUND steps.
+    # Rotation "impulse", in flight; the group is read by bench_table.py.
+    benchmark.group = f"dynamics step: {bodies}, rotation impulse, one step per call"
+    scene, _ = bench_scene(bodies, "impulse")
+    runner = _engine(engine, oracle)
+    runner.load(scene)
+    if engine == "refsim-compiled":
+        runner.advance(1)           # the compile (or numba's cache load), untimed
+        runner.load(scene)
+    start = runner.snapshot()
+    benchmark.extra_info["steps_per_round"] = STEPS_PER_ROUND
+    benchmark.extra_info["engine"] = engine
+    try:
+        benchmark.pedantic(_one_step_per_call, args=(runner, STEPS_PER_ROUND),
+                           setup=lambda: runner.restore(start),
+                           rounds=1 if benchmark.disabled else ROUNDS, iterations=1)
+        x = runner.positions()
+        assert x.shape == (len(scene.bodies), 3) and np.isfinite(x).all()
+        if isinstance(runner, RefsimEngine):
+            assert runner.sim.steps == start["steps"] + STEPS_PER_ROUND
+    finally:
+        if isinstance(runner, OracleEngine):
+            runner.close()
+
+
 def test_restore_repeats_the_same_steps_bit_for_bit():
     # what makes the rounds comparable: from a restored snapshot, refsim takes
     # the same steps again, to the bit, on either kernel
