@@ -25,14 +25,26 @@ function's docstring names the readable one it mirrors ("Mirrors: ...").
 numba caches machine code on disk only for functions defined at module level
 (``cache=True`` keys a function by its source and globals), so every
 compiled kernel is a module-level function, compiled on first use.
+
+numba's cache of a module is kept while that module's file keeps its time
+and size, whatever happened to the modules it compiles code or constants in
+from (the simulation loop compiles in the contact solve of
+``refsim/dynamics/impulse.py``): after an edit there, the old machine code
+would run. So each module of cached kernels that imports other refsim
+modules holds ``SOURCES_DIGEST``, :func:`sources_digest` of them;
+tests/test_kernels.py checks it, and the edit that updates it is an edit of
+the kernel module itself, which renews its cache.
 """
 
 from __future__ import annotations
 
+import ast
 import functools
+import hashlib
 import importlib
 import os
 import warnings
+from pathlib import Path
 
 from refsim.errors import OptionError, check_option
 
@@ -121,6 +133,66 @@ def compile_kernel(function):
     import numba
 
     return numba.njit(cache=True)(function)
+
+
+def _source_file(module: str) -> Path | None:
+    """The source file of a refsim module (``refsim.a.b``), or None."""
+    base = Path(__file__).parent.joinpath(*module.split(".")[1:])
+    for path in (base.with_suffix(".py"), base / "__init__.py"):
+        if path.is_file():
+            return path
+    return None
+
+
+def _imported_modules(module: str) -> set[str]:
+    """The refsim modules ``module`` imports when it is imported (its
+    top-level imports, also inside ``try``; not those under ``if``, such as
+    ``TYPE_CHECKING``, nor those inside functions)."""
+    path = _source_file(module)
+    if path is None:
+        return set()
+    found: set[str] = set()
+    for statement in ast.parse(path.read_text(encoding="utf-8")).body:
+        nodes = ast.walk(statement) if isinstance(statement, ast.Try) else [statement]
+        for node in nodes:
+            if isinstance(node, ast.Import):
+                found |= {a.name for a in node.names if a.name.split(".")[0] == "refsim"}
+            elif (isinstance(node, ast.ImportFrom) and node.level == 0 and node.module
+                  and node.module.split(".")[0] == "refsim"):
+                found.add(node.module)
+                # ``from refsim.models import ear_index``: a module too
+                found |= {f"{node.module}.{a.name}" for a in node.names
+                          if _source_file(f"{node.module}.{a.name}") is not None}
+    return found
+
+
+def imported_sources(module: str) -> list[str]:
+    """Every refsim module that ``module`` (dotted name) imports, directly or
+    through them (as :func:`_imported_modules` reads imports), sorted."""
+    seen: set[str] = set()
+    todo = [module]
+    while todo:
+        for name in _imported_modules(todo.pop()):
+            if name not in seen and name != module:
+                seen.add(name)
+                todo.append(name)
+    return sorted(seen)
+
+
+def sources_digest(module: str) -> str:
+    """SHA-256 (first 16 hex digits) of the source text of every module of
+    :func:`imported_sources`, in name order; ``""`` when there is none.
+    Newlines are read as ``\n``, so a checkout with other line endings gives
+    the same digest."""
+    names = imported_sources(module)
+    if not names:
+        return ""
+    digest = hashlib.sha256()
+    for name in names:
+        path = _source_file(name)
+        digest.update(name.encode())
+        digest.update(b"\0" + (path.read_text(encoding="utf-8").encode() if path else b""))
+    return digest.hexdigest()[:16]
 
 
 def resolve(dotted: str):

@@ -218,3 +218,61 @@ def test_without_numba_compiled_is_refused_and_readable_is_the_default(monkeypat
     kernels._warn_readable.cache_clear()
     with pytest.warns(kernels.KernelWarning, match="readable kernels"):
         assert kernels.choose_kernel(None) == "readable"
+
+
+# -- numba's cache and the sources a cached module compiles in -----------------------------
+
+def _cached_kernel_modules() -> dict[str, str]:
+    """Every refsim module with a function numba caches on disk (by its
+    decorator's ``cache=True``): dotted name -> source. (refsim.kernels's
+    compile_kernel caches the readable functions of other modules, each
+    keyed by its own file; they call no compiled code of another module.)"""
+    from pathlib import Path
+
+    root = Path(refsim.__file__).parent
+    found = {}
+    for path in sorted(root.rglob("*.py")):
+        text = path.read_text(encoding="utf-8")
+        dotted = ".".join(("refsim", *path.relative_to(root).with_suffix("").parts))
+        if "cache=True" in text and dotted != "refsim.kernels":
+            found[dotted] = text
+    return found
+
+
+def test_each_cached_kernel_module_holds_the_digest_of_what_it_compiles_in():
+    # an edit of a module that a cached kernel compiles in (the contact solve
+    # in the simulation loop) must come with an edit of the kernel's module,
+    # or numba would go on running the old machine code
+    import re
+
+    modules = _cached_kernel_modules()
+    assert {"refsim.dynamics._numba_kernels", "refsim.collision._numba_kernels",
+            "refsim.collision._numba_exact", "refsim.bounds._numba_kernels"} <= set(modules)
+    stale = []
+    for name, text in modules.items():
+        expected = kernels.sources_digest(name)
+        written = re.findall(r'^SOURCES_DIGEST = "([0-9a-f]*)"$', text, flags=re.M)
+        if expected and written != [expected]:
+            stale.append(f'{name}: SOURCES_DIGEST = "{expected}" (written: {written})')
+        if not expected:
+            assert not written, name                       # imports no refsim module
+    assert not stale, "\n".join(stale)
+
+
+def test_the_digest_covers_what_the_loop_compiles_in_and_changes_with_it(monkeypatch,
+                                                                         tmp_path):
+    loop = "refsim.dynamics._numba_kernels"
+    names = kernels.imported_sources(loop)
+    assert {"refsim.dynamics.impulse", "refsim.bounds._numba_kernels",
+            "refsim.dynamics.rotation_impulse"} <= set(names)
+    assert "refsim.models.ear_index" in kernels.imported_sources("refsim.models._numba_kernels")
+    assert kernels.imported_sources("refsim.bounds._numba_kernels") == []
+    before = kernels.sources_digest(loop)
+    source = kernels._source_file("refsim.dynamics.impulse")
+    edited = tmp_path / "impulse.py"
+    edited.write_text(source.read_text(encoding="utf-8").replace("ITERATIONS = 32",
+                                                                  "ITERATIONS = 33"))
+    real = kernels._source_file
+    monkeypatch.setattr(kernels, "_source_file",
+                        lambda m: edited if m == "refsim.dynamics.impulse" else real(m))
+    assert kernels.sources_digest(loop) != before

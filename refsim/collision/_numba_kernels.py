@@ -31,6 +31,11 @@ from refsim.collision.predicates import (
     O3D_ERRBOUND_A,
 )
 
+#: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
+#: an edit there must change this line, so that numba renews its cache of
+#: this module (tests/test_kernels.py checks it).
+SOURCES_DIGEST = "e4950cd60311ee39"
+
 # -- the certified triangle-pair filter (triangle_numba's steps 1-4) -------------------
 #
 # Points are 3-tuples and triangles 3-tuples of points. Tuples are passed by

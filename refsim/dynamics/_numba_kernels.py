@@ -97,6 +97,11 @@ from refsim.bounds._numba_kernels import incremental_update_numba
 from refsim.dynamics.impulse import _matvec, solve_contacts_python
 from refsim.dynamics.rotation_impulse import SERIES_BELOW
 
+#: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
+#: an edit there must change this line, so that numba renews its cache of
+#: this module (tests/test_kernels.py checks it).
+SOURCES_DIGEST = "3be96fbfe957a56f"
+
 #: The kernel took every step it was asked for.
 DONE = 0
 #: The next step needs the readable step (state restored to its start).
