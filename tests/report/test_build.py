@@ -58,18 +58,25 @@ def test_page_is_self_contained(quick_report):
     assert "<script" not in html and "<link" not in html
 
 
-def test_results_are_deterministic(tmp_path, quick_report):
-    """Two quick builds agree exactly on everything but the timings that
+def test_results_are_deterministic_and_the_same_on_workers(tmp_path, quick_report):
+    """Two quick builds, the second with ``--workers 2`` (the sweep entries
+    and the untimed studies on two local processes, the timed studies here
+    after them), agree exactly on everything but the timings that
     results.json lists (``timing_paths``) and the items marked as resting on
     timings (a verdict, a table of timings, a catalogue entry that exists
-    because of a timing verdict). This test's build is the session's only
+    because of a timing verdict): the report is deterministic, and its
+    workers change no result. This test's build is the session's only
     second one."""
+    from refsim.report import plan
+
     _, _, first = quick_report
-    build_report(tmp_path, quick=True, stream=io.StringIO())
+    build_report(tmp_path, quick=True, stream=io.StringIO(), workers=2)
     second = json.loads((tmp_path / "results.json").read_text())
     assert first["timing_paths"] == second["timing_paths"]
     paths = [tuple(p) for p in first["timing_paths"]]
     assert _without_timings(first, paths) == _without_timings(second, paths)
+    assert sorted(p.name for p in (tmp_path / "replays").iterdir()) == \
+        sorted(f"{name}.html" for name, _, _ in plan.REPLAYS)
 
 
 def _timed(path: tuple, patterns: list[tuple]) -> bool:

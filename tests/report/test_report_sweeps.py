@@ -15,7 +15,7 @@ from refsim.claims import CLAIMS
 from refsim.conformance.matrix import conformance_matrix, run_matrix
 from refsim.conformance.results import ConformanceResult, tally
 from refsim.report import plan
-from refsim.report.build import AREAS, _build_section, claim_rows, render, section_json
+from refsim.report.build import render
 from refsim.report.section import Section, to_json
 from refsim.report.sections import advisor as advisor_section
 from refsim.report.sections import conformance as conformance_section
@@ -230,50 +230,6 @@ def test_the_advisor_section_lists_a_refused_scene():
 
 
 # -- workers --------------------------------------------------------------------------------------
-
-
-def _untimed(value, timings):
-    """``value`` (JSON) without the paths in ``timings``."""
-    def strip(v, path):
-        if isinstance(v, dict):
-            return {k: strip(x, path + (k,)) for k, x in v.items()
-                    if path + (k,) not in timings}
-        if isinstance(v, list):
-            return [strip(x, path + ("*",)) for x in v]
-        return v
-    return strip(value, ())
-
-
-def test_workers_give_the_serial_results(quick_report, tmp_path):
-    """Every section built from a run on 2 local processes (the sweep
-    entries and the untimed studies on the workers, the timed ones here
-    after them) gives the quick report's results (built in this process),
-    timings aside."""
-    _, _, results = quick_report
-    run = plan.Run(quick=True, out_dir=tmp_path, workers=2)
-    run.prefetch(plan.PARALLEL_ENTRIES + plan.SWEEP_ENTRIES)   # as the report does
-    assert len(plan.PARALLEL_ENTRIES) >= 15
-    quiet = SimpleNamespace(announce=lambda text: None)
-    ctx = SimpleNamespace(quick=True, run=run, seed=plan.REPORT_SEED, progress=quiet)
-    sections = []
-    for key, title, pending in AREAS:
-        timings: set = set()
-        sections.append(_build_section(key, title, pending, ctx))
-        parallel = json.loads(json.dumps(section_json(sections[-1], timings)))
-        serial = _section(results, key)
-        paths = {tuple(p[3:]) for p in results["timing_paths"] if p[1] == key} | \
-            {tuple(p[3:]) for p in timings}
-        assert _untimed(parallel["results"], paths) == _untimed(serial["results"], paths), key
-        assert [t for t in parallel["tables"] if not t["timing"]] == \
-            [t for t in serial["tables"] if not t["timing"]], key
-    claims = json.loads(json.dumps(claim_rows(sections)))
-    assert [c for c in claims if not c["timing"]] == \
-        [c for c in results["claims"] if not c["timing"]]
-    assert run.missing == {}
-    replays = json.loads(json.dumps(to_json(run.get("replays"))))
-    assert replays == _section(results, "dynamics")["results"]["replays"]
-    assert sorted(p.name for p in (tmp_path / "replays").iterdir()) == \
-        sorted(f"{name}.html" for name, _, _ in plan.REPLAYS)
 
 
 def test_the_timed_studies_stay_in_the_reports_process():
