@@ -28,11 +28,10 @@ from contextlib import contextmanager
 
 try:
     # The C functions behind signal.getsignal and signal.signal, without
-    # their conversions of numbers to enums (2-3 us a call against 0.03-0.3
-    # here): held_signals swaps handlers at every Simulation.advance call,
-    # which made a one-step advance cost 21 us, 15 of them in these
-    # conversions. They take and return the same handlers (SIG_DFL and
-    # SIG_IGN as plain numbers).
+    # their conversions of numbers to enums, which cost ten times the call
+    # itself: held_signals swaps handlers at every Simulation.advance call
+    # (docs/decisions/compiled-loop.md, "One step per call"). They take and
+    # return the same handlers (SIG_DFL and SIG_IGN as plain numbers).
     from _signal import getsignal as _getsignal  # type: ignore[import-not-found]
     from _signal import signal as _setsignal
 except ImportError:  # an interpreter without CPython's _signal module
@@ -85,8 +84,8 @@ def signals_raise() -> Iterator[None]:
 class SignalHold:
     """Signals held by :func:`held_signals`, acted on at :meth:`check`; the
     context manager that :func:`held_signals` returns (a class rather than a
-    generator: entered at every ``Simulation.advance`` call, where a
-    microsecond counts)."""
+    generator, which costs more to enter: it is entered at every
+    ``Simulation.advance`` call)."""
 
     def __init__(self) -> None:
         self.caught: list[int] = []

@@ -572,12 +572,11 @@ def intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> np.nd
 
     The compiled path asks the boolean query first (:func:`_collide_code`):
     most pairs of bodies a scene asks about are apart, and its answer (a
-    code, no arrays; it stops at the first hit) costs about two thirds of
-    the full query's when there is nothing to find (3.1 against 4.9 us for
-    spheres far apart). When it finds them apart, no pair intersects, from
-    the same exact stage; otherwise the full query runs, a few microseconds
-    more on queries of 9 us and up
-    (docs/decisions/query-fixed-cost.md)."""
+    code, no arrays; it stops at the first hit) costs less than the full
+    query's when there is nothing to find. When it finds them apart, no
+    pair intersects, from the same exact stage; otherwise the full query
+    runs, and the boolean query's cost is added to a longer one (figures:
+    docs/decisions/query-fixed-cost.md)."""
     if kernel == "readable":
         pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
         candidates = candidate_pairs(mesh_a, pose_a, mesh_b, pose_b)

@@ -133,8 +133,8 @@ def _quiet_overflow() -> np.errstate:
     """numpy's warnings of overflow on the way to a non-finite state,
     silenced around readable steps: the check stage raises DivergenceError,
     and the warnings would repeat the news once per operation, unattributed.
-    (The compiled loop raises none; entering this costs a microsecond, which
-    a one-step ``advance`` call would otherwise pay.)"""
+    (The compiled loop raises none, so a one-step ``advance`` call on it
+    does not pay for entering this.)"""
     return np.errstate(over="ignore", invalid="ignore", divide="ignore")
 
 BOXES = ("auto", "trackers", "batched")
