@@ -181,7 +181,9 @@ def imported_sources(module: str) -> list[str]:
 
 def sources_digest(module: str) -> str:
     """SHA-256 (first 16 hex digits) of the source text of every module of
-    :func:`imported_sources`, in name order; ``""`` when there is none.
+    :func:`imported_sources`, in name order, without their own
+    ``SOURCES_DIGEST`` lines (so that an edit asks for new digests in one
+    round, not one per level of imports); ``""`` when there is none.
     Newlines are read as ``\n``, so a checkout with other line endings gives
     the same digest."""
     names = imported_sources(module)
@@ -191,7 +193,9 @@ def sources_digest(module: str) -> str:
     for name in names:
         path = _source_file(name)
         digest.update(name.encode())
-        digest.update(b"\0" + (path.read_text(encoding="utf-8").encode() if path else b""))
+        text = path.read_text(encoding="utf-8") if path else ""
+        lines = [line for line in text.split("\n") if not line.startswith("SOURCES_DIGEST = ")]
+        digest.update(b"\0" + "\n".join(lines).encode())
     return digest.hexdigest()[:16]
 
 

@@ -100,7 +100,7 @@ from refsim.dynamics.rotation_impulse import SERIES_BELOW
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "3be96fbfe957a56f"
+SOURCES_DIGEST = "0090b05e0178d1db"
 
 #: The kernel took every step it was asked for.
 DONE = 0

@@ -136,7 +136,8 @@ class CompiledLoop:
         self.I_body = np.ascontiguousarray(sim.I_body, dtype=np.float64)
         self.I_body_inv = np.ascontiguousarray(sim.I_body_inv, dtype=np.float64)
         self._lay_out_trackers()
-        self._lay_out_leaves(vertices)
+        # the leaves serve the corrected wall response only
+        self._lay_out_leaves(vertices if sim.wall_response == "impulse" else [])
         if not sim.body_body:
             self.body_mode = kernels.BODY_NONE
         elif sim.level == "aabb" and sim.body_response == "seed":
@@ -204,10 +205,12 @@ class CompiledLoop:
         """Every body's :func:`vertex_leaves`, concatenated: body b's leaves
         are ``first_leaf[b]:first_leaf[b + 1]``, their vertex indices count
         from ``first_vertex[b]`` (columns of ``vertices_t``). Bodies of one
-        mesh share its leaves' layout."""
+        mesh share its leaves' layout. No ``vertices`` (a scene without the
+        corrected wall response): no leaves."""
         made: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
-        orders, starts, spheres = [], [np.zeros(1, np.int64)], []
-        self.first_leaf = np.zeros(len(vertices) + 1, np.int64)
+        orders, starts = [np.zeros(0, np.int64)], [np.zeros(1, np.int64)]
+        spheres = [np.zeros((0, 5))]
+        self.first_leaf = np.zeros(len(self.sim.bodies) + 1, np.int64)
         n_leaves = 0
         for b, vs in enumerate(vertices):
             key = id(self.sim.bodies[b].mesh)

@@ -188,14 +188,18 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
     v_a, w_a, v_b, w_b : (3,) float64, updated in place.
     A static B (a wall): ``r_b``, ``I_inv_b``, ``v_b`` and ``w_b`` None and
     ``m_inv_b = 0``. B's terms are then left out, which gives the values
-    that zero arrays would (+0.0 everywhere): with ``m_inv_b``, ``I_inv_b``,
-    ``v_b``, ``w_b`` and ``r_b`` zero, B's velocity at the contact is +0
-    and ``x - (+0) = x`` for every float; B's inverse mass terms are +-0
+    that zero arrays would (+0.0 everywhere) as long as the impulses are
+    finite: with ``m_inv_b``, ``I_inv_b``, ``v_b``, ``w_b`` and ``r_b`` zero,
+    B's velocity at the contact is +0 and ``x - (+0) = x`` for every float;
+    B's inverse mass terms are +-0
     added to a positive ``K``; B's velocities stay +0 (``+0 - (+-0) =
     +0``); and B's energy terms are +-0 added to ``dE``, which can change
     only the sign of a zero ``dE``, which no result depends on (it enters
     only comparisons and ``1 - lam`` with ``lam = -dE1 / G`` clamped to
-    ``[0, 1]``). (Numba compiles the ``is None`` branches away.)
+    ``[0, 1]``). An infinite impulse would make the zero arrays' B
+    velocities NaN (``0 inf``), where None leaves them out: a state the
+    simulation's divergence check has stopped before. (Numba compiles the
+    ``is None`` branches away.)
     e, mu, threshold : restitution, Coulomb coefficient, restitution threshold.
     iterations : int, sweeps of phase 1.
     P : (c, 4) float64 output: accumulated normal impulse and friction impulse

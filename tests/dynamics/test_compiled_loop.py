@@ -407,6 +407,88 @@ def test_the_vertices_past_a_wall_are_those_of_testing_every_vertex():
     assert checked == 2700 and hits > 1000
 
 
+def _rotation_with_row(u: np.ndarray, k: int, rng) -> np.ndarray:
+    """A rotation whose row k is the unit vector u."""
+    t = rng.normal(size=3)
+    t -= (t @ u) * u
+    t /= np.linalg.norm(t)
+    R = np.empty((3, 3))
+    R[k], R[(k + 1) % 3], R[(k + 2) % 3] = u, t, np.cross(u, t)
+    if np.linalg.det(R) < 0:
+        R[(k + 1) % 3] *= -1.0
+    return R
+
+
+def test_a_wall_touching_a_leafs_sphere_finds_the_vertices_past_it():
+    # where the slack matters: each leaf's farthest vertex from its centre
+    # lies on its sphere, so with the rotation's row k pointing from it to
+    # the centre (away from it, for a high wall) and the wall through it
+    # (and one float either side), the leaf's sphere touches the wall up to
+    # rounding. Walls near 0 make that rounding large against the wall's
+    # spacing of floats: with CULL_SLACK = 0 this test fails (some leaves
+    # are passed over with a vertex past the wall).
+    from refsim.dynamics import _numba_kernels as kernels
+    from refsim.dynamics.compiled_loop import vertex_leaves
+
+    rng = np.random.default_rng(1)
+    checked = 0
+    for model in ("sphere-2k.ac", "torus.ac"):
+        vertices = _model_vertices(model)
+        X = np.ascontiguousarray(vertices.T)
+        order, start, spheres = vertex_leaves(vertices)
+        first_leaf = np.array([0, len(spheres)], np.int64)
+        past = np.empty(len(vertices), np.int64)
+        for leaf in range(len(spheres)):
+            members = order[start[leaf]:start[leaf + 1]]
+            centre = spheres[leaf, :3]
+            far = members[np.argmax(np.linalg.norm(vertices[members] - centre, axis=1))]
+            d = (vertices[far] - centre) / np.linalg.norm(vertices[far] - centre)
+            for k, low, size in ((leaf % 3, True, 0.01), ((leaf + 1) % 3, False, 0.01),
+                                 ((leaf + 2) % 3, True, 2.0)):
+                R = _rotation_with_row(-d if low else d, k, rng)[None]
+                assert abs(np.linalg.det(R[0]) - 1.0) < 1e-12
+                wall = -size if low else size
+                a = R[0, k]
+                through = wall - ((a[0] * X[0, far] + a[1] * X[1, far]) + a[2] * X[2, far])
+                for o_k in (through, np.nextafter(through, np.inf),
+                            np.nextafter(through, -np.inf)):
+                    expected = _past_by_testing_every_vertex(a, X, o_k, wall, low)
+                    count = kernels._vertices_past_wall(0, k, low, wall, o_k, R, X, order,
+                                                        start, spheres, first_leaf, past)
+                    assert past[:count].tolist() == expected.tolist()
+                    checked += 1
+    assert checked == 3 * 3 * (64 + 64)
+
+
+def test_several_bodies_with_several_leaves_each_bit_for_bit():
+    # the leaves' layout across bodies: two spheres sharing a mesh, cubes,
+    # a torus, each with its own slice of leaves and vertex columns
+    bodies = [("sphere-2k.ac", [-1.0, 0.0, 0.0], [3.0, -2.0, 1.0]),
+              ("cube.ac", [1.5, 1.5, 1.5], [-2.0, 1.0, 3.0]),
+              ("sphere-2k.ac", [1.5, -1.2, -1.0], [1.0, 4.0, -2.0]),
+              ("torus.ac", [-1.5, 1.5, -1.5], [2.0, -3.0, -1.0]),
+              ("cube.ac", [1.6, 1.6, -1.6], [0.5, 0.5, 4.0])]
+    scene = scene_from_dict({
+        "world": {"half_size": 3.0, "restitution": 0.8, "friction": 0.3},
+        "integration": {"step": 1e-3, "duration": 2.0},
+        "collision": {"level": "none"}, "dynamics": {"rotation": "impulse"},
+        "body": [{"name": f"b{i}", "model": model, "position": x, "velocity": v,
+                  "angular_velocity": [1.0, -2.0, 0.5]}
+                 for i, (model, x, v) in enumerate(bodies)]})
+    readable, compiled = _pair(scene, 1200, every=40)
+    loop = compiled._loop
+    assert loop is not None and compiled.loop_steps == 1200
+    leaves = np.diff(loop.first_leaf)
+    assert leaves.tolist() == [64, 1, 64, 64, 1]
+    for b in range(len(bodies)):                     # each body's indices in its own columns
+        first, end = loop.first_leaf[b], loop.first_leaf[b + 1]
+        columns = loop.leaf_order[loop.leaf_start[first]:loop.leaf_start[end]]
+        assert sorted(columns.tolist()) == list(range(loop.first_vertex[b],
+                                                      loop.first_vertex[b + 1]))
+    _assert_same(readable, compiled)
+    assert len({e.body for e in compiled.events if e.kind == "wall"}) == len(bodies)
+
+
 def test_impulse_sphere_rolling_on_the_floor_bit_for_bit(monkeypatch):
     # the benchmark's settled sphere: rolling on the floor, a few of its 1002
     # vertices past it in almost every step (the leaves passed over, the

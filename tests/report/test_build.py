@@ -58,7 +58,8 @@ def test_page_is_self_contained(quick_report):
     assert "<script" not in html and "<link" not in html
 
 
-def test_results_are_deterministic_and_the_same_on_workers(tmp_path, quick_report):
+def test_results_are_deterministic_and_the_same_on_workers(tmp_path, quick_report,
+                                                           monkeypatch):
     """Two quick builds, the second with ``--workers 2`` (the sweep entries
     and the untimed studies on two local processes, the timed studies here
     after them), agree exactly on everything but the timings that
@@ -70,7 +71,18 @@ def test_results_are_deterministic_and_the_same_on_workers(tmp_path, quick_repor
     from refsim.report import plan
 
     _, _, first = quick_report
+    sent, runs = [], []                       # what went to the workers, and from which run
+    measure_parallel = plan.Run._measure_parallel
+
+    def spy(run, futures):
+        runs.append(run)
+        sent.extend(futures)
+        return measure_parallel(run, futures)
+
+    monkeypatch.setattr(plan.Run, "_measure_parallel", spy)
     build_report(tmp_path, quick=True, stream=io.StringIO(), workers=2)
+    assert len(runs) == 1 and runs[0].workers == 2 and runs[0].missing == {}
+    assert sorted(sent) == sorted(plan.PARALLEL_ENTRIES) and len(sent) >= 15
     second = json.loads((tmp_path / "results.json").read_text())
     assert first["timing_paths"] == second["timing_paths"]
     paths = [tuple(p) for p in first["timing_paths"]]
