@@ -128,15 +128,6 @@ DIVERGENCE_FACTOR = 1e6
 #: where the incremental walk pays off (claim C1).
 BATCH_VERTICES = 64
 
-
-def _quiet_overflow() -> np.errstate:
-    """numpy's warnings of overflow on the way to a non-finite state,
-    silenced around readable steps: the check stage raises DivergenceError,
-    and the warnings would repeat the news once per operation, unattributed.
-    (The compiled loop raises none, so a one-step ``advance`` call on it
-    does not pay for entering this.)"""
-    return np.errstate(over="ignore", invalid="ignore", divide="ignore")
-
 BOXES = ("auto", "trackers", "batched")
 
 #: Steps per call of the compiled loop, at most: a call holds the interpreter
@@ -147,6 +138,15 @@ LOOP_CHUNK = 4096
 
 STAGES = ("integrate", "rotation", "check", "bounds", "walls", "broad-phase", "narrow-phase",
           "body-response")
+
+
+def _quiet_overflow() -> np.errstate:
+    """numpy's warnings of overflow on the way to a non-finite state,
+    silenced around readable steps: the check stage raises DivergenceError,
+    and the warnings would repeat the news once per operation, unattributed.
+    (The compiled loop raises none, so a one-step ``advance`` call on it
+    does not pay for entering this.)"""
+    return np.errstate(over="ignore", invalid="ignore", divide="ignore")
 
 
 class Contact(NamedTuple):

@@ -125,7 +125,7 @@ def test_a_static_b_given_as_none_gives_the_values_of_zero_arrays(kernel):
         n = np.zeros(3)
         n[trial % 3] = 1.0 if trial % 2 else -1.0
         r = rng.normal(size=(c, 3))
-        r -= 0.8 * np.outer(r @ n, n)                        # mostly on the contact side
+        r -= 0.8 * np.outer(r @ n, n)                        # points near the contact plane
         m_inv = rng.uniform(0.1, 2.0)
         M = rng.normal(size=(3, 3))
         I_inv = np.linalg.inv(M @ M.T + np.eye(3))
