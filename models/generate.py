@@ -18,6 +18,8 @@ by refsim's own AC3D writer, so running this again gives the same bytes
 | l-beam.ac         | 20        | non-convex, flat faces, sharp inner corner       |
 | star.ac           | 36        | non-convex star prism                            |
 | long-box.ac       | 12        | a long thin box (4 x 0.25 x 0.25)                |
+| brick.ac          | 12        | three different sides (1 x 0.6 x 0.3): free      |
+|                   |           | rotation about the middle axis is unstable       |
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ MODELS = {
     "l-beam.ac": lambda: shapes.l_beam(),
     "star.ac": lambda: shapes.star_prism(),
     "long-box.ac": lambda: shapes.box((4.0, 0.25, 0.25), name="long-box"),
+    "brick.ac": lambda: shapes.box((1.0, 0.6, 0.3), name="brick"),
 }
 
 

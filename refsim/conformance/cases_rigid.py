@@ -22,6 +22,13 @@ spin-cube              the cube resting face down, spinning at 5 rad/s about
                        the vertical, mu = 0.5: friction brings it to rest
 rest-cube              the cube resting face down, mu = 0.5: it stays on
                        the floor
+free-brick             the brick (1 x 0.6 x 0.3 m, three different moments)
+                       in the middle of the cube without gravity, spun at
+                       10 rad/s about its middle axis with 0.1 rad/s about
+                       each of the others: torque-free, it flips over every
+                       2.436 s (Euler's equations in closed form,
+                       :class:`refsim.dynamics.free_body.FreeBody`), 5 times
+                       in 12 s, with constant energy
 =====================  =====================================================
 
 Two choices keep the answers exact for every reasonable engine:
@@ -47,8 +54,9 @@ velocity and ``w . I w / 2`` with the uniform solid's inertia.
 A run of each scene is kept per engine (:meth:`RigidCases.run`), so the
 checks share it; ``rerun`` runs a scene again for the determinism check.
 
-Cost: about 15,300 steps per engine in all (the drops are 1.8 to 3.0 s of
-simulated time), and 1,700 more for the determinism check's reruns.
+Cost: about 27,300 steps per engine in all (the drops are 1.8 to 3.0 s of
+simulated time, the free brick 12 s), and 1,700 more for the determinism
+check's reruns.
 """
 
 from __future__ import annotations
@@ -88,6 +96,11 @@ SPIN_FRICTION = 0.5
 SPIN_E = 0.5
 SPIN_DURATION = 1.5
 REST_DURATION = 1.0
+BRICK = "brick.ac"
+#: The free brick: its angular velocity in its own axes (rad/s; y is the
+#: middle axis), and how long it turns.
+FREE_SPIN = (0.1, 10.0, 0.1)
+FREE_DURATION = 12.0
 
 
 @dataclass(frozen=True)
@@ -170,7 +183,51 @@ def rigid_scenes() -> tuple[RigidScene, ...]:
     scenes.append(RigidScene("rest-cube", "rest",
                              _scene(CUBE, SPIN_E, SPIN_FRICTION, 0.0, REST_DURATION),
                              SPIN_E, SPIN_FRICTION))
+    scenes.append(RigidScene("free-brick", "free", _free_scene(), 1.0))
     return tuple(scenes)
+
+
+def _free_scene():
+    """The brick at the middle of the cube, no gravity, spinning (FREE_SPIN)."""
+    from refsim.scenes.loader import scene_from_dict
+    from refsim.solvers.integrate import covering_duration
+
+    return scene_from_dict({
+        "world": {"half_size": HALF_SIZE, "gravity": 0.0, "drag": 0.0},
+        "integration": {"solver": SOLVER, "step": STEP,
+                        "duration": covering_duration(FREE_DURATION, STEP)},
+        "collision": {"level": "aabb"},
+        "body": [{"name": "body", "model": BRICK, "position": [0.0, 0.0, 0.0],
+                  "angular_velocity": list(FREE_SPIN)}],
+    })
+
+
+def free_body(scene: RigidScene):
+    """The closed-form torque-free motion of a free scene: the uniform
+    solid's principal moments (the brick's axes are its mesh axes, moments
+    increasing along x, y, z) and the start's body-frame angular velocity."""
+    from refsim.dynamics.free_body import FreeBody
+
+    _, _, inertia = _body(_model(scene))
+    mass = scene.scene.bodies[0].mass
+    w = scene.scene.bodies[0].angular_velocity
+    return FreeBody((float(mass * inertia[0, 0]), float(mass * inertia[1, 1]),
+                     float(mass * inertia[2, 2])), (float(w[0]), float(w[1]), float(w[2])))
+
+
+def body_angular_velocity(trajectory) -> np.ndarray:
+    """(F, 3) the angular velocity in the body's own axes, ``R^T w``."""
+    R = np.asarray(trajectory.orientation)[:, 0]
+    w = np.asarray(trajectory.angular_velocity)[:, 0]
+    return np.einsum("fji,fj->fi", R, w)
+
+
+def sign_changes(t: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Times at which ``values`` (F,) changes sign, each by linear
+    interpolation between the frames on either side."""
+    s = np.sign(values)
+    k = np.flatnonzero(s[1:] * s[:-1] < 0)
+    return t[k] - values[k] * (t[k + 1] - t[k]) / (values[k + 1] - values[k])
 
 
 @dataclass(frozen=True)

@@ -33,7 +33,8 @@ meet them within these bounds.
   contact at the vertices; a uniform pressure over the face, ``r = 0.3826
   s``, is the slowest plausible distribution; the limit is twice that
   (0.89 s here).
-- ``rigid.energy`` (every scene): the mechanical energy never exceeds its
+- ``rigid.energy`` (every scene with contacts; the free brick's energy is
+  ``rigid.free_rotation``'s): the mechanical energy never exceeds its
   initial value by more than ``CONTACT_STEPS m g v_max h`` (a contact
   resolved a step late may leave the body ``2 v h`` higher), ``v_max`` the
   scene's largest speed.
@@ -44,6 +45,15 @@ meet them within these bounds.
   soft-contact engine holds a steady penetration of that order).
 - ``rigid.determinism`` (the oblique and the spinning scene): a second run
   of the same scene in the same engine gives the same trajectory, bit for bit.
+- ``rigid.free_rotation`` (the free brick, spun near its middle axis):
+  torque-free motion as Euler's equations give it in closed form
+  (:class:`refsim.dynamics.free_body.FreeBody`; Landau & Lifshitz,
+  *Mechanics*, section 37): the body-frame angular velocity about the middle
+  axis changes sign as often as the closed form's in the same time, the
+  mean time between the flips is the closed form's within
+  :data:`FLIP_INTERVAL_TOL`, and the kinetic energy stays within
+  :data:`FREE_ENERGY_TOL` of its start, and so does the world angular
+  momentum (no contact, no force: any change is the integrator's).
 
 A failure within twice its tolerance is "tolerance"; beyond, "bug" (unless
 recognised as above).
@@ -92,6 +102,20 @@ NO_SPIN_FRACTION = 1e-3
 
 #: Resting penetration allowed, in units of ``g h^2`` (one step's fall from rest).
 REST_PENETRATION_STEPS = 10
+
+#: The free brick's mean time between flips, relative to the closed form's:
+#: 1 % shifts the fifth flip by 5 % of an interval, about the width of the
+#: flip itself; a second-order rotation step is at 1e-6 at h = 1e-3.
+FLIP_INTERVAL_TOL = 0.01
+
+#: The free brick's kinetic energy and world angular momentum may change by
+#: this fraction of their start. Both are constants of the motion; a
+#: second-order rotation step errs by O((h |w|)^2) = 1e-4 relative here
+#: (h |w| = 0.01; refsim's splitting keeps the energy to 5e-7 and the
+#: momentum to rounding), a first-order one by O(h |w|) = 1e-2 at every flip,
+#: when W changes fastest. 1e-3 lies between the two. (The flip interval alone
+#: does not catch a uniform scaling of W, which keeps the orbit's shape.)
+FREE_ENERGY_TOL = 1e-3
 
 
 def apex_tolerance(scene) -> float:
@@ -238,7 +262,7 @@ def check_rigid_energy(engine, cases) -> CheckResult:
     mechanical energy never rises beyond :func:`energy_tolerance`."""
     start = time.perf_counter()
     outcomes, examples, measured = [], [], {}
-    for scene in cases.scenes:
+    for scene in cases.of_kind("drop", "oblique", "spin", "rest"):
         trajectory = cases.run(engine, scene)
         energy = R.energy(scene, trajectory)
         rise = float((energy - energy[0]).max())
@@ -301,4 +325,48 @@ def check_rigid_determinism(engine, cases) -> CheckResult:
             examples.append({"class": "bug", "largest_position_difference": diff,
                              **scene.to_dict()})
     return tally("rigid", "determinism", outcomes, examples=examples,
+                 seconds=time.perf_counter() - start)
+
+
+def check_rigid_free_rotation(engine, cases) -> CheckResult:
+    """``rigid.free_rotation``: the free brick flips as Euler's equations say,
+    and keeps its energy (module docstring)."""
+    start = time.perf_counter()
+    outcomes, examples, measured = [], [], {}
+    for scene in cases.of_kind("free"):
+        trajectory = cases.run(engine, scene)
+        t = np.asarray(trajectory.t)
+        closed = R.free_body(scene)
+        W = R.body_angular_velocity(trajectory)
+        flips = R.sign_changes(t, W[:, 1])
+        expected = closed.flips(float(t[-1]))
+        interval = float(np.diff(flips).mean()) if len(flips) > 1 else math.nan
+        interval_error = abs(interval / closed.flip_interval - 1.0)
+        moments = np.array(closed.moments)
+        energy = 0.5 * (W * W * moments).sum(axis=1)
+        L = np.einsum("fij,fj->fi", np.asarray(trajectory.orientation)[:, 0], W * moments)
+        momentum = float(np.sqrt(((L - L[0]) ** 2).sum(axis=1)).max()
+                         / math.sqrt(closed.momentum_squared))
+        drift = max(float(np.abs(energy / closed.energy - 1.0).max()), momentum)
+        measured[scene.name] = {"flips": len(flips), "closed_form_flips": expected,
+                                "flip_interval": interval,
+                                "closed_form_interval": closed.flip_interval,
+                                "interval_error": interval_error,
+                                "energy_drift": float(np.abs(energy / closed.energy
+                                                             - 1.0).max()),
+                                "momentum_drift": momentum}
+        misses = [classify_miss(drift, FREE_ENERGY_TOL) if math.isfinite(drift) else "bug",
+                  classify_miss(interval_error, FLIP_INTERVAL_TOL)
+                  if math.isfinite(interval_error) else "bug",
+                  None if len(flips) == expected else "bug"]
+        outcome = "bug" if "bug" in misses else next((m for m in misses if m), None)
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, "flips": len(flips),
+                             "closed_form_flips": expected, "flip_interval": interval,
+                             "closed_form_interval": closed.flip_interval,
+                             "energy_or_momentum_drift": drift,
+                             "drift_tolerance": FREE_ENERGY_TOL,
+                             "interval_tolerance": FLIP_INTERVAL_TOL, **scene.to_dict()})
+    return tally("rigid", "free_rotation", outcomes, examples=examples, measured=measured,
                  seconds=time.perf_counter() - start)

@@ -17,10 +17,9 @@ What it runs (one step, the stages of the readable outline, same order):
 2. rotation     none (``rotation = "off"``), the seed's Euler step of the
                 axes with Gram-Schmidt
                 (:func:`refsim.dynamics.rotation_seed.orientation_step_seed_loops`),
-                or the corrected exact rotation with angular momentum
-                (:func:`refsim.dynamics.rotation_impulse.orientation_step_exact`:
-                the exponential map with the C library's sine and cosine,
-                every product summed left to right);
+                or the corrected free-body splitting step
+                (:func:`refsim.dynamics.rotation_impulse.free_rotation_step`,
+                compiled from its own source);
 3. check        the energy bound, conservatively (below);
 4. bounds       the linear scan of a body's vertices
                 (:func:`refsim.dynamics.boxes.boxes_loops`), or the
@@ -94,13 +93,13 @@ import numba
 import numpy as np
 
 from refsim.bounds._numba_kernels import incremental_update_numba
-from refsim.dynamics.impulse import _matvec, solve_contacts_python
-from refsim.dynamics.rotation_impulse import SERIES_BELOW
+from refsim.dynamics.impulse import solve_contacts_python
+from refsim.dynamics.rotation_impulse import free_rotation_step
 
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "0090b05e0178d1db"
+SOURCES_DIGEST = "88f1981ae77570a5"
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -129,7 +128,7 @@ _solve_contacts = numba.njit(cache=True, nogil=True)(solve_contacts_python)
 def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
             restitution, friction, wall_speed_at_wall, wall_impulse, threshold, iterations,
             half_size, vertices_t, first_vertex, centred, center, lam, mass, inv_mass,
-            I_body, I_body_inv, energy_limit, leaf_order, leaf_start, leaf_spheres,
+            Q, moments, I_body_inv, energy_limit, leaf_order, leaf_start, leaf_spheres,
             first_leaf, body_mode,
             x, v, w, R, lo, hi, walls, bodies, events, tracked, tracker_rows, trackers_f,
             trackers_i):
@@ -154,7 +153,9 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
         (B, 3), ``R c`` summed left to right
         (:attr:`Simulation.position`, :func:`refsim.dynamics.products.matvec`)
     lam, mass, inv_mass : (B,) largest principal moment, mass, 1 / mass
-    I_body, I_body_inv : (B, 3, 3) body-space inertia and its inverse
+    Q, moments : (B, 3, 3), (B, 3) principal axes (mesh frame) and moments
+        (:func:`refsim.dynamics.rotation_impulse.principal_frame`)
+    I_body_inv : (B, 3, 3) body-space inverse inertia
     leaf_order, leaf_start, leaf_spheres, first_leaf : every body's groups
         of vertices (:func:`refsim.dynamics.compiled_loop.vertex_leaves`,
         laid out by ``CompiledLoop._lay_out_leaves``), for the wall stage of
@@ -182,7 +183,8 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
     w0 = np.empty((B, 3))
     R0 = np.empty((B, 3, 3))
     A = np.empty((3, 3))
-    E = np.empty((3, 3))            # rotation_exp of one body; then its world I^-1
+    E = np.empty((3, 3))            # scratch of the rotation step; a body's world I^-1
+    L = np.empty(3)
     corr = np.empty(3)
     # the wall impulses' arrays: the vertices past a wall, contacts r_a, the
     # normal n and the impulses P
@@ -247,7 +249,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
         # Gram-Schmidt; or the exact step
         if rotation_mode == ROTATION_EXACT:
             for b in range(B):
-                _orientation_step_exact(b, h, R, w, I_body[b], I_body_inv[b], E, A)
+                free_rotation_step(R[b], w[b], Q[b], moments[b], h, A, L, E)
         elif rotation_mode == ROTATION_SEED:
             for b in range(B):
                 wx, wy, wz = w[b, 0], w[b, 1], w[b, 2]
@@ -566,63 +568,6 @@ def _wall_speed(v_k, a_k, correction_k):
     if 0.0 > squared:
         squared = 0.0
     return np.copysign(np.sqrt(squared), v_k)
-
-
-@numba.njit(cache=True, nogil=True)
-def _rotation_exp(t0, t1, t2, E):
-    """Mirrors :func:`refsim.dynamics.rotation_impulse.rotation_exp` for one
-    rotation vector, into E (3, 3): the same series below ``SERIES_BELOW``,
-    the C library's sine and cosine (``math.sin``, ``math.cos``), each entry
-    in the same order."""
-    a2 = (t0 * t0 + t1 * t1) + t2 * t2
-    if a2 < SERIES_BELOW:
-        s = 1.0 - a2 / 6.0
-        c = 0.5 - a2 / 24.0
-        cos_a = 1.0 - 0.5 * a2
-    else:
-        a = math.sqrt(a2)
-        s = math.sin(a) / a
-        cos_a = math.cos(a)
-        c = (1.0 - cos_a) / (a * a)
-    ct0, ct1, ct2 = c * t0, c * t1, c * t2
-    st0, st1, st2 = s * t0, s * t1, s * t2
-    E[0, 0] = ct0 * t0 + cos_a
-    E[0, 1] = ct0 * t1 - st2
-    E[0, 2] = ct0 * t2 + st1
-    E[1, 0] = ct1 * t0 + st2
-    E[1, 1] = ct1 * t1 + cos_a
-    E[1, 2] = ct1 * t2 - st0
-    E[2, 0] = ct2 * t0 - st1
-    E[2, 1] = ct2 * t1 + st0
-    E[2, 2] = ct2 * t2 + cos_a
-
-
-@numba.njit(cache=True, nogil=True)
-def _matTvec(M, x0, x1, x2):
-    """``M^T x`` summed left to right (:func:`refsim.dynamics.products.matTvec`)."""
-    return ((M[0, 0] * x0 + M[1, 0] * x1) + M[2, 0] * x2,
-            (M[0, 1] * x0 + M[1, 1] * x1) + M[2, 1] * x2,
-            (M[0, 2] * x0 + M[1, 2] * x1) + M[2, 2] * x2)
-
-
-@numba.njit(cache=True, nogil=True)
-def _orientation_step_exact(b, h, R, w, I_body, I_body_inv, E, R_next):
-    """Mirrors :func:`refsim.dynamics.rotation_impulse.orientation_step_exact`
-    for body b, in place (E and R_next (3, 3) scratch)."""
-    Rb = R[b]
-    u = _matTvec(Rb, w[b, 0], w[b, 1], w[b, 2])
-    p = _matvec(I_body, u[0], u[1], u[2])
-    L = _matvec(Rb, p[0], p[1], p[2])                     # R (I_body (R^T w))
-    _rotation_exp(h * w[b, 0], h * w[b, 1], h * w[b, 2], E)
-    for i in range(3):
-        for j in range(3):
-            R_next[i, j] = (E[i, 0] * Rb[0, j] + E[i, 1] * Rb[1, j]) + E[i, 2] * Rb[2, j]
-    for i in range(3):
-        for j in range(3):
-            Rb[i, j] = R_next[i, j]
-    u = _matTvec(Rb, L[0], L[1], L[2])
-    p = _matvec(I_body_inv, u[0], u[1], u[2])
-    w[b, 0], w[b, 1], w[b, 2] = _matvec(Rb, p[0], p[1], p[2])
 
 
 @numba.njit(cache=True, nogil=True)

@@ -133,7 +133,8 @@ class CompiledLoop:
         self.center = np.ascontiguousarray(sim.center, dtype=np.float64)
         self.rotation_mode = {"off": kernels.ROTATION_OFF, "seed": kernels.ROTATION_SEED,
                               "impulse": kernels.ROTATION_EXACT}[sim.rotation]
-        self.I_body = np.ascontiguousarray(sim.I_body, dtype=np.float64)
+        self.Q = np.ascontiguousarray(sim.Q, dtype=np.float64)
+        self.moments = np.ascontiguousarray(sim.moments, dtype=np.float64)
         self.I_body_inv = np.ascontiguousarray(sim.I_body_inv, dtype=np.float64)
         self._lay_out_trackers()
         # the leaves serve the corrected wall response only
@@ -278,7 +279,7 @@ class CompiledLoop:
             sim.wall_speed == "wall", sim.wall_response == "impulse",
             impulse.RESTITUTION_THRESHOLD, impulse.ITERATIONS, world.half_size,
             self.vertices_t, self.first_vertex, sim._centred, self.center, sim._lambda_max,
-            sim.mass, sim.inv_mass, self.I_body, self.I_body_inv, sim._energy_limit,
+            sim.mass, sim.inv_mass, self.Q, self.moments, self.I_body_inv, sim._energy_limit,
             self.leaf_order, self.leaf_start, self.leaf_spheres, self.first_leaf,
             self.body_mode, sim.x, sim.v, sim.w, sim.R, sim.lo, sim.hi, self.walls,
             self.bodies, self.events, self.tracked, self.tracker_rows, self.trackers_f,

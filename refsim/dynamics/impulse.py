@@ -86,26 +86,26 @@ RESTITUTION_THRESHOLD = 0.05
 try:
     # register_jitable: a plain Python function when called from Python, and
     # compiled inline when called from a numba-compiled function.
-    from numba.extending import register_jitable as _jitable
+    from numba.extending import register_jitable as jitable
 except Exception:  # numba missing or unusable: the plain path only
     # The same name for the identity decorator, the usual optional import.
-    def _jitable(f):                                # type: ignore[no-redef]
+    def jitable(f):                                 # type: ignore[no-redef]
         return f
 
 
-@_jitable
+@jitable
 def _cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@_jitable
+@jitable
 def _matvec(M, x0, x1, x2):
     return (M[0, 0] * x0 + M[0, 1] * x1 + M[0, 2] * x2,
             M[1, 0] * x0 + M[1, 1] * x1 + M[1, 2] * x2,
             M[2, 0] * x0 + M[2, 1] * x1 + M[2, 2] * x2)
 
 
-@_jitable
+@jitable
 def _relative_velocity(i, r_a, r_b, v_a, w_a, v_b, w_b):
     """v_rel at contact i: (v_a + w_a x r_a) - (v_b + w_b x r_b); B static
     (``r_b is None``): v_a + w_a x r_a."""
@@ -117,7 +117,7 @@ def _relative_velocity(i, r_a, r_b, v_a, w_a, v_b, w_b):
             v_a[2] + ca[2] - v_b[2] - cb[2])
 
 
-@_jitable
+@jitable
 def _angular_inverse_mass(i, d0, d1, d2, r, I_inv):
     """d . ((I^-1 (r x d)) x r) = (r x d) . I^-1 (r x d) at contact i."""
     c = _cross(r[i, 0], r[i, 1], r[i, 2], d0, d1, d2)
@@ -125,7 +125,7 @@ def _angular_inverse_mass(i, d0, d1, d2, r, I_inv):
     return c[0] * q[0] + c[1] * q[1] + c[2] * q[2]
 
 
-@_jitable
+@jitable
 def _effective_inverse_mass(i, d0, d1, d2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b, I_inv_b):
     """K_d = 1/m_a + 1/m_b + d . ((I_a^-1 (r_a x d)) x r_a + (I_b^-1 (r_b x d)) x r_b);
     B static (``r_b is None``): without B's angular term."""
@@ -136,7 +136,7 @@ def _effective_inverse_mass(i, d0, d1, d2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b, 
     return k
 
 
-@_jitable
+@jitable
 def _apply(i, P0, P1, P2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b, I_inv_b, v_a, w_a, v_b, w_b):
     """+P on A, -P on B at contact i: v += P / m, w += I^-1 (r x P).
 

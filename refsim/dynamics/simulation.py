@@ -83,7 +83,8 @@ from refsim.dynamics.forces import translational_rhs
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
 from refsim.dynamics.products import matvec
 from refsim.dynamics.rotation_impulse import (
-    orientation_step_exact,
+    free_rotation_steps,
+    principal_frame,
     wall_contacts,
     world_inertia,
 )
@@ -103,7 +104,7 @@ from refsim.errors import (
     check_option,
 )
 from refsim.frames import FrameSink, MemorySink, frame_count
-from refsim.kernels import choose_kernel
+from refsim.kernels import choose_kernel, compile_kernel
 from refsim.limits import MAX_STEPS
 from refsim.models.mesh import Mesh
 from refsim.scenes.schema import Scene
@@ -298,6 +299,13 @@ class Simulation:
         self._centred = not self.center.any()          # every centroid at the mesh origin
         self.I_body = np.array([b.inertia for b in bodies])                 # (B, 3, 3)
         self.I_body_inv = np.linalg.inv(self.I_body)
+        # the principal axes (mesh frame) and moments of the corrected
+        # rotation step (rotation_impulse.free_rotation_step)
+        self.Q = np.empty((B, 3, 3))
+        self.moments = np.empty((B, 3))
+        if self.rotation == "impulse":
+            for i, b in enumerate(bodies):
+                self.Q[i], self.moments[i] = principal_frame(b.inertia)
 
         # Bodies whose boxes come from the batched scan, one group per mesh;
         # the others call their own tracker (see ``boxes``).
@@ -561,8 +569,9 @@ class Simulation:
         self.R[...] = orientation_step_seed_kernel(self.R, self.w, self.h, kernel=self.kernel)
 
     def _rotate_exact(self) -> None:
-        self.R[...], self.w[...] = orientation_step_exact(
-            self.R, self.w, self.h, self.I_body, self.I_body_inv)
+        step = (compile_kernel(free_rotation_steps) if self.kernel == "compiled"
+                else free_rotation_steps)
+        step(self.R, self.w, self.Q, self.moments, self.h)
 
     # 4. boxes (S2)
     def _bounds(self) -> None:

@@ -142,7 +142,8 @@ def test_rigid_scenes_and_their_tolerances():
     cases = R.rigid_cases()
     names = [s.name for s in cases.scenes]
     assert names == ["drop-sphere-e0.5", "drop-sphere-e0.8", "drop-cube-e0.5", "drop-cube-e0.8",
-                     "drop-icosahedron-e0.8", "oblique-sphere", "spin-cube", "rest-cube"]
+                     "drop-icosahedron-e0.8", "oblique-sphere", "spin-cube", "rest-cube",
+                     "free-brick"]
     for scene in cases.of_kind("drop"):
         body = scene.scene.bodies[0]
         vertices = R._body(body.model.name)[0]
@@ -159,6 +160,33 @@ def test_rigid_scenes_and_their_tolerances():
                                                  rel=1e-6)
     rest = cases.of_kind("rest")[0]
     assert energy_tolerance(rest) == pytest.approx(2 * 9.81 * 9.81e-3 * 1e-3)
+
+
+def test_free_brick_and_its_closed_form():
+    free = R.rigid_cases().of_kind("free")[0]
+    assert free.scene.world.gravity == 0.0
+    assert free.scene.bodies[0].model.name == "brick.ac"
+    closed = R.free_body(free)
+    # the uniform box's moments m (b^2 + c^2) / 12 of its 1 x 0.6 x 0.3 sides
+    assert closed.moments == pytest.approx(((0.36 + 0.09) / 12, (1 + 0.09) / 12,
+                                            (1 + 0.36) / 12), rel=1e-12)
+    assert closed.omega0 == (0.1, 10.0, 0.1)
+    assert closed.flips(12.0) == 5
+    assert closed.flip_interval == pytest.approx(2.43573, rel=1e-5)
+
+
+def test_free_rotation_check_passes_the_corrected_model_and_fails_a_still_body():
+    from refsim.conformance.checks_rigid import check_rigid_free_rotation
+    from refsim.engines.refsim_engines import corrected
+
+    cases = R.RigidCases(scenes=tuple(R.rigid_cases().of_kind("free")))
+    result = check_rigid_free_rotation(corrected(), cases)
+    measured = result.measured["free-brick"]
+    assert (result.failed, measured["flips"]) == (0, 5)
+    assert measured["energy_drift"] < 1e-5 and measured["momentum_drift"] < 1e-10
+    still = check_rigid_free_rotation(_Still(), cases)
+    assert still.failed == 1 and still.examples[0]["class"] == "bug"
+    assert still.measured["free-brick"]["flips"] == 0
 
 
 class _Still:

@@ -16,7 +16,7 @@ from tests.helpers import assert_meshes_identical
 
 MODELS = bundled_models()
 CONVEX = {"tetrahedron.ac", "cube.ac", "icosahedron.ac", "sphere-2k.ac", "sphere-5k.ac",
-          "sphere-20k.ac", "long-box.ac"}
+          "sphere-20k.ac", "long-box.ac", "brick.ac"}
 
 #: trimesh sums volumes and moments in a different order; its results agree
 #: with refsim's to rounding, a few ulps times the triangle count.
