@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import platform
+from pathlib import Path
+
 import pytest
 
 from refsim.errors import SceneError
@@ -47,3 +50,45 @@ def new_workers(process, before: set[int]) -> list:
         except psutil.NoSuchProcess:
             continue
     return found
+
+
+#: The OpenBLAS core types a test may force with ``OPENBLAS_CORETYPE``, each
+#: with the /proc/cpuinfo flags its kernels use: forcing a core type whose
+#: instructions the processor lacks kills the process with SIGILL (SkylakeX
+#: on an x86-64 processor without AVX-512, as many AMD EPYC are). Prescott
+#: (SSE3) runs on every x86-64 processor.
+OPENBLAS_CORE_FLAGS = {
+    "Prescott": frozenset(),
+    "Haswell": frozenset({"avx2", "fma"}),
+    "SkylakeX": frozenset({"avx512f", "avx512bw", "avx512dq", "avx512vl", "avx512cd"}),
+}
+
+#: platform.machine()'s names for x86-64 (Linux, the BSDs and macOS; Windows).
+X86_64_MACHINES = frozenset({"x86_64", "amd64", "AMD64"})
+
+
+def cpu_flags(cpuinfo: Path = Path("/proc/cpuinfo")) -> frozenset[str]:
+    """The processor's feature flags (the first ``flags`` line of ``cpuinfo``;
+    none where the file is missing or has no such line)."""
+    try:
+        text = cpuinfo.read_text()
+    except OSError:
+        return frozenset()
+    for line in text.splitlines():
+        key, _, value = line.partition(":")
+        if key.strip() == "flags":
+            return frozenset(value.split())
+    return frozenset()
+
+
+def openblas_core_types(flags: frozenset[str] | None = None,
+                        machine: str | None = None) -> list[str]:
+    """The OpenBLAS core types this host can run, in the order of
+    :data:`OPENBLAS_CORE_FLAGS`: none off x86-64 (there only the default
+    kernels run), else Prescott and those whose flags are all in ``flags``
+    (default: :func:`cpu_flags`)."""
+    machine = platform.machine() if machine is None else machine
+    if machine not in X86_64_MACHINES:
+        return []
+    flags = cpu_flags() if flags is None else flags
+    return [core for core, needed in OPENBLAS_CORE_FLAGS.items() if needed <= flags]

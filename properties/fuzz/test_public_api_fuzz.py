@@ -6,9 +6,9 @@ also a ValueError or TypeError (or a DivergenceError / OutputError); a call
 with an argument the contract forbids is refused, one with only allowed
 arguments is accepted, and the result keeps the probe's law (a symmetric
 answer, a conservative coarse level, a uniform scale keeping convexity...).
-Each call runs in a worker process under a memory limit and a timeout
-(``tests.fuzz.api_worker``), so a crash, a hang or a multi-GB allocation is
-a failing example, not a dead test run.
+Each call runs in a worker process under a memory limit, a CPU-time limit and
+a wall-clock backstop (``tests.fuzz.api_worker``), so a crash, a hang, a
+runaway loop or a multi-GB allocation is a failing example, not a dead test run.
 
 Under the ``ci`` profile the examples are derandomized, so the same calls
 run every time; shrinking is off (a probe is a readable expression already,
@@ -32,9 +32,10 @@ from tests.fuzz.api_worker import judge_probe, shared_runner
 #: crash restarts the worker in about a second).
 API_EXAMPLES = 10
 
-#: Seconds a probe may take before it counts as a hang (probes take
-#: milliseconds); the same worker as the slice's (tests/fuzz/test_fuzz_slice.py).
-PROBE_TIMEOUT = 3.0
+#: Seconds of CPU time a probe may use before it counts as over its CPU
+#: limit (probes use milliseconds); the same worker as the slice's
+#: (tests/fuzz/test_fuzz_slice.py).
+PROBE_CPU_LIMIT = 3.0
 
 #: The first root cause each function's derandomized examples hit, for a
 #: function that breaks a law (none does today; see the module docstring).
@@ -43,7 +44,7 @@ KNOWN: dict[str, str] = {}
 
 @pytest.fixture(scope="session")
 def probe_runner():
-    return shared_runner(PROBE_TIMEOUT)
+    return shared_runner(PROBE_CPU_LIMIT)
 
 
 def _params():

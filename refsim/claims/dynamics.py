@@ -37,8 +37,8 @@ DETECTION_FRAMES = 1
 #: starts with none, and rounding alone leaves pybullet's cube below 1e-4.
 NOTICEABLE_SPIN = 0.01
 
-#: The issue's step-cost target: refsim at most this many times pybullet's
-#: time per step at the largest body count.
+#: refsim's step-cost target: at most this many times pybullet's time per
+#: step at the largest body count.
 STEP_COST_TARGET = 2.0
 
 #: The cube of the bounce studies (refsim.studies.bounce.CUBE).
@@ -107,7 +107,7 @@ def _finite(values) -> list[float]:
 
 def apex_findings(rows: Sequence[ApexRow], target: float, rounding: float) -> dict:
     """The apex table's findings: the largest error from e^2 with rotation
-    off (at ``rounding``? within the issue's ``target``?), of the seed's
+    off (at ``rounding``? within the apex-ratio ``target``?), of the seed's
     literal wall speed, of the cube face down; the cube with the seed's
     rotation (its spin, its error, how often above e^2); and whether
     pybullet's cube tips (a spin above :data:`NOTICEABLE_SPIN`)."""

@@ -44,6 +44,6 @@ TERMINOLOGY: tuple[tuple[str, str], ...] = (
      "Heun's method (the explicit trapezoidal rule), a one-step, two-stage method; "
      "not a two-step (multistep) method."),
     ("angular velocity in \"revolutions / time\"",
-     "refsim uses radians per second (DESIGN.md, Conventions); w x X is a velocity "
+     "refsim uses radians per second throughout; w x X is a velocity "
      "only when w is in radians per unit time."),
 )

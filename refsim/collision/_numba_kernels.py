@@ -7,8 +7,8 @@ arrays. The functions are defined at module level on purpose: numba's on-disk
 cache (``cache=True``) keys a function by its source and its globals, and a
 kernel built inside a factory function closes over other dispatchers, which
 pickle differently in every process, so the cache never hit and every process
-recompiled (6-10 s). At module level the cache hits and the compile is paid
-once per machine (measured in :mod:`refsim.studies.levels`).
+recompiled. At module level the cache hits and the compile is paid once per
+machine (measured in :mod:`refsim.studies.levels`).
 
 Arithmetic: numba compiles without fast-math, so each operation is rounded
 once, as in Python and in elementwise numpy; the tests compare the kernels

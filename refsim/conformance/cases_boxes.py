@@ -40,8 +40,8 @@ near-identity   the identity rotation and a translation of 10^-12 .. 10^-8
 tiny            points of size 10^-12 .. 10^-9 moved by a unit translation
 ==============  ============================================================
 
-Cost: O(n) rational operations per case; the truth is about 20 us per
-vertex.
+Cost: O(n) rational operations per case (the truth, in exact arithmetic,
+dominates).
 """
 
 from __future__ import annotations
@@ -62,7 +62,8 @@ from refsim.conformance.draw import (
 FAMILIES = ("random", "bundled", "far", "exact", "near-identity", "tiny")
 
 #: Bundled models whose vertices the "bundled" family uses (up to 1002
-#: vertices: the sphere-2k is the largest that keeps a case under 25 ms).
+#: vertices: the sphere-2k is the largest, as the truth's rational
+#: arithmetic costs O(vertices) per case).
 BOX_MODELS = ("cube.ac", "icosahedron.ac", "l-beam.ac", "star.ac", "sphere-2k.ac")
 
 #: The unit roundoff of float64 and gamma_4 = 4u / (1 - 4u) (module docstring).

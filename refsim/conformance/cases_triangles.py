@@ -36,8 +36,8 @@ Precision Floating-Point Arithmetic and Fast Robust Geometric Predicates",
 Discrete Comput. Geom. 18, 1997 (inputs within rounding of a plane), and the
 C4 study (:mod:`refsim.studies.triangles`).
 
-Cost: O(1) per pair to build; the truth is about a millisecond per pair
-(rational arithmetic), so 10^5 pairs take about 100 s.
+Cost: O(1) per pair to build; the truth (rational arithmetic) is the
+dominant cost, O(1) per pair but large: size ``n`` accordingly.
 """
 
 from __future__ import annotations
@@ -202,8 +202,8 @@ class TriangleCases:
 
 
 def triangle_cases(n: int, seed: int = 0) -> TriangleCases:
-    """The seeded set of ``n`` pairs (module docstring). Cost: about 1 ms a
-    pair (the exact answers)."""
+    """The seeded set of ``n`` pairs (module docstring). Cost: O(n), the
+    exact answers in rational arithmetic."""
     draw = NumpyDraw(np.random.default_rng([seed, 0x7219]))
     pairs = tuple(build_pair(draw, FAMILIES[i % len(FAMILIES)]) for i in range(n))
     return TriangleCases(pairs=pairs, seed=seed)

@@ -63,8 +63,8 @@ AREAS: tuple[tuple[str, str, str], ...] = (
 )
 
 # The page's cross-cutting parts: figures and tables (by id prefix) that are
-# shown together there rather than in their area's section (issue 7: speed
-# against accuracy as charts; stability, predicted and measured).
+# shown together there rather than in their area's section (speed against
+# accuracy as charts; stability, predicted and measured).
 PARTS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ("speed-accuracy", "Speed against accuracy",
      "What each method buys for its cost, measured on this machine: error or false "

@@ -483,8 +483,8 @@ def _bounds_compile(run: Run):
 
 # -- collision -------------------------------------------------------------------------------
 
-#: (quick, full) sizes of each collision measurement. Quick keeps the section
-#: within ~15 s (after numba's first compile); full within ~2 min.
+#: (quick, full) sizes of each collision measurement: quick keeps the
+#: section to seconds (after numba's first compile), full to minutes.
 COLLISION_SIZES = {
     "repeats": (3, 21),
     "random_per_pair": (5, 50),
@@ -749,7 +749,7 @@ def _quick_choice(run: Run) -> list:
     """:class:`refsim.studies.particles.SolverChoice` rows read off the quick
     run's own measurements with the helpers measure_solver_choice uses
     (measure_solver_choice runs its own work-precision study, up to 16384
-    steps per solver, ~5 s whatever the particle count)."""
+    steps per solver, whatever the particle count)."""
     from refsim.claims.solvers import JITTER_QUOTED_STEP, SAME_STEP
     from refsim.solvers.methods import SOLVERS
     from refsim.studies.particles import SolverChoice

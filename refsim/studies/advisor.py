@@ -1,5 +1,5 @@
 """The fidelity advisor: the cheapest settings whose run stays within TOL of
-a reference run (issue 17; DESIGN.md, "model no more than a scene needs").
+a reference run (model no more than a scene needs).
 
 What: :func:`advise` holds a scene's physics fixed (rotation model, body
 and wall response, wall speed, forces, world, bodies) and searches its four
@@ -207,8 +207,8 @@ REDUCTION_MIN = 1.5
 #: constant gravity differ by rounding alone, and land on either side of it).
 SPREAD_FACTOR = 2.0
 
-#: Default most steps of one reference run: about a minute of one core for
-#: one body with the compiled kernels, and 5 s at a step of 1e-5 s.
+#: Default most steps of one reference run: 5 s of simulated time at a step
+#: of 1e-5 s; the cap keeps a reference for a fine tolerance finite.
 MAX_REFERENCE_STEPS = 2**19
 
 #: Until a solver has a step that meets TOL, the search aims each predicted

@@ -65,8 +65,8 @@ GRAVITY = 9.81
 DROP_HEIGHT = 4.0
 #: Bounces whose apex ratios are averaged.
 BOUNCES = 3
-#: The reference step and solver (the issue's target: apex ratio within
-#: APEX_RATIO_TARGET of e^2 at this step with this solver).
+#: The reference step and solver (refsim's accuracy target: apex ratio
+#: within APEX_RATIO_TARGET of e^2 at this step with this solver).
 STEP = 1e-3
 SOLVER = "rk4"
 APEX_RATIO_TARGET = 0.005

@@ -703,8 +703,8 @@ SPEED_CONFIGURATIONS: tuple[SpeedConfiguration, ...] = (
                        "centres 2.66 apart along (1,0,1)"),
     SpeedConfiguration("torus", "deep", XZ_DIAGONAL, 1.0,
                        "centres 1 apart along (1,0,1)"),
-    # issue 16's touching configurations: nearly every candidate pair touches
-    # exactly, the float filter certifies none, the exact stage answers them all
+    # touching configurations: nearly every candidate pair touches exactly,
+    # the float filter certifies none, the exact stage answers them all
     SpeedConfiguration("cube", "touching", (0.0, 1.0, 0.0), 1.0,
                        "unit cubes sharing the face y = 0.5 (84 triangle-box pairs, 62 touch)",
                        rotation_b="identity"),
@@ -829,9 +829,9 @@ def measure_hierarchy_speed(fcl=None, repeats: int = 21, *,
     (``refsim.oracles.fcl_adapter.FCLOracle``), or None to time refsim
     alone. Its models are built once per mesh before timing, as refsim's
     trees are. The seed's path is timed with
-    ``max(3, repeats // 4)`` repeats (it takes up to ~0.1 s a call).
+    ``max(3, repeats // 4)`` repeats (it is the slowest path, by far).
     ``compile_cost``: also measure the numba compile cost (two fresh
-    interpreters for the hierarchy, one for the triangle kernel: ~10 s).
+    interpreters for the hierarchy, one for the triangle kernel).
     """
     kernel = choose_kernel(kernel)
     cases = []

@@ -6,9 +6,8 @@ takes its ``seed`` and plain arguments (a scene by its file name), runs
 refsim, and returns a small record. The tests run it on every backend, and
 the sweep benchmarks (:mod:`refsim.studies.sweep`) time it.
 
-Cost: one ``refsim.simulate`` of the scene for ``duration`` seconds (about
-0.15 s of CPU per simulated second for the bundled bounce.toml, with the
-compiled kernels), plus loading the scene.
+Cost: one ``refsim.simulate`` of the scene for ``duration`` simulated
+seconds, plus loading the scene.
 """
 
 from __future__ import annotations

@@ -439,15 +439,26 @@ def test_the_exact_levels_tree_does_not_depend_on_the_blas_core():
     """The tree (its splits and its node boxes, to the bit) is built without
     BLAS or LAPACK, so OpenBLAS's kernels for other processors give the same
     one (with numpy.linalg.eigh they did not: another tree, and another count
-    of node pairs visited)."""
+    of node pairs visited). The default kernels are compared with every core
+    type this processor can run (tests.helpers.openblas_core_types): on
+    x86-64 at least Prescott, elsewhere the default alone."""
     import os
+    import platform
     import subprocess
     import sys
 
-    digests = set()
-    for core in ("Prescott", "Haswell", "SkylakeX"):
-        env = dict(os.environ, OPENBLAS_CORETYPE=core)
+    from tests.helpers import X86_64_MACHINES, openblas_core_types
+
+    default = {k: v for k, v in os.environ.items() if k != "OPENBLAS_CORETYPE"}
+    cores = openblas_core_types()
+    if platform.machine() in X86_64_MACHINES:
+        assert "Prescott" in cores
+    digests = {}
+    for core in [None, *cores]:
+        env = default if core is None else dict(default, OPENBLAS_CORETYPE=core)
         result = subprocess.run([sys.executable, "-c", TREE_DIGEST], env=env,
                                 capture_output=True, text=True, timeout=300, check=True)
-        digests.add(result.stdout.strip())
-    assert len(digests) == 1 and len(next(iter(digests))) == 64
+        digests[core or "default"] = result.stdout.strip()
+    assert len(digests) == 1 + len(cores)
+    assert len(set(digests.values())) == 1, digests
+    assert len(digests["default"]) == 64

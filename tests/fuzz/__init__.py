@@ -14,7 +14,8 @@ This package checks those laws by mutation and by hostile arguments:
   findings of the earlier manual campaign): a command line, its input files
   and special nodes, and what a refusal must name;
 - :mod:`tests.fuzz.runner` and :mod:`tests.fuzz.zygote`: each case run as
-  ``refsim ...`` in a subprocess with a timeout and a memory limit (forked
+  ``refsim ...`` in a subprocess with a CPU-time limit, a wall-clock
+  backstop and a memory limit (forked
   from a warmed interpreter, or a fresh one to confirm a failure);
 - :mod:`tests.fuzz.execute`: a case's files made, the command run, what it
   left behind observed;

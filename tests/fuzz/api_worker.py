@@ -19,8 +19,12 @@ runs the prelude and the expression and prints what happened.
 
 :class:`ProbeRunner` keeps one worker (``python -m tests.fuzz.api_worker
 --serve``) with the prelude loaded and an address-space limit above what it
-already maps; each probe has a timeout. A worker that crashes or hangs is
-replaced (its stack, from faulthandler, names the frame).
+already maps; each probe has a CPU-time limit (the worker's ``RLIMIT_CPU``,
+set before each probe to the CPU time used so far plus the limit: SIGXCPU
+then ends the worker) and a much larger wall-clock backstop, for a probe
+that waits instead of computing (a hang). A worker that crashes, hangs or
+overruns its CPU limit is replaced (its stack, from faulthandler, names the
+frame).
 """
 
 from __future__ import annotations
@@ -47,7 +51,9 @@ from tests.fuzz.runner import (
     DUMP_GRACE,
     ENV,
     ROOT,
+    WALL_FACTOR,
     close_quietly,
+    cpu_rlimit,
     die_with_parent,
     stop_server,
 )
@@ -56,8 +62,8 @@ from tests.fuzz.runner import (
 #: more than any honest call with the fixtures needs, far less than "GB".
 PROBE_MEMORY = 2 * 2**30
 
-#: Seconds a probe may take before it counts as a hang.
-PROBE_TIMEOUT = 10.0
+#: Seconds of CPU time a probe may use before it counts as over its CPU limit.
+PROBE_CPU_LIMIT = 10.0
 
 #: The fixtures every probe may use. Files that cannot be made portably in a
 #: probe (a FIFO, a symlink loop, a deep TOML file) are made here, in a
@@ -121,7 +127,7 @@ FIFO_NPZ = _node("pipe.npz", os.mkfifo)
 
 # Compile the kernels the probes reach (or load them from numba's cache)
 # before the worker says it is ready: a first compilation takes tens of
-# seconds on a cold cache and must not count against a probe's timeout.
+# seconds on a cold cache and must not count against a probe's CPU-time limit.
 _TOUCH = (np.eye(3), np.array([1.0, 0.0, 0.0]))
 bodies_collide(CUBE, ID, CUBE, _TOUCH)
 for _method in ("bvh", "seed"):
@@ -201,17 +207,33 @@ def run_probe(namespace: dict, code: str, check: str | None) -> dict:
     return facts
 
 
+def _limit_cpu(seconds: float | None) -> None:
+    """Let this process use ``seconds`` more of CPU time before SIGXCPU
+    (None: no limit). Only the soft limit moves, so it can be raised again."""
+    _, hard = resource.getrlimit(resource.RLIMIT_CPU)
+    soft = hard
+    if seconds is not None:
+        usage = resource.getrusage(resource.RUSAGE_SELF)
+        soft, _ = cpu_rlimit(seconds, used=usage.ru_utime + usage.ru_stime)
+        if hard != resource.RLIM_INFINITY:
+            soft = min(soft, hard)
+    resource.setrlimit(resource.RLIMIT_CPU, (soft, hard))
+
+
 def serve() -> None:
-    """The worker: the prelude, a memory limit, then one probe per stdin line.
+    """The worker: the prelude, a memory limit, then one probe per stdin line,
+    each under the CPU-time limit its request names (``cpu``, seconds).
 
     Results go to the original stdout; anything a probe prints goes to
-    stderr, with faulthandler's dumps (a crash, or SIGUSR1 at a timeout).
+    stderr, with faulthandler's dumps (a crash, SIGUSR1 at the wall-clock
+    backstop, SIGXCPU at the CPU-time limit, of which the worker then dies).
     """
     die_with_parent()
     results = os.dup(1)
     os.dup2(2, 1)
     faulthandler.enable(sys.stderr, all_threads=True)
     faulthandler.register(signal.SIGUSR1, file=sys.stderr, all_threads=True)
+    faulthandler.register(signal.SIGXCPU, file=sys.stderr, all_threads=True, chain=True)
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
     namespace = _prelude_namespace()
     with open("/proc/self/status") as status:
@@ -222,7 +244,9 @@ def serve() -> None:
     os.write(results, (json.dumps({"ready": os.getpid(), "limit": limit}) + "\n").encode())
     for line in sys.stdin:
         request = json.loads(line)
+        _limit_cpu(request.get("cpu"))
         facts = run_probe(namespace, request["code"], request.get("check"))
+        _limit_cpu(None)
         os.write(results, (json.dumps(facts) + "\n").encode())
 
 
@@ -260,22 +284,28 @@ def _shell_quote(text: str) -> str:
 
 @dataclass(frozen=True)
 class ProbeOutcome:
-    """What a probe did: the worker's facts, or a crash (``signal``) or a
-    hang (``timed_out``) with faulthandler's stack in ``stack``."""
+    """What a probe did: the worker's facts, or a crash (``signal``), a
+    hang (``timed_out``: killed at the wall-clock backstop) or a CPU-time
+    overrun (``cpu_exceeded``: the worker died of SIGXCPU) with
+    faulthandler's stack in ``stack``."""
 
     facts: dict
     signal: int | None = None
     timed_out: bool = False
     stack: str = ""
     seconds: float = 0.0
+    cpu_exceeded: bool = False
 
 
 class ProbeRunner:
-    """One worker process and the probes sent to it (module docstring)."""
+    """One worker process and the probes sent to it (module docstring):
+    each may use ``cpu_limit`` seconds of CPU time, and is killed as a hang
+    after ``wall_limit`` seconds (default: WALL_FACTOR times ``cpu_limit``)."""
 
-    def __init__(self, timeout: float = PROBE_TIMEOUT, log: Path | None = None,
-                 python: str = sys.executable):
-        self.timeout = timeout
+    def __init__(self, cpu_limit: float = PROBE_CPU_LIMIT, log: Path | None = None,
+                 python: str = sys.executable, wall_limit: float | None = None):
+        self.cpu_limit = cpu_limit
+        self.wall_limit = WALL_FACTOR * cpu_limit if wall_limit is None else wall_limit
         self.python = python
         self._base = Path(tempfile.mkdtemp(prefix="refsim-api-"))   # fixtures; removed by close
         self.log = Path(log) if log else self._base / "worker.log"
@@ -319,10 +349,10 @@ class ProbeRunner:
     def run(self, probe: Probe) -> ProbeOutcome:
         offset = self.log.stat().st_size
         start = time.monotonic()
-        request = {"code": probe.code, "check": probe.check}
+        request = {"code": probe.code, "check": probe.check, "cpu": self.cpu_limit}
         self._process.stdin.write((json.dumps(request) + "\n").encode())
         self._process.stdin.flush()
-        facts = self._line(self.timeout)
+        facts = self._line(self.wall_limit)
         if facts is not None and "eof" not in facts:
             return ProbeOutcome(facts, seconds=time.monotonic() - start)
         timed_out = facts is None
@@ -331,11 +361,13 @@ class ProbeRunner:
             time.sleep(DUMP_GRACE)
             self._process.kill()
         code = self._process.wait()
+        cpu_exceeded = code == -signal.SIGXCPU and not timed_out
         stack = self._stack_since(offset)
         self._close_pipes()
         self._start()
-        return ProbeOutcome({}, signal=None if timed_out else -code, timed_out=timed_out,
-                            stack=stack, seconds=time.monotonic() - start)
+        return ProbeOutcome({}, signal=None if timed_out or cpu_exceeded else -code,
+                            timed_out=timed_out, stack=stack,
+                            seconds=time.monotonic() - start, cpu_exceeded=cpu_exceeded)
 
     def _close_pipes(self) -> None:
         close_quietly(self._process.stdin, self._process.stdout, self._err)
@@ -395,16 +427,16 @@ KNOWN_PROBES = {
 _SHARED: dict[float, ProbeRunner] = {}
 
 
-def shared_runner(timeout: float) -> ProbeRunner:
-    """One worker per process and timeout, for test modules that share it
-    (the slice and the property tests: one start-up instead of two). It is
-    closed when the process exits."""
-    if timeout not in _SHARED:
+def shared_runner(cpu_limit: float) -> ProbeRunner:
+    """One worker per process and CPU-time limit, for test modules that
+    share it (the slice and the property tests: one start-up instead of
+    two). It is closed when the process exits."""
+    if cpu_limit not in _SHARED:
         import atexit
 
-        _SHARED[timeout] = ProbeRunner(timeout=timeout)
-        atexit.register(_SHARED[timeout].close)
-    return _SHARED[timeout]
+        _SHARED[cpu_limit] = ProbeRunner(cpu_limit=cpu_limit)
+        atexit.register(_SHARED[cpu_limit].close)
+    return _SHARED[cpu_limit]
 
 
 # -- the law ----------------------------------------------------------------------------
@@ -413,12 +445,18 @@ def shared_runner(timeout: float) -> ProbeRunner:
 def judge_probe(probe: Probe, outcome: ProbeOutcome) -> list[Failure]:
     """The failures of one probe, in the campaign's columns: "traceback" (an
     exception outside refsim's hierarchy, MemoryError included), "signal",
-    "hang", "bad message" (a RefsimError that is neither a ValueError nor a
+    "hang" (killed at the wall-clock backstop), "cpu time" (stopped at the
+    CPU-time limit), "bad message" (a RefsimError that is neither a ValueError nor a
     TypeError, OSError or DivergenceError), "bad output" (returned where it
     must refuse, refused where it must accept, or broke its law)."""
     if outcome.timed_out:
         return [Failure("hang", f"hang in {hang_site(outcome.stack)}",
                         f"{probe.function}: killed after {outcome.seconds:.1f} s in "
+                        f"{innermost_frame(outcome.stack, dump=True)}")]
+    if outcome.cpu_exceeded:
+        return [Failure("cpu time", f"over the CPU limit in {hang_site(outcome.stack)}",
+                        f"{probe.function}: stopped at the CPU-time limit after "
+                        f"{outcome.seconds:.1f} s in "
                         f"{innermost_frame(outcome.stack, dump=True)}")]
     if outcome.signal is not None:
         name = signal.Signals(outcome.signal).name if outcome.signal > 0 else "exit"

@@ -56,8 +56,9 @@ from tests.fuzz.runner import ExecRunner, ForkServer
 #: rebuilt from its id with --replay; these are the ones written out).
 REPRODUCERS_PER_SIGNATURE = 3
 
-#: Seconds a probe may run in the campaign before it counts as a hang.
-CAMPAIGN_PROBE_TIMEOUT = 6.0
+#: Seconds of CPU time a probe may use in the campaign before it counts as
+#: over its CPU limit (its wall-clock backstop: runner.WALL_FACTOR times that).
+CAMPAIGN_PROBE_CPU_LIMIT = 6.0
 
 #: Runs of a signal case whose command ended before its signal arrived
 #: (a loaded machine can delay the poll that sends it) before it counts as
@@ -170,7 +171,7 @@ def run_probes(seed, deadline: float, max_probes: int | None, logs: Path,
     import properties.conftest  # noqa: F401  (registers the "fuzz" profile)
     from properties.fuzz.strategies import API_FUNCTIONS, api_probes
 
-    runner = ProbeRunner(timeout=CAMPAIGN_PROBE_TIMEOUT, log=logs / "api-worker.log")
+    runner = ProbeRunner(cpu_limit=CAMPAIGN_PROBE_CPU_LIMIT, log=logs / "api-worker.log")
     results: list[ProbeResult] = []
     seen: set[str] = set()
 
@@ -238,7 +239,7 @@ def confirm(firsts: dict, workdir: Path, logs: Path, progress=None) -> dict[str,
             record = execute(result.case, exec_runner, workdir)
             found = {f.signature for f in judge(result.case, record).failures}
         else:
-            runner = ProbeRunner(timeout=CAMPAIGN_PROBE_TIMEOUT,
+            runner = ProbeRunner(cpu_limit=CAMPAIGN_PROBE_CPU_LIMIT,
                                  log=logs / "api-confirm.log")
             try:
                 outcome = runner.run(result.probe)
@@ -254,7 +255,7 @@ def confirm(firsts: dict, workdir: Path, logs: Path, progress=None) -> dict[str,
 # -- the table -----------------------------------------------------------------------------
 
 HEADER = ("cases", "accepted", "refused ok", "tracebacks", "signals", "hangs",
-          "bad messages", "files left", "files replaced", "bad output")
+          "cpu overruns", "bad messages", "files left", "files replaced", "bad output")
 
 
 def row_label(case: Case) -> tuple[str, str]:
@@ -332,6 +333,7 @@ def _case_failure(result: CaseResult, failure: Failure, reproducer) -> dict:
             "mutator": result.case.mutator, "subject": result.case.subject,
             "column": failure.column, "signature": failure.signature,
             "detail": failure.detail, "exit": o.returncode, "timed_out": o.timed_out,
+            "cpu_exceeded": o.cpu_exceeded,
             "seconds": round(o.elapsed, 3), "stderr_tail": o.stderr[-600:],
             "replay": f"python -m tests.fuzz.campaign --replay {result.case.id}",
             "reproducer": reproducer}
@@ -414,7 +416,8 @@ def replay(case_id: str, out: Path) -> int:
     o = record.outcome
     print(f"case {case.id}: {case.family} {case.mutator} on {case.subject}")
     print(f"command: refsim {' '.join(case.argv)}")
-    print(f"exit {o.returncode}{' (timed out)' if o.timed_out else ''} after {o.elapsed:.2f} s")
+    limit = " (timed out)" if o.timed_out else " (over its CPU limit)" if o.cpu_exceeded else ""
+    print(f"exit {o.returncode}{limit} after {o.elapsed:.2f} s")
     print("stderr:\n" + (o.stderr.rstrip() or "(empty)"))
     for failure in verdict.failures:
         print(f"FAILURE [{failure.column}] {failure.signature}\n    {failure.detail}")

@@ -36,7 +36,7 @@ from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
 from tests.fuzz import corpus, mutate
-from tests.fuzz.runner import TIMEOUT
+from tests.fuzz.runner import CPU_LIMIT
 
 RANDOM_FAMILIES = ("model", "scene", "scene+model")
 FIXED_FAMILIES = ("special", "output", "signal", "args", "known")
@@ -51,7 +51,8 @@ MODEL_HOSTS = ("bounce.toml", "head-on.toml", "spinning-cube.toml", "mixed.toml"
 
 #: Seconds a long polygon may take (the ear clipper must be fast: a 20 000
 #: corner polygon is a fraction of a second of work for an O(n log n) or a
-#: well-pruned O(n^2) clipper); past this the case counts as a hang.
+#: well-pruned O(n^2) clipper); past this much CPU time the case counts as
+#: over its CPU limit.
 FAST = 5.0
 
 #: Model refusals that concern the whole file and so name no line.
@@ -92,6 +93,8 @@ class Case:
     must_refuse: accepting the input is a failure.
     unprivileged: run without root's file-permission override (a permission
     case: root reads every file otherwise).
+    cpu_limit: the seconds of CPU time the command may use (its wall-clock
+    backstop is :data:`tests.fuzz.runner.WALL_FACTOR` times that).
     """
 
     id: str
@@ -109,7 +112,7 @@ class Case:
     must_refuse: bool = False
     unprivileged: bool = False
     interrupt: tuple[int, str, float] | None = None
-    timeout: float = TIMEOUT
+    cpu_limit: float = CPU_LIMIT
 
 
 # -- the random families ----------------------------------------------------------------
@@ -177,7 +180,7 @@ def make_case(family: str, mutator: str, seed, index: int) -> Case:
         path = "{in}/m" + corpus.FORMAT_SUFFIX[fmt]
         return Case(case_id, family, mutator, subject, ("info", path),
                     files=((path, data),), names=(_model_names(path, fmt, False),),
-                    facts=facts, timeout=FAST if mutator == "long_polygon" else TIMEOUT)
+                    facts=facts, cpu_limit=FAST if mutator == "long_polygon" else CPU_LIMIT)
     if family == "scene":
         subject = rng.choice(sorted(corpus.scenes()))
         path = "{in}/" + subject
@@ -195,7 +198,7 @@ def make_case(family: str, mutator: str, seed, index: int) -> Case:
                     files=((scene_path, scene), (model_path, data)),
                     names=((scene_path, "key"), _model_names(model_path, fmt, True)),
                     output="{out}/out.npz",
-                    timeout=2 * FAST if mutator == "long_polygon" else TIMEOUT)
+                    cpu_limit=2 * FAST if mutator == "long_polygon" else CPU_LIMIT)
     raise ValueError(f"not a random family: {family!r}")
 
 
@@ -245,28 +248,28 @@ def special_cases() -> list[Case]:
     cases = []
 
     def model(name, path, *, specials=(), files=(), forbid=not_missing, unprivileged=False,
-              names=None, must_refuse=True, timeout=TIMEOUT):
+              names=None, must_refuse=True, cpu_limit=CPU_LIMIT):
         cases.append(_fixed("special", "model-" + name, argv=("info", path),
                             specials=specials, files=files, forbid=forbid,
                             unprivileged=unprivileged,
                             names=((path, "file"),) if names is None else names,
-                            must_refuse=must_refuse, timeout=timeout))
+                            must_refuse=must_refuse, cpu_limit=cpu_limit))
 
     def scene(name, path, *, specials=(), files=(), forbid=not_missing, unprivileged=False,
-              names=None, must_refuse=True, timeout=TIMEOUT):
+              names=None, must_refuse=True, cpu_limit=CPU_LIMIT):
         cases.append(_fixed("special", "scene-" + name, argv=("run", path, *RUN_ARGS),
                             specials=specials, files=files, forbid=forbid,
                             unprivileged=unprivileged,
                             names=((path, "file"),) if names is None else names,
                             output="{out}/out.npz", must_refuse=must_refuse,
-                            timeout=timeout))
+                            cpu_limit=cpu_limit))
 
     for role, add, suffix in (("model", model, ".ac"), ("scene", scene, ".toml")):
         p = "{in}/x" + suffix
         add("directory", p, specials=(Special("dir", p),))
-        add("fifo", p, specials=(Special("fifo", p),), timeout=10.0)
+        add("fifo", p, specials=(Special("fifo", p),), cpu_limit=10.0)
         add("dev-null-link", p, specials=(Special("symlink", p, "/dev/null"),))
-        add("dev-zero-link", p, specials=(Special("symlink", p, "/dev/zero"),), timeout=20.0)
+        add("dev-zero-link", p, specials=(Special("symlink", p, "/dev/zero"),), cpu_limit=20.0)
         add("symlink-loop", p, specials=(Special("symlink", p, p),))
         add("dangling-symlink", p, specials=(Special("symlink", p, "{in}/gone" + suffix),),
             forbid=())
@@ -294,10 +297,10 @@ def special_cases() -> list[Case]:
           must_refuse=False)
     model("polygon-20000-star", "{in}/p.ac", must_refuse=False, forbid=(),
           files=(("{in}/p.ac", corpus.long_polygon_ac3d(20_000, star=True)),),
-          names=(("{in}/p.ac", "line"),), timeout=FAST)
+          names=(("{in}/p.ac", "line"),), cpu_limit=FAST)
     model("polygon-4000-star", "{in}/p.ac", must_refuse=False, forbid=(),
           files=(("{in}/p.ac", corpus.long_polygon_ac3d(4000, star=True)),),
-          names=(("{in}/p.ac", "line"),), timeout=FAST)
+          names=(("{in}/p.ac", "line"),), cpu_limit=FAST)
     scene("empty", "{in}/e.toml", files=(("{in}/e.toml", b""),), forbid=(),
           names=(("{in}/e.toml", "key"),))
     scene("dev-null", "/dev/null", forbid=(), names=(("/dev/null", "file"),))
@@ -332,7 +335,7 @@ def output_cases() -> list[Case]:
             ("fifo", Special("fifo", out)),
             ("directory", Special("dir", out))):
         cases.append(_fixed("output", name, argv=("run", scene, *RUN_ARGS), files=files,
-                            specials=(special,), watch=(out,), output=out, timeout=20.0,
+                            specials=(special,), watch=(out,), output=out, cpu_limit=20.0,
                             must_refuse=name == "directory"))
     cases.append(_fixed("output", "missing-directory", argv=(
         "run", scene, "-o", "{out}/no/out.npz", "--duration", "0.02"), files=files,
@@ -366,12 +369,12 @@ def signal_cases() -> list[Case]:
     files = ((scene, particles),)
     argv = ("run", scene, "-o", "out.npz", "--duration", "0.4")
     cases = [_fixed("signal", signal.Signals(signum).name, files=files, argv=argv,
-                    output="{out}/out.npz", timeout=60.0,
+                    output="{out}/out.npz", cpu_limit=60.0,
                     interrupt=(signum, ".out.npz.*.tmp", delay))
              for signum, delay in ((signal.SIGTERM, 0.0), (signal.SIGHUP, 0.0),
                                    (signal.SIGINT, INTO_THE_WRITE))]
     cases.append(_fixed("signal", "SIGINT-at-mkstemp", files=files, argv=argv,
-                        output="{out}/out.npz", timeout=60.0,
+                        output="{out}/out.npz", cpu_limit=60.0,
                         interrupt=(signal.SIGINT, ".out.npz.*.tmp", 0.0)))
     return cases
 
@@ -491,6 +494,6 @@ def case_from_id(case_id: str) -> Case:
     raise KeyError(f"no case {case_id!r}")
 
 
-def with_timeout(case: Case, timeout: float) -> Case:
-    """``case`` with another timeout (the slice uses shorter ones)."""
-    return replace(case, timeout=timeout)
+def with_cpu_limit(case: Case, cpu_limit: float) -> Case:
+    """``case`` with another CPU-time limit (the slice uses smaller ones)."""
+    return replace(case, cpu_limit=cpu_limit)

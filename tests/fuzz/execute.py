@@ -208,7 +208,7 @@ def execute(case: Case, runner, workdir: Path) -> Record:
                 for s in case.specials if s.path.startswith("{out}")}
         command = Command(
             argv=tuple(fill(a, places) for a in case.argv), cwd=Path(places["{out}"]),
-            stdout=root / "stdout", stderr=root / "stderr", timeout=case.timeout,
+            stdout=root / "stdout", stderr=root / "stderr", cpu_limit=case.cpu_limit,
             unprivileged=case.unprivileged, interrupt=case.interrupt)
         outcome = runner.run(command)
         output = fill(case.output, places) if case.output else None

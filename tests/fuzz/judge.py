@@ -14,8 +14,9 @@ failures can be grouped:
 
 - a traceback: the exception type and the innermost refsim frame
   (``RecursionError in refsim/scenes/loader.py:load_scene``);
-- a signal or a hang: the signal and the innermost refsim frame of
-  faulthandler's stack dump;
+- a signal, a hang or a CPU-time overrun: the signal, respectively the
+  module (``hang in refsim/x.py``, ``over the CPU limit in refsim/x.py``),
+  of the innermost refsim frame of faulthandler's stack dump;
 - a bad message: what is wrong with it and the message with paths, numbers
   and quoted names blanked (``names no line or key: <in>/x.ac: no such file``);
 - files left, files replaced, bad output: what was left, replaced or wrong.
@@ -27,7 +28,11 @@ traceback       "Traceback" on stderr, or a stray stderr line (not ``refsim:
                 error:``/``refsim: warning:``) on a run that exited normally
                 and was not a refusal (a refusal's extra lines are a bad message)
 signal          ended by a signal refsim was not sent
-hang            killed at the case's timeout
+hang            killed at the case's wall-clock backstop: it waited (for a
+                FIFO, a lock) instead of computing
+cpu time        stopped by SIGXCPU at the case's CPU-time limit: it computed
+                too long (a loaded machine slows a case, it does not make it
+                use more CPU time)
 bad message     a refusal that is not exactly one line naming the file and the
                 line or key, gives a wrong reason, or names the body twice
 files left      a temporary or partial file in the output directory
@@ -47,8 +52,8 @@ from dataclasses import dataclass
 from tests.fuzz.cases import WHOLE_FILE_MODEL, Case
 from tests.fuzz.execute import Record, fill
 
-COLUMNS = ("traceback", "signal", "hang", "bad message", "files left", "files replaced",
-           "bad output")
+COLUMNS = ("traceback", "signal", "hang", "cpu time", "bad message", "files left",
+           "files replaced", "bad output")
 
 ERROR = "refsim: error: "
 WARNING = "refsim: warning: "
@@ -117,9 +122,10 @@ def innermost_frame(stderr: str, dump: bool) -> str:
 
 
 def hang_site(stack: str) -> str:
-    """Where a hang is: the module of the innermost refsim frame of the
-    dump (a slow loop is caught in whichever of its helpers it is in at the
-    timeout, so the function would split one cause into several)."""
+    """Where a hang or a CPU-time overrun is: the module of the innermost
+    refsim frame of the dump (a slow loop is caught in whichever of its
+    helpers it is in at the limit, so the function would split one cause
+    into several)."""
     return innermost_frame(stack, dump=True).rsplit(":", 1)[0]
 
 
@@ -263,6 +269,11 @@ def judge(case: Case, record: Record) -> Verdict:
         failures.append(Failure("hang", f"hang in {hang_site(o.stderr)}",
                                 f"killed after {o.elapsed:.1f} s in "
                                 f"{innermost_frame(o.stderr, dump=True)}"))
+    elif o.cpu_exceeded:
+        failures.append(Failure("cpu time", f"over the CPU limit in {hang_site(o.stderr)}",
+                                f"stopped after {case.cpu_limit:g} s of CPU time "
+                                f"({o.elapsed:.1f} s) in "
+                                f"{innermost_frame(o.stderr, dump=True)}"))
     elif o.signal is not None and o.signal != sent:
         name = signal.Signals(o.signal).name
         failures.append(Failure("signal", f"{name} in {innermost_frame(o.stderr, dump=True)}",
@@ -308,6 +319,7 @@ def judge(case: Case, record: Record) -> Verdict:
     for name in record.left:
         kind = "temporary file" if re.match(r"(?:.*/)?\..*\.tmp$", name) else "partial output"
         how = ("after " + signal.Signals(sent).name if sent else "after a hang" if o.timed_out
+               else "after the CPU limit" if o.cpu_exceeded
                else "after a crash" if o.signal else f"after exit {o.returncode}")
         failures.append(Failure("files left", f"{kind} left {how}", name))
     for change in record.replaced:

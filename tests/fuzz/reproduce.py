@@ -4,7 +4,8 @@
 mutant and any other input file, byte for byte) and ``repro.sh``, which makes
 a fresh temporary directory, copies ``in/`` there, makes the special nodes
 (FIFOs, symlinks, a device node, an unreadable file), changes to ``out/`` and
-runs the command the campaign ran, with its timeout (and, for a permission
+runs the command the campaign ran, with its CPU-time limit and wall-clock
+backstop (and, for a permission
 case, without root's file-permission override, through ``setpriv``). It then
 prints the exit status and what is left in ``out/``. The command is
 ``${REFSIM:-refsim}``: put the project's ``.venv/bin`` on PATH, or set
@@ -16,13 +17,14 @@ The same case can also be rebuilt from its id alone:
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import shlex
 from pathlib import Path
 
 from tests.fuzz.cases import Case
-from tests.fuzz.runner import UNPRIVILEGED
+from tests.fuzz.runner import UNPRIVILEGED, WALL_FACTOR
 
 
 def shell_word(text: str) -> str:
@@ -76,8 +78,11 @@ def write_reproducer(case: Case, dest: Path, signature: str = "") -> Path:
             if special.kind == "unreadable":
                 make.append(f"chmod 000 {where}")
     user = " ".join(UNPRIVILEGED) + " " if case.unprivileged else ""
-    command = (f"timeout -s KILL {case.timeout:g} {user}\"${{REFSIM:-refsim}}\" "
-               + " ".join(shell_word(a) for a in case.argv))
+    # the campaign's limits: CPU time (soft, so SIGXCPU ends it), then the
+    # wall-clock backstop; exec keeps the subshell's pid for the signal cases
+    cpu, wall = math.ceil(case.cpu_limit), WALL_FACTOR * case.cpu_limit
+    command = (f"(ulimit -S -t {cpu}; exec timeout -s KILL {wall:g} {user}"
+               "\"${REFSIM:-refsim}\" " + " ".join(shell_word(a) for a in case.argv) + ")")
     if case.interrupt is None:
         run = [command, 'echo "exit status: $?"']
     else:

@@ -11,10 +11,15 @@ Two backends give the same :class:`Outcome` for a :class:`Command`:
   campaign runs its mutants here and confirms each distinct failure with
   :class:`ExecRunner`.
 
-Supervision, the same for both: a timeout (a hang: the child gets SIGUSR1,
-so that faulthandler prints where it hangs, then SIGKILL); an address-space
-limit (``RLIMIT_AS``, so that a multi-GB allocation fails as a MemoryError
-instead of taking the shared machine's memory); and, for the signal cases,
+Supervision, the same for both: a limit on the CPU time the child uses
+(``RLIMIT_CPU``: at the limit the kernel sends SIGXCPU, faulthandler prints
+where the child is and the child dies of it; the outcome is
+``cpu_exceeded``), so that a loaded machine, which slows a command down
+without making it do more work, cannot fail a case; a much larger wall-clock
+backstop for a child that waits instead of computing (a hang: the child gets
+SIGUSR1, so that faulthandler prints where it hangs, then SIGKILL); an
+address-space limit (``RLIMIT_AS``, so that a multi-GB allocation fails as a
+MemoryError instead of taking the shared machine's memory); and, for the signal cases,
 a signal sent as soon as a file matching a pattern appears in the working
 directory (the moment an output's temporary file exists).
 
@@ -25,7 +30,9 @@ changes no result refsim computes (its bits never go through BLAS).
 from __future__ import annotations
 
 import json
+import math
 import os
+import resource
 import select
 import signal
 import subprocess
@@ -42,15 +49,28 @@ ROOT = Path(__file__).resolve().parents[2]
 #: sizes and stops an attempt at a multi-GB allocation.
 MEMORY_LIMIT = 4 * 2**30
 
-#: Seconds a command may take before it counts as a hang.
-TIMEOUT = 30.0
+#: Seconds of CPU time a command may use before it counts as over its CPU
+#: limit (a limit in CPU time, not wall time: a command on a loaded machine
+#: takes longer but uses no more CPU).
+CPU_LIMIT = 30.0
+
+#: The wall-clock backstop, as a multiple of the CPU limit: a child that
+#: waits (a FIFO's open, a lock) uses no CPU and is stopped only by the
+#: clock, after long enough that a child which computes, however little of
+#: a core a loaded machine gives it, reaches its CPU limit first.
+WALL_FACTOR = 10.0
+
+#: Seconds of CPU time between SIGXCPU (the soft limit: faulthandler dumps
+#: the stack and the child dies of the signal) and the kernel's SIGKILL
+#: (the hard limit), for a child that would survive SIGXCPU.
+CPU_GRACE = 1
 
 #: How much of stdout and stderr is kept (a mutant may make refsim print a lot).
 KEEP_BYTES = 256 * 1024
 
-#: Seconds between SIGUSR1 (faulthandler dumps the stack) and SIGKILL at a
-#: timeout: the dump takes microseconds, but on a loaded machine the process
-#: may wait that long to be scheduled (0.2 s lost one dump in 60).
+#: Seconds between SIGUSR1 (faulthandler dumps the stack) and SIGKILL at the
+#: wall-clock backstop: the dump takes microseconds, but on a loaded machine
+#: the process may wait that long to be scheduled (0.2 s lost one dump in 60).
 DUMP_GRACE = 0.5
 
 ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
@@ -58,10 +78,11 @@ ENV = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
 ENV.pop("REFSIM_MODELS", None)          # the bundled models, always
 
 #: The console script (``refsim = refsim.cli:main``) with a memory limit, no
-#: core file, a stack dump on SIGUSR1, a terminal's signal dispositions
-#: (:func:`terminal_signals`), and death with its parent (a killed campaign
-#: leaves no hanging command behind). ``sys.argv[1]`` is the limit
-#: in bytes (0: none).
+#: core file, a stack dump on SIGUSR1 and on SIGXCPU (then death by it), a
+#: terminal's signal dispositions (:func:`terminal_signals`), and death with
+#: its parent (a killed campaign leaves no hanging command behind).
+#: ``sys.argv[1]`` is the memory limit in bytes (0: none); the CPU-time
+#: limit is set from outside (``prlimit``).
 SHIM = ("import ctypes, sys, resource, signal, faulthandler\n"
         "try:\n"
         "    ctypes.CDLL(None).prctl(1, signal.SIGKILL)   # as die_with_parent()\n"
@@ -74,6 +95,7 @@ SHIM = ("import ctypes, sys, resource, signal, faulthandler\n"
         "if limit: resource.setrlimit(resource.RLIMIT_AS, (limit, limit))\n"
         "resource.setrlimit(resource.RLIMIT_CORE, (0, 0))\n"
         "faulthandler.register(signal.SIGUSR1, all_threads=True)\n"
+        "faulthandler.register(signal.SIGXCPU, all_threads=True, chain=True)\n"
         "from refsim.cli import main\n"
         "sys.exit(main())\n")
 
@@ -152,6 +174,14 @@ def stop_server(process: subprocess.Popen) -> None:
         process.wait()
 
 
+def cpu_rlimit(seconds: float, used: float = 0.0) -> tuple[int, int]:
+    """``RLIMIT_CPU``'s (soft, hard) pair for a child that has used ``used``
+    seconds of CPU and may use ``seconds`` more: SIGXCPU at the soft limit
+    (whole seconds, so rounded up), SIGKILL :data:`CPU_GRACE` later."""
+    soft = max(1, math.ceil(used + seconds))
+    return soft, soft + CPU_GRACE
+
+
 def die_with_parent() -> None:
     """Have the kernel SIGKILL this process when its parent dies (Linux
     ``prctl(PR_SET_PDEATHSIG)``; elsewhere nothing): a campaign stopped by
@@ -168,6 +198,8 @@ def die_with_parent() -> None:
 class Command:
     """``refsim ARGV`` run in ``cwd``.
 
+    ``cpu_limit``: the seconds of CPU time it may use; ``wall_limit``: the
+    wall-clock backstop (default :data:`WALL_FACTOR` times ``cpu_limit``).
     ``interrupt = (signum, pattern, delay)`` sends ``signum`` ``delay``
     seconds after a file matching the glob ``pattern`` appears in ``cwd``.
     ``unprivileged`` runs it without the capabilities that let root read
@@ -180,10 +212,16 @@ class Command:
     cwd: Path
     stdout: Path
     stderr: Path
-    timeout: float = TIMEOUT
+    cpu_limit: float = CPU_LIMIT
     unprivileged: bool = False
     interrupt: tuple[int, str, float] | None = None
     memory: int = MEMORY_LIMIT
+    wall_limit: float | None = None
+
+    @property
+    def wall(self) -> float:
+        """Seconds of wall-clock time before the command counts as a hang."""
+        return WALL_FACTOR * self.cpu_limit if self.wall_limit is None else self.wall_limit
 
 
 @dataclass(frozen=True)
@@ -192,9 +230,11 @@ class Outcome:
 
     ``returncode`` is the exit status, or ``-signum`` when a signal ended the
     process (as ``subprocess`` reports it); ``timed_out`` when it was killed
-    for running past its timeout (``stderr`` then ends with faulthandler's
-    stack dump); ``interrupted`` when the command's own ``interrupt`` signal
-    was sent.
+    at its wall-clock backstop (a hang; ``stderr`` then ends with
+    faulthandler's stack dump); ``cpu_exceeded`` when it died of SIGXCPU at
+    its CPU-time limit (a command that computes too long; the stack dump
+    too); ``interrupted`` when the command's own ``interrupt`` signal was
+    sent.
     """
 
     returncode: int
@@ -203,11 +243,18 @@ class Outcome:
     stdout: str
     stderr: str
     elapsed: float
+    cpu_exceeded: bool = False
 
     @property
     def signal(self) -> int | None:
         """The signal that ended the process, or None."""
         return -self.returncode if self.returncode < 0 else None
+
+
+def _died_of_cpu_limit(code: int, timed_out: bool) -> bool:
+    """Whether a child that ended with ``code`` was stopped by its CPU-time
+    limit (SIGXCPU) rather than at the wall-clock backstop."""
+    return code == -signal.SIGXCPU and not timed_out
 
 
 def _read(path: Path) -> str:
@@ -226,11 +273,12 @@ def _interrupt_due(command: Command) -> bool:
 
 def _supervise(command: Command, pid: int, poll) -> tuple[int, bool, bool]:
     """Wait for ``pid`` through ``poll(seconds) -> status or None``; send the
-    interrupt when due; at the timeout dump the stack and kill it.
+    interrupt when due; at the wall-clock backstop dump the stack and kill it
+    (the CPU-time limit is the kernel's, set when the child starts).
 
     Returns ``(returncode, timed_out, interrupted)``.
     """
-    deadline = time.monotonic() + command.timeout
+    deadline = time.monotonic() + command.wall
     pending = command.interrupt is not None
     seen = None                                   # when the interrupt's file appeared
     while True:
@@ -276,6 +324,11 @@ class ExecRunner:
             process = subprocess.Popen(
                 self.argv(command), cwd=command.cwd, stdin=subprocess.DEVNULL, stdout=out,
                 stderr=err, env=ENV)
+            try:      # the limit counts the CPU time used before it was set too
+                resource.prlimit(process.pid, resource.RLIMIT_CPU,
+                                 cpu_rlimit(command.cpu_limit))
+            except ProcessLookupError:                # already gone
+                pass
 
             def poll(seconds):
                 try:
@@ -285,7 +338,8 @@ class ExecRunner:
 
             code, timed_out, interrupted = _supervise(command, process.pid, poll)
         return Outcome(code, timed_out, interrupted, _read(command.stdout),
-                       _read(command.stderr), time.monotonic() - start)
+                       _read(command.stderr), time.monotonic() - start,
+                       _died_of_cpu_limit(code, timed_out))
 
     def close(self) -> None:
         pass
@@ -343,7 +397,8 @@ class ForkServer:
         start = time.monotonic()
         request = {"argv": list(command.argv), "cwd": str(command.cwd),
                    "stdout": str(command.stdout), "stderr": str(command.stderr),
-                   "unprivileged": command.unprivileged, "memory": command.memory}
+                   "unprivileged": command.unprivileged, "memory": command.memory,
+                   "cpu": cpu_rlimit(command.cpu_limit)}
         self._process.stdin.write((json.dumps(request) + "\n").encode())
         self._process.stdin.flush()
         pid = self._message(60.0)["pid"]
@@ -354,7 +409,8 @@ class ForkServer:
 
         code, timed_out, interrupted = _supervise(command, pid, poll)
         return Outcome(code, timed_out, interrupted, _read(command.stdout),
-                       _read(command.stderr), time.monotonic() - start)
+                       _read(command.stderr), time.monotonic() - start,
+                       _died_of_cpu_limit(code, timed_out))
 
     def _close_pipes(self) -> None:
         close_quietly(self._process.stdin, self._process.stdout)

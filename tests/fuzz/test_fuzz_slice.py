@@ -23,24 +23,28 @@ from __future__ import annotations
 import pytest
 
 from tests.fuzz.api_worker import KNOWN_PROBES, Probe, judge_probe, shared_runner
-from tests.fuzz.cases import case_from_id, with_timeout
+from tests.fuzz.cases import case_from_id, with_cpu_limit
 from tests.fuzz.execute import execute
 from tests.fuzz.judge import judge
 from tests.fuzz.runner import ForkServer
 
-#: Seconds a slice case may take before it counts as a hang: the slice's
-#: cases take 0.02-0.6 s each on a loaded two-core machine, and a hang
-#: coming back (a FIFO, a long polygon) must not cost the suite more than this.
-SLICE_TIMEOUT = 3.0
+#: Seconds of CPU time a slice case may use before it counts as over its CPU
+#: limit: the slice's cases use well under a second each, and a slow loop
+#: coming back (a long polygon) must not cost the suite more than this. A
+#: limit in CPU time, not wall time, so that a loaded machine cannot fail a
+#: case; a case that waits (a FIFO) is stopped by the wall-clock backstop,
+#: tests.fuzz.runner.WALL_FACTOR times its CPU limit, as a hang.
+SLICE_CPU_LIMIT = 3.0
 
-#: Shorter limits for cases that once hung: opening a FIFO blocks at once,
-#: so any correct refusal takes milliseconds; a 20 000-corner polygon is a
-#: fraction of a second for an ear clipper that prunes its tests.
-CASE_TIMEOUT = {"special:scene-fifo": 1.0, "special:model-polygon-20000-star": 2.0}
+#: Smaller limits for cases that once hung: opening a FIFO blocks at once,
+#: so any correct refusal takes milliseconds (and the backstop comes sooner);
+#: a 20 000-corner polygon is a fraction of a second for an ear clipper that
+#: prunes its tests.
+CASE_CPU_LIMIT = {"special:scene-fifo": 1.0, "special:model-polygon-20000-star": 2.0}
 
-#: The same for an API probe (each probe takes milliseconds; a worker
-#: restart after a crash takes about a second and is not counted here).
-SLICE_PROBE_TIMEOUT = 3.0
+#: The same for an API probe (each probe uses milliseconds; a worker
+#: restart after a crash is not counted here).
+SLICE_PROBE_CPU_LIMIT = 3.0
 
 REFUSED, ACCEPTED = "refused", "accepted"
 
@@ -106,14 +110,15 @@ def fork_server(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def probe_runner():
-    return shared_runner(SLICE_PROBE_TIMEOUT)
+    return shared_runner(SLICE_PROBE_CPU_LIMIT)
 
 
 def _case_report(case, record, verdict) -> str:
     o = record.outcome
     lines = [f"case {case.id}: {case.family} {case.mutator} on {case.subject}",
              f"refsim {' '.join(case.argv)}",
-             f"exit {o.returncode}{' (timed out)' if o.timed_out else ''}, "
+             f"exit {o.returncode}{' (timed out)' if o.timed_out else ''}"
+             f"{' (over its CPU limit)' if o.cpu_exceeded else ''}, "
              f"{o.elapsed:.2f} s; stderr:", o.stderr.rstrip()[-1500:] or "(empty)"]
     lines += [f"[{f.column}] {f.signature}" for f in verdict.failures]
     lines.append(f"reproduce: python -m tests.fuzz.campaign --replay {case.id}")
@@ -123,7 +128,8 @@ def _case_report(case, record, verdict) -> str:
 @pytest.mark.parametrize(("case_id", "expected"), CASES)
 def test_command_line_keeps_the_error_laws(case_id, expected, fork_server, tmp_path):
     case = case_from_id(case_id)
-    case = with_timeout(case, min(case.timeout, CASE_TIMEOUT.get(case_id, SLICE_TIMEOUT)))
+    case = with_cpu_limit(case, min(case.cpu_limit,
+                                    CASE_CPU_LIMIT.get(case_id, SLICE_CPU_LIMIT)))
     record = execute(case, fork_server, tmp_path)
     verdict = judge(case, record)
     report = _case_report(case, record, verdict)
@@ -183,7 +189,9 @@ def test_public_api_keeps_the_error_law(probe, expected, probe_runner):
     outcome = probe_runner.run(probe)
     failures = judge_probe(probe, outcome)
     facts = outcome.facts
-    status = facts.get("status") or (f"signal {outcome.signal}" if outcome.signal else "hang")
+    status = facts.get("status") or (f"signal {outcome.signal}" if outcome.signal
+                                     else "over its CPU limit" if outcome.cpu_exceeded
+                                     else "hang")
     said = facts.get("message", facts.get("repr", ""))[:300]
     report = "\n".join([f"{probe.function}: {probe.code}",
                         f"outcome: {status} {facts.get('type', '')} {said}",

@@ -196,8 +196,9 @@ def test_shell_word_quotes_text_and_expands_the_case_directories():
 def test_a_reproducer_holds_the_mutant_and_runs_the_same_command(tmp_path):
     case = Case("special:x", "special", "x", "s", ("info", "{in}/x.ac"),
                 files=(("{in}/m.ac", b"AC3Db\n"),),
-                specials=(Special("fifo", "{in}/x.ac"),), timeout=7.0)
+                specials=(Special("fifo", "{in}/x.ac"),), cpu_limit=7.0)
     script = write_reproducer(case, tmp_path / "r").read_text()
     assert (tmp_path / "r" / "in" / "m.ac").read_bytes() == b"AC3Db\n"
     assert 'mkfifo "$work/in"/x.ac' in script
-    assert 'timeout -s KILL 7 "${REFSIM:-refsim}" info "$work/in"/x.ac' in script
+    assert ('(ulimit -S -t 7; exec timeout -s KILL 70 "${REFSIM:-refsim}" info '
+            '"$work/in"/x.ac)') in script

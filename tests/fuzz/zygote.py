@@ -7,7 +7,7 @@ This process pays that once (imports, then one short run of every bundled
 scene and one ``refsim info`` per model format), then serves requests: for
 each it forks a child that becomes the command line, ``refsim.cli.main(argv)``
 with stdin from /dev/null, stdout and stderr to the given files, the given
-working directory and address-space limit, and, for a permission case, without
+working directory, address-space limit and CPU-time limit, and, for a permission case, without
 root's file-permission override. The child does what the
 console script does (``sys.exit(main())``); an exception that escapes is
 printed as the interpreter would print it (``Traceback ...``, status 1).
@@ -21,7 +21,8 @@ this server are confirmed in a fresh process (:class:`runner.ExecRunner`)
 before they are reported.
 
 Protocol (JSON lines): a request ``{"argv", "cwd", "stdout", "stderr",
-"unprivileged", "memory"}`` on stdin; the replies ``{"pid": n}`` once the child runs
+"unprivileged", "memory", "cpu"}`` (``cpu``: ``RLIMIT_CPU``'s soft and hard
+limits) on stdin; the replies ``{"pid": n}`` once the child runs
 and ``{"status": s}`` (the raw ``waitpid`` status) when it ends.
 """
 
@@ -108,12 +109,16 @@ def _child(request: dict) -> None:
             os.close(fd)
         faulthandler.enable(sys.stderr, all_threads=True)
         faulthandler.register(signal.SIGUSR1, file=sys.stderr, all_threads=True)
+        # at the CPU-time limit: the stack, then death by SIGXCPU (the runner's cpu_exceeded)
+        faulthandler.register(signal.SIGXCPU, file=sys.stderr, all_threads=True, chain=True)
         os.chdir(request["cwd"])
         if request.get("unprivileged"):
             drop_file_capabilities()
         if request.get("memory"):
             resource.setrlimit(resource.RLIMIT_AS, (request["memory"], request["memory"]))
         resource.setrlimit(resource.RLIMIT_CORE, (0, 0))   # a crash leaves no core file
+        if request.get("cpu"):
+            resource.setrlimit(resource.RLIMIT_CPU, tuple(request["cpu"]))
         _reset_warnings()
         from refsim.cli import main
 

@@ -219,18 +219,45 @@ def test_replay_draws_from_file_without_the_network(browser, replay_file):
     assert severe == []
 
 
+#: The size of the iframe the report embeds a replay in (CSS pixels).
+IFRAME_SIZE = (900, 600)
+
+#: The size (CSS pixels) and the URL of the largest canvas of the page.
+CANVAS_BOX = """
+const c = Array.from(document.querySelectorAll('canvas'))
+  .sort((a, b) => b.width * b.height - a.width * a.height)[0];
+const r = c.getBoundingClientRect();
+return [r.width, r.height, document.location.href];
+"""
+
+
 def test_replay_plays_inside_an_iframe(browser, replay_file, tmp_path):
+    """As the report shows it: in an iframe the replay fills the frame,
+    draws, plays (the canvas changes by itself) and shows its panel."""
+    width, height = IFRAME_SIZE
     host = tmp_path / "host.html"
     host.write_text(f'<!doctype html><html><body style="margin:0">'
-                    f'<iframe id="r" src="{replay_file.as_uri()}" width="900" height="600">'
-                    f'</iframe></body></html>')
-    t0 = time.perf_counter()
+                    f'<iframe id="r" src="{replay_file.as_uri()}" width="{width}" '
+                    f'height="{height}"></iframe></body></html>')
     browser.get(host.as_uri())
-    print("get", time.perf_counter() - t0)
-    browser.switch_to.frame(browser.find_element("id", "r"))
-    print("switch", time.perf_counter() - t0)
+    frame = browser.find_element("id", "r")
+    assert browser.execute_script("return [arguments[0].clientWidth, arguments[0].clientHeight];",
+                                  frame) == [width, height]             # inside its border
+    browser.switch_to.frame(frame)
     try:
-        _wait_for(browser, lambda p: not _is_blank(p), "the replay in an iframe",
-                  settled=False)
+        first = _wait_for(browser, lambda p: not _is_blank(p), "the replay in an iframe",
+                          settled=False)
+        w, h, url = browser.execute_script(CANVAS_BOX)
+        assert url == replay_file.as_uri()
+        assert 0.5 * width <= w <= width and 0.5 * height <= h <= height
+        later = _wait_for(browser, lambda p: not _is_blank(p) and not np.array_equal(p, first),
+                          "the replay playing on", settled=False)
+        assert not np.array_equal(later, first)
+        panel = browser.execute_script(
+            "return document.getElementById('refsim-replay').innerText;")
+        assert "refsim replay" in panel and "2 runs side by side" in panel
+        assert "seed" in panel and "impulse" in panel
     finally:
         browser.switch_to.default_content()
+    severe = [e for e in _console(browser) if e["level"] == "SEVERE"]
+    assert severe == []

@@ -1,4 +1,4 @@
-"""Report section: the fidelity advisor on every bundled scene (issue 17).
+"""Report section: the fidelity advisor on every bundled scene.
 
 Arranges the plan's ``advisor``: for each bundled scene, the answer of
 :func:`refsim.studies.advisor.advise` at each of the report's tolerances

@@ -1,4 +1,4 @@
-"""Report section: the shipped engines side by side (the conformance kit, issue 14).
+"""Report section: the shipped engines side by side (the conformance kit).
 
 Arranges the plan's ``conformance-matrix``: each shipped engine (refsim's
 seed and corrected models, python-fcl, trimesh, pybullet, MuJoCo) run

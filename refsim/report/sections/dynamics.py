@@ -383,11 +383,11 @@ def _apex_findings(found: dict) -> str:
             "e^2 ("
             + ("rounding" if found["off_at_rounding"] else
                ("inside" if found["off_within_target"] else "outside")
-               + f" the issue's {_pct(target)} target")
+               + f" refsim's {_pct(target)} target")
             + f"); the seed's literal flip (the deeper, faster speed one step past the wall) "
             f"is at most {_pct(found['literal_worst'])} off, "
             + ("inside" if found["literal_within_target"] else "outside")
-            + f" the issue's {_pct(target)} target.")
+            + f" refsim's {_pct(target)} target.")
     if "cube_off_worst" in found:
         parts.append(f"The cube's face-down bounce with rotation off: at most "
                      f"{_pct(found['cube_off_worst'])} from e^2.")
@@ -472,7 +472,7 @@ def _step_cost_findings(step_rows, found: dict) -> str:
         parts.append("The ratio falls as bodies are added: refsim's time per step grows far "
                      "less with the body count than pybullet's." if found["ratio_falls"] else
                      "The ratio does not fall steadily as bodies are added.")
-    parts.append(f"The issue's target is refsim at most {found['target']:g}x pybullet at "
+    parts.append(f"refsim's target is at most {found['target']:g}x pybullet's time per step at "
                  f"{found['largest_bodies']} bodies; this run measured "
                  + ", ".join(f"{r['ratio']:.2g}x (rotation {r['rotation']}, after step "
                              f"{r['warmup']}{', within' if r['within_target'] else ', above'} it)"
