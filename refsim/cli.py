@@ -19,7 +19,9 @@ naming the file and the line or key, and exits with status 2; ``--debug``
 shows the traceback instead. A run that diverges prints one line naming the
 step and time, writes the frames computed before it, and exits with status 3.
 Anything else is a bug in refsim and keeps its traceback. Output files are
-written whole or not at all (a temporary file, then ``os.replace``).
+written whole or not at all (a temporary file, then ``os.replace``). Output
+cut short by its reader (``refsim info X | head -1``) ends quietly with
+status 1. ``refsim --version`` prints the installed version.
 """
 
 from __future__ import annotations
@@ -37,6 +39,10 @@ from refsim.signals import Interrupted, signals_raise
 
 EXIT_USER_ERROR = 2
 EXIT_DIVERGED = 3
+
+#: The status of a command whose reader went away (``refsim info X | head -1``):
+#: not a success, since the output was cut short, yet nothing to report.
+EXIT_BROKEN_PIPE = 1
 
 def _info(args) -> int:
     from refsim.models.facts import describe, format_facts
@@ -565,6 +571,8 @@ def build_parser() -> argparse.ArgumentParser:
                     "checked against FCL, trimesh, scipy and pybullet.")
     parser.add_argument("--debug", action="store_true",
                         help="show the full traceback on errors")
+    parser.add_argument("--version", action="version", version=f"refsim {version()}",
+                        help="print refsim's version and exit")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     info = commands.add_parser("info", help="print facts about model files")
@@ -619,7 +627,40 @@ def _one_line_warning(message, category, filename, lineno, file=None, line=None)
     print(f"refsim: warning: {one_line(message)}", file=sys.stderr if file is None else file)
 
 
+def version() -> str:
+    """refsim's version: the installed distribution's, else the package's own
+    ``__version__`` (a source tree on the path without an install)."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as installed_version
+
+    try:
+        return installed_version("refsim")
+    except PackageNotFoundError:
+        from refsim import __version__
+
+        return __version__
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run the command of ``argv`` (default: the process's arguments) and
+    return its exit status. Output cut short by its reader (a pipe into
+    ``head``) ends quietly with :data:`EXIT_BROKEN_PIPE`, as Python's
+    documentation of SIGPIPE advises: standard output is pointed at
+    ``os.devnull`` so that the interpreter's final flush cannot fail again."""
+    try:
+        status = _main(argv)
+        sys.stdout.flush()          # a broken pipe shows here, not at exit
+        return status
+    except BrokenPipeError:
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError):   # a stream with no descriptor (a test's capture)
+            pass
+        return EXIT_BROKEN_PIPE
+
+
+def _main(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if not args.debug:

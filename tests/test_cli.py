@@ -192,3 +192,31 @@ def test_a_body_wider_than_float64_is_refused_without_a_numpy_warning(tmp_path, 
     assert err.count("\n") == 1 and "warning" not in err
     assert err.startswith(f"refsim: error: {scene}: body[0].model: model wide.ac at scale 1 is "
                           "larger than the world cube: its box spans inf x ")
+
+
+# What a new user tries first.
+
+def test_version_prints_the_installed_version(capsys):
+    import tomllib
+    from pathlib import Path
+
+    declared = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml")
+                             .read_text())["project"]["version"]
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--version"])
+    assert exit_info.value.code == 0
+    assert capsys.readouterr().out == f"refsim {declared}\n"
+
+
+def test_output_cut_short_by_its_reader_ends_quietly():
+    # Far more than a pipe holds (64 KiB on Linux), so the command is still
+    # writing when the reader closes its end after the first line.
+    argv = [sys.executable, "-m", "refsim.cli", "info", *["cube.ac"] * 400]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = proc.stdout.readline()
+    proc.stdout.close()
+    err = proc.stderr.read()
+    proc.stderr.close()
+    assert proc.wait(timeout=120) == 1
+    assert first.split() == ["model", "cube.ac"]
+    assert err == ""
