@@ -220,3 +220,9 @@ def test_output_cut_short_by_its_reader_ends_quietly():
     assert proc.wait(timeout=120) == 1
     assert first.split() == ["model", "cube.ac"]
     assert err == ""
+
+
+def test_info_of_a_directory_says_it_is_one(tmp_path, capsys):
+    assert main(["info", str(tmp_path)]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (f"refsim: error: {tmp_path}: a directory, not a model "
+                                       "file (.ac, .obj, .stl, .ply, .off)\n")

@@ -52,11 +52,13 @@ def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
     Raises
     ------
     ModelError
-        When the file is missing, its suffix is not supported, or it cannot
-        be read as a triangle mesh.
+        When the file is missing or a directory, its suffix is not
+        supported, or it cannot be read as a triangle mesh.
     """
     path = as_path(path)
     suffix = path.suffix.lower()
+    if suffix not in SUFFIXES and path.is_dir():     # a folder is no format, known or not
+        raise ModelError(f"a directory, not a model file ({', '.join(SUFFIXES)})", path=path)
     if suffix not in SUFFIXES:
         raise ModelError(f"unknown model format {path.suffix or '(no suffix)'!r}; "
                          f"supported: {', '.join(SUFFIXES)}", path=path)
