@@ -44,6 +44,38 @@ EXIT_DIVERGED = 3
 #: not a success, since the output was cut short, yet nothing to report.
 EXIT_BROKEN_PIPE = 1
 
+#: The suffixes of the files refsim's commands write. An output directory
+#: named with one of them is a file name given where a directory is meant
+#: (``refsim report -o report.html``), refused rather than made a directory.
+FILE_SUFFIXES = (".npz", ".html", ".htm", ".json", ".svg", ".toml", ".txt")
+
+
+def _output_file(path, suffixes: tuple[str, ...], command: str) -> Path:
+    """``path`` as a Path when its suffix is one of ``suffixes`` (in any
+    case): the command writes that format whatever the name says, so another
+    suffix is refused (OutputError naming the path) before any work."""
+    from refsim.io import output_error
+
+    out = Path(path)
+    if out.suffix.lower() not in suffixes:
+        raise output_error(out, f"refsim {command} writes {' or '.join(suffixes)} files; "
+                                f"name the output with the suffix {suffixes[0]}")
+    return out
+
+
+def _output_directory(path, command: str, writes: str) -> Path:
+    """``path`` as a Path for a command that writes a directory (``writes``
+    says what goes in it); a name with a file's suffix (FILE_SUFFIXES) that
+    is not already a directory is refused before any work."""
+    from refsim.io import output_error
+
+    out = Path(path)
+    if out.suffix.lower() in FILE_SUFFIXES and not out.is_dir():
+        raise output_error(out, f"refsim {command} writes a directory ({writes}), not a "
+                                f"{out.suffix} file; name a directory")
+    return out
+
+
 def _info(args) -> int:
     from refsim.models.facts import describe, format_facts
     from refsim.models.loading import load_model
@@ -72,6 +104,8 @@ def _settings(scene, every: int) -> dict:
 def _run(args) -> int:
     from refsim.scenes.loader import load_scene
 
+    if args.output:
+        _output_file(args.output, (".npz",), "run")
     scene = load_scene(args.scene)
     if args.duration is not None:
         scene = _with_duration(scene, args.duration)
@@ -205,7 +239,8 @@ def _report(args) -> int:
     from refsim.errors import check_count
     from refsim.report.build import build_report
 
-    out = Path(args.output)
+    out = _output_directory(args.output, "report", "index.html, results.json and the pages "
+                                                   "they link")
     workers = None if args.workers is None else check_count("--workers", args.workers, 1)
     try:
         page = build_report(out, quick=args.quick, workers=workers)
@@ -229,6 +264,7 @@ def _view(args) -> int:
 def _replay(args) -> int:
     from refsim.viewer.replay import load_runs, write_replay
 
+    _output_file(args.output, (".html", ".htm"), "replay")
     runs = load_runs(args.runs, scenes=args.scene or ())
     info = write_replay(runs, args.output, overlay=args.overlay, max_bytes=args.max_bytes,
                         boxes=args.boxes)
@@ -249,7 +285,8 @@ def _study(args) -> int:
     if args.output is not None:
         from refsim.conformance.matrix import make_directory
 
-        out = make_directory(args.output)
+        out = make_directory(_output_directory(args.output, "study", "the pages of the "
+                                                                     "studies that write them"))
     run = Run(quick=args.quick, seed=args.seed, out_dir=out, workers=workers,
               announce=lambda text: print(f"refsim: measuring {text}", file=sys.stderr))
     try:
@@ -317,7 +354,7 @@ def _conform(args) -> int:
                           "engine's own file (refsim/conformance/expected/)")
     cases = check_count("--cases", DEFAULT_CASES if args.cases is None else args.cases, 1)
     seed = check_count("--seed", args.seed, minimum=0)
-    out = Path(args.output)
+    out = _output_directory(args.output, "conform", "its JSON record and pages")
     if args.only is not None and args.only not in CAPABILITIES:
         raise OptionError(f"--only {args.only!r}: not a capability (capabilities: "
                           f"{', '.join(CAPABILITIES)})")
@@ -429,7 +466,7 @@ def _add_viewer_commands(commands) -> None:
                     "scene the run records. Needs the viewer extra.")
     replay.add_argument("runs", nargs="+", metavar="RUN.npz", help="recorded trajectories")
     replay.add_argument("-o", "--output", required=True, metavar="OUT.html",
-                        help="the replay page to write")
+                        help="the replay page to write, named .html")
     replay.add_argument("--scene", action="append", metavar="SCENE.toml",
                         help="the scene of the runs (once for all, or once per run in order)")
     replay.add_argument("--overlay", action="store_true",
@@ -465,7 +502,9 @@ def _advise(args) -> int:
     if args.workers is not None and args.scheduler is not None:
         raise StateError("give --workers (local processes) or --scheduler (a Dask "
                          "cluster), not both")
-    out = None if args.output is None else Path(args.output)
+    out = (None if args.output is None
+           else _output_directory(args.output, "advise", "the advice as TOML and JSON, and "
+                                                         "its chart"))
     if out is not None and out.exists() and not out.is_dir():
         raise output_error(out, "it is not a directory")
     if out is not None and not out.parent.is_dir():
@@ -591,7 +630,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("scene", metavar="SCENE",
                      help="a scene file (TOML) with [[body]] tables or a [particles] table")
     run.add_argument("-o", "--output", metavar="OUT.npz",
-                     help="output file (default: the scene's name with .npz, here)")
+                     help="output file, named .npz (default: the scene's name with .npz, "
+                          "here)")
     run.add_argument("--every", type=int, metavar="K",
                      help="store every K-th step (default: at most about 1000 frames for "
                           "bodies, 200 for particles); the last step is always stored")

@@ -226,3 +226,28 @@ def test_info_of_a_directory_says_it_is_one(tmp_path, capsys):
     assert main(["info", str(tmp_path)]) == EXIT_USER_ERROR
     assert capsys.readouterr().err == (f"refsim: error: {tmp_path}: a directory, not a model "
                                        "file (.ac, .obj, .stl, .ply, .off)\n")
+
+
+@pytest.mark.parametrize("argv, written", [
+    (["replay", "spin.npz", "-o", "spin.txt"], "writes .html or .htm files; name the output "
+                                              "with the suffix .html"),
+    (["report", "--quick", "-o", "report.html"], "refsim report writes a directory"),
+    (["study", "bounds-error", "--quick", "-o", "study.json"], "refsim study writes a directory"),
+    (["conform", "--all", "-o", "matrix.json"], "refsim conform writes a directory"),
+    (["advise", "bounce.toml", "-o", "advice.toml"], "refsim advise writes a directory"),
+])
+def test_an_output_the_command_does_not_write_is_refused_before_any_work(
+        argv, written, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith(f"refsim: error: {argv[-1]}: cannot write: ") and written in err
+    assert err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_directory_named_like_a_file_is_still_a_directory(tmp_path, capsys):
+    out = tmp_path / "study.json"
+    out.mkdir()
+    assert main(["study", "bounds-error", "--quick", "-o", str(out)]) == 0
+    assert "\nC2: partly\n" in capsys.readouterr().out

@@ -450,3 +450,16 @@ def test_a_full_disk_is_one_line_and_leaves_no_file(tmp_path, count):
     assert result.returncode == EXIT_USER_ERROR and result.stdout == ""
     assert result.stderr == f"refsim: error: {out}: cannot write: File too large\n"
     assert files(tmp_path) == ["out.npz", "scene.toml"] and out.read_bytes() == b"old"
+
+
+def test_an_output_suffix_run_does_not_write_is_refused(tmp_path, capsys):
+    scene = write(tmp_path, TINY)
+    out = tmp_path / "out.txt"
+    assert main(["run", str(scene), "-o", str(out)]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (f"refsim: error: {out}: cannot write: refsim run writes "
+                                       ".npz files; name the output with the suffix .npz\n")
+    assert files(tmp_path) == ["scene.toml"]
+    upper = tmp_path / "OUT.NPZ"                   # the suffix in any case is the format's
+    assert main(["run", str(scene), "-o", str(upper), "--every", "50"]) == 0
+    with np.load(upper) as data:
+        assert data["t"].shape == (3,)
