@@ -1,6 +1,7 @@
 """The ``refsim`` command line.
 
     refsim info MODEL                  facts about a model file
+    refsim info --bundled              the bundled models and scenes, by name
     refsim run SCENE [-o OUT.npz] [--every K]
                                        simulate a scene (bodies or particles), write frames
     refsim report [--quick] [-o DIR] [--workers N]
@@ -77,9 +78,22 @@ def _output_directory(path, command: str, writes: str) -> Path:
 
 
 def _info(args) -> int:
+    from refsim.errors import OptionError
     from refsim.models.facts import describe, format_facts
     from refsim.models.loading import load_model
 
+    if args.bundled:
+        if args.models:
+            raise OptionError("--bundled lists the bundled models and scenes; give it "
+                              "without MODEL files")
+        from refsim.bundled import bundled_models, bundled_scenes
+
+        for path in (*bundled_models(), *bundled_scenes()):
+            print(path.name)
+        return 0
+    if not args.models:
+        raise OptionError("give one or more MODEL files, or --bundled to list the bundled "
+                          "models and scenes (see refsim info --help)")
     for i, path in enumerate(args.models):
         if i:
             print()
@@ -614,9 +628,17 @@ def build_parser() -> argparse.ArgumentParser:
                         help="print refsim's version and exit")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    info = commands.add_parser("info", help="print facts about model files")
-    info.add_argument("models", nargs="+", metavar="MODEL",
+    info = commands.add_parser(
+        "info", help="print facts about model files",
+        description="Print each MODEL's triangles, vertices, convexity, closedness, bounds "
+                    "and centroids. A bare file name (cube.ac) that is not in the current "
+                    "directory names a bundled model; --bundled lists the bundled models "
+                    "and scenes.")
+    info.add_argument("models", nargs="*", metavar="MODEL",
                       help=".ac (refsim's reader), .obj, .stl, .ply or .off")
+    info.add_argument("--bundled", action="store_true",
+                      help="list the bundled models and scenes, one name a line (each can "
+                           "be named so from any directory)")
     info.set_defaults(run=_info)
 
     run = commands.add_parser(

@@ -251,3 +251,61 @@ def test_a_directory_named_like_a_file_is_still_a_directory(tmp_path, capsys):
     out.mkdir()
     assert main(["study", "bounds-error", "--quick", "-o", str(out)]) == 0
     assert "\nC2: partly\n" in capsys.readouterr().out
+
+
+# Bundled models and scenes by bare name.
+
+def test_a_missing_path_to_a_bundled_model_names_the_bare_name(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)                      # no models/ folder here
+    assert main(["info", "models/sphere-2k.ac"]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (
+        "refsim: error: models/sphere-2k.ac: no such file (a bundled model of that name "
+        "exists: use 'sphere-2k.ac')\n")
+    assert main(["info", "sphere-2k.ac"]) == 0
+    assert capsys.readouterr().out.splitlines()[0].split() == ["model", "sphere-2k.ac"]
+
+
+def test_a_missing_path_to_a_bundled_scene_names_the_bare_name(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "scenes/spinning-cube.toml", "-o", "spin.npz"]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (
+        "refsim: error: scenes/spinning-cube.toml: no such file (a bundled scene of that name "
+        "exists: use 'spinning-cube.toml')\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_missing_path_with_no_bundled_namesake_gets_no_hint(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["info", "models/no-such-model.ac"]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == "refsim: error: models/no-such-model.ac: no such file\n"
+
+
+def test_a_scenes_model_path_to_a_bundled_model_names_the_bare_name(tmp_path, capsys):
+    scene = _scene_naming(tmp_path, "models/cube.ac")
+    assert main(["run", str(scene), "-o", str(tmp_path / "out.npz")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith(f"refsim: error: {scene}: body[0].model: model 'models/cube.ac' "
+                          "not found (looked in ")
+    assert err.endswith("; a bundled model of that name exists: use 'cube.ac'\n")
+
+
+def test_info_bundled_lists_every_bundled_model_and_scene(capsys):
+    from refsim.bundled import scenes_dir
+
+    assert main(["info", "--bundled"]) == 0
+    names = capsys.readouterr().out.splitlines()
+    models = sorted(p.name for p in models_dir().glob("*.ac"))
+    scenes = sorted(p.name for p in scenes_dir().glob("*.toml"))
+    assert names == models + scenes
+    assert {"cube.ac", "sphere-2k.ac", "torus.ac", "bounce.toml",
+            "spinning-cube.toml"} <= set(names)
+
+
+@pytest.mark.parametrize("argv, phrase", [
+    (["info"], "give one or more MODEL files, or --bundled"),
+    (["info", "--bundled", "cube.ac"], "give it without MODEL files"),
+])
+def test_info_needs_models_or_bundled(argv, phrase, capsys):
+    assert main(argv) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith("refsim: error: ") and phrase in err and err.count("\n") == 1

@@ -28,7 +28,7 @@ import numpy as np
 
 from refsim.bundled import models_dir
 from refsim.errors import ModelError
-from refsim.files import as_path, bundled_if_bare, read_regular_file
+from refsim.files import as_path, bundled_if_bare, read_regular_file, refuse_missing_bundled
 from refsim.models.ac3d import read_ac3d
 from refsim.models.mesh import Mesh
 
@@ -63,6 +63,7 @@ def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
         raise ModelError(f"unknown model format {path.suffix or '(no suffix)'!r}; "
                          f"supported: {', '.join(SUFFIXES)}", path=path)
     path = bundled_if_bare(path, models_dir())
+    refuse_missing_bundled(path, models_dir(), "model", ModelError)
     if suffix == ".ac":
         return read_ac3d(path, weld_tolerance=weld_tolerance)
     return _load_with_trimesh(path, read_regular_file(path, ModelError), weld_tolerance)

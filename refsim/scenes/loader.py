@@ -26,7 +26,13 @@ import numpy as np
 from refsim.bundled import models_dir, scenes_dir
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
 from refsim.errors import ModelError, SceneError, StateError
-from refsim.files import as_path, bundled_if_bare, decode_utf8, read_regular_file
+from refsim.files import (
+    as_path,
+    bundled_if_bare,
+    decode_utf8,
+    read_regular_file,
+    refuse_missing_bundled,
+)
 from refsim.limits import MAX_MAGNITUDE, MAX_SCENE_BYTES, MAX_SCENE_NESTING
 from refsim.models.loading import load_model
 from refsim.scenes.schema import (
@@ -71,6 +77,7 @@ def load_scene(path) -> Scene:
         scene, the body's key and the model file's own line.
     """
     path = bundled_if_bare(as_path(path), scenes_dir())
+    refuse_missing_bundled(path, scenes_dir(), "scene", SceneError)
     data = read_regular_file(path, SceneError, max_bytes=MAX_SCENE_BYTES)
     text = decode_utf8(data, path, SceneError)
     too_deep = first_line_nested_deeper(text, MAX_SCENE_NESTING)
@@ -305,7 +312,11 @@ def _resolve_model(name: str, scene_path: Path | None, key: str) -> Path:
                              key) from None
         return candidate.absolute()           # a symlink keeps the name (and suffix) given
     looked = ", ".join(str(c) for c in candidates)
-    raise SceneError(f"model {name!r} not found (looked in {looked})", scene_path, key)
+    bare = Path(name).name
+    hint = ""
+    if bare != name and (models_dir() / bare).is_file():
+        hint = f"; a bundled model of that name exists: use {bare!r}"
+    raise SceneError(f"model {name!r} not found (looked in {looked}){hint}", scene_path, key)
 
 
 def _load_meshes(bodies, scene_path) -> dict:
