@@ -2,7 +2,7 @@
 
 One module per engine; each converts conventions (units, frames, float32,
 semantics) inside itself and nowhere else. The engines are optional
-dependencies (``pip install -e '.[oracles]'``): an adapter imports its engine
+dependencies (``pip install 'refsim[oracles]'``): an adapter imports its engine
 only when used and raises :class:`OracleUnavailable` if it is missing. Tests
 turn that into a skip that names the reason (``require`` in tests/conftest.py).
 """
@@ -10,6 +10,9 @@ turn that into a skip that names the reason (``require`` in tests/conftest.py).
 from __future__ import annotations
 
 import importlib
+
+#: What ``pip`` installs for the oracles (pyproject.toml's ``oracles`` extra).
+INSTALL_HINT = "pip install 'refsim[oracles]'"
 
 
 class OracleUnavailable(RuntimeError):
@@ -27,7 +30,7 @@ def import_engine(module: str, package: str):
     except ImportError as exc:
         raise OracleUnavailable(
             f"oracle engine {package!r} is not installed "
-            f"(pip install -e '.[oracles]'): {exc}") from None
+            f"({INSTALL_HINT}): {exc}") from None
 
 
 def trajectory_of_frames(frames, times, names, events, step_seconds: float,

@@ -251,6 +251,9 @@ def _run_particles(scene, out: Path, every: int | None) -> int:
 
 def _report(args) -> int:
     from refsim.errors import check_count
+    from refsim.report import require_report
+
+    require_report()        # before any work: the charts import matplotlib when drawn
     from refsim.report.build import build_report
 
     out = _output_directory(args.output, "report", "index.html, results.json and the pages "
@@ -277,8 +280,10 @@ def _view(args) -> int:
 
 def _replay(args) -> int:
     from refsim.viewer.replay import load_runs, write_replay
+    from refsim.viewer.server import require_viser
 
     _output_file(args.output, (".html", ".htm"), "replay")
+    require_viser()
     runs = load_runs(args.runs, scenes=args.scene or ())
     info = write_replay(runs, args.output, overlay=args.overlay, max_bytes=args.max_bytes,
                         boxes=args.boxes)
@@ -391,7 +396,15 @@ def _conform(args) -> int:
             print(f"refsim: warning: {name} not run: {one_line(reason)}", file=sys.stderr)
         for d in matrix.divergences:
             print(f"  {d.engine:17} {d.check:22} {d.status:8} {d.reason}")
-        print(f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine")
+        wrote = f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine"
+        if matrix.unavailable:
+            # a matrix with engines missing is not the check asked for
+            from refsim.oracles import INSTALL_HINT
+
+            print(f"{wrote}; not run: {', '.join(sorted(matrix.unavailable))} (see the "
+                  f"warnings; {INSTALL_HINT})")
+            return EXIT_CHECK_FAILED
+        print(wrote)
         return 0 if matrix.ok else EXIT_CHECK_FAILED
     # MODULE is looked up in the current directory first, as `python -m`
     # does: a user's myengine.py beside them is found without PYTHONPATH
@@ -427,7 +440,8 @@ def _add_conform_command(commands) -> None:
                     "DIR/conformance.json and a self-contained DIR/index.html, prints a "
                     "table. --all runs the six shipped engines and writes their matrix. "
                     "Exit status 0: every check passed (declared expected failures "
-                    "aside); 1: a check failed; 2: a usage error.")
+                    "aside); 1: a check failed, or --all left out an engine whose package "
+                    "is missing; 2: a usage error.")
     conform.add_argument("engine", nargs="?", metavar="MODULE:FACTORY",
                          help="the engine, e.g. refsim.engines.refsim_engines:corrected")
     conform.add_argument("--all", action="store_true",

@@ -309,3 +309,35 @@ def test_info_needs_models_or_bundled(argv, phrase, capsys):
     assert main(argv) == EXIT_USER_ERROR
     err = capsys.readouterr().err
     assert err.startswith("refsim: error: ") and phrase in err and err.count("\n") == 1
+
+
+# A core-only install: one line naming the missing package and the extra.
+
+@pytest.mark.parametrize("module", ["matplotlib", "jinja2"])
+def test_report_without_its_extra_names_the_package_and_the_extra(module, tmp_path, capsys,
+                                                                 monkeypatch):
+    monkeypatch.setitem(sys.modules, module, None)         # import MODULE -> ImportError
+    out = tmp_path / "rep"
+    assert main(["report", "--quick", "-o", str(out)]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (f"refsim: error: the report needs {module}, which is "
+                                       "not installed: pip install 'refsim[report]'\n")
+    assert not out.exists()
+
+
+def test_replay_without_viser_names_the_extra(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "viser", None)
+    out = tmp_path / "r.html"
+    assert main(["replay", str(tmp_path / "run.npz"), "-o", str(out)]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == ("refsim: error: the viewer needs viser, which is not "
+                                       "installed: pip install 'refsim[viewer]'\n")
+    assert not out.exists()
+
+
+def test_the_oracles_hint_is_for_an_installed_refsim(monkeypatch):
+    from refsim.oracles import OracleUnavailable, import_engine
+
+    monkeypatch.setitem(sys.modules, "pybullet", None)
+    with pytest.raises(OracleUnavailable) as info:
+        import_engine("pybullet", "pybullet")
+    assert str(info.value).startswith("oracle engine 'pybullet' is not installed "
+                                      "(pip install 'refsim[oracles]'): ")
