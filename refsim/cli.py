@@ -116,11 +116,11 @@ def _settings(scene, every: int) -> dict:
 
 
 def _run(args) -> int:
-    from refsim.scenes.loader import load_scene
+    from refsim.scenes.loader import load_scene_text
 
     if args.output:
         _output_file(args.output, (".npz",), "run")
-    scene = load_scene(args.scene)
+    scene, text = load_scene_text(args.scene)
     if args.duration is not None:
         scene = _with_duration(scene, args.duration)
     if scene.bodies and scene.particles is not None:
@@ -132,7 +132,7 @@ def _run(args) -> int:
     if not out.parent.is_dir():
         raise RefsimError(f"{out}: cannot write: no directory {out.parent}")
     if scene.bodies:
-        return _run_bodies(scene, out, args.every)
+        return _run_bodies(scene, text, out, args.every)
     return _run_particles(scene, out, args.every)
 
 
@@ -168,13 +168,16 @@ def _write(out: Path, save) -> None:
         raise output_error(out, exc.strerror or str(exc)) from exc
 
 
-def _run_bodies(scene, out: Path, every: int | None) -> int:
+def _run_bodies(scene, text: str, out: Path, every: int | None) -> int:
     """Rigid bodies: ``refsim.simulate`` with the frames spilled beside
     ``out`` as they are computed (:class:`refsim.frames.SpillSink`: memory
-    does not grow with the steps), then written as a Trajectory (.npz)."""
+    does not grow with the steps), then written as a Trajectory (.npz) whose
+    settings record the scene: its file and its ``text``, from which
+    ``refsim replay`` rebuilds the meshes."""
     from refsim.dynamics.simulation import default_every, simulate
     from refsim.frames import SpillSink, check_disk_space
     from refsim.io import output_target
+    from refsim.viewer.replay import recorded_scene_settings
 
     output_target(out)                  # a FIFO, device or directory: refused before running
     B = len(scene.bodies)
@@ -189,11 +192,13 @@ def _run_bodies(scene, out: Path, every: int | None) -> int:
             trajectory = simulate(scene, every=every, sink=sink)
         except DivergenceError as exc:
             partial = exc.partial
+            partial.settings.update(recorded_scene_settings(scene.path, text))
             _write(out, partial.save)
             raise DivergenceError(
                 f"{exc.message}; wrote the {partial.n_frames} frames before "
                 f"it (t = 0 to {partial.t[-1]:.6g}) to {out}", step=exc.step, time=exc.time,
                 body=exc.body) from None
+        trajectory.settings.update(recorded_scene_settings(scene.path, text))
         _write(out, trajectory.save)
         n_frames, t_end = trajectory.n_frames, float(trajectory.t[-1])
     ran = ", ".join(trajectory.stages)
@@ -660,7 +665,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Simulate SCENE for its [integration] duration and write an .npz. "
                     "Rigid bodies: t (frames,), position, velocity, angular_velocity "
                     "(frames, bodies, 3), orientation (frames, bodies, 3, 3), names, events, "
-                    "stages, stage_seconds, settings (see refsim.Trajectory.load). "
+                    "stages, stage_seconds, settings (with the scene file's path and text, "
+                    "for refsim replay; see refsim.Trajectory.load). "
                     "Particles: t, step (frames,), position and velocity (frames, N, 3), "
                     "the scene's settings as JSON (scene) and status.")
     run.add_argument("scene", metavar="SCENE",

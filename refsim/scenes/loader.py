@@ -76,10 +76,23 @@ def load_scene(path) -> Scene:
         Never: a body's broken model is reported as a SceneError naming the
         scene, the body's key and the model file's own line.
     """
+    return load_scene_text(path)[0]
+
+
+def load_scene_text(path) -> tuple[Scene, str]:
+    """:func:`load_scene`, and the text of the file as it was read (what
+    ``refsim run`` records, so that a replay can rebuild the scene)."""
     path = bundled_if_bare(as_path(path), scenes_dir())
     refuse_missing_bundled(path, scenes_dir(), "scene", SceneError)
     data = read_regular_file(path, SceneError, max_bytes=MAX_SCENE_BYTES)
     text = decode_utf8(data, path, SceneError)
+    return scene_from_text(text, path), text
+
+
+def scene_from_text(text: str, path: Path | None = None) -> Scene:
+    """The scene of TOML ``text``, validated as :func:`load_scene` does;
+    ``path`` is where the text came from, for messages and for resolving
+    model paths relative to it (None: against the bundled models only)."""
     too_deep = first_line_nested_deeper(text, MAX_SCENE_NESTING)
     if too_deep is not None:
         raise SceneError(f"invalid TOML: arrays and inline tables nested more than "
