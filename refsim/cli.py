@@ -52,12 +52,15 @@ FILE_SUFFIXES = (".npz", ".html", ".htm", ".json", ".svg", ".toml", ".txt")
 
 
 def _output_file(path, suffixes: tuple[str, ...], command: str) -> Path:
-    """``path`` as a Path when its suffix is one of ``suffixes`` (in any
-    case): the command writes that format whatever the name says, so another
-    suffix is refused (OutputError naming the path) before any work."""
-    from refsim.io import output_error
+    """``path`` as a Path when it can be written (:func:`refsim.io.output_target`:
+    not a directory, device or FIFO, in a directory that exists) and its
+    suffix is one of ``suffixes`` (in any case): the command writes that
+    format whatever the name says, so another suffix is refused
+    (OutputError naming the path) before any work."""
+    from refsim.io import output_error, output_target
 
     out = Path(path)
+    output_target(out)
     if out.suffix.lower() not in suffixes:
         raise output_error(out, f"refsim {command} writes {' or '.join(suffixes)} files; "
                                 f"name the output with the suffix {suffixes[0]}")
