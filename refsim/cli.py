@@ -123,9 +123,10 @@ def _run(args) -> int:
 
     if args.output:
         _output_file(args.output, (".npz",), "run")
-    scene, text = load_scene_text(args.scene)
+    max_steps = _max_steps(args)
+    scene, text = load_scene_text(args.scene, max_steps=max_steps)
     if args.duration is not None:
-        scene = _with_duration(scene, args.duration)
+        scene = _with_duration(scene, args.duration, max_steps)
     if scene.bodies and scene.particles is not None:
         raise SceneError("refsim run simulates either rigid bodies or particles; this scene "
                          "has both (split it in two)", scene.path, "particles")
@@ -139,18 +140,33 @@ def _run(args) -> int:
     return _run_particles(scene, out, args.every)
 
 
-def _with_duration(scene, duration: float):
-    """``scene`` simulated for ``duration`` seconds instead of its own."""
+def _max_steps(args) -> int:
+    """``--max-steps``, checked, or the scenes' default limit."""
+    from refsim.errors import check_count
+    from refsim.limits import DEFAULT_MAX_STEPS, MAX_STEPS
+
+    if args.max_steps is None:
+        return DEFAULT_MAX_STEPS
+    return check_count("--max-steps", args.max_steps, 1, MAX_STEPS)
+
+
+def _with_duration(scene, duration: float, max_steps: int | None = None):
+    """``scene`` simulated for ``duration`` seconds instead of its own, in
+    at most ``max_steps`` steps (default: the scenes' limit)."""
     from dataclasses import replace
 
     from refsim.errors import StateError
+    from refsim.limits import DEFAULT_MAX_STEPS
+    from refsim.scenes.loader import steps_limit_hint
     from refsim.solvers.integrate import whole_steps
 
+    max_steps = DEFAULT_MAX_STEPS if max_steps is None else max_steps
     try:
-        whole_steps(duration, scene.integration.step)
+        whole_steps(duration, scene.integration.step, max_steps)
     except StateError as exc:
         if not 0.0 < duration < scene.integration.step:   # the option's own fault
-            raise RefsimError(f"--duration {duration!r}: {exc}") from None
+            hint = steps_limit_hint(duration, scene.integration.step, max_steps)
+            raise RefsimError(f"--duration {duration!r}: {exc}{hint}") from None
         # no whole step fits: the option against the scene's step, both named
         raise SceneError(f"the step {scene.integration.step:g} is longer than --duration "
                          f"{duration!r}: no whole step fits", scene.path,
@@ -282,7 +298,8 @@ def _view(args) -> int:
 
     require_viser()
     check_port(args.port)
-    serve(load_scene(args.scene), host=args.host, port=args.port)   # until Ctrl-C
+    scene = load_scene(args.scene, max_steps=_max_steps(args))
+    serve(scene, host=args.host, port=args.port)   # until Ctrl-C
     return 0
 
 
@@ -477,6 +494,15 @@ def _add_conform_command(commands) -> None:
     conform.set_defaults(run=_conform)
 
 
+def _add_max_steps(command) -> None:
+    """``--max-steps N`` of the commands that simulate a scene as it is given."""
+    from refsim.limits import DEFAULT_MAX_STEPS, MAX_STEPS
+
+    command.add_argument("--max-steps", type=int, metavar="N",
+                         help=f"refuse a scene of more than N steps (duration over step; "
+                              f"default {DEFAULT_MAX_STEPS}, at most {MAX_STEPS})")
+
+
 def _add_viewer_commands(commands) -> None:
     """``refsim view`` and ``refsim replay`` (refsim.viewer; the ``viewer`` extra)."""
     from refsim.viewer import REPLAY_MAX_BYTES as DEFAULT_MAX_BYTES
@@ -492,6 +518,7 @@ def _add_viewer_commands(commands) -> None:
                       help="port to serve on (default 8080; 0 for any free port)")
     view.add_argument("--host", default="127.0.0.1", metavar="ADDRESS",
                       help="address to bind (default 127.0.0.1, this machine only)")
+    _add_max_steps(view)
     view.set_defaults(run=_view)
 
     replay = commands.add_parser(
@@ -682,6 +709,7 @@ def build_parser() -> argparse.ArgumentParser:
                           "bodies, 200 for particles); the last step is always stored")
     run.add_argument("--duration", type=float, metavar="SECONDS",
                      help="simulate this long instead of the scene's [integration] duration")
+    _add_max_steps(run)
     run.set_defaults(run=_run)
 
     report = commands.add_parser("report", help="write the HTML accuracy report")

@@ -47,6 +47,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from refsim.errors import OutputError, RefsimError, check_count
+from refsim.limits import MAX_STEPS
 from refsim.viewer import REPLAY_MAX_BYTES as DEFAULT_MAX_BYTES
 
 if TYPE_CHECKING:
@@ -168,7 +169,7 @@ def load_run(path, scene=None, *, label: str | None = None) -> ReplayRun:
                               f"the scene with --scene SCENE.toml")
         scene = recorded
     if not isinstance(scene, Scene):
-        scene = load_scene(scene)
+        scene = load_scene(scene, max_steps=MAX_STEPS)      # run already: any length
     assert isinstance(traj, Trajectory)
     return run_from_scene(label, scene, traj)
 
@@ -189,7 +190,8 @@ def _recorded_scene(path: Path, settings: dict):
     recorded = settings.get("scene")
     try:
         return scene_from_text(settings[SCENE_TEXT],
-                               Path(recorded) if isinstance(recorded, str) else None)
+                               Path(recorded) if isinstance(recorded, str) else None,
+                               max_steps=MAX_STEPS)
     except SceneError as exc:
         raise RefsimError(f"{path}: the scene the run records cannot be rebuilt ({exc}); "
                           f"name the scene with --scene SCENE.toml") from None
@@ -231,7 +233,7 @@ def load_runs(paths, scenes=()) -> list[ReplayRun]:
     if len(scenes) == 1 and len(paths) > 1:
         from refsim.scenes.loader import load_scene
 
-        scenes = [load_scene(scenes[0])] * len(paths)
+        scenes = [load_scene(scenes[0], max_steps=MAX_STEPS)] * len(paths)
     labels = _labels(paths)
     return [load_run(p, scenes[i] if scenes else None, label=labels[i])
             for i, p in enumerate(paths)]
