@@ -2,14 +2,20 @@
 
 One module per engine; each converts conventions (units, frames, float32,
 semantics) inside itself and nowhere else. The engines are optional
-dependencies (``pip install -e '.[oracles]'``): an adapter imports its engine
+dependencies (``pip install 'refsim[oracles]'``): an adapter imports its engine
 only when used and raises :class:`OracleUnavailable` if it is missing. Tests
 turn that into a skip that names the reason (``require`` in tests/conftest.py).
 """
 
 from __future__ import annotations
 
+import contextlib
 import importlib
+import os
+import sys
+
+#: What ``pip`` installs for the oracles (pyproject.toml's ``oracles`` extra).
+INSTALL_HINT = "pip install 'refsim[oracles]'"
 
 
 class OracleUnavailable(RuntimeError):
@@ -27,7 +33,62 @@ def import_engine(module: str, package: str):
     except ImportError as exc:
         raise OracleUnavailable(
             f"oracle engine {package!r} is not installed "
-            f"(pip install -e '.[oracles]'): {exc}") from None
+            f"({INSTALL_HINT}): {exc}") from None
+
+
+@contextlib.contextmanager
+def c_banner_dropped(banner: str):
+    """Standard output and error (file descriptors 1 and 2) captured for the
+    block, then put back with what was written to them, less the lines that
+    start with ``banner``: for an engine whose C code prints a banner as it
+    loads (pybullet's build time, to standard output or error depending on
+    its build), which would otherwise land in the output of ``refsim
+    report`` or ``conform --all``. Anything else written meanwhile (a
+    warning) still reaches its stream, after the block."""
+    with contextlib.ExitStack() as stack:
+        for fd, stream in ((1, sys.stdout), (2, sys.stderr)):
+            stack.enter_context(_fd_filtered(fd, stream, banner.encode()))
+        yield
+
+
+@contextlib.contextmanager
+def _fd_filtered(fd: int, stream, banner: bytes):
+    """Descriptor ``fd`` into a temporary file for the block; then restored,
+    and the file's lines that do not start with ``banner`` written to it."""
+    import tempfile
+
+    try:
+        saved = os.dup(fd)
+    except OSError:                     # no such descriptor: nothing to capture
+        yield
+        return
+    with tempfile.TemporaryFile() as captured:
+        try:
+            if stream is not None:
+                stream.flush()          # what Python buffered goes out before the swap
+            os.dup2(captured.fileno(), fd)
+            yield
+        finally:
+            if stream is not None:
+                stream.flush()
+            _flush_c_stdio()            # what C buffered goes into the file
+            os.dup2(saved, fd)
+            os.close(saved)
+            captured.seek(0)
+            kept = b"".join(line for line in captured.read().splitlines(keepends=True)
+                            if not line.startswith(banner))
+            if kept:
+                os.write(fd, kept)
+
+
+def _flush_c_stdio() -> None:
+    """C's ``fflush(NULL)``, where the C library can be loaded."""
+    import ctypes
+
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError, TypeError):    # no C library to call (Windows)
+        pass
 
 
 def trajectory_of_frames(frames, times, names, events, step_seconds: float,

@@ -127,7 +127,7 @@ import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from refsim.oracles import import_engine, trajectory_of_frames
+from refsim.oracles import c_banner_dropped, import_engine, trajectory_of_frames
 
 
 @dataclass(frozen=True)
@@ -212,7 +212,8 @@ class PybulletOracle:
     name = "pybullet"
 
     def __init__(self, settings: PybulletSettings | None = None):
-        self.p = import_engine("pybullet", "pybullet")
+        with c_banner_dropped("pybullet build time:"):      # printed as it loads
+            self.p = import_engine("pybullet", "pybullet")
         self.settings = settings or PybulletSettings()
         self.client = self.p.connect(self.p.DIRECT)
         self.bodies: list[int] = []

@@ -1,6 +1,7 @@
 """The ``refsim`` command line.
 
     refsim info MODEL                  facts about a model file
+    refsim info --bundled              the bundled models and scenes, by name
     refsim run SCENE [-o OUT.npz] [--every K]
                                        simulate a scene (bodies or particles), write frames
     refsim report [--quick] [-o DIR] [--workers N]
@@ -19,7 +20,9 @@ naming the file and the line or key, and exits with status 2; ``--debug``
 shows the traceback instead. A run that diverges prints one line naming the
 step and time, writes the frames computed before it, and exits with status 3.
 Anything else is a bug in refsim and keeps its traceback. Output files are
-written whole or not at all (a temporary file, then ``os.replace``).
+written whole or not at all (a temporary file, then ``os.replace``). Output
+cut short by its reader (``refsim info X | head -1``) ends quietly with
+status 1. ``refsim --version`` prints the installed version.
 """
 
 from __future__ import annotations
@@ -38,10 +41,62 @@ from refsim.signals import Interrupted, signals_raise
 EXIT_USER_ERROR = 2
 EXIT_DIVERGED = 3
 
+#: The status of a command whose reader went away (``refsim info X | head -1``):
+#: not a success, since the output was cut short, yet nothing to report.
+EXIT_BROKEN_PIPE = 1
+
+#: The suffixes of the files refsim's commands write. An output directory
+#: named with one of them is a file name given where a directory is meant
+#: (``refsim report -o report.html``), refused rather than made a directory.
+FILE_SUFFIXES = (".npz", ".html", ".htm", ".json", ".svg", ".toml", ".txt")
+
+
+def _output_file(path, suffixes: tuple[str, ...], command: str) -> Path:
+    """``path`` as a Path when it can be written (:func:`refsim.io.output_target`:
+    not a directory, device or FIFO, in a directory that exists) and its
+    suffix is one of ``suffixes`` (in any case): the command writes that
+    format whatever the name says, so another suffix is refused
+    (OutputError naming the path) before any work."""
+    from refsim.io import output_error, output_target
+
+    out = Path(path)
+    output_target(out)
+    if out.suffix.lower() not in suffixes:
+        raise output_error(out, f"refsim {command} writes {' or '.join(suffixes)} files; "
+                                f"name the output with the suffix {suffixes[0]}")
+    return out
+
+
+def _output_directory(path, command: str, writes: str) -> Path:
+    """``path`` as a Path for a command that writes a directory (``writes``
+    says what goes in it); a name with a file's suffix (FILE_SUFFIXES) that
+    is not already a directory is refused before any work."""
+    from refsim.io import output_error
+
+    out = Path(path)
+    if out.suffix.lower() in FILE_SUFFIXES and not out.is_dir():
+        raise output_error(out, f"refsim {command} writes a directory ({writes}), not a "
+                                f"{out.suffix} file; name a directory")
+    return out
+
+
 def _info(args) -> int:
+    from refsim.errors import OptionError
     from refsim.models.facts import describe, format_facts
     from refsim.models.loading import load_model
 
+    if args.bundled:
+        if args.models:
+            raise OptionError("--bundled lists the bundled models and scenes; give it "
+                              "without MODEL files")
+        from refsim.bundled import bundled_models, bundled_scenes
+
+        for path in (*bundled_models(), *bundled_scenes()):
+            print(path.name)
+        return 0
+    if not args.models:
+        raise OptionError("give one or more MODEL files, or --bundled to list the bundled "
+                          "models and scenes (see refsim info --help)")
     for i, path in enumerate(args.models):
         if i:
             print()
@@ -64,11 +119,14 @@ def _settings(scene, every: int) -> dict:
 
 
 def _run(args) -> int:
-    from refsim.scenes.loader import load_scene
+    from refsim.scenes.loader import load_scene_text
 
-    scene = load_scene(args.scene)
+    if args.output:
+        _output_file(args.output, (".npz",), "run")
+    max_steps = _max_steps(args)
+    scene, text = load_scene_text(args.scene, max_steps=max_steps)
     if args.duration is not None:
-        scene = _with_duration(scene, args.duration)
+        scene = _with_duration(scene, args.duration, max_steps)
     if scene.bodies and scene.particles is not None:
         raise SceneError("refsim run simulates either rigid bodies or particles; this scene "
                          "has both (split it in two)", scene.path, "particles")
@@ -78,22 +136,37 @@ def _run(args) -> int:
     if not out.parent.is_dir():
         raise RefsimError(f"{out}: cannot write: no directory {out.parent}")
     if scene.bodies:
-        return _run_bodies(scene, out, args.every)
+        return _run_bodies(scene, text, out, args.every)
     return _run_particles(scene, out, args.every)
 
 
-def _with_duration(scene, duration: float):
-    """``scene`` simulated for ``duration`` seconds instead of its own."""
+def _max_steps(args) -> int:
+    """``--max-steps``, checked, or the scenes' default limit."""
+    from refsim.errors import check_count
+    from refsim.limits import DEFAULT_MAX_STEPS, MAX_STEPS
+
+    if args.max_steps is None:
+        return DEFAULT_MAX_STEPS
+    return check_count("--max-steps", args.max_steps, 1, MAX_STEPS)
+
+
+def _with_duration(scene, duration: float, max_steps: int | None = None):
+    """``scene`` simulated for ``duration`` seconds instead of its own, in
+    at most ``max_steps`` steps (default: the scenes' limit)."""
     from dataclasses import replace
 
     from refsim.errors import StateError
+    from refsim.limits import DEFAULT_MAX_STEPS
+    from refsim.scenes.loader import steps_limit_hint
     from refsim.solvers.integrate import whole_steps
 
+    max_steps = DEFAULT_MAX_STEPS if max_steps is None else max_steps
     try:
-        whole_steps(duration, scene.integration.step)
+        whole_steps(duration, scene.integration.step, max_steps)
     except StateError as exc:
         if not 0.0 < duration < scene.integration.step:   # the option's own fault
-            raise RefsimError(f"--duration {duration!r}: {exc}") from None
+            hint = steps_limit_hint(duration, scene.integration.step, max_steps)
+            raise RefsimError(f"--duration {duration!r}: {exc}{hint}") from None
         # no whole step fits: the option against the scene's step, both named
         raise SceneError(f"the step {scene.integration.step:g} is longer than --duration "
                          f"{duration!r}: no whole step fits", scene.path,
@@ -114,13 +187,16 @@ def _write(out: Path, save) -> None:
         raise output_error(out, exc.strerror or str(exc)) from exc
 
 
-def _run_bodies(scene, out: Path, every: int | None) -> int:
+def _run_bodies(scene, text: str, out: Path, every: int | None) -> int:
     """Rigid bodies: ``refsim.simulate`` with the frames spilled beside
     ``out`` as they are computed (:class:`refsim.frames.SpillSink`: memory
-    does not grow with the steps), then written as a Trajectory (.npz)."""
+    does not grow with the steps), then written as a Trajectory (.npz) whose
+    settings record the scene: its file and its ``text``, from which
+    ``refsim replay`` rebuilds the meshes."""
     from refsim.dynamics.simulation import default_every, simulate
     from refsim.frames import SpillSink, check_disk_space
     from refsim.io import output_target
+    from refsim.viewer.replay import recorded_scene_settings
 
     output_target(out)                  # a FIFO, device or directory: refused before running
     B = len(scene.bodies)
@@ -135,11 +211,13 @@ def _run_bodies(scene, out: Path, every: int | None) -> int:
             trajectory = simulate(scene, every=every, sink=sink)
         except DivergenceError as exc:
             partial = exc.partial
+            partial.settings.update(recorded_scene_settings(scene.path, text))
             _write(out, partial.save)
             raise DivergenceError(
                 f"{exc.message}; wrote the {partial.n_frames} frames before "
                 f"it (t = 0 to {partial.t[-1]:.6g}) to {out}", step=exc.step, time=exc.time,
                 body=exc.body) from None
+        trajectory.settings.update(recorded_scene_settings(scene.path, text))
         _write(out, trajectory.save)
         n_frames, t_end = trajectory.n_frames, float(trajectory.t[-1])
     ran = ", ".join(trajectory.stages)
@@ -197,9 +275,13 @@ def _run_particles(scene, out: Path, every: int | None) -> int:
 
 def _report(args) -> int:
     from refsim.errors import check_count
+    from refsim.report import require_report
+
+    require_report()        # before any work: the charts import matplotlib when drawn
     from refsim.report.build import build_report
 
-    out = Path(args.output)
+    out = _output_directory(args.output, "report", "index.html, results.json and the pages "
+                                                   "they link")
     workers = None if args.workers is None else check_count("--workers", args.workers, 1)
     try:
         page = build_report(out, quick=args.quick, workers=workers)
@@ -216,13 +298,17 @@ def _view(args) -> int:
 
     require_viser()
     check_port(args.port)
-    serve(load_scene(args.scene), host=args.host, port=args.port)   # until Ctrl-C
+    scene = load_scene(args.scene, max_steps=_max_steps(args))
+    serve(scene, host=args.host, port=args.port)   # until Ctrl-C
     return 0
 
 
 def _replay(args) -> int:
     from refsim.viewer.replay import load_runs, write_replay
+    from refsim.viewer.server import require_viser
 
+    _output_file(args.output, (".html", ".htm"), "replay")
+    require_viser()
     runs = load_runs(args.runs, scenes=args.scene or ())
     info = write_replay(runs, args.output, overlay=args.overlay, max_bytes=args.max_bytes,
                         boxes=args.boxes)
@@ -243,7 +329,8 @@ def _study(args) -> int:
     if args.output is not None:
         from refsim.conformance.matrix import make_directory
 
-        out = make_directory(args.output)
+        out = make_directory(_output_directory(args.output, "study", "the pages of the "
+                                                                     "studies that write them"))
     run = Run(quick=args.quick, seed=args.seed, out_dir=out, workers=workers,
               announce=lambda text: print(f"refsim: measuring {text}", file=sys.stderr))
     try:
@@ -311,7 +398,7 @@ def _conform(args) -> int:
                           "engine's own file (refsim/conformance/expected/)")
     cases = check_count("--cases", DEFAULT_CASES if args.cases is None else args.cases, 1)
     seed = check_count("--seed", args.seed, minimum=0)
-    out = Path(args.output)
+    out = _output_directory(args.output, "conform", "its JSON record and pages")
     if args.only is not None and args.only not in CAPABILITIES:
         raise OptionError(f"--only {args.only!r}: not a capability (capabilities: "
                           f"{', '.join(CAPABILITIES)})")
@@ -334,7 +421,15 @@ def _conform(args) -> int:
             print(f"refsim: warning: {name} not run: {one_line(reason)}", file=sys.stderr)
         for d in matrix.divergences:
             print(f"  {d.engine:17} {d.check:22} {d.status:8} {d.reason}")
-        print(f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine")
+        wrote = f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine"
+        if matrix.unavailable:
+            # a matrix with engines missing is not the check asked for
+            from refsim.oracles import INSTALL_HINT
+
+            print(f"{wrote}; not run: {', '.join(sorted(matrix.unavailable))} (see the "
+                  f"warnings; {INSTALL_HINT})")
+            return EXIT_CHECK_FAILED
+        print(wrote)
         return 0 if matrix.ok else EXIT_CHECK_FAILED
     # MODULE is looked up in the current directory first, as `python -m`
     # does: a user's myengine.py beside them is found without PYTHONPATH
@@ -370,7 +465,8 @@ def _add_conform_command(commands) -> None:
                     "DIR/conformance.json and a self-contained DIR/index.html, prints a "
                     "table. --all runs the six shipped engines and writes their matrix. "
                     "Exit status 0: every check passed (declared expected failures "
-                    "aside); 1: a check failed; 2: a usage error.")
+                    "aside); 1: a check failed, or --all left out an engine whose package "
+                    "is missing; 2: a usage error.")
     conform.add_argument("engine", nargs="?", metavar="MODULE:FACTORY",
                          help="the engine, e.g. refsim.engines.refsim_engines:corrected")
     conform.add_argument("--all", action="store_true",
@@ -398,6 +494,15 @@ def _add_conform_command(commands) -> None:
     conform.set_defaults(run=_conform)
 
 
+def _add_max_steps(command) -> None:
+    """``--max-steps N`` of the commands that simulate a scene as it is given."""
+    from refsim.limits import DEFAULT_MAX_STEPS, MAX_STEPS
+
+    command.add_argument("--max-steps", type=int, metavar="N",
+                         help=f"refuse a scene of more than N steps (duration over step; "
+                              f"default {DEFAULT_MAX_STEPS}, at most {MAX_STEPS})")
+
+
 def _add_viewer_commands(commands) -> None:
     """``refsim view`` and ``refsim replay`` (refsim.viewer; the ``viewer`` extra)."""
     from refsim.viewer import REPLAY_MAX_BYTES as DEFAULT_MAX_BYTES
@@ -413,6 +518,7 @@ def _add_viewer_commands(commands) -> None:
                       help="port to serve on (default 8080; 0 for any free port)")
     view.add_argument("--host", default="127.0.0.1", metavar="ADDRESS",
                       help="address to bind (default 127.0.0.1, this machine only)")
+    _add_max_steps(view)
     view.set_defaults(run=_view)
 
     replay = commands.add_parser(
@@ -423,7 +529,7 @@ def _add_viewer_commands(commands) -> None:
                     "scene the run records. Needs the viewer extra.")
     replay.add_argument("runs", nargs="+", metavar="RUN.npz", help="recorded trajectories")
     replay.add_argument("-o", "--output", required=True, metavar="OUT.html",
-                        help="the replay page to write")
+                        help="the replay page to write, named .html")
     replay.add_argument("--scene", action="append", metavar="SCENE.toml",
                         help="the scene of the runs (once for all, or once per run in order)")
     replay.add_argument("--overlay", action="store_true",
@@ -459,7 +565,9 @@ def _advise(args) -> int:
     if args.workers is not None and args.scheduler is not None:
         raise StateError("give --workers (local processes) or --scheduler (a Dask "
                          "cluster), not both")
-    out = None if args.output is None else Path(args.output)
+    out = (None if args.output is None
+           else _output_directory(args.output, "advise", "the advice as TOML and JSON, and "
+                                                         "its chart"))
     if out is not None and out.exists() and not out.is_dir():
         raise output_error(out, "it is not a directory")
     if out is not None and not out.parent.is_dir():
@@ -565,11 +673,21 @@ def build_parser() -> argparse.ArgumentParser:
                     "checked against FCL, trimesh, scipy and pybullet.")
     parser.add_argument("--debug", action="store_true",
                         help="show the full traceback on errors")
+    parser.add_argument("--version", action="version", version=f"refsim {version()}",
+                        help="print refsim's version and exit")
     commands = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    info = commands.add_parser("info", help="print facts about model files")
-    info.add_argument("models", nargs="+", metavar="MODEL",
+    info = commands.add_parser(
+        "info", help="print facts about model files",
+        description="Print each MODEL's triangles, vertices, convexity, closedness, bounds "
+                    "and centroids. A bare file name (cube.ac) that is not in the current "
+                    "directory names a bundled model; --bundled lists the bundled models "
+                    "and scenes.")
+    info.add_argument("models", nargs="*", metavar="MODEL",
                       help=".ac (refsim's reader), .obj, .stl, .ply or .off")
+    info.add_argument("--bundled", action="store_true",
+                      help="list the bundled models and scenes, one name a line (each can "
+                           "be named so from any directory)")
     info.set_defaults(run=_info)
 
     run = commands.add_parser(
@@ -577,18 +695,21 @@ def build_parser() -> argparse.ArgumentParser:
         description="Simulate SCENE for its [integration] duration and write an .npz. "
                     "Rigid bodies: t (frames,), position, velocity, angular_velocity "
                     "(frames, bodies, 3), orientation (frames, bodies, 3, 3), names, events, "
-                    "stages, stage_seconds, settings (see refsim.Trajectory.load). "
+                    "stages, stage_seconds, settings (with the scene file's path and text, "
+                    "for refsim replay; see refsim.Trajectory.load). "
                     "Particles: t, step (frames,), position and velocity (frames, N, 3), "
                     "the scene's settings as JSON (scene) and status.")
     run.add_argument("scene", metavar="SCENE",
                      help="a scene file (TOML) with [[body]] tables or a [particles] table")
     run.add_argument("-o", "--output", metavar="OUT.npz",
-                     help="output file (default: the scene's name with .npz, here)")
+                     help="output file, named .npz (default: the scene's name with .npz, "
+                          "here)")
     run.add_argument("--every", type=int, metavar="K",
                      help="store every K-th step (default: at most about 1000 frames for "
                           "bodies, 200 for particles); the last step is always stored")
     run.add_argument("--duration", type=float, metavar="SECONDS",
                      help="simulate this long instead of the scene's [integration] duration")
+    _add_max_steps(run)
     run.set_defaults(run=_run)
 
     report = commands.add_parser("report", help="write the HTML accuracy report")
@@ -619,7 +740,40 @@ def _one_line_warning(message, category, filename, lineno, file=None, line=None)
     print(f"refsim: warning: {one_line(message)}", file=sys.stderr if file is None else file)
 
 
+def version() -> str:
+    """refsim's version: the installed distribution's, else the package's own
+    ``__version__`` (a source tree on the path without an install)."""
+    from importlib.metadata import PackageNotFoundError
+    from importlib.metadata import version as installed_version
+
+    try:
+        return installed_version("refsim")
+    except PackageNotFoundError:
+        from refsim import __version__
+
+        return __version__
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run the command of ``argv`` (default: the process's arguments) and
+    return its exit status. Output cut short by its reader (a pipe into
+    ``head``) ends quietly with :data:`EXIT_BROKEN_PIPE`, as Python's
+    documentation of SIGPIPE advises: standard output is pointed at
+    ``os.devnull`` so that the interpreter's final flush cannot fail again."""
+    try:
+        status = _main(argv)
+        sys.stdout.flush()          # a broken pipe shows here, not at exit
+        return status
+    except BrokenPipeError:
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        except (OSError, ValueError):   # a stream with no descriptor (a test's capture)
+            pass
+        return EXIT_BROKEN_PIPE
+
+
+def _main(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if not args.debug:

@@ -4,7 +4,9 @@ Every file refsim reads (a model, a scene, a recorded trajectory) is read
 through :func:`read_regular_file`: a directory, FIFO, socket or device is
 refused before it is opened (reading a FIFO would block forever, a device
 might never end), and every failure is the caller's error type carrying the
-path, so the command line prints one line naming the file.
+path, so the command line prints one line naming the file. A bare file name that
+is not here names a bundled model or scene (:func:`bundled_if_bare`), and a
+missing path whose base name is bundled says so (:func:`refuse_missing_bundled`).
 """
 
 from __future__ import annotations
@@ -79,6 +81,21 @@ def bundled_if_bare(path: Path, directory: Path) -> Path:
         return bundled if bundled.is_file() else path
     except (OSError, ValueError):       # ValueError: a NUL byte in the name
         return path
+
+
+def refuse_missing_bundled(path: Path, directory: Path, kind: str, error: type) -> None:
+    """Nothing, unless ``path`` names no file while ``directory`` holds a
+    bundled ``kind`` ("model", "scene") of the same base name; then the
+    usual ``error("no such file", path)`` with the bare name that works from
+    any directory added, since a path such as ``models/cube.ac`` only exists
+    in a source checkout."""
+    try:
+        if os.path.lexists(path) or not (directory / path.name).is_file():
+            return
+    except (OSError, ValueError):       # ValueError: a NUL byte in the name
+        return
+    raise error(f"no such file (a bundled {kind} of that name exists: use '{path.name}')",
+                path)
 
 
 def decode_utf8(data: bytes, path, error: type) -> str:

@@ -19,8 +19,18 @@ MIN_POSITIVE = 1e-50
 
 #: At most this many steps in one run (an interval over a step): a guard
 #: against a step such as 1e-12 or 5e-324 that would run for days or ask for
-#: terabytes.
+#: terabytes. The simulation loop, the particle system and the integrator
+#: refuse more; a scene's own limit (below) may be raised up to it.
 MAX_STEPS = 100_000_000
+
+#: At most this many steps in a scene (its ``integration.duration`` over its
+#: ``step``) unless the caller raises the limit (``load_scene(...,
+#: max_steps=N)``, ``refsim run --max-steps N``), up to ``MAX_STEPS``. The
+#: bundled scenes take thousands of steps and the report's longest runs
+#: hundreds of thousands; a scene a hundred times beyond that most likely
+#: has a duration or a step in the wrong unit, and would hold the machine
+#: for hours before anything is written, so it is refused while it is read.
+DEFAULT_MAX_STEPS = 10_000_000
 
 #: The largest trajectory :func:`refsim.solvers.integrate.solve_fixed_step`
 #: allocates, in bytes: a longer run or a larger state is refused before any

@@ -192,3 +192,152 @@ def test_a_body_wider_than_float64_is_refused_without_a_numpy_warning(tmp_path, 
     assert err.count("\n") == 1 and "warning" not in err
     assert err.startswith(f"refsim: error: {scene}: body[0].model: model wide.ac at scale 1 is "
                           "larger than the world cube: its box spans inf x ")
+
+
+# What a new user tries first.
+
+def test_version_prints_the_installed_version(capsys):
+    import tomllib
+    from pathlib import Path
+
+    declared = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml")
+                             .read_text())["project"]["version"]
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--version"])
+    assert exit_info.value.code == 0
+    assert capsys.readouterr().out == f"refsim {declared}\n"
+
+
+def test_output_cut_short_by_its_reader_ends_quietly():
+    # Far more than a pipe holds (64 KiB on Linux), so the command is still
+    # writing when the reader closes its end after the first line.
+    argv = [sys.executable, "-m", "refsim.cli", "info", *["cube.ac"] * 400]
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = proc.stdout.readline()
+    proc.stdout.close()
+    err = proc.stderr.read()
+    proc.stderr.close()
+    assert proc.wait(timeout=120) == 1
+    assert first.split() == ["model", "cube.ac"]
+    assert err == ""
+
+
+def test_info_of_a_directory_says_it_is_one(tmp_path, capsys):
+    assert main(["info", str(tmp_path)]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (f"refsim: error: {tmp_path}: a directory, not a model "
+                                       "file (.ac, .obj, .stl, .ply, .off)\n")
+
+
+@pytest.mark.parametrize("argv, written", [
+    (["replay", "spin.npz", "-o", "spin.txt"], "writes .html or .htm files; name the output "
+                                              "with the suffix .html"),
+    (["report", "--quick", "-o", "report.html"], "refsim report writes a directory"),
+    (["study", "bounds-error", "--quick", "-o", "study.json"], "refsim study writes a directory"),
+    (["conform", "--all", "-o", "matrix.json"], "refsim conform writes a directory"),
+    (["advise", "bounce.toml", "-o", "advice.toml"], "refsim advise writes a directory"),
+])
+def test_an_output_the_command_does_not_write_is_refused_before_any_work(
+        argv, written, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith(f"refsim: error: {argv[-1]}: cannot write: ") and written in err
+    assert err.count("\n") == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_directory_named_like_a_file_is_still_a_directory(tmp_path, capsys):
+    out = tmp_path / "study.json"
+    out.mkdir()
+    assert main(["study", "bounds-error", "--quick", "-o", str(out)]) == 0
+    assert "\nC2: partly\n" in capsys.readouterr().out
+
+
+# Bundled models and scenes by bare name.
+
+def test_a_missing_path_to_a_bundled_model_names_the_bare_name(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)                      # no models/ folder here
+    assert main(["info", "models/sphere-2k.ac"]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (
+        "refsim: error: models/sphere-2k.ac: no such file (a bundled model of that name "
+        "exists: use 'sphere-2k.ac')\n")
+    assert main(["info", "sphere-2k.ac"]) == 0
+    assert capsys.readouterr().out.splitlines()[0].split() == ["model", "sphere-2k.ac"]
+
+
+def test_a_missing_path_to_a_bundled_scene_names_the_bare_name(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "scenes/spinning-cube.toml", "-o", "spin.npz"]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (
+        "refsim: error: scenes/spinning-cube.toml: no such file (a bundled scene of that name "
+        "exists: use 'spinning-cube.toml')\n")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_missing_path_with_no_bundled_namesake_gets_no_hint(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["info", "models/no-such-model.ac"]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == "refsim: error: models/no-such-model.ac: no such file\n"
+
+
+def test_a_scenes_model_path_to_a_bundled_model_names_the_bare_name(tmp_path, capsys):
+    scene = _scene_naming(tmp_path, "models/cube.ac")
+    assert main(["run", str(scene), "-o", str(tmp_path / "out.npz")]) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith(f"refsim: error: {scene}: body[0].model: model 'models/cube.ac' "
+                          "not found (looked in ")
+    assert err.endswith("; a bundled model of that name exists: use 'cube.ac'\n")
+
+
+def test_info_bundled_lists_every_bundled_model_and_scene(capsys):
+    from refsim.bundled import scenes_dir
+
+    assert main(["info", "--bundled"]) == 0
+    names = capsys.readouterr().out.splitlines()
+    models = sorted(p.name for p in models_dir().glob("*.ac"))
+    scenes = sorted(p.name for p in scenes_dir().glob("*.toml"))
+    assert names == models + scenes
+    assert {"cube.ac", "sphere-2k.ac", "torus.ac", "bounce.toml",
+            "spinning-cube.toml"} <= set(names)
+
+
+@pytest.mark.parametrize("argv, phrase", [
+    (["info"], "give one or more MODEL files, or --bundled"),
+    (["info", "--bundled", "cube.ac"], "give it without MODEL files"),
+])
+def test_info_needs_models_or_bundled(argv, phrase, capsys):
+    assert main(argv) == EXIT_USER_ERROR
+    err = capsys.readouterr().err
+    assert err.startswith("refsim: error: ") and phrase in err and err.count("\n") == 1
+
+
+# A core-only install: one line naming the missing package and the extra.
+
+@pytest.mark.parametrize("module", ["matplotlib", "jinja2"])
+def test_report_without_its_extra_names_the_package_and_the_extra(module, tmp_path, capsys,
+                                                                 monkeypatch):
+    monkeypatch.setitem(sys.modules, module, None)         # import MODULE -> ImportError
+    out = tmp_path / "rep"
+    assert main(["report", "--quick", "-o", str(out)]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (f"refsim: error: the report needs {module}, which is "
+                                       "not installed: pip install 'refsim[report]'\n")
+    assert not out.exists()
+
+
+def test_replay_without_viser_names_the_extra(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "viser", None)
+    out = tmp_path / "r.html"
+    assert main(["replay", str(tmp_path / "run.npz"), "-o", str(out)]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == ("refsim: error: the viewer needs viser, which is not "
+                                       "installed: pip install 'refsim[viewer]'\n")
+    assert not out.exists()
+
+
+def test_the_oracles_hint_is_for_an_installed_refsim(monkeypatch):
+    from refsim.oracles import OracleUnavailable, import_engine
+
+    monkeypatch.setitem(sys.modules, "pybullet", None)
+    with pytest.raises(OracleUnavailable) as info:
+        import_engine("pybullet", "pybullet")
+    assert str(info.value).startswith("oracle engine 'pybullet' is not installed "
+                                      "(pip install 'refsim[oracles]'): ")

@@ -450,3 +450,84 @@ def test_a_full_disk_is_one_line_and_leaves_no_file(tmp_path, count):
     assert result.returncode == EXIT_USER_ERROR and result.stdout == ""
     assert result.stderr == f"refsim: error: {out}: cannot write: File too large\n"
     assert files(tmp_path) == ["out.npz", "scene.toml"] and out.read_bytes() == b"old"
+
+
+def test_an_output_suffix_run_does_not_write_is_refused(tmp_path, capsys):
+    scene = write(tmp_path, TINY)
+    out = tmp_path / "out.txt"
+    assert main(["run", str(scene), "-o", str(out)]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (f"refsim: error: {out}: cannot write: refsim run writes "
+                                       ".npz files; name the output with the suffix .npz\n")
+    assert files(tmp_path) == ["scene.toml"]
+    upper = tmp_path / "OUT.NPZ"                   # the suffix in any case is the format's
+    assert main(["run", str(scene), "-o", str(upper), "--every", "50"]) == 0
+    with np.load(upper) as data:
+        assert data["t"].shape == (3,)
+
+
+#: A cube for twenty thousand seconds in steps of a millisecond: 2e7 steps,
+#: twice the scenes' default limit and within the loop's own.
+LONG = """
+[integration]
+step = 0.001
+duration = 20000.0
+
+[[body]]
+model = "cube.ac"
+"""
+
+
+def test_a_scene_beyond_the_step_limit_is_refused_saying_how_to_raise_it(tmp_path, capsys):
+    from refsim.limits import DEFAULT_MAX_STEPS
+
+    assert DEFAULT_MAX_STEPS == 10_000_000
+    scene = write(tmp_path, LONG)
+    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz")]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (
+        f"refsim: error: {scene}: integration.duration: duration / step = 20000 / 0.001 = "
+        "2e+07 steps exceeds the limit of 1e+07; to run it, raise the limit to 20000000 "
+        "(--max-steps of refsim run and view, max_steps= of refsim.load_scene)\n")
+    assert files(tmp_path) == ["scene.toml"]
+
+
+def test_max_steps_lets_a_long_scene_through_validation(tmp_path, capsys, monkeypatch):
+    import refsim.cli
+
+    taken = []
+    monkeypatch.setattr(refsim.cli, "_run_bodies",           # validated, then not run
+                        lambda scene, text, out, every: taken.append(scene) or 0)
+    scene = write(tmp_path, LONG)
+    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz"),
+                 "--max-steps", "20000000"]) == 0
+    assert [s.integration.n_steps for s in taken] == [20_000_000]
+    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz"), "--max-steps", "20000000",
+                 "--duration", "1000.0"]) == 0
+    assert [s.integration.n_steps for s in taken] == [20_000_000, 1_000_000]
+    capsys.readouterr()
+    # one step short of the scene, and a --duration beyond the limit given, are refused
+    for argv in (["--max-steps", "19999999"],
+                 ["--max-steps", "20000000", "--duration", "30000.0"]):
+        assert main(["run", str(scene), "-o", str(tmp_path / "o.npz"), *argv]) == 2
+    first, second = capsys.readouterr().err.splitlines()
+    assert "2e+07 steps exceeds the limit of 19999999; to run it, raise the limit to " \
+           "20000000 (" in first
+    assert second.startswith("refsim: error: --duration 30000.0: duration / step = 30000 / "
+                             "0.001 = 3e+07 steps exceeds the limit of 2e+07; to run it, raise "
+                             "the limit to 30000000 (")
+    assert len(taken) == 2
+
+
+@pytest.mark.parametrize("argv, expected", [
+    (["--max-steps", "20000000", "--duration", "1e12"],
+     "--duration 1000000000000.0: duration / step = 1e+12 / 0.001 = 1e+15 steps exceeds the "
+     "limit of 2e+07; no run may take more than 100000000 steps (refsim.limits.MAX_STEPS): "
+     "lengthen the step or shorten the duration"),
+    (["--max-steps", "100000001"], "--max-steps must be at least 1 and at most 100000000, "
+                                   "got 100000001"),
+    (["--max-steps", "0"], "--max-steps must be at least 1 and at most 100000000, got 0"),
+])
+def test_a_run_beyond_what_any_limit_allows_is_refused(tmp_path, capsys, argv, expected):
+    scene = write(tmp_path, LONG)
+    assert main(["run", str(scene), "-o", str(tmp_path / "o.npz"), *argv]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == f"refsim: error: {expected}\n"
+    assert files(tmp_path) == ["scene.toml"]

@@ -28,7 +28,7 @@ import numpy as np
 
 from refsim.bundled import models_dir
 from refsim.errors import ModelError
-from refsim.files import as_path, bundled_if_bare, read_regular_file
+from refsim.files import as_path, bundled_if_bare, read_regular_file, refuse_missing_bundled
 from refsim.models.ac3d import read_ac3d
 from refsim.models.mesh import Mesh
 
@@ -52,15 +52,18 @@ def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
     Raises
     ------
     ModelError
-        When the file is missing, its suffix is not supported, or it cannot
-        be read as a triangle mesh.
+        When the file is missing or a directory, its suffix is not
+        supported, or it cannot be read as a triangle mesh.
     """
     path = as_path(path)
     suffix = path.suffix.lower()
+    if suffix not in SUFFIXES and path.is_dir():     # a folder is no format, known or not
+        raise ModelError(f"a directory, not a model file ({', '.join(SUFFIXES)})", path=path)
     if suffix not in SUFFIXES:
         raise ModelError(f"unknown model format {path.suffix or '(no suffix)'!r}; "
                          f"supported: {', '.join(SUFFIXES)}", path=path)
     path = bundled_if_bare(path, models_dir())
+    refuse_missing_bundled(path, models_dir(), "model", ModelError)
     if suffix == ".ac":
         return read_ac3d(path, weld_tolerance=weld_tolerance)
     return _load_with_trimesh(path, read_regular_file(path, ModelError), weld_tolerance)

@@ -25,9 +25,21 @@ import numpy as np
 
 from refsim.bundled import models_dir, scenes_dir
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
-from refsim.errors import ModelError, SceneError, StateError
-from refsim.files import as_path, bundled_if_bare, decode_utf8, read_regular_file
-from refsim.limits import MAX_MAGNITUDE, MAX_SCENE_BYTES, MAX_SCENE_NESTING
+from refsim.errors import ModelError, SceneError, StateError, check_count
+from refsim.files import (
+    as_path,
+    bundled_if_bare,
+    decode_utf8,
+    read_regular_file,
+    refuse_missing_bundled,
+)
+from refsim.limits import (
+    DEFAULT_MAX_STEPS,
+    MAX_MAGNITUDE,
+    MAX_SCENE_BYTES,
+    MAX_SCENE_NESTING,
+    MAX_STEPS,
+)
 from refsim.models.loading import load_model
 from refsim.scenes.schema import (
     BODY_FIELDS,
@@ -40,11 +52,11 @@ from refsim.scenes.schema import (
     ParticleConfig,
     Scene,
 )
-from refsim.solvers.integrate import whole_steps
+from refsim.solvers.integrate import STEP_COUNT_RTOL, whole_steps
 from refsim.types import transform_points
 
 
-def load_scene(path) -> Scene:
+def load_scene(path, *, max_steps: int = DEFAULT_MAX_STEPS) -> Scene:
     """Read, validate and resolve the scene file at ``path`` (seed S11).
 
     Parameters
@@ -54,6 +66,9 @@ def load_scene(path) -> Scene:
         ``[[body]] model`` has a default). A bare file name that is not in
         the current directory names a bundled scene
         (``refsim.bundled.scenes_dir()``), e.g. ``"bounce.toml"``.
+    max_steps : int
+        The most steps (duration over step) the scene may take: by default
+        ``refsim.limits.DEFAULT_MAX_STEPS``, at most ``refsim.limits.MAX_STEPS``.
 
     Returns
     -------
@@ -70,9 +85,24 @@ def load_scene(path) -> Scene:
         Never: a body's broken model is reported as a SceneError naming the
         scene, the body's key and the model file's own line.
     """
+    return load_scene_text(path, max_steps=max_steps)[0]
+
+
+def load_scene_text(path, *, max_steps: int = DEFAULT_MAX_STEPS) -> tuple[Scene, str]:
+    """:func:`load_scene`, and the text of the file as it was read (what
+    ``refsim run`` records, so that a replay can rebuild the scene)."""
     path = bundled_if_bare(as_path(path), scenes_dir())
+    refuse_missing_bundled(path, scenes_dir(), "scene", SceneError)
     data = read_regular_file(path, SceneError, max_bytes=MAX_SCENE_BYTES)
     text = decode_utf8(data, path, SceneError)
+    return scene_from_text(text, path, max_steps=max_steps), text
+
+
+def scene_from_text(text: str, path: Path | None = None, *,
+                    max_steps: int = DEFAULT_MAX_STEPS) -> Scene:
+    """The scene of TOML ``text``, validated as :func:`load_scene` does;
+    ``path`` is where the text came from, for messages and for resolving
+    model paths relative to it (None: against the bundled models only)."""
     too_deep = first_line_nested_deeper(text, MAX_SCENE_NESTING)
     if too_deep is not None:
         raise SceneError(f"invalid TOML: arrays and inline tables nested more than "
@@ -81,7 +111,24 @@ def load_scene(path) -> Scene:
         table = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"invalid TOML: {exc}", path) from None
-    return scene_from_dict(table, path)
+    return scene_from_dict(table, path, max_steps=max_steps)
+
+
+def steps_limit_hint(duration: float, step: float, max_steps: int) -> str:
+    """What to do about a run of ``duration / step`` steps beyond
+    ``max_steps`` (to append to the refusal), or "" when it is within: raise
+    the limit, or, beyond ``MAX_STEPS``, change the scene."""
+    ratio = duration / step if duration > 0.0 and step > 0.0 else 0.0
+    if not ratio > max_steps:
+        return ""
+    # a whole number of steps to the loop's tolerance is that number
+    needed = round(ratio) if abs(ratio - round(ratio)) <= STEP_COUNT_RTOL * ratio else \
+        math.ceil(ratio)
+    if needed <= MAX_STEPS:
+        return (f"; to run it, raise the limit to {needed} (--max-steps of refsim "
+                f"run and view, max_steps= of refsim.load_scene)")
+    return (f"; no run may take more than {MAX_STEPS} steps (refsim.limits.MAX_STEPS): "
+            f"lengthen the step or shorten the duration")
 
 
 def first_line_nested_deeper(text: str, limit: int) -> int | None:
@@ -136,9 +183,12 @@ def _skip_string(text: str, i: int, line: int) -> tuple[int, int]:
     return i, line
 
 
-def scene_from_dict(data: dict, path: Path | None = None) -> Scene:
+def scene_from_dict(data: dict, path: Path | None = None, *,
+                    max_steps: int = DEFAULT_MAX_STEPS) -> Scene:
     """Validate an already parsed scene (``path`` is for messages and for
-    resolving relative model paths; None resolves against the bundled models)."""
+    resolving relative model paths; None resolves against the bundled
+    models; ``max_steps`` as for :func:`load_scene`)."""
+    max_steps = check_count("max_steps", max_steps, 1, MAX_STEPS)
     known = set(TABLES) | {"body", "particles"}
     for key in data:
         if key not in known:
@@ -153,9 +203,10 @@ def scene_from_dict(data: dict, path: Path | None = None) -> Scene:
 
     integration = configs["integration"]
     try:
-        whole_steps(integration.duration, integration.step)
+        whole_steps(integration.duration, integration.step, max_steps)
     except StateError as exc:
-        raise SceneError(str(exc), path, "integration.duration") from None
+        hint = steps_limit_hint(integration.duration, integration.step, max_steps)
+        raise SceneError(f"{exc}{hint}", path, "integration.duration") from None
 
     raw_bodies = data.get("body", [])
     if not isinstance(raw_bodies, list):
@@ -305,7 +356,11 @@ def _resolve_model(name: str, scene_path: Path | None, key: str) -> Path:
                              key) from None
         return candidate.absolute()           # a symlink keeps the name (and suffix) given
     looked = ", ".join(str(c) for c in candidates)
-    raise SceneError(f"model {name!r} not found (looked in {looked})", scene_path, key)
+    bare = Path(name).name
+    hint = ""
+    if bare != name and (models_dir() / bare).is_file():
+        hint = f"; a bundled model of that name exists: use {bare!r}"
+    raise SceneError(f"model {name!r} not found (looked in {looked}){hint}", scene_path, key)
 
 
 def _load_meshes(bodies, scene_path) -> dict:

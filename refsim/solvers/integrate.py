@@ -48,10 +48,11 @@ from refsim.solvers.methods import SEED_LITERAL_VARIANTS, SOLVERS
 STEP_COUNT_RTOL = 1e-9
 
 
-def whole_steps(duration: float, h: float) -> int:
+def whole_steps(duration: float, h: float, max_steps: int = MAX_STEPS) -> int:
     """The number of steps of ``h`` in ``duration``, which must be a whole
     number of them (to ``STEP_COUNT_RTOL``), at least one and at most
-    ``MAX_STEPS``.
+    ``max_steps`` (default ``MAX_STEPS``; a scene's is
+    ``refsim.limits.DEFAULT_MAX_STEPS`` unless raised).
 
     Raises
     ------
@@ -62,9 +63,10 @@ def whole_steps(duration: float, h: float) -> int:
     if not (math.isfinite(duration) and math.isfinite(h) and duration > 0.0 and h > 0.0):
         raise StateError(f"duration {duration!r} and step {h!r} must be finite and > 0")
     ratio = duration / h
-    if ratio > MAX_STEPS:
+    if ratio > max_steps:
+        limit = f"{max_steps:.3g}" if float(f"{max_steps:.3g}") == max_steps else max_steps
         raise StateError(f"duration / step = {duration:g} / {h:g} = {ratio:.3g} steps exceeds "
-                         f"the limit of {MAX_STEPS:.0e}")
+                         f"the limit of {limit}")
     n = round(ratio)
     if n < 1:
         raise StateError(f"duration {duration:g} is shorter than one step of {h:g}")

@@ -19,9 +19,12 @@ and from the page with none, and widens the stride until the page fits.
 The stride chosen is reported (:class:`ReplayInfo`) and shown on the page.
 
 Meshes. A trajectory records its bodies' names and the run's settings, not
-their meshes. :func:`load_run` takes the meshes from a scene file: the one
-given (``refsim replay --scene``), else the scene file the run records in
-its settings (``settings["scene"]``, when the recording has it). The scene
+their meshes. :func:`load_run` takes the meshes from a scene: the one given
+(``refsim replay --scene``), else the scene the run records in its settings:
+``refsim run`` stores the scene file's text and path
+(:func:`recorded_scene_settings`), read again as if from that path, so that
+its models resolve as they did; a recording with the path alone names a
+scene file that must still be there. The scene
 must have the run's bodies, by name and in order, and a warning says when
 the run's first frame is not the scene's initial state (the file changed
 since the run, or the run was made from another scene). A body's mesh is
@@ -44,6 +47,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from refsim.errors import OutputError, RefsimError, check_count
+from refsim.limits import MAX_STEPS
 from refsim.viewer import REPLAY_MAX_BYTES as DEFAULT_MAX_BYTES
 
 if TYPE_CHECKING:
@@ -69,6 +73,10 @@ OVERLAY_OPACITY = 0.65
 #: Settings shown first on the page, in this order (others follow, sorted).
 SETTINGS_ORDER = ("scene", "engine", "solver", "step", "rotation", "body_response",
                   "collision_level", "aabb", "every", "steps", "wall_speed", "boxes")
+
+#: The settings entry that holds the text of the run's scene file (beside
+#: ``scene``, its path); not shown on the page.
+SCENE_TEXT = "scene_toml"
 
 #: Widening of the stride per retry when the estimate missed the budget.
 STRIDE_GROWTH = 1.25
@@ -114,6 +122,7 @@ def run_from_scene(label: str, scene, trajectory, settings: dict | None = None) 
 
     check_bodies(label, scene, trajectory)
     shown = dict(trajectory.settings if settings is None else settings)
+    shown.pop(SCENE_TEXT, None)
     if scene.path is not None:
         shown.setdefault("scene", Path(scene.path).name)
     return ReplayRun(label=label, trajectory=trajectory, meshes=body_meshes(scene),
@@ -148,6 +157,8 @@ def load_run(path, scene=None, *, label: str | None = None) -> ReplayRun:
     path = Path(path)
     label = label or path.stem
     traj = _load_trajectory(path)
+    if scene is None and isinstance(traj.settings.get(SCENE_TEXT), str):
+        scene = _recorded_scene(path, traj.settings)
     if scene is None:
         recorded = traj.settings.get("scene")
         if not recorded:
@@ -158,9 +169,32 @@ def load_run(path, scene=None, *, label: str | None = None) -> ReplayRun:
                               f"the scene with --scene SCENE.toml")
         scene = recorded
     if not isinstance(scene, Scene):
-        scene = load_scene(scene)
+        scene = load_scene(scene, max_steps=MAX_STEPS)      # run already: any length
     assert isinstance(traj, Trajectory)
     return run_from_scene(label, scene, traj)
+
+
+def recorded_scene_settings(scene_path, text: str) -> dict:
+    """The settings entries that let :func:`load_run` rebuild a run's scene:
+    its file's absolute path (``scene``) and text (:data:`SCENE_TEXT`)."""
+    return {"scene": None if scene_path is None else str(Path(scene_path).absolute()),
+            SCENE_TEXT: text}
+
+
+def _recorded_scene(path: Path, settings: dict):
+    """The scene whose text the run at ``path`` records, read as if from the
+    scene file's path (its relative model paths resolve as they did)."""
+    from refsim.errors import SceneError
+    from refsim.scenes.loader import scene_from_text
+
+    recorded = settings.get("scene")
+    try:
+        return scene_from_text(settings[SCENE_TEXT],
+                               Path(recorded) if isinstance(recorded, str) else None,
+                               max_steps=MAX_STEPS)
+    except SceneError as exc:
+        raise RefsimError(f"{path}: the scene the run records cannot be rebuilt ({exc}); "
+                          f"name the scene with --scene SCENE.toml") from None
 
 
 def _load_trajectory(path: Path):
@@ -199,7 +233,7 @@ def load_runs(paths, scenes=()) -> list[ReplayRun]:
     if len(scenes) == 1 and len(paths) > 1:
         from refsim.scenes.loader import load_scene
 
-        scenes = [load_scene(scenes[0])] * len(paths)
+        scenes = [load_scene(scenes[0], max_steps=MAX_STEPS)] * len(paths)
     labels = _labels(paths)
     return [load_run(p, scenes[i] if scenes else None, label=labels[i])
             for i, p in enumerate(paths)]

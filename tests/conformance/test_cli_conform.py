@@ -143,3 +143,19 @@ def test_same_inputs_give_the_same_record_but_timings(tmp_path, capsys):
     assert first["checks"][0]["examples"][0]["shrunk"] is True
     assert (tmp_path / "a" / "index.html").read_text() == \
         (tmp_path / "b" / "index.html").read_text()
+
+
+def test_all_with_an_engine_missing_says_so_last_and_exits_1(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "pybullet", None)       # import pybullet -> ImportError
+    monkeypatch.setitem(sys.modules, "mujoco", None)
+    out = tmp_path / "all"
+    assert main(["conform", "--all", "--only", "ode", "-o", str(out)]) == 1
+    printed = capsys.readouterr()
+    assert printed.out.splitlines()[-1] == (
+        f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine; not run: "
+        "mujoco, pybullet (see the warnings; pip install 'refsim[oracles]')")
+    warned = [line for line in printed.err.splitlines() if " not run: " in line]
+    assert [line.split()[2] for line in warned] == ["pybullet", "mujoco"]
+    assert all("pip install 'refsim[oracles]'" in line for line in warned)
+    matrix = json.loads((out / "matrix.json").read_text())
+    assert sorted(matrix["unavailable"]) == ["mujoco", "pybullet"]

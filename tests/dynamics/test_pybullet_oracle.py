@@ -230,3 +230,42 @@ def test_drag_is_an_external_force_in_bullet_s_euler_step(pybullet):
     factor = (1.0 - k * h / m) ** n
     np.testing.assert_allclose(trajectory.velocity[-1, 0], [2.0 * factor, 0.0, -factor],
                                rtol=1e-9, atol=1e-12)
+
+
+#: A fresh interpreter that loads pybullet through the adapter and writes a
+#: line of its own to each stream, before and after.
+LOAD_PYBULLET = """
+import sys
+print("out before", flush=True)
+print("err before", file=sys.stderr, flush=True)
+from refsim.oracles.pybullet_adapter import PybulletOracle
+with PybulletOracle() as oracle:
+    oracle.p.getAPIVersion()
+print("out after", flush=True)
+print("err after", file=sys.stderr, flush=True)
+"""
+
+
+def test_loading_pybullet_prints_no_banner(oracle):
+    import subprocess
+    import sys
+
+    oracle(PybulletOracle).close()          # skips with the reason where pybullet is missing
+    result = subprocess.run([sys.executable, "-c", LOAD_PYBULLET], capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout == "out before\nout after\n"
+    assert result.stderr == "err before\nerr after\n"
+
+
+def test_what_else_a_loading_engine_prints_still_reaches_its_stream(capfd):
+    import os
+
+    from refsim.oracles import c_banner_dropped
+
+    with c_banner_dropped("engine build time:"):
+        os.write(1, b"engine build time: today\nkept on stdout\n")
+        os.write(2, b"engine build time: today\nkept on stderr\n")
+    captured = capfd.readouterr()
+    assert captured.out == "kept on stdout\n"
+    assert captured.err == "kept on stderr\n"

@@ -301,3 +301,22 @@ def test_a_dangling_symlink_beside_the_scene_is_not_replaced_by_the_bundled_mode
 def test_a_model_name_with_a_nul_byte_is_refused_at_its_key(tmp_path):
     assert_scene_error(tmp_path, '[[body]]\nmodel = "cu\\u0000be.ac"\n', "body[0].model",
                        "cannot be looked up: it contains a NUL byte")
+
+
+def test_a_scene_beyond_the_default_step_limit_needs_max_steps(tmp_path):
+    from refsim.errors import StateError
+    from refsim.limits import DEFAULT_MAX_STEPS, MAX_STEPS
+
+    path = tmp_path / "long.toml"
+    path.write_text("[integration]\nstep = 0.001\nduration = 20000.0\n" + MINIMAL)
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    assert info.value.key == "integration.duration"
+    assert info.value.message.startswith(f"duration / step = 20000 / 0.001 = 2e+07 steps "
+                                         f"exceeds the limit of {DEFAULT_MAX_STEPS:.0e}; "
+                                         "to run it, raise the limit to 20000000 (")
+    assert load_scene(path, max_steps=20_000_000).integration.n_steps == 20_000_000
+    with pytest.raises(SceneError, match="exceeds the limit of 19999999;"):
+        load_scene(path, max_steps=19_999_999)
+    with pytest.raises(StateError, match=f"max_steps must be at least 1 and at most {MAX_STEPS}"):
+        load_scene(path, max_steps=MAX_STEPS + 1)

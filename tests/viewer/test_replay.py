@@ -236,3 +236,67 @@ def test_wall_bounce_demo_beside_pybullet(tmp_path, oracle):
     text = info.path.read_text()
     _check_page(info.path, 0.5)
     assert "pybullet" in text and "engine" in text
+
+
+# -- runs of `refsim run` record their scene ----------------------------------------------
+
+#: A cube of the scene's own folder, dropped for ten steps.
+OWN_MODEL_SCENE = """
+[integration]
+solver = "rk4"
+step = 0.001
+duration = 0.01
+
+[[body]]
+name = "box"
+model = "my-cube.ac"
+position = [0.0, 0.5, 0.0]
+velocity = [0.5, 0.0, 0.0]
+"""
+
+
+@pytest.fixture
+def own_model_run(tmp_path):
+    from refsim.bundled import models_dir
+
+    folder = tmp_path / "scene"
+    folder.mkdir()
+    (folder / "my-cube.ac").write_bytes((models_dir() / "cube.ac").read_bytes())
+    scene = folder / "drop.toml"
+    scene.write_text(OWN_MODEL_SCENE)
+    run = tmp_path / "drop.npz"
+    assert main(["run", str(scene), "-o", str(run)]) == 0
+    return run
+
+
+def test_a_run_of_refsim_run_replays_without_a_scene(own_model_run, tmp_path, capsys,
+                                                     monkeypatch):
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)                  # the model resolves beside the scene file
+    out = elsewhere / "drop.html"
+    assert main(["replay", str(own_model_run), "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert printed.splitlines()[-1].startswith(f"wrote {out}: 1 run, 11 of 11 frames")
+    assert CLIENT_BYTES < out.stat().st_size
+    recording = _check_page(out, 0.01)
+    assert len(recording["messages"]) > 11           # a pose update per frame
+    text = out.read_text()
+    assert "drop.toml" in text and "scene_toml" not in text and "my-cube.ac" not in text
+
+
+def test_the_recorded_scene_is_the_file_as_run(own_model_run):
+    traj = refsim.Trajectory.load(own_model_run)
+    assert traj.settings["scene_toml"] == OWN_MODEL_SCENE
+    assert traj.settings["scene"] == str(own_model_run.parent / "scene" / "drop.toml")
+
+
+def test_a_recorded_scene_whose_model_is_gone_says_to_name_the_scene(own_model_run, tmp_path,
+                                                                     capsys):
+    (own_model_run.parent / "scene" / "my-cube.ac").unlink()
+    err = _one_line_error(capsys, ["replay", str(own_model_run), "-o",
+                                   str(tmp_path / "r.html")], "--scene SCENE.toml")
+    assert err.startswith(f"refsim: error: {own_model_run}: the scene the run records cannot "
+                          "be rebuilt (")
+    assert "model 'my-cube.ac' not found" in err
+    assert not (tmp_path / "r.html").exists()
