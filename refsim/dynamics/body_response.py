@@ -21,7 +21,7 @@ Terminology: this is a perfectly *elastic* collision of equal masses
 (momentum and kinetic energy both conserved, relative normal velocity
 reversed: restitution 1). A perfectly inelastic collision would leave both
 with the common velocity ``(v_a + v_b) / 2`` along N. The seed's
-"perfectly inelastic" is a misnomer (DESIGN.md asks us to record it). The
+"perfectly inelastic" is a misnomer (the report's terminology table records it). The
 seed ignores the masses: with unequal masses the exchange conserves neither
 momentum nor energy.
 

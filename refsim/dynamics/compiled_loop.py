@@ -12,11 +12,11 @@ vertices), the contacts as flags instead of a set, and the kernel's event
 rows turned into :class:`~refsim.dynamics.trajectory.Event` in the readable
 order.
 
-Why a loop and not faster stages: the readable step's cost is ~50 us of
-calls between ~1 us of arithmetic; stage kernels keep the calls, and the
-per-call cost of a numba function with many array arguments (a few
-microseconds) stays above pybullet's whole step for a few bodies. One call
-for K steps pays it once.
+Why a loop and not faster stages: the readable step's cost is mostly the
+interpreter's calls between little arithmetic; stage kernels keep the calls,
+and the per-call cost of a numba function with many array arguments stays
+above a peer engine's whole step for a few bodies. One call for K steps pays
+it once (docs/decisions/compiled-loop.md has the figures).
 
 Seed sections: as the readable step (S2, S3, S5-S9). Cost: the kernel's
 per step, plus O(B + events) per call here, plus O(B^2) when the contacts

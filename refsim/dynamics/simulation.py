@@ -132,9 +132,10 @@ BATCH_VERTICES = 64
 BOXES = ("auto", "trackers", "batched")
 
 #: Steps per call of the compiled loop, at most: a call holds the interpreter
-#: (no signal handler runs until it returns), so a call lasts milliseconds
-#: (4096 steps of 40 cubes, ~20 ms), while the cost of a call (~5 us of
-#: argument passing) stays below 1 % of it for a single cube.
+#: (no signal handler runs until it returns), so a call must stay short (a
+#: few milliseconds for tens of bodies), while the fixed cost of a call
+#: (argument passing) stays a small fraction of it for a single cube
+#: (docs/decisions/compiled-loop.md has the figures).
 LOOP_CHUNK = 4096
 
 STAGES = ("integrate", "rotation", "check", "bounds", "walls", "broad-phase", "narrow-phase",
