@@ -11,10 +11,11 @@ from __future__ import annotations
 
 import sys
 
+from refsim.oracles import OracleUnavailable
+
 from refsim.conformance import cases_rigid as R
 from refsim.conformance.checks_rigid import check_rigid_free_rotation
 from refsim.engines import load_engine
-from refsim.oracles import OracleUnavailable
 
 ENGINES = ("refsim.engines.refsim_engines:corrected", "refsim.engines.refsim_engines:seed",
            "refsim.oracles.pybullet_adapter:engine", "refsim.oracles.mujoco_adapter:engine")
