@@ -16,7 +16,8 @@ What it runs (one step, the stages of the readable outline, same order):
                 with :func:`refsim.dynamics.forces.translational_rhs`;
 2. rotation     none (``rotation = "off"``), the seed's Euler step of the
                 axes with Gram-Schmidt
-                (:func:`refsim.dynamics.rotation_seed.orientation_step_seed_loops`),
+                (:func:`refsim.dynamics.rotation_seed.axes_step_seed`,
+                compiled from its own source),
                 or the corrected free-body splitting step
                 (:func:`refsim.dynamics.rotation_impulse.free_rotation_step`,
                 compiled from its own source);
@@ -95,11 +96,12 @@ import numpy as np
 from refsim.bounds._numba_kernels import incremental_update_numba
 from refsim.dynamics.impulse import solve_contacts_python
 from refsim.dynamics.rotation_impulse import free_rotation_step
+from refsim.dynamics.rotation_seed import axes_step_seed
 
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "88f1981ae77570a5"
+SOURCES_DIGEST = "83f09ddaf96e66b8"
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -252,23 +254,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
                 free_rotation_step(R[b], w[b], Q[b], moments[b], h, A, L, E)
         elif rotation_mode == ROTATION_SEED:
             for b in range(B):
-                wx, wy, wz = w[b, 0], w[b, 1], w[b, 2]
-                for c in range(3):
-                    X0, X1, X2 = R[b, 0, c], R[b, 1, c], R[b, 2, c]
-                    A[0, c] = X0 + h * (wy * X2 - wz * X1)
-                    A[1, c] = X1 + h * (wz * X0 - wx * X2)
-                    A[2, c] = X2 + h * (wx * X1 - wy * X0)
-                nx = np.sqrt((A[0, 0] * A[0, 0] + A[1, 0] * A[1, 0]) + A[2, 0] * A[2, 0])
-                u0, u1, u2 = A[0, 0] / nx, A[1, 0] / nx, A[2, 0] / nx
-                dot = (A[0, 1] * u0 + A[1, 1] * u1) + A[2, 1] * u2
-                t0, t1, t2 = A[0, 1] - dot * u0, A[1, 1] - dot * u1, A[2, 1] - dot * u2
-                ny = np.sqrt((t0 * t0 + t1 * t1) + t2 * t2)
-                t0, t1, t2 = t0 / ny, t1 / ny, t2 / ny
-                R[b, 0, 0], R[b, 1, 0], R[b, 2, 0] = u0, u1, u2
-                R[b, 0, 1], R[b, 1, 1], R[b, 2, 1] = t0, t1, t2
-                R[b, 0, 2] = u1 * t2 - u2 * t1
-                R[b, 1, 2] = u2 * t0 - u0 * t2
-                R[b, 2, 2] = u0 * t1 - u1 * t0
+                axes_step_seed(R[b], w[b], h, A, R[b])
 
         # 3. check, conservatively (module docstring)
         total = 0.0

@@ -67,6 +67,7 @@ import math
 
 import numpy as np
 
+from refsim.dynamics.products import jitable
 from refsim.kernels import choose_kernel, compile_kernel
 
 #: Sweeps of phase 1. Gauss-Seidel over the four corners of a face landing
@@ -83,14 +84,6 @@ ITERATIONS = 32
 RESTITUTION_THRESHOLD = 0.05
 
 
-try:
-    # register_jitable: a plain Python function when called from Python, and
-    # compiled inline when called from a numba-compiled function.
-    from numba.extending import register_jitable as jitable
-except Exception:  # numba missing or unusable: the plain path only
-    # The same name for the identity decorator, the usual optional import.
-    def jitable(f):                                 # type: ignore[no-redef]
-        return f
 
 
 @jitable

@@ -10,6 +10,10 @@ What: for 3-vectors ``a``, ``b`` and 3x3 matrices ``M`` (shapes ``(3,)`` and
     (M^T x)_i      = (M_0i x0 + M_1i x1) + M_2i x2
     (A B)_ij       = (A_i0 B_0j + A_i1 B_1j) + A_i2 B_2j
 
+and the Gram-Schmidt orthonormalisation of a 3x3 matrix's columns
+(:func:`orthonormalize_columns`), which the seed's rotation step and the
+corrected one share.
+
 each product and sum rounded once, left to right, as
 :mod:`refsim.bounds.aabb_linear` does for a transformed coordinate.
 
@@ -26,12 +30,27 @@ Seed sections: none of their own; used by S8 (the seed's exchange), for
 the mesh origin ``x - R c`` of every body (S2, S9), and by the corrected
 rotation model (:mod:`refsim.dynamics.rotation_impulse`).
 
+Functions marked :func:`jitable` are plain Python when called from Python
+and compiled inline when a numba-compiled kernel calls them, so the readable
+and compiled paths run one source.
+
 Cost: O(1) per body, a handful of numpy calls per product.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+
+try:
+    # register_jitable: a plain Python function when called from Python, and
+    # compiled inline when called from a numba-compiled function.
+    from numba.extending import register_jitable as jitable
+except Exception:  # numba missing or unusable: the plain path only
+    # The same name for the identity decorator, the usual optional import.
+    def jitable(f):                                 # type: ignore[no-redef]
+        return f
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -58,3 +77,22 @@ def matmul(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """``A B``: (..., 3, 3), (..., 3, 3) -> (..., 3, 3)."""
     return ((A[..., :, 0:1] * B[..., 0:1, :] + A[..., :, 1:2] * B[..., 1:2, :])
             + A[..., :, 2:3] * B[..., 2:3, :])
+
+
+@jitable
+def orthonormalize_columns(A, out):
+    """Gram-Schmidt on the columns of A (3, 3), into out (3, 3), which may be
+    A itself: the first column normalised, the second made orthogonal to it
+    and normalised, the third their cross product (right-handed). Every sum
+    left to right; A is read whole before out is written."""
+    n0 = math.sqrt((A[0, 0] * A[0, 0] + A[1, 0] * A[1, 0]) + A[2, 0] * A[2, 0])
+    u0, u1, u2 = A[0, 0] / n0, A[1, 0] / n0, A[2, 0] / n0
+    d = (A[0, 1] * u0 + A[1, 1] * u1) + A[2, 1] * u2
+    t0, t1, t2 = A[0, 1] - d * u0, A[1, 1] - d * u1, A[2, 1] - d * u2
+    n1 = math.sqrt((t0 * t0 + t1 * t1) + t2 * t2)
+    t0, t1, t2 = t0 / n1, t1 / n1, t2 / n1
+    out[0, 0], out[1, 0], out[2, 0] = u0, u1, u2
+    out[0, 1], out[1, 1], out[2, 1] = t0, t1, t2
+    out[0, 2] = u1 * t2 - u2 * t1
+    out[1, 2] = u2 * t0 - u0 * t2
+    out[2, 2] = u0 * t1 - u1 * t0

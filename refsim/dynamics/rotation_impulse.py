@@ -84,8 +84,7 @@ import math
 
 import numpy as np
 
-from refsim.dynamics.impulse import jitable
-from refsim.dynamics.products import matmul
+from refsim.dynamics.products import jitable, matmul, orthonormalize_columns
 
 #: Below this ``|theta|^2`` (``|theta| < 1e-4``) :func:`rotation_exp_into`
 #: uses the series of ``sin(a)/a`` and ``(1 - cos(a))/a^2``, whose truncation
@@ -177,33 +176,6 @@ def _axis_flow(P, L, i, rate):
 
 
 @jitable
-def _orthonormalize(P):
-    """Gram-Schmidt on the columns of P (3, 3), in place: the first column
-    normalised, the second made orthogonal to it and normalised, the third
-    their cross product.
-
-    Why each step: ``R = P Q^T`` and the next step's ``P = R Q`` multiply P by
-    ``Q^T Q``, which is the identity only to rounding (``Q`` is a computed
-    eigenvector matrix), the same factor every step; and the step reads
-    ``L = diag(I) P^T w`` back from ``w = P (L / I)``, which keeps ``L`` only
-    as far as ``P^T P = E``. Without this, ``|R^T R - E|`` grows like the
-    number of steps and the angular momentum drifts like its square (3e-8
-    of ``|L|`` in 10^4 steps of the l-beam); with it, both stay at rounding.
-    """
-    n0 = math.sqrt((P[0, 0] * P[0, 0] + P[1, 0] * P[1, 0]) + P[2, 0] * P[2, 0])
-    u0, u1, u2 = P[0, 0] / n0, P[1, 0] / n0, P[2, 0] / n0
-    d = (P[0, 1] * u0 + P[1, 1] * u1) + P[2, 1] * u2
-    t0, t1, t2 = P[0, 1] - d * u0, P[1, 1] - d * u1, P[2, 1] - d * u2
-    n1 = math.sqrt((t0 * t0 + t1 * t1) + t2 * t2)
-    t0, t1, t2 = t0 / n1, t1 / n1, t2 / n1
-    P[0, 0], P[1, 0], P[2, 0] = u0, u1, u2
-    P[0, 1], P[1, 1], P[2, 1] = t0, t1, t2
-    P[0, 2] = u1 * t2 - u2 * t1
-    P[1, 2] = u2 * t0 - u0 * t2
-    P[2, 2] = u0 * t1 - u1 * t0
-
-
-@jitable
 def free_rotation_step(R, w, Q, moments, h, P, L, E):
     """One torque-free step of one body (module docstring), in place.
 
@@ -223,7 +195,13 @@ def free_rotation_step(R, w, Q, moments, h, P, L, E):
     for i in range(3):                                  # P = R Q
         for j in range(3):
             P[i, j] = (R[i, 0] * Q[0, j] + R[i, 1] * Q[1, j]) + R[i, 2] * Q[2, j]
-    _orthonormalize(P)
+    # Why each step: R = P Q^T and the next step's P = R Q multiply P by
+    # Q^T Q, the identity only to rounding (Q is a computed eigenvector
+    # matrix), the same factor every step; and L = diag(I) P^T w is read back
+    # from w = P (L / I), which keeps L only as far as P^T P = E. Without
+    # this, |R^T R - E| grows like the number of steps and the angular
+    # momentum drifts like its square; with it, both stay at rounding.
+    orthonormalize_columns(P, P)
     for j in range(3):                                  # L = diag(I) P^T w
         L[j] = moments[j] * ((P[0, j] * w[0] + P[1, j] * w[1]) + P[2, j] * w[2])
     I_1 = moments[1]

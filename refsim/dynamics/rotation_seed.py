@@ -76,6 +76,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from refsim.dynamics.products import jitable, orthonormalize_columns
 from refsim.kernels import choose_kernel, compile_kernel
 
 
@@ -135,31 +136,30 @@ def orientation_step_seed(R: np.ndarray, w: np.ndarray, h: float) -> np.ndarray:
     return gram_schmidt(R + h * skew_apply(w, R))
 
 
+@jitable
+def axes_step_seed(R, w, h, A, out):
+    """:func:`orientation_step_seed` of one body: R (3, 3), w (3,), into out
+    (3, 3), which may be R itself (A (3, 3) scratch): ``X += h (w x X)`` for
+    each column c, then Gram-Schmidt, X first
+    (:func:`refsim.dynamics.products.orthonormalize_columns`); the same
+    operations in the same order as the vectorised step."""
+    wx, wy, wz = w[0], w[1], w[2]
+    for c in range(3):
+        X0, X1, X2 = R[0, c], R[1, c], R[2, c]
+        A[0, c] = X0 + h * (wy * X2 - wz * X1)
+        A[1, c] = X1 + h * (wz * X0 - wx * X2)
+        A[2, c] = X2 + h * (wx * X1 - wy * X0)
+    orthonormalize_columns(A, out)
+
+
+@jitable
 def orientation_step_seed_loops(R: np.ndarray, w: np.ndarray, h: float,
                                 out: np.ndarray) -> None:
-    """:func:`orientation_step_seed` as loops over the bodies, into ``out``:
-    the same operations in the same order (the kernel numba compiles)."""
+    """:func:`orientation_step_seed` as loops over the bodies, into ``out``
+    (:func:`axes_step_seed` of each; the kernel numba compiles)."""
+    A = np.empty((3, 3))
     for b in range(R.shape[0]):
-        wx, wy, wz = w[b, 0], w[b, 1], w[b, 2]
-        # X += h (w x X) for each column c
-        A = np.empty((3, 3))
-        for c in range(3):
-            X0, X1, X2 = R[b, 0, c], R[b, 1, c], R[b, 2, c]
-            A[0, c] = X0 + h * (wy * X2 - wz * X1)
-            A[1, c] = X1 + h * (wz * X0 - wx * X2)
-            A[2, c] = X2 + h * (wx * X1 - wy * X0)
-        # Gram-Schmidt, X first
-        nx = np.sqrt((A[0, 0] * A[0, 0] + A[1, 0] * A[1, 0]) + A[2, 0] * A[2, 0])
-        x0, x1, x2 = A[0, 0] / nx, A[1, 0] / nx, A[2, 0] / nx
-        d = (A[0, 1] * x0 + A[1, 1] * x1) + A[2, 1] * x2
-        y0, y1, y2 = A[0, 1] - d * x0, A[1, 1] - d * x1, A[2, 1] - d * x2
-        ny = np.sqrt((y0 * y0 + y1 * y1) + y2 * y2)
-        y0, y1, y2 = y0 / ny, y1 / ny, y2 / ny
-        out[b, 0, 0], out[b, 1, 0], out[b, 2, 0] = x0, x1, x2
-        out[b, 0, 1], out[b, 1, 1], out[b, 2, 1] = y0, y1, y2
-        out[b, 0, 2] = x1 * y2 - x2 * y1
-        out[b, 1, 2] = x2 * y0 - x0 * y2
-        out[b, 2, 2] = x0 * y1 - x1 * y0
+        axes_step_seed(R[b], w[b], h, A, out[b])
 
 
 def orientation_step_seed_compiled(R: np.ndarray, w: np.ndarray, h: float) -> np.ndarray:

@@ -302,11 +302,13 @@ class Simulation:
         self.I_body_inv = np.linalg.inv(self.I_body)
         # the principal axes (mesh frame) and moments of the corrected
         # rotation step (rotation_impulse.free_rotation_step)
-        self.Q = np.empty((B, 3, 3))
-        self.moments = np.empty((B, 3))
+        self.Q = np.zeros((B, 3, 3))
+        self.moments = np.zeros((B, 3))
         if self.rotation == "impulse":
             for i, b in enumerate(bodies):
                 self.Q[i], self.moments[i] = principal_frame(b.inertia)
+        self._free_steps = (compile_kernel(free_rotation_steps) if self.kernel == "compiled"
+                            else free_rotation_steps)
 
         # Bodies whose boxes come from the batched scan, one group per mesh;
         # the others call their own tracker (see ``boxes``).
@@ -570,9 +572,7 @@ class Simulation:
         self.R[...] = orientation_step_seed_kernel(self.R, self.w, self.h, kernel=self.kernel)
 
     def _rotate_exact(self) -> None:
-        step = (compile_kernel(free_rotation_steps) if self.kernel == "compiled"
-                else free_rotation_steps)
-        step(self.R, self.w, self.Q, self.moments, self.h)
+        self._free_steps(self.R, self.w, self.Q, self.moments, self.h)
 
     # 4. boxes (S2)
     def _bounds(self) -> None:
