@@ -13,11 +13,20 @@ drop-icosahedron-e0.8  icosahedron on an edge): apex heights e^(2k) h0,
                        apex ratio e^2; each lands on a vertex, face or edge
                        straight below its centre of mass, so no impulse has
                        a moment about it and the body does not turn
-oblique-sphere         the sphere 5 cm above the floor moving at (5, -2, 0)
-                       m/s, Coulomb friction mu = 0.3, e = 0.8: a uniform
-                       ball sliding throughout the impact leaves with
-                       ``v_t - mu (1 + e) |v_n|`` (it slides throughout:
-                       ``mu (1 + e) |v_n| <= 2/7 v_t``)
+oblique-*              the sphere striking the floor obliquely, in every
+                       regime of Coulomb friction over the whole impact:
+                       ``oblique-sphere`` (5 cm up, (5, -2, 0) m/s, mu 0.3,
+                       e 0.8) slides throughout; ``oblique-rolling`` ((2,
+                       -2, 0)) leaves rolling; ``oblique-spin-e1`` (spin
+                       only, 3 rad/s, mu 0.1, e 1) slides throughout;
+                       ``oblique-backspin`` ((0.2, -1, 0), 3 rad/s of
+                       backspin, mu 0.4, e 0.5) slides throughout and its
+                       lateral velocity reverses; ``oblique-e0`` ((3, -2,
+                       0), e 0) slides, then stays on the floor. The answer
+                       (lateral velocity and spin after the impact) is
+                       :func:`refsim.dynamics.analytic.oblique_impact_ball`
+                       with the mesh's own inertia and its lowest vertex's
+                       depth below the centre
 spin-cube              the cube resting face down, spinning at 5 rad/s about
                        the vertical, mu = 0.5: friction brings it to rest
 rest-cube              the cube resting face down, mu = 0.5: it stays on
@@ -54,7 +63,7 @@ velocity and ``w . I w / 2`` with the uniform solid's inertia.
 A run of each scene is kept per engine (:meth:`RigidCases.run`), so the
 checks share it; ``rerun`` runs a scene again for the determinism check.
 
-Cost: about 27,300 steps per engine in all (the drops are 1.8 to 3.0 s of
+Cost: about 27,900 steps per engine in all (the drops are 1.8 to 3.0 s of
 simulated time, the free brick 12 s), and 1,700 more for the determinism
 check's reruns.
 """
@@ -90,6 +99,19 @@ OBLIQUE_VELOCITY = (5.0, -2.0, 0.0)
 OBLIQUE_HEIGHT = 0.05
 OBLIQUE_FRICTION = 0.3
 OBLIQUE_E = 0.8
+#: The oblique impacts: name, velocity (m/s), spin about z (rad/s; positive
+#: moves the contact point along +x), height of the lowest point (m), mu, e.
+#: The spinning ones start one step's fall up and spin slowly: the mesh
+#: turns little before its lowest vertex lands, whose lever off the vertical
+#: (and the spin's share of its normal speed, ``|w|`` times that lever) the
+#: check allows for (:mod:`refsim.conformance.checks_rigid`).
+OBLIQUE_IMPACTS = (
+    ("oblique-sphere", OBLIQUE_VELOCITY, 0.0, OBLIQUE_HEIGHT, OBLIQUE_FRICTION, OBLIQUE_E),
+    ("oblique-rolling", (2.0, -2.0, 0.0), 0.0, OBLIQUE_HEIGHT, 0.3, 0.8),
+    ("oblique-spin-e1", (0.0, -2.0, 0.0), 3.0, 0.002, 0.1, 1.0),
+    ("oblique-backspin", (0.2, -1.0, 0.0), 3.0, 0.001, 0.4, 0.5),
+    ("oblique-e0", (3.0, -2.0, 0.0), 0.0, OBLIQUE_HEIGHT, 0.3, 0.0),
+)
 #: The spinning cube: angular speed about the vertical (rad/s), friction.
 SPIN = 5.0
 SPIN_FRICTION = 0.5
@@ -150,10 +172,26 @@ def _scene(model: str, e: float, friction: float, height: float, duration: float
     })
 
 
-def oblique_impact_speed() -> float:
-    """Normal speed at the oblique scene's impact (it falls 5 cm first)."""
-    v_n = -OBLIQUE_VELOCITY[1]
-    return math.sqrt(v_n * v_n + 2.0 * GRAVITY * OBLIQUE_HEIGHT)
+def oblique_impact_speed(v_y: float = OBLIQUE_VELOCITY[1],
+                         height: float = OBLIQUE_HEIGHT) -> float:
+    """Normal speed at an oblique scene's impact: ``v_y`` (< 0) after a fall
+    of ``height``."""
+    return math.sqrt(v_y * v_y + 2.0 * GRAVITY * height)
+
+
+def oblique_answer(scene: RigidScene) -> tuple[float, float, float]:
+    """``(v_n, v_t', w_z')`` of an oblique scene: the impact speed and
+    :func:`refsim.dynamics.analytic.oblique_impact_ball` with the sphere
+    mesh's own moment of inertia (about z, for the scene's mass) and the
+    depth of its lowest vertex below the centre of mass."""
+    vertices, center, inertia = _body(_model(scene))
+    body = scene.scene.bodies[0]
+    v_n = oblique_impact_speed(body.velocity[1], scene.height)
+    radius = float(center[1] - vertices[:, 1].min())
+    v_t, w = analytic.oblique_impact_ball(
+        body.velocity[0], body.angular_velocity[2], v_n, scene.friction, scene.e, radius,
+        body.mass, body.mass * float(inertia[2, 2]))
+    return v_n, v_t, w
 
 
 def rigid_scenes() -> tuple[RigidScene, ...]:
@@ -168,14 +206,15 @@ def rigid_scenes() -> tuple[RigidScene, ...]:
         scenes.append(RigidScene(f"drop-{label}-e{e}", "drop",
                                  _scene(model, e, 0.0, DROP_HEIGHT, duration), e,
                                  height=DROP_HEIGHT))
-    v_imp = oblique_impact_speed()
-    v_n = -OBLIQUE_VELOCITY[1]
-    # to the middle of the flight after the first bounce
-    duration = (v_imp - v_n) / GRAVITY + OBLIQUE_E * v_imp / GRAVITY
-    scenes.append(RigidScene("oblique-sphere", "oblique",
-                             _scene(SPHERE, OBLIQUE_E, OBLIQUE_FRICTION, OBLIQUE_HEIGHT,
-                                    duration, velocity=OBLIQUE_VELOCITY),
-                             OBLIQUE_E, OBLIQUE_FRICTION, OBLIQUE_HEIGHT))
+    for name, velocity, spin, height, mu, e in OBLIQUE_IMPACTS:
+        v_imp = oblique_impact_speed(velocity[1], height)
+        # to the middle of the flight after the first bounce (e = 0: as long
+        # as the fall, sliding on the floor)
+        duration = (v_imp + velocity[1]) / GRAVITY + max(e, 0.5) * v_imp / GRAVITY
+        scenes.append(RigidScene(name, "oblique",
+                                 _scene(SPHERE, e, mu, height, duration, velocity=velocity,
+                                        angular_velocity=(0.0, 0.0, spin)),
+                                 e, mu, height))
     scenes.append(RigidScene("spin-cube", "spin",
                              _scene(CUBE, SPIN_E, SPIN_FRICTION, 0.0, SPIN_DURATION,
                                     angular_velocity=(0.0, SPIN, 0.0)),

@@ -20,11 +20,24 @@ meet them within these bounds.
   impulse has a moment about the centre, so the body must not turn; its
   largest angular speed times its reach stays below
   :data:`NO_SPIN_FRACTION` of the impact speed.
-- ``rigid.oblique_bounce`` (the sphere sliding through an impact): the
-  lateral velocity after it is Coulomb's ``v_t - mu (1 + e) |v_n|``
-  (:func:`refsim.dynamics.analytic.lateral_velocity_coulomb`) within
-  ``mu CONTACT_STEPS g h`` (6e-3 m/s). One that matches the seed's law
-  ``(1 - friction) v_t`` instead (S5, S7) is "known-divergence".
+- ``rigid.oblique_bounce`` (the sphere striking the floor obliquely, in
+  every regime: sliding throughout, leaving rolling, spin only at e = 1,
+  backspin that reverses the lateral velocity, e = 0): the lateral velocity
+  and the spin after the impact are Coulomb's over the whole impact
+  (:func:`refsim.dynamics.analytic.oblique_impact_ball`) within ``mu
+  CONTACT_STEPS g h`` (friction spread over the steps of a contact meets
+  gravity's ``g h`` per step) plus what a contact found ``CONTACT_STEPS``
+  late costs a spinning mesh: it has turned by ``(t_fall + CONTACT_STEPS h)
+  |w|`` (``t_fall``: the scene's fall to the floor, height over speed), its
+  contact vertex is that far (times the radius) off the vertical and moves
+  along the normal at ``|w|`` times that lever, which changes the normal
+  impulse by ``m (1 + e) |w| lever`` and the friction by ``mu`` times that.
+  The spin is allowed what that friction does to it (``radius m / I`` times
+  the velocity's tolerance) plus the normal impulse ``m (1 + e) v_n`` acting
+  on the lever.
+  The velocity is read ``CONTACT_STEPS`` steps after the impact. One that
+  matches the seed's law ``(1 - friction) v_t`` instead (S5, S7) is
+  "known-divergence".
 - ``rigid.spin_to_rest`` (the cube spinning flat on the floor): by
   :func:`spin_rest_time` its angular speed is below
   :data:`SPIN_REST_FRACTION` of the initial one. Coulomb friction at the
@@ -172,29 +185,62 @@ def check_rigid_no_spin(engine, cases) -> CheckResult:
                  seconds=time.perf_counter() - start)
 
 
+def _after_impact(trajectory) -> int:
+    """The frame ``CONTACT_STEPS`` steps after the first impact: the first
+    frame whose vertical velocity is above the previous frame's by more than
+    the fall's ``g h`` per step can explain (the bounce)."""
+    t = np.asarray(trajectory.t)
+    v_y = np.asarray(trajectory.velocity)[:, 0, 1]
+    jump = np.diff(v_y) - 2.0 * R.GRAVITY * np.diff(t)
+    k = np.flatnonzero(jump > 0.0)
+    if not len(k):
+        return len(t) - 1
+    return min(int(k[0]) + 1 + CONTACT_STEPS, len(t) - 1)
+
+
 def check_rigid_oblique_bounce(engine, cases) -> CheckResult:
-    """``rigid.oblique_bounce``: Coulomb's lateral velocity after a sliding
-    impact (module docstring)."""
+    """``rigid.oblique_bounce``: Coulomb's lateral velocity and spin after an
+    oblique impact, in every regime (module docstring)."""
     start = time.perf_counter()
     outcomes, examples, measured = [], [], {}
-    v_n = R.oblique_impact_speed()
     for scene in cases.of_kind("oblique"):
         trajectory = cases.run(engine, scene)
-        v_t = R.OBLIQUE_VELOCITY[0]
-        got = float(np.asarray(trajectory.velocity)[-1, 0, 0])
-        coulomb = analytic.lateral_velocity_coulomb(v_t, v_n, scene.friction, scene.e)
-        seed_law = analytic.lateral_velocity_seed(v_t, scene.friction)
-        tol = scene.friction * CONTACT_STEPS * R.GRAVITY * scene.scene.integration.step
-        outcome = classify_miss(abs(got - coulomb), tol)
+        k = _after_impact(trajectory)
+        body = scene.scene.bodies[0]
+        v_n, coulomb, coulomb_spin = R.oblique_answer(scene)
+        got = float(np.asarray(trajectory.velocity)[k, 0, 0])
+        spin = float(np.asarray(trajectory.angular_velocity)[k, 0, 2])
+        seed_law = analytic.lateral_velocity_seed(body.velocity[0], scene.friction)
+        h = scene.scene.integration.step
+        vertices, _, inertia = R._body(R._model(scene))
+        radius = float(np.sqrt((vertices ** 2).sum(axis=1)).max())
+        w_0 = abs(body.angular_velocity[2])
+        I_zz = float(inertia[2, 2])                   # per unit mass
+        # the contact vertex, turned off the vertical by the spin during the
+        # fall to the floor and the steps before the contact is found, moves
+        # along n at w_0 lever: that changes the normal impulse by (1 + e) w_0
+        # lever (per unit mass), and so the friction by mu times that; the
+        # normal impulse acts on the lever
+        fall = scene.height / abs(body.velocity[1]) if body.velocity[1] else 0.0
+        lever = (fall + CONTACT_STEPS * h) * w_0 * radius
+        tol = scene.friction * (CONTACT_STEPS * R.GRAVITY * h
+                                + (1.0 + scene.e) * w_0 * lever)
+        spin_tol = tol * radius / I_zz + lever * (1.0 + scene.e) * v_n / I_zz
+        error = max(abs(got - coulomb) / tol, abs(spin - coulomb_spin) / spin_tol)
+        outcome = classify_miss(error, 1.0) if math.isfinite(error) else "bug"
         if outcome is not None and abs(got - seed_law) <= tol:
             outcome = "known-divergence"
         measured[scene.name] = {"lateral_velocity": got, "coulomb": coulomb,
-                                "seed_law": seed_law, "tolerance": tol}
+                                "spin": spin, "coulomb_spin": coulomb_spin,
+                                "seed_law": seed_law, "tolerance": tol,
+                                "spin_tolerance": spin_tol}
         outcomes.append(outcome)
         if outcome is not None:
             examples.append({"class": outcome, "lateral_velocity": got, "coulomb": coulomb,
+                             "spin": spin, "coulomb_spin": coulomb_spin,
                              "seed_law": seed_law, "impact_normal_speed": v_n,
-                             "tolerance": tol, **scene.to_dict()})
+                             "tolerance": tol, "spin_tolerance": spin_tol,
+                             **scene.to_dict()})
     return tally("rigid", "oblique_bounce", outcomes, examples=examples, measured=measured,
                  seconds=time.perf_counter() - start)
 

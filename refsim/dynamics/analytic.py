@@ -153,3 +153,33 @@ def sliding_throughout(v_t: float, v_n: float, mu: float, e: float) -> bool:
     """Whether a uniform ball keeps sliding through the whole impact:
     ``mu (1 + e) |v_n| <= 2/7 |v_t|`` (so the point-mass answer holds for it)."""
     return mu * (1.0 + e) * abs(v_n) <= 2.0 / 7.0 * abs(v_t)
+
+
+def oblique_impact_ball(v_t: float, w: float, v_n: float, mu: float, e: float,
+                        radius: float, mass: float, inertia: float) -> tuple[float, float]:
+    """A ball (mass ``m``, moment of inertia ``I`` about its centre, contact
+    at distance ``radius`` straight below its centre) striking a fixed plane
+    with normal speed ``v_n`` (> 0, into the plane), lateral velocity ``v_t``
+    and spin ``w`` about the horizontal axis across ``v_t`` (positive when the
+    contact point moves with ``v_t``: its slip is ``u = v_t + w radius``),
+    Coulomb friction ``mu`` over the whole impact and restitution ``e``.
+
+    The normal impulse ``J_n = m (1 + e) v_n`` passes through the centre and
+    does not change the slip, so the slip keeps its direction until friction
+    stops it and then stays zero (no reversal of slip for a ball: Stronge,
+    *Impact Mechanics*, 2000, section 5.1; Brach, *Mechanical Impact
+    Dynamics*, 1991, ch. 5). The friction impulse that stops the slip is
+    ``J_stick = |u| / (1/m + radius^2 / I)``; Coulomb allows ``mu J_n``:
+
+    - ``mu J_n >= J_stick``: the ball leaves rolling, ``J_t = J_stick``;
+    - else it slides throughout, ``J_t = mu J_n``;
+
+    and with ``J = -sign(u) J_t`` along ``v_t``: ``v_t' = v_t + J / m``,
+    ``w' = w + radius J / I``. Returns ``(v_t', w')``.
+    """
+    u = v_t + w * radius
+    j_n = mass * (1.0 + e) * v_n
+    j_stick = abs(u) / (1.0 / mass + radius * radius / inertia)
+    j_t = min(j_stick, mu * j_n)
+    j = -math.copysign(j_t, u) if u != 0.0 else 0.0
+    return v_t + j / mass, w + radius * j / inertia

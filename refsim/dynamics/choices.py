@@ -75,19 +75,13 @@ D8 Energy-limited restitution (impulse): Poisson's restitution impulse
    make the collision add kinetic energy (a known failing of Poisson's
    hypothesis with friction; Stronge's energetic restitution avoids it
    in general at a higher cost).
-D9 Friction during compression only (impulse, phase 1; a known limitation,
-   found by the conformance kit's rigid.oblique_bounce): the friction
-   impulse is clamped to ``mu`` times the compression impulse ``P_n``, and
-   the restitution impulse ``e P_n`` of phase 2 carries no friction, so a
-   body sliding through an impact loses ``mu |v_n|`` of its lateral speed
-   where Coulomb's law over the whole impact takes ``mu (1 + e) |v_n|``
-   (refsim.dynamics.analytic.lateral_velocity_coulomb; measured 4.3305 m/s
-   against Coulomb's 3.7948 for v_t = 5, |v_n| = 2.2318, mu = 0.3, e = 0.8).
-   This is box2d-lite's sequential-impulse scheme as cited in the module;
-   friction in phase 2 as well would give Coulomb's answer for a sliding
-   single contact. Left as it is in this round: changing it changes every
-   frictional bounce the report measures, so it is declared in
-   refsim/conformance/expected/refsim-corrected.txt and reported.
+D9 Retired. Friction acted during compression only (phase 1 of the impulse
+   solve), so a body sliding through an impact lost ``mu |v_n|`` of lateral
+   speed where Coulomb's law over the whole impact takes ``mu (1 + e) |v_n|``
+   (found by the conformance kit's rigid.oblique_bounce: 4.3305 m/s against
+   3.7948). The solve now runs its friction sweeps again after restitution,
+   in the cone of the whole impact (refsim.dynamics.impulse, phase 3); the
+   number is kept so that older reports' references stay readable.
 """
 
 from __future__ import annotations

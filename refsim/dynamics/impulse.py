@@ -29,7 +29,12 @@ Poisson's hypothesis, Mirtich 1996 section 3.4):
    if need be so that the collision as a whole adds no kinetic energy
    (Poisson's hypothesis with friction at several contacts can add some;
    the kernel tracks the energy change of every partial impulse exactly
-   from the velocities and the inverse inertia).
+   from the velocities and the inverse inertia);
+3. friction through restitution: when phase 2 gave an impulse, the
+   friction sweeps run again in the cone of the whole impact, ``|P_t| <= mu
+   (P_n + lam e P_n)``, so that friction acts over the whole impact as
+   Coulomb's law has it (a ball sliding throughout loses ``mu (1 + e)
+   |v_n|`` of lateral speed; Stronge, *Impact Mechanics*, 2000, ch. 3-5).
 
 Every partial impulse of phase 1 removes kinetic energy: an impulse
 ``lambda (-v_d / K_d) d`` with ``0 <= lambda <= 1`` changes the energy by
@@ -167,6 +172,36 @@ def _apply(i, P0, P1, P2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b, I_inv_b, v_a, w_a
     return dE
 
 
+@jitable
+def _friction(i, mu, r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, m_inv_b, I_inv_b, v_a, w_a,
+              v_b, w_b, P):
+    """The friction impulse at contact i that stops its sliding, accumulated
+    in ``P[i, 1:4]`` and clamped to the Coulomb cone ``|P_t| <= mu P[i, 0]``
+    (the normal impulse so far); applied in place. Returns ``(moved, dE)``:
+    whether it changed P, and the kinetic energy it changed (<= 0)."""
+    vr = _relative_velocity(i, r_a, r_b, v_a, w_a, v_b, w_b)
+    vn = vr[0] * n0 + vr[1] * n1 + vr[2] * n2
+    t0, t1, t2 = vr[0] - vn * n0, vr[1] - vn * n1, vr[2] - vn * n2
+    speed = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+    if speed == 0.0:
+        return False, 0.0
+    d0, d1, d2 = t0 / speed, t1 / speed, t2 / speed
+    Kt = _effective_inverse_mass(i, d0, d1, d2, r_a, r_b, m_inv_a, I_inv_a,
+                                 m_inv_b, I_inv_b)
+    jt = -speed / Kt                                 # stops the sliding along d
+    q0, q1, q2 = P[i, 1] + jt * d0, P[i, 2] + jt * d1, P[i, 3] + jt * d2
+    size = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2)
+    limit = mu * P[i, 0]                             # Coulomb: |P_t| <= mu P_n
+    if size > limit:
+        scale = limit / size
+        q0, q1, q2 = q0 * scale, q1 * scale, q2 * scale
+    dP0, dP1, dP2 = q0 - P[i, 1], q1 - P[i, 2], q2 - P[i, 3]
+    moved = dP0 != 0.0 or dP1 != 0.0 or dP2 != 0.0
+    P[i, 1], P[i, 2], P[i, 3] = q0, q1, q2
+    return moved, _apply(i, dP0, dP1, dP2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b, I_inv_b,
+                         v_a, w_a, v_b, w_b)
+
+
 def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_inv_b, v_b,
                           w_b, e, mu, threshold, iterations, P):
     """The contact solve (see the module docstring), in place.
@@ -195,8 +230,9 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
     ``is None`` branches away.)
     e, mu, threshold : restitution, Coulomb coefficient, restitution threshold.
     iterations : int, sweeps of phase 1.
-    P : (c, 4) float64 output: accumulated normal impulse and friction impulse
-        vector of each contact (phase 1), for the caller's bookkeeping.
+    P : (c, 4) float64 output: accumulated normal impulse (with restitution's,
+        when phase 3 ran) and friction impulse vector of each contact, for
+        the caller's bookkeeping.
 
     Returns
     -------
@@ -236,28 +272,11 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
             P[i, 0] = Pn
             dE1 += _apply(i, dPn * n0, dPn * n1, dPn * n2, r_a, r_b, m_inv_a, I_inv_a,
                           m_inv_b, I_inv_b, v_a, w_a, v_b, w_b)
-            # friction: the tangential relative velocity after the normal impulse
-            vr = _relative_velocity(i, r_a, r_b, v_a, w_a, v_b, w_b)
-            vn = vr[0] * n0 + vr[1] * n1 + vr[2] * n2
-            t0, t1, t2 = vr[0] - vn * n0, vr[1] - vn * n1, vr[2] - vn * n2
-            speed = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-            if speed == 0.0:
-                continue
-            d0, d1, d2 = t0 / speed, t1 / speed, t2 / speed
-            Kt = _effective_inverse_mass(i, d0, d1, d2, r_a, r_b, m_inv_a, I_inv_a,
-                                         m_inv_b, I_inv_b)
-            jt = -speed / Kt                                 # stops the sliding along d
-            q0, q1, q2 = P[i, 1] + jt * d0, P[i, 2] + jt * d1, P[i, 3] + jt * d2
-            size = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2)
-            limit = mu * P[i, 0]                             # Coulomb: |P_t| <= mu P_n
-            if size > limit:
-                scale = limit / size
-                q0, q1, q2 = q0 * scale, q1 * scale, q2 * scale
-            dP0, dP1, dP2 = q0 - P[i, 1], q1 - P[i, 2], q2 - P[i, 3]
-            moved = moved or dP0 != 0.0 or dP1 != 0.0 or dP2 != 0.0
-            P[i, 1], P[i, 2], P[i, 3] = q0, q1, q2
-            dE1 += _apply(i, dP0, dP1, dP2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b,
-                          I_inv_b, v_a, w_a, v_b, w_b)
+            # friction in the cone |P_t| <= mu P_n of the normal impulse so far
+            slid, dE = _friction(i, mu, r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, m_inv_b,
+                                 I_inv_b, v_a, w_a, v_b, w_b, P)
+            moved = moved or slid
+            dE1 += dE
         if not moved:
             break
     # Phase 2, restitution (Poisson): e times the compression impulse,
@@ -274,11 +293,14 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
             vr = _relative_velocity(i, r_a, r_b, v_a, w_a, v_b, w_b)
             G += e * P[i, 0] * (vr[0] * n0 + vr[1] * n1 + vr[2] * n2)
     dE2 = 0.0
+    restituted = False
     for i in range(c):
         if vn0[i] < -threshold and P[i, 0] > 0.0:
+            restituted = True
             j = e * P[i, 0]
             dE2 += _apply(i, j * n0, j * n1, j * n2, r_a, r_b, m_inv_a, I_inv_a,
                           m_inv_b, I_inv_b, v_a, w_a, v_b, w_b)
+    lam = 1.0
     if dE1 + dE2 > 0.0:
         Q = max(dE2 - G, 0.0)
         if Q > 0.0:
@@ -291,6 +313,27 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
                 j = -(1.0 - lam) * e * P[i, 0]
                 _apply(i, j * n0, j * n1, j * n2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b,
                        I_inv_b, v_a, w_a, v_b, w_b)
+    if not restituted or mu == 0.0:
+        return approaching
+    # Phase 3, friction through restitution: the normal impulse now includes
+    # the restitution impulse lam e P_n, and Coulomb's cone is that of the
+    # whole impact, |P_t| <= mu (1 + lam e) P_n; the friction sweeps of
+    # phase 1 run again in it. A contact that slid throughout takes
+    # mu (1 + e) P_n of friction in all, Coulomb's law over the impact
+    # (Stronge 2000, ch. 3-5); one that stuck in compression stays stuck.
+    # Each friction impulse removes energy, so the energy bound of phase 2
+    # still holds.
+    for i in range(c):
+        if vn0[i] < -threshold and P[i, 0] > 0.0:
+            P[i, 0] = P[i, 0] + lam * e * P[i, 0]
+    for _ in range(iterations):
+        moved = False
+        for i in range(c):
+            slid, dE = _friction(i, mu, r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, m_inv_b,
+                                 I_inv_b, v_a, w_a, v_b, w_b, P)
+            moved = moved or slid
+        if not moved:
+            break
     return approaching
 
 

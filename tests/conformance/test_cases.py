@@ -142,7 +142,8 @@ def test_rigid_scenes_and_their_tolerances():
     cases = R.rigid_cases()
     names = [s.name for s in cases.scenes]
     assert names == ["drop-sphere-e0.5", "drop-sphere-e0.8", "drop-cube-e0.5", "drop-cube-e0.8",
-                     "drop-icosahedron-e0.8", "oblique-sphere", "spin-cube", "rest-cube",
+                     "drop-icosahedron-e0.8", "oblique-sphere", "oblique-rolling",
+                     "oblique-spin-e1", "oblique-backspin", "oblique-e0", "spin-cube", "rest-cube",
                      "free-brick"]
     for scene in cases.of_kind("drop"):
         body = scene.scene.bodies[0]

@@ -56,8 +56,16 @@ def test_cubes_bounce_and_collide_bit_for_bit(count, seed, solver, rotation):
     assert "wall" in kinds
     if count == 40:
         assert "body" in kinds
-    if rotation != "off":
-        assert np.abs(compiled.w).max() > 0.1       # the walls' torques turned them
+    spins = np.abs(compiled.trajectory().angular_velocity).max()
+    if rotation == "seed" or (rotation == "impulse" and count > 1):
+        assert spins > 0.1       # the walls' (and, for 40, each other's) torques turned them
+    elif rotation == "impulse":
+        # a lone axis-aligned cube meets every wall face-flat: with Coulomb
+        # friction over the whole impact the pure translation is the answer
+        # (the friction's moment is balanced by a larger normal impulse at the
+        # leading corners, possible for mu <= 1), so it does not turn; what is
+        # left is the contact solve's residual after its sweeps
+        assert spins < 1e-5
 
 
 def test_quadratic_drag_euler_and_the_seeds_wall_speed_bit_for_bit():

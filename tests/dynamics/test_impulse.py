@@ -148,3 +148,51 @@ def test_a_static_b_given_as_none_gives_the_values_of_zero_arrays(kernel):
         assert out[0] == out[1]
         solved += out[0][0] > 0
     assert solved > 150                                      # impulses, not only no-ops
+
+
+#: Coulomb's answer for one contact straight below a ball's centre, against
+#: the solve: the sweeps converge exactly for one contact (each friction
+#: impulse stops the slip or reaches the cone at once), so only rounding.
+BALL_TOL = 1e-12
+
+
+@pytest.mark.parametrize(("v_t", "w", "v_n", "mu", "e"), [
+    (5.0, 0.0, 2.2318, 0.3, 0.8),      # slides throughout
+    (2.0, 0.0, 2.2318, 0.3, 0.8),      # leaves rolling
+    (0.0, 3.0, 2.0, 0.1, 1.0),         # spin only, e = 1: slides throughout
+    (0.2, 3.0, 1.0, 0.4, 0.5),         # backspin: slides, its velocity reverses
+    (3.0, 0.0, 2.0, 0.3, 0.0),         # e = 0
+    (1.0, -5.0, 2.0, 0.3, 0.5),        # topspin, leaves rolling
+])
+@pytest.mark.parametrize("kernel", ["readable", "compiled"])
+def test_ball_impact_is_coulombs_over_the_whole_impact(v_t, w, v_n, mu, e, kernel):
+    """A uniform ball (m = 1, I = 2/5, radius 1) on a fixed floor: lateral
+    velocity and spin after the impact as
+    refsim.dynamics.analytic.oblique_impact_ball gives them (Stronge, Impact
+    Mechanics, 5.1), friction acting through restitution as well."""
+    from refsim.dynamics.analytic import oblique_impact_ball
+
+    inertia = 0.4
+    v = np.array([v_t, -v_n, 0.0])
+    spin = np.array([0.0, 0.0, w])
+    impulse.wall_impulses(np.array([[0.0, -1.0, 0.0]]), np.array([0.0, 1.0, 0.0]), 1.0,
+                          np.eye(3) / inertia, v, spin, e, mu, kernel=kernel)
+    v_t_after, w_after = oblique_impact_ball(v_t, w, v_n, mu, e, 1.0, 1.0, inertia)
+    print(f"v_t {v[0]:.6f} ({v_t_after:.6f}), w {spin[2]:.6f} ({w_after:.6f})")
+    assert abs(v[0] - v_t_after) < BALL_TOL
+    assert abs(spin[2] - w_after) < BALL_TOL
+    assert abs(v[1] - e * v_n) < BALL_TOL           # the normal impulse passes the centre
+
+
+def test_closed_form_ball_impact_regimes():
+    """The closed form's own regimes: sliding throughout takes mu (1 + e) v_n
+    of lateral speed; a ball that leaves rolling keeps 5/7 of v_t (no spin
+    before, I = 2/5); the slip never reverses."""
+    from refsim.dynamics.analytic import oblique_impact_ball
+
+    assert oblique_impact_ball(5.0, 0.0, 2.0, 0.3, 0.8, 1.0, 1.0, 0.4)[0] == pytest.approx(
+        5.0 - 0.3 * 1.8 * 2.0)
+    v_t, w = oblique_impact_ball(2.0, 0.0, 2.0, 0.3, 0.8, 1.0, 1.0, 0.4)
+    assert (v_t, w) == pytest.approx((10.0 / 7.0, -10.0 / 7.0))     # rolling: v + w r = 0
+    v_t, w = oblique_impact_ball(0.2, 3.0, 1.0, 0.4, 0.5, 1.0, 1.0, 0.4)
+    assert v_t == pytest.approx(0.2 - 0.6) and v_t + w > 0.0        # reversed, still slipping
