@@ -24,8 +24,9 @@ SIGNALS = ("import faulthandler, signal\n"
            "faulthandler.register(signal.SIGUSR1, all_threads=True)\n"
            "faulthandler.register(signal.SIGXCPU, all_threads=True, chain=True)\n")
 
-#: A child that computes until it is stopped.
-SPIN = SIGNALS + "def spin():\n    while True:\n        pass\nspin()\n"
+#: A child that computes until it is stopped; the loop is one line (line 5),
+#: so that the dump names that line wherever the signal lands in it.
+SPIN = SIGNALS + "def spin():\n    while True: pass\nspin()\n"
 
 #: The CPU-time limit of these children (RLIMIT_CPU counts whole seconds).
 CPU_LIMIT = 1.0
