@@ -21,10 +21,13 @@ Conventions converted here and nowhere else
   ``<inertial pos quat>``. MuJoCo's free joint holds the frame's position and
   its orientation as a quaternion ``(w, x, y, z)`` (scalar first, unlike
   pybullet and scipy); its velocity ``qvel[0:3]`` is the frame origin's, in
-  world coordinates, and its angular velocity ``qvel[3:6]`` is in the
-  **body** frame: ``w_world = R w_body`` when reading, ``w_body = R^T
-  w_world`` when setting the initial state (measured here: a body spinning
-  about its tilted axis).
+  world coordinates, where refsim's is the centre of mass's
+  (:mod:`refsim.dynamics.trajectory`): ``v_com = v_origin + w x (R c)`` when
+  reading, ``v_origin = v_com - w x (R c)`` when setting the initial state,
+  for the centre of mass ``c`` in the mesh frame. Its angular velocity
+  ``qvel[3:6]`` is in the **body** frame: ``w_world = R w_body`` when
+  reading, ``w_body = R^T w_world`` when setting the initial state (measured
+  here: a body spinning about its tilted axis).
 - Meshes. ``<mesh vertex="...">`` without faces: MuJoCo collides a mesh as
   the convex hull of its vertices (qhull), so the l-beam, the star and the
   torus collide as their hulls, as in pybullet. The scene's ``scale`` is
@@ -216,7 +219,9 @@ class MujocoOracle:
         for i, body in enumerate(scene.bodies):
             r = np.asarray(body.orientation, dtype=np.float64)
             w_world = np.asarray(body.angular_velocity, dtype=np.float64)
-            self.data.qvel[6 * i:6 * i + 3] = np.asarray(body.velocity, dtype=np.float64)
+            v_com = np.asarray(body.velocity, dtype=np.float64)
+            self.data.qvel[6 * i:6 * i + 3] = v_com - np.cross(w_world,
+                                                               r @ self.properties[i].center)
             self.data.qvel[6 * i + 3:6 * i + 6] = r.T @ w_world
         mj.mj_forward(self.model, self.data)
         self._scene = scene
@@ -228,9 +233,8 @@ class MujocoOracle:
         if world.drag == 0.0:
             return
         d = self.data
-        for i, props in enumerate(self.properties):
-            x, v, w, r = self._body_state(i)
-            v_com = v + np.cross(w, r @ props.center)
+        for i in range(len(self.properties)):
+            _, v_com, _, _ = self._body_state(i)
             k = world.drag * (np.linalg.norm(v_com) if world.drag_model == "quadratic" else 1.0)
             d.xfrc_applied[i + 1, :3] = -k * v_com           # body 0 is the world
 
@@ -243,13 +247,14 @@ class MujocoOracle:
         qpos, qvel = self.data.qpos, self.data.qvel
         r = _matrix(qpos[7 * i + 3:7 * i + 7])
         x = np.array(qpos[7 * i:7 * i + 3])
-        v = np.array(qvel[6 * i:6 * i + 3])
         w = r @ np.array(qvel[6 * i + 3:6 * i + 6])
-        return x, v, w, r
+        v_com = np.array(qvel[6 * i:6 * i + 3]) + np.cross(w, r @ self.properties[i].center)
+        return x, v_com, w, r
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(B, 3) positions and velocities of the mesh origins, (B, 3) angular
-        velocities (world frame), (B, 3, 3) orientations (columns: body axes)."""
+        """(B, 3) positions of the mesh origins, (B, 3) velocities of the
+        centres of mass, (B, 3) angular velocities (world frame), (B, 3, 3)
+        orientations (columns: body axes)."""
         parts = [self._body_state(i) for i in range(len(self._scene.bodies))]
         return tuple(np.array([p[k] for p in parts]) for k in range(4))
 

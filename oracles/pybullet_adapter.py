@@ -16,11 +16,12 @@ Conventions converted here and nowhere else
 - Frames: refsim's orientation is a 3x3 matrix whose columns are the body's
   axes; pybullet's is a quaternion ``[x, y, z, w]`` (scipy's scalar-last
   order). pybullet's base pose and velocity are those of the *inertial* frame
-  (centre of mass, principal axes); refsim's are those of the mesh's origin.
-  :meth:`PybulletOracle.simulate` converts both ways:
-  ``R_link = R_inertial R_i^T``, ``p_link = p_com - R_link c`` and
-  ``v_link = v_com + w x (p_link - p_com)``, where ``c`` and ``R_i`` are the
-  centre of mass and principal axes in the mesh frame.
+  (centre of mass, principal axes); refsim's position and orientation are
+  the mesh origin's and the mesh's axes, its velocity is the centre of
+  mass's (:mod:`refsim.dynamics.trajectory`), as pybullet's is.
+  :meth:`PybulletOracle.simulate` converts the pose both ways:
+  ``R_link = R_inertial R_i^T`` and ``p_link = p_com - R_link c``, where ``c``
+  and ``R_i`` are the centre of mass and principal axes in the mesh frame.
 - Mass properties: pybullet's mesh shapes get the inertia of their bounding
   box (padded by the margin) unless told otherwise. Each body's principal
   moments (uniform solid of the body's mass, from trimesh's integrals, see
@@ -66,10 +67,13 @@ Every setting, and why (:class:`PybulletSettings` holds them)
   changing its velocity. (pybullet ignores negative values of this
   parameter.)
 - Restitution: Bullet's contact restitution is the *product* of the two
-  bodies' (``btManifoldResult::calculateCombinedRestitution``). Walls get 1,
-  bodies ``scene.world.restitution``, so the product is the scene's ``e``.
-- Friction likewise multiplies (``calculateCombinedFriction``): walls get 1,
-  bodies ``scene.world.friction`` as the Coulomb coefficient ``mu``. This is a
+  bodies' (``btManifoldResult::calculateCombinedRestitution``). Every body
+  and every wall gets ``sqrt(e)`` of the scene's ``e``, so that a body-wall
+  contact and a body-body contact both see ``e`` (1 on the walls and ``e`` on
+  the bodies would give ``e^2`` between two bodies).
+- Friction likewise multiplies (``calculateCombinedFriction``): every body
+  and wall gets ``sqrt(mu)`` of the scene's ``friction`` read as the Coulomb
+  coefficient ``mu``, so that every contact sees ``mu``. This is a
   different law from the seed's: the seed keeps ``(1 - friction)`` of the
   lateral velocity at every bounce; Coulomb friction removes at most
   ``mu (1 + e) |v_n|`` of it and stops at sticking
@@ -123,6 +127,7 @@ broadphase plus GJK/EPA per overlapping pair plus the solver's iterations.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import asdict, dataclass
 
@@ -145,8 +150,6 @@ class PybulletSettings:
     linear_damping: float = 0.0
     angular_damping: float = 0.0
     hull_collision_margin: float = 0.0
-    wall_restitution: float = 1.0
-    wall_friction: float = 1.0
     #: Wall boxes are this thick (as a fraction of the half size): thick
     #: enough that no step carries a body through one.
     wall_thickness: float = 1.0
@@ -257,8 +260,9 @@ class PybulletOracle:
             deterministicOverlappingPairs=1,
             physicsClientId=c)
 
-    def _add_walls(self, half_size: float) -> None:
+    def _add_walls(self, world) -> None:
         p, s, c = self.p, self.settings, self.client
+        half_size = world.half_size
         t = s.wall_thickness * half_size                 # half thickness of a wall box
         span = half_size + 2.0 * t                       # walls overlap at the edges
         self.walls = []
@@ -273,8 +277,9 @@ class PybulletOracle:
                 wall = p.createMultiBody(0.0, shape, basePosition=center,
                                          useMaximalCoordinates=s.use_maximal_coordinates,
                                          physicsClientId=c)
-                p.changeDynamics(wall, -1, restitution=s.wall_restitution,
-                                 lateralFriction=s.wall_friction, rollingFriction=0.0,
+                p.changeDynamics(wall, -1, restitution=math.sqrt(world.restitution),
+                                 lateralFriction=math.sqrt(world.friction),
+                                 rollingFriction=0.0,
                                  spinningFriction=0.0,
                                  contactProcessingThreshold=s.contact_processing_threshold,
                                  physicsClientId=c)
@@ -295,26 +300,24 @@ class PybulletOracle:
             baseInertialFrameOrientation=_quat(props.axes),
             useMaximalCoordinates=s.use_maximal_coordinates, physicsClientId=c)
         p.changeDynamics(uid, -1, mass=body.mass, localInertiaDiagonal=props.inertia.tolist(),
-                         restitution=scene.world.restitution,
-                         lateralFriction=scene.world.friction, rollingFriction=0.0,
+                         restitution=math.sqrt(scene.world.restitution),
+                         lateralFriction=math.sqrt(scene.world.friction), rollingFriction=0.0,
                          spinningFriction=0.0, linearDamping=s.linear_damping,
                          angularDamping=s.angular_damping,
                          contactProcessingThreshold=s.contact_processing_threshold,
                          collisionMargin=s.hull_collision_margin,
                          activationState=p.ACTIVATION_STATE_DISABLE_SLEEPING,
                          physicsClientId=c)
-        # Initial velocity: the scene gives the mesh origin's; pybullet wants
-        # the centre of mass's, v_com = v + w x (p_com - p_link).
-        w = np.asarray(body.angular_velocity, dtype=np.float64)
-        v = np.asarray(body.velocity, dtype=np.float64) + np.cross(w, r @ props.center)
-        p.resetBaseVelocity(uid, v.tolist(), w.tolist(), physicsClientId=c)
+        # The scene's velocity is the centre of mass's, as pybullet's is.
+        p.resetBaseVelocity(uid, [float(a) for a in body.velocity],
+                            [float(a) for a in body.angular_velocity], physicsClientId=c)
         self.properties.append(props)
         return uid
 
     def load(self, scene) -> None:
         """Build ``scene`` in this client (replacing whatever was there)."""
         self._configure(scene)
-        self._add_walls(scene.world.half_size)
+        self._add_walls(scene.world)
         self.bodies = []
         self.properties = []
         for body in scene.bodies:
@@ -341,8 +344,9 @@ class PybulletOracle:
         self.p.stepSimulation(physicsClientId=self.client)
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """(B, 3) positions and velocities of the mesh origins, (B, 3) angular
-        velocities, (B, 3, 3) orientations (columns are the body axes)."""
+        """(B, 3) positions of the mesh origins, (B, 3) velocities of the
+        centres of mass, (B, 3) angular velocities, (B, 3, 3) orientations
+        (columns are the body axes)."""
         p, c = self.p, self.client
         n = len(self.bodies)
         x = np.empty((n, 3))
@@ -356,7 +360,7 @@ class PybulletOracle:
             com = np.asarray(com)
             x[i] = com - r_link @ props.center
             w[i] = w_i
-            v[i] = np.asarray(v_com) + np.cross(w[i], x[i] - com)
+            v[i] = v_com
             r[i] = r_link
         return x, v, w, r
 

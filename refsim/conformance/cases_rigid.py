@@ -47,10 +47,11 @@ Two choices keep the answers exact for every reasonable engine:
   between its lowest vertex and the next ring of vertices: the first contact
   is one vertex straight below the centre (no torque); from 4 m a step can
   carry the ring into the floor too, and a contact solver that treats the
-  ring's vertices one after another spins the sphere;
-- the cube and the sphere have their centre of mass at their mesh origin, so
-  the reference point's velocity is the centre of mass's in every engine's
-  convention.
+  ring's vertices one after another spins the sphere.
+
+The state's meaning (:mod:`refsim.dynamics.trajectory`, for scenes and
+trajectories alike): ``position`` is the mesh origin's, ``velocity`` the
+centre of mass's, ``angular_velocity`` in the world frame.
 
 Reading a trajectory (:func:`lowest_height`, :func:`energy`): the height of
 the body's lowest vertex above the floor in every frame (from the frame's
@@ -331,9 +332,9 @@ def lowest_height(scene: RigidScene, trajectory) -> np.ndarray:
 def energy(scene: RigidScene, trajectory) -> np.ndarray:
     """(F,) mechanical energy by :func:`refsim.dynamics.energy.mechanical_energy`
     with the uniform solid's mass properties, whatever the engine's own: the
-    centre of mass at ``x + R c`` moving at ``v + w x (R c)`` (the recorded
-    velocity is the reference point's, the mesh origin's, in every engine's
-    convention), potential from the floor (joules, for the scene's mass)."""
+    centre of mass at ``x + R c`` for the mesh origin ``x``, moving at the
+    recorded velocity (the centre of mass's), potential from the floor
+    (joules, for the scene's mass)."""
     from refsim.dynamics.energy import mechanical_energy
 
     _, center, inertia = _body(_model(scene))
@@ -344,8 +345,7 @@ def energy(scene: RigidScene, trajectory) -> np.ndarray:
     w = np.asarray(trajectory.angular_velocity)[:, 0]
     rc = np.einsum("fij,j->fi", R, center)
     parts = mechanical_energy([mass], [inertia * mass], GRAVITY, -HALF_SIZE,
-                              (x + rc)[:, None], R[:, None], (v + np.cross(w, rc))[:, None],
-                              w[:, None])
+                              (x + rc)[:, None], R[:, None], v[:, None], w[:, None])
     return parts.total[:, 0]
 
 

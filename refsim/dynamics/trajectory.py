@@ -6,12 +6,17 @@ the pybullet oracle, so that the two can be compared array for array.
 Shapes, for F frames and B bodies:
 
 - ``t`` (F,): time of each frame, seconds;
-- ``position``, ``velocity``, ``angular_velocity`` (F, B, 3): the body's
-  reference point (its mesh's origin), its velocity, and its angular velocity
-  in radians per second, world frame (refsim's loop reports the velocity of
-  the body's centroid, the seed's Vel; for a mesh whose centroid is its
-  origin, as for every bundled model but the l-beam and the star, the two
-  coincide);
+- ``position`` (F, B, 3): the body's reference point, its mesh's origin,
+  in the world frame (metres);
+- ``velocity`` (F, B, 3): the velocity of the body's centre of mass (m/s),
+  not of its reference point: the seed's Vel. The centre of mass is the
+  uniform solid's in the corrected model and in the oracles, the vertex
+  average in the seed model (a scene's ``[[body]] velocity`` means the
+  same). For a mesh whose centre is its origin, as for every bundled model
+  but the l-beam and the star, the two points move alike; for the others
+  the origin moves at ``velocity + angular_velocity x (R c)``, ``c`` the
+  centre in the mesh frame;
+- ``angular_velocity`` (F, B, 3): radians per second, world frame;
 - ``orientation`` (F, B, 3, 3): columns are the body's axes in world space.
 
 ``events`` lists wall hits and body contacts. ``stages`` names the stages of
