@@ -63,6 +63,34 @@ def _impulses(kernel):
     return out
 
 
+def _island_impulses(kernel):
+    """Random islands: three bodies and a wall (the static fourth row), sets
+    of one to four contacts between random pairs and against the wall."""
+    rng = np.random.default_rng(RNG_SEED)
+    out = []
+    for _ in range(20):
+        v, w = np.zeros((4, 3)), np.zeros((4, 3))
+        v[:3], w[:3] = rng.normal(size=(3, 3)), rng.normal(size=(3, 3))
+        I_inv = np.zeros((4, 3, 3))
+        I_inv[:3] = np.eye(3) * rng.uniform(0.5, 2.0, size=(3, 1, 1))
+        body_a = np.array([0, 1, 2, 0], dtype=np.int64)
+        body_b = np.array([3, 0, 1, 2], dtype=np.int64)
+        sizes = rng.integers(1, 5, size=4)
+        starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        r_a = rng.normal(size=(starts[-1], 3))
+        r_b = rng.normal(size=(starts[-1], 3))
+        r_b[:starts[1]] = 0.0                                    # the wall's
+        normals = rng.normal(size=(4, 3))
+        normals /= np.linalg.norm(normals, axis=1)[:, None]
+        P = np.empty((starts[-1], 4))
+        m_inv = np.array([1.0, 0.5, 2.0, 0.0])
+        count = impulse.solve_island(starts, body_a, body_b, r_a, r_b, normals, m_inv, I_inv,
+                                     v, w, 0.7, 0.4, impulse.RESTITUTION_THRESHOLD,
+                                     impulse.ITERATIONS, P, kernel=kernel)
+        out.append((count, P, v, w))
+    return out
+
+
 def _ear_clipping(kernel):
     return [ear_clip_indexed(polygons.star(200), kernel=kernel),
             ear_clip_indexed(polygons.comb(120), kernel=kernel)]
@@ -157,6 +185,7 @@ def _simulation_loop(kernel):
 CASES = {
     "broad-phase sweep": _broad_phase,
     "contact impulses": _impulses,
+    "island contact impulses": _island_impulses,
     "indexed ear clipping": _ear_clipping,
     "seed orientation step": _seed_rotation,
     "batched boxes": _batched_boxes,

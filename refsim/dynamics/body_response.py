@@ -68,6 +68,14 @@ from refsim.dynamics.products import dot, norm
 #: (~1e-15 relative) and far below anything visible.
 SEPARATION_SLOP = 1e-9
 
+#: A vertex within this fraction of the half size of a wall touches it: the
+#: contacts of the walls that the bodies of a body contact rest on, solved
+#: together with it (:meth:`refsim.dynamics.simulation.Simulation._solve_island`).
+#: The wall stage leaves a body's outermost vertex on the wall up to the
+#: rounding of a coordinate (~1e-16 relative); 1e-9 of a 5 m cube is 5 nm,
+#: far below anything a scene shows.
+WALL_TOUCH = 1e-9
+
 
 def exchange_velocities_seed(c_a, c_b, v_a, v_b) -> tuple[np.ndarray, np.ndarray, bool]:
     """The seed's response: ``(v_a', v_b', approaching)``; new arrays."""

@@ -52,13 +52,19 @@ D2 Friction as a Coulomb coefficient in the corrected model (impulse):
    is the fraction of lateral speed removed at a bounce. The seed itself says
    the friction "should normally be proportional to the normal component of
    the incident velocity", which the Coulomb cone is.
-D3 Orientation by the exact rotation ``exp(h [w]x)`` and angular momentum
-   with the real inertia tensor (rotation_impulse), instead of the Euler
-   step of the axes and the identity.
-D4 Contact normal between bodies (body_response.contact_geometry): the axis
-   of least projection overlap among the centroid line and both bodies'
-   axes, instead of the centroid line alone (wrong for boxes meeting face to
-   face off-centre).
+D3 Orientation and angular velocity of a free body by Euler's equations
+   with the real inertia tensor, stepped by a symmetric splitting that keeps
+   the angular momentum and bounds the energy error
+   (rotation_impulse.free_rotation_step), instead of the Euler step of the
+   axes with the identity for the inertia.
+D4 Contact between bodies (body_response.contact_geometry,
+   collision.contact): the normal is the axis of least projection overlap
+   among the centroid line and both bodies' axes, instead of the centroid
+   line alone (wrong for boxes meeting face to face off-centre); the
+   impulses act at the corners of the contact polygon of the region where
+   the meshes overlap, and are solved together with the contacts of the
+   walls those bodies touch (impulse.solve_island), instead of at one point
+   between the bodies, one pair after another.
 D5 Positional correction (body_response.separate_bodies, and the wall
    push-back in the corrected model): bodies are moved apart along the
    normal until their projections are disjoint by ``SEPARATION_SLOP``, so no

@@ -242,8 +242,32 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
     n0, n1, n2 = n[0], n[1], n[2]
     vn0 = np.empty(c)
     Kn = np.empty(c)
+    approaching = _begin(r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_inv_b,
+                         v_b, w_b, vn0, Kn, P)
+    if approaching == 0:
+        return 0
+    # Phase 1, compression. A sweep whose every increment is exactly zero
+    # changed no value, so each later sweep would start from the same
+    # numbers and change none either: the solve stops there, with the
+    # values all ``iterations`` sweeps give.
+    dE1 = 0.0
+    for _ in range(iterations):
+        moved, dE1 = _compression_sweep(r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, v_a, w_a,
+                                        m_inv_b, I_inv_b, v_b, w_b, mu, Kn, P, dE1)
+        if not moved:
+            break
+    _restitution(r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_inv_b, v_b, w_b,
+                 e, mu, threshold, iterations, vn0, P, dE1)
+    return approaching
+
+
+@jitable
+def _begin(r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_inv_b, v_b, w_b,
+           vn0, Kn, P):
+    """Each contact's approach speed ``vn0`` and effective inverse mass
+    along n ``Kn``; ``P`` zeroed. Returns how many approach (v_n < 0)."""
     approaching = 0
-    for i in range(c):
+    for i in range(r_a.shape[0]):
         vr = _relative_velocity(i, r_a, r_b, v_a, w_a, v_b, w_b)
         vn0[i] = vr[0] * n0 + vr[1] * n1 + vr[2] * n2
         Kn[i] = _effective_inverse_mass(i, n0, n1, n2, r_a, r_b, m_inv_a, I_inv_a,
@@ -254,31 +278,41 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
         P[i, 1] = 0.0
         P[i, 2] = 0.0
         P[i, 3] = 0.0
-    if approaching == 0:
-        return 0
-    # Phase 1, compression: v_n -> 0 with P_n >= 0, then friction in the cone.
-    # A sweep whose every increment is exactly zero changed no value, so each
-    # later sweep would start from the same numbers and change none either:
-    # the solve stops there, with the values all ``iterations`` sweeps give.
-    dE1 = 0.0
-    for _ in range(iterations):
-        moved = False
-        for i in range(c):
-            vr = _relative_velocity(i, r_a, r_b, v_a, w_a, v_b, w_b)
-            vn = vr[0] * n0 + vr[1] * n1 + vr[2] * n2
-            Pn = max(P[i, 0] - vn / Kn[i], 0.0)           # accumulated, clamped
-            dPn = Pn - P[i, 0]
-            moved = moved or dPn != 0.0
-            P[i, 0] = Pn
-            dE1 += _apply(i, dPn * n0, dPn * n1, dPn * n2, r_a, r_b, m_inv_a, I_inv_a,
-                          m_inv_b, I_inv_b, v_a, w_a, v_b, w_b)
-            # friction in the cone |P_t| <= mu P_n of the normal impulse so far
-            slid, dE = _friction(i, mu, r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, m_inv_b,
-                                 I_inv_b, v_a, w_a, v_b, w_b, P)
-            moved = moved or slid
-            dE1 += dE
-        if not moved:
-            break
+    return approaching
+
+
+@jitable
+def _compression_sweep(r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_inv_b,
+                       v_b, w_b, mu, Kn, P, dE1):
+    """One Gauss-Seidel sweep of phase 1 over the contacts: at each, the
+    normal impulse that brings v_n to 0, accumulated and clamped to
+    ``P_n >= 0``, then friction in the cone ``|P_t| <= mu P_n`` of the
+    normal impulse so far. Returns ``(moved, dE1)``: whether any impulse
+    changed, and ``dE1`` plus the kinetic energy the sweep changed, summed
+    contact by contact."""
+    moved = False
+    for i in range(r_a.shape[0]):
+        vr = _relative_velocity(i, r_a, r_b, v_a, w_a, v_b, w_b)
+        vn = vr[0] * n0 + vr[1] * n1 + vr[2] * n2
+        Pn = max(P[i, 0] - vn / Kn[i], 0.0)           # accumulated, clamped
+        dPn = Pn - P[i, 0]
+        moved = moved or dPn != 0.0
+        P[i, 0] = Pn
+        dE1 += _apply(i, dPn * n0, dPn * n1, dPn * n2, r_a, r_b, m_inv_a, I_inv_a,
+                      m_inv_b, I_inv_b, v_a, w_a, v_b, w_b)
+        slid, dE = _friction(i, mu, r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, m_inv_b,
+                             I_inv_b, v_a, w_a, v_b, w_b, P)
+        moved = moved or slid
+        dE1 += dE
+    return moved, dE1
+
+
+@jitable
+def _restitution(r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_inv_b, v_b,
+                 w_b, e, mu, threshold, iterations, vn0, P, dE1):
+    """Phases 2 and 3 (module docstring) for the contacts whose compression
+    impulses ``P`` phase 1 left, ``dE1`` the energy phase 1 changed."""
+    c = r_a.shape[0]
     # Phase 2, restitution (Poisson): e times the compression impulse,
     # limited so that the collision as a whole adds no energy.
     # DEVIATION (D8): at several contacts with friction, Poisson's
@@ -314,7 +348,7 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
                 _apply(i, j * n0, j * n1, j * n2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b,
                        I_inv_b, v_a, w_a, v_b, w_b)
     if not restituted or mu == 0.0:
-        return approaching
+        return
     # Phase 3, friction through restitution: the normal impulse now includes
     # the restitution impulse lam e P_n, and Coulomb's cone is that of the
     # whole impact, |P_t| <= mu (1 + lam e) P_n; the friction sweeps of
@@ -334,8 +368,87 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
             moved = moved or slid
         if not moved:
             break
+
+
+def solve_island_python(starts, body_a, body_b, r_a, r_b, normals, m_inv, I_inv, v, w,
+                        e, mu, threshold, iterations, P):
+    """The contact solve of several contact sets at once, in place: the sets
+    of one step that share bodies (a stack on the floor: the floor's
+    contacts with the lower body, the two bodies' contacts), so that each
+    impulse is answered by the others within the step, as a resting
+    contact needs (a lower body pressed down off its centre is held by the
+    floor under that side, instead of turning and walking away).
+
+    Phase 1 runs its Gauss-Seidel sweeps over every contact of every set,
+    until a sweep changes nothing or ``iterations`` sweeps; phases 2 and 3
+    then run set by set, each with the energy its own phase 1 changed
+    (module docstring). A single set gives what :func:`solve_contacts_python`
+    gives.
+
+    Parameters
+    ----------
+    starts : (S + 1,) int64
+        Set s holds contacts ``starts[s]:starts[s + 1]``.
+    body_a, body_b : (S,) int64
+        The rows of A and B of each set in the body arrays; a wall is B
+        with a row of zeros (no mass, no inertia, at rest; the values are
+        those of :func:`solve_contacts_python` with B None, see there).
+    r_a, r_b : (C, 3) float64
+        Contact points from A's and B's centres of mass (zeros for a wall).
+    normals : (S, 3) float64
+        Each set's unit normal from B into A.
+    m_inv : (N,); I_inv : (N, 3, 3); v, w : (N, 3) float64
+        Inverse masses, world-frame inverse inertia, and velocities of the
+        bodies (the velocities updated in place).
+    e, mu, threshold, iterations : as :func:`solve_contacts_python`.
+    P : (C, 4) float64 output, as there.
+
+    Returns
+    -------
+    int : the number of contacts that approached at the start.
+    """
+    S = starts.shape[0] - 1
+    C = r_a.shape[0]
+    vn0 = np.empty(C)
+    Kn = np.empty(C)
+    dE1 = np.zeros(S)
+    approaching = 0
+    for s in range(S):
+        lo, hi, a, b = starts[s], starts[s + 1], body_a[s], body_b[s]
+        approaching += _begin(r_a[lo:hi], r_b[lo:hi], normals[s, 0], normals[s, 1],
+                              normals[s, 2], m_inv[a], I_inv[a], v[a], w[a], m_inv[b],
+                              I_inv[b], v[b], w[b], vn0[lo:hi], Kn[lo:hi], P[lo:hi])
+    if approaching == 0:
+        return 0
+    for _ in range(iterations):
+        moved = False
+        for s in range(S):
+            lo, hi, a, b = starts[s], starts[s + 1], body_a[s], body_b[s]
+            changed, dE1[s] = _compression_sweep(
+                r_a[lo:hi], r_b[lo:hi], normals[s, 0], normals[s, 1], normals[s, 2], m_inv[a],
+                I_inv[a], v[a], w[a], m_inv[b], I_inv[b], v[b], w[b], mu, Kn[lo:hi],
+                P[lo:hi], dE1[s])
+            moved = moved or changed
+        if not moved:
+            break
+    for s in range(S):
+        lo, hi, a, b = starts[s], starts[s + 1], body_a[s], body_b[s]
+        _restitution(r_a[lo:hi], r_b[lo:hi], normals[s, 0], normals[s, 1], normals[s, 2],
+                     m_inv[a], I_inv[a], v[a], w[a], m_inv[b], I_inv[b], v[b], w[b], e, mu,
+                     threshold, iterations, vn0[lo:hi], P[lo:hi], dE1[s])
     return approaching
 
+
+def solve_island_compiled(*args):
+    """:func:`solve_island_python` compiled by numba as it stands."""
+    return compile_kernel(solve_island_python)(*args)
+
+
+def solve_island(*args, kernel: str | None = None):
+    """:func:`solve_island_python` on the chosen kernel (:mod:`refsim.kernels`)."""
+    if choose_kernel(kernel) == "compiled":
+        return solve_island_compiled(*args)
+    return solve_island_python(*args)
 
 
 def solve_contacts_compiled(*args):
@@ -364,15 +477,15 @@ def wall_impulses(r_a, n, inv_mass: float, I_inv, v, w, restitution: float,
     return P
 
 
-def body_impulse(r_a, r_b, n, inv_mass_a: float, I_inv_a, v_a, w_a, inv_mass_b: float,
-                 I_inv_b, v_b, w_b, restitution: float, friction: float, *,
-                 kernel: str | None = None) -> np.ndarray:
-    """The impulse at one contact point between bodies A and B: ``r_a``,
-    ``r_b`` (3,) from each centre of mass, ``n`` from B into A; the (3,)
-    velocities updated in place. Returns the (1, 4) impulse."""
-    P = np.empty((1, 4))
-    solve_contacts(np.asarray(r_a, dtype=np.float64)[None, :],
-                   np.asarray(r_b, dtype=np.float64)[None, :], n, inv_mass_a, I_inv_a,
+def body_impulses(r_a, r_b, n, inv_mass_a: float, I_inv_a, v_a, w_a, inv_mass_b: float,
+                  I_inv_b, v_b, w_b, restitution: float, friction: float, *,
+                  kernel: str | None = None) -> np.ndarray:
+    """The impulses between bodies A and B at contact points ``r_a``, ``r_b``
+    (k, 3) (the same points, from each centre of mass), ``n`` from B into
+    A; the (3,) velocities updated in place. Returns the (k, 4) impulses."""
+    r_a = np.ascontiguousarray(r_a, dtype=np.float64)
+    P = np.empty((len(r_a), 4))
+    solve_contacts(r_a, np.ascontiguousarray(r_b, dtype=np.float64), n, inv_mass_a, I_inv_a,
                    v_a, w_a, inv_mass_b, I_inv_b, v_b, w_b, restitution, friction,
                    RESTITUTION_THRESHOLD, ITERATIONS, P, kernel=kernel)
     return P

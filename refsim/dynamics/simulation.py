@@ -70,8 +70,10 @@ from refsim.bounds.tracker import AABBTracker, make_aabb_tracker
 from refsim.bounds.world_cube import world_cube_test
 from refsim.collision.bodies import bodies_collide
 from refsim.collision.broad_phase import overlapping_pairs
+from refsim.collision.contact import contact_polygon, intersection_points
 from refsim.dynamics import impulse
 from refsim.dynamics.body_response import (
+    WALL_TOUCH,
     contact_geometry,
     exchange_velocities_seed,
     separate_bodies,
@@ -346,6 +348,8 @@ class Simulation:
         self.hi = np.empty((B, 3))
         self.events: list[Event] = []
         self._touching: set[Contact] = set()
+        # the wall stage's contacts of the step, (body, axis, low wall) -> r
+        self._wall_contacts: dict[tuple[int, int, bool], np.ndarray] = {}
         self.stages = tuple(s for s in STAGES if self._needs(s))
         self.timer = StageTimer(self.stages)
         self._frames: FrameSink = MemorySink() if sink is None else sink
@@ -459,6 +463,7 @@ class Simulation:
         self._bounds()
         timer.lap("bounds")
         touching: set[Contact] = set()
+        self._wall_contacts = {}
         # AMBIGUITY (A9): walls before bodies, the order of the seed's text
         self._walls(touching)
         timer.lap("walls")
@@ -631,6 +636,7 @@ class Simulation:
             low = correction[k] > 0.0
             W = self.world_vertices(i)
             r_a = W[wall_contacts(W, k, -H if low else H, low)] - self.x[i]
+            self._wall_contacts[i, k, low] = r_a          # for a body contact's solve
             self.x[i, k] += correction[k]                   # no interpenetration persists
             # DEVIATION (D6): the speed at the wall (energy of the push-back, as in S7), but
             # only for a real bounce: in resting contact this torque-free change
@@ -674,7 +680,7 @@ class Simulation:
 
     # 8. body-body response (S8, or corrected)
     def _body_response(self, pairs, touching: set) -> None:
-        world = self.scene.world
+        contacts = []
         for a, b in pairs:
             a, b = int(a), int(b)
             touching.add(Contact("body", self.names[a], self.names[b]))
@@ -686,18 +692,65 @@ class Simulation:
                                         self.x[a], self.x[b], self.R[a], self.R[b])
             if geometry.depth < 0.0:
                 continue                  # a separating axis: coarse-level false contact
-            if self.rotation == "off":
-                I_inv_a = I_inv_b = np.zeros((3, 3))
-            else:
-                I_inv_a, I_inv_b = world_inertia(self.R[[a, b]], self.I_body_inv[[a, b]])
-            impulse.body_impulse(
-                geometry.point - self.x[a], geometry.point - self.x[b], geometry.n,
-                self.inv_mass[a], I_inv_a, self.v[a], self.w[a],
-                self.inv_mass[b], I_inv_b, self.v[b], self.w[b], world.restitution,
-                world.friction, kernel=self.kernel)
+            # the impulses act over the corners of the region where the
+            # meshes overlap (an offset stack is held along its whole strip);
+            # at a coarse level the meshes may not meet: the normal's point
+            points = contact_polygon(
+                intersection_points(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
+                                    self.pose(b), kernel=self.kernel), geometry.n)
+            if not len(points):
+                points = geometry.point[None, :]
+            contacts.append((a, b, points, geometry))
+        if not contacts:
+            return
+        self._solve_island(contacts)
+        for a, b, _, geometry in contacts:
             dx_a, dx_b = separate_bodies(geometry, self.inv_mass[a], self.inv_mass[b])
             self.x[a] += dx_a
             self.x[b] += dx_b
+
+    def _solve_island(self, contacts) -> None:
+        """One impulse solve (:func:`refsim.dynamics.impulse.solve_island`)
+        over the step's body contacts and the walls the bodies in them touch:
+        the vertices the wall stage found past a wall in this step (a body
+        resting on the floor sinks into it by ``g h^2`` each step, all its
+        supporting vertices at once), else those the wall stage left on it."""
+        world = self.scene.world
+        H = world.half_size
+        B = len(self.bodies)
+        sets = []                                  # (a, b, r_a, r_b, n)
+        for i in sorted({c[0] for c in contacts} | {c[1] for c in contacts}):
+            W = self.world_vertices(i)
+            for k in range(3):
+                for low in (True, False):
+                    r = self._wall_contacts.get((i, k, low))
+                    if r is None or not len(r):
+                        column = W[:, k]
+                        on = (column <= -H + WALL_TOUCH * H if low
+                              else column >= H - WALL_TOUCH * H)
+                        r = W[on] - self.x[i]
+                    if len(r):
+                        n = np.zeros(3)
+                        n[k] = 1.0 if low else -1.0
+                        sets.append((i, B, r, np.zeros_like(r), n))
+        for a, b, points, geometry in contacts:
+            sets.append((a, b, points - self.x[a], points - self.x[b], geometry.n))
+        starts = np.cumsum([0] + [len(s[2]) for s in sets]).astype(np.int64)
+        static = np.zeros((1, 3))
+        v, w = np.concatenate([self.v, static]), np.concatenate([self.w, static])
+        I_inv = np.zeros((B + 1, 3, 3))
+        if self.rotation != "off":
+            I_inv[:B] = world_inertia(self.R, self.I_body_inv)
+        P = np.empty((int(starts[-1]), 4))
+        impulse.solve_island(
+            starts, np.array([s[0] for s in sets], dtype=np.int64),
+            np.array([s[1] for s in sets], dtype=np.int64),
+            np.concatenate([s[2] for s in sets]), np.concatenate([s[3] for s in sets]),
+            np.array([s[4] for s in sets]), np.concatenate([self.inv_mass, [0.0]]), I_inv, v, w,
+            world.restitution, world.friction, impulse.RESTITUTION_THRESHOLD,
+            impulse.ITERATIONS, P, kernel=self.kernel)
+        self.v[...] = v[:B]
+        self.w[...] = w[:B]
 
     # 3. divergence
     def _check(self) -> None:
