@@ -40,13 +40,14 @@ def _e(text) -> str:
 
 def _json(value) -> str:
     """A record as JSON, one top-level key a line (its value on that line)."""
-    from refsim.conformance.results import _jsonable
+    from refsim.conformance.results import plain
 
+    value = plain(value)
     if isinstance(value, dict):
-        text = "{\n" + ",\n".join(f" {json.dumps(k)}: {json.dumps(v, default=_jsonable)}"
+        text = "{\n" + ",\n".join(f" {json.dumps(k)}: {json.dumps(v, allow_nan=False)}"
                                   for k, v in value.items()) + "\n}"
     else:
-        text = json.dumps(value, default=_jsonable)
+        text = json.dumps(value, allow_nan=False)
     if len(text) > EXAMPLE_CHARS:
         text = text[:EXAMPLE_CHARS] + "\n... (cut; conformance.json has it all)"
     return _e(text)

@@ -28,8 +28,6 @@ built once per session and shared by the tests that need it.
 
 from __future__ import annotations
 
-import json
-
 import pytest
 
 #: Where the session's results are kept for the terminal summary.
@@ -81,7 +79,7 @@ class CheckItem(pytest.Item):
 
     def repr_failure(self, excinfo, style=None):
         if isinstance(excinfo.value, ConformanceFailure):
-            from refsim.conformance.results import _jsonable
+            from refsim.conformance.results import strict_json
 
             r = excinfo.value.result
             classes = ", ".join(f"{k} {v}" for k, v in r.classes.items())
@@ -90,7 +88,7 @@ class CheckItem(pytest.Item):
                 lines.append(f"declared: {r.reason}")
             for example in r.examples[:3]:
                 label = "minimal example (shrunk)" if example.get("shrunk") else "example"
-                lines.append(f"{label}: {json.dumps(example, default=_jsonable)[:2000]}")
+                lines.append(f"{label}: {strict_json(example, indent=None)[:2000].rstrip()}")
             return "\n".join(lines)
         return super().repr_failure(excinfo, style=style)
 
