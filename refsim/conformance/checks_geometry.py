@@ -429,8 +429,11 @@ def _box_check(name: str, engine, cases, side: int) -> CheckResult:
             return {**(classify_box(c, lo, hi, side, declared) or {}),
                     "lo": lo.tolist(), "hi": hi.tolist()}
 
-        shrunk = _shrunk(cases, lambda c: classify_box(c, *_box(engine, c), side, declared)
-                         is not None, classified, lambda c: c.to_dict())
+        def fails(c):
+            lo, hi = _box(engine, c)
+            return classify_box(c, lo, hi, side, declared) is not None
+
+        shrunk = _shrunk(cases, fails, classified, lambda c: c.to_dict())
     return tally("aabb", name, outcomes, examples=_examples(found, shrunk), misses=misses,
                  measured={"largest_excess_metres": worst,
                            "largest_excess_rounding_bounds": worst_ratio},

@@ -72,7 +72,9 @@ def check_ode_order(engine, cases) -> CheckResult:
     none below the declared one."""
     start = time.perf_counter()
     declared = float(engine.ode_order)
-    outcomes, examples, orders = [], [], {}
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    orders: dict = {}
     for problem in cases.problems:
         steps = [(problem.t1 - problem.t0) / n for n in cases.step_counts]
         errors = attempt(lambda p: [end_error(engine.ode_step, p, n)

@@ -69,7 +69,8 @@ def _entries(text: str, key: str, where: str) -> tuple[tuple, dict]:
     from refsim.conformance.registry import check_by_key
     from refsim.conformance.results import CLASSES
 
-    names, bounds = [], {}
+    names: list[str] = []
+    bounds: dict[str, float] = {}
     for raw in text.split(","):
         entry = raw.strip()
         match = _ENTRY.match(entry)
@@ -118,7 +119,8 @@ def parse_expected(text: str, source: str = "<expected failures>") -> dict[str, 
                               f"{', '.join(CHECK_KEYS)})")
         if not match["reason"]:
             raise OptionError(f"{where}: {key}: a reason is required after the check")
-        classes, bounds = None, {}
+        classes: tuple | None = None
+        bounds: dict[str, float] = {}
         if match["classes"] is not None:
             classes, bounds = _entries(match["classes"], key, where)
         if key in found:
