@@ -74,6 +74,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, field, replace
+from types import SimpleNamespace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -287,15 +288,48 @@ class RigidCases:
         return [s for s in self.scenes if s.kind in kinds]
 
     def run(self, engine, scene: RigidScene):
-        """``engine.simulate(scene.scene)``, once per engine and scene."""
+        """``engine.simulate(scene.scene)`` read by :func:`read_trajectory`,
+        once per engine and scene; an exception it raised is kept too, and
+        raised again for every check that asks."""
         key = (id(engine), scene.name)
         if key not in self._runs:
-            self._runs[key] = (engine, engine.simulate(scene.scene))
-        return self._runs[key][1]
+            try:
+                self._runs[key] = (engine, read_trajectory(engine.simulate(scene.scene), scene))
+            except Exception as exc:  # noqa: BLE001 - each check records it as a crash
+                self._runs[key] = (engine, exc)
+        answer = self._runs[key][1]
+        if isinstance(answer, Exception):
+            raise answer
+        return answer
 
     def rerun(self, engine, scene: RigidScene):
         """A fresh run (not kept)."""
-        return engine.simulate(scene.scene)
+        return read_trajectory(engine.simulate(scene.scene), scene)
+
+
+#: The arrays a trajectory holds, each's shape after the frame count F (one body).
+TRAJECTORY_SHAPES = {"position": (1, 3), "velocity": (1, 3), "angular_velocity": (1, 3),
+                     "orientation": (1, 3, 3)}
+
+
+def read_trajectory(trajectory, scene: RigidScene) -> SimpleNamespace:
+    """The engine's answer as float64 arrays ``t`` (F,) and those of
+    :data:`TRAJECTORY_SHAPES`; ValueError naming the field and its shape for
+    an answer that has not the contract's (:mod:`refsim.engines`), so that
+    the check records what is wrong with it."""
+    read = {}
+    for name in ("t", *TRAJECTORY_SHAPES):
+        if not hasattr(trajectory, name):
+            raise ValueError(f"{scene.name}: the trajectory has no {name!r}")
+        read[name] = np.asarray(getattr(trajectory, name), dtype=np.float64)
+    frames = read["t"].shape
+    if len(frames) != 1 or frames[0] < 2:
+        raise ValueError(f"{scene.name}: trajectory.t has shape {frames}, expected (F,), F >= 2")
+    for name, shape in TRAJECTORY_SHAPES.items():
+        if read[name].shape != frames + shape:
+            raise ValueError(f"{scene.name}: trajectory.{name} has shape {read[name].shape}, "
+                             f"expected {frames + shape}")
+    return SimpleNamespace(**read)
 
 
 def rigid_cases(seed: int = 0) -> RigidCases:

@@ -37,7 +37,14 @@ import time
 import numpy as np
 
 from refsim.conformance.cases_ode import end_error, fitted_order
-from refsim.conformance.results import CheckResult, classify_miss, not_applicable, tally
+from refsim.conformance.results import (
+    CheckResult,
+    Crash,
+    attempt,
+    classify_miss,
+    not_applicable,
+    tally,
+)
 
 #: Observed and declared order may differ by this much. The fits of refsim's
 #: five methods on these problems land within 0.15 of their orders (the
@@ -65,10 +72,17 @@ def check_ode_order(engine, cases) -> CheckResult:
     none below the declared one."""
     start = time.perf_counter()
     declared = float(engine.ode_order)
-    outcomes, examples, orders = [], [], {}
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    orders: dict = {}
     for problem in cases.problems:
         steps = [(problem.t1 - problem.t0) / n for n in cases.step_counts]
-        errors = [end_error(engine.ode_step, problem, n) for n in cases.step_counts]
+        errors = attempt(lambda p: [end_error(engine.ode_step, p, n)
+                                    for n in cases.step_counts], problem)
+        if isinstance(errors, Crash):
+            outcomes.append("crash")
+            examples.append(errors.example(problem=problem.name))
+            continue
         observed = fitted_order(steps, errors)
         orders[problem.name] = observed
         miss = 0.0 if observed is None else (math.inf if math.isnan(observed)
@@ -111,8 +125,15 @@ def check_ode_stability(engine, cases) -> CheckResult:
     examples: list[dict] = []
     measured: list[float] = []           # R(z) realised by one step, per point
     for z in cases.stability_points:
-        got = _amplification(engine, z)
-        declared = complex(engine.ode_stability(z))
+        answer = attempt(lambda x: (_amplification(engine, x), complex(engine.ode_stability(x))),
+                         z)
+        if isinstance(answer, Crash):
+            outcomes.append("crash")
+            measured.append(math.inf)            # the stable interval ends before it
+            if len(examples) < 5:
+                examples.append(answer.example(z=z))
+            continue
+        got, declared = answer
         miss = abs(got - declared) / max(1.0, abs(declared)) if math.isfinite(got) else math.inf
         outcome = classify_miss(miss, STABILITY_RTOL)
         outcomes.append(outcome)

@@ -69,7 +69,14 @@ meet them within these bounds.
   momentum (no contact, no force: any change is the integrator's).
 
 A failure within twice its tolerance is "tolerance"; beyond, "bug" (unless
-recognised as above).
+recognised as above). An engine that declares a contact law other than a
+restitution coefficient (``contact_law``, :func:`refsim.engines.declarations`)
+is not held to the answers that assume one: its misses of
+``rigid.apex_ratio`` and ``rigid.oblique_bounce`` are "law", naming it. An
+apex ratio that cannot be read (fewer bounces than it needs) is
+"unmeasurable", with the reason. A scene whose ``simulate`` raises, or
+returns arrays of other shapes than the contract's, is that scene's
+"crash" in every check that reads it.
 
 References: the analytic answers of :mod:`refsim.dynamics.analytic`
 (Mirtich 1996, ch. 3; Stronge, *Impact Mechanics*, 2000); the spin-down of
@@ -90,7 +97,7 @@ import time
 import numpy as np
 
 from refsim.conformance import cases_rigid as R
-from refsim.conformance.results import CheckResult, classify_miss, tally
+from refsim.conformance.results import CheckResult, Crash, attempt, classify_miss, tally
 from refsim.dynamics import analytic
 
 #: Steps over which an engine may find and resolve one contact (module docstring).
@@ -131,6 +138,31 @@ FLIP_INTERVAL_TOL = 0.01
 FREE_ENERGY_TOL = 1e-3
 
 
+def _runs(engine, cases, kinds, outcomes: list, examples: list):
+    """Each scene of ``kinds`` with the engine's trajectory of it; a scene
+    whose run crashed is recorded in ``outcomes`` and ``examples`` (class
+    "crash", the scene and the traceback's last line) and skipped."""
+    for scene in cases.of_kind(*kinds):
+        trajectory = attempt(cases.run, engine, scene)
+        if isinstance(trajectory, Crash):
+            outcomes.append("crash")
+            examples.append(trajectory.example(**scene.to_dict()))
+            continue
+        yield scene, trajectory
+
+
+def _law(engine, outcome: str | None, example: dict) -> str | None:
+    """``outcome``, or "law" for a miss of an engine that declares a contact
+    law other than restitution (its name added to ``example``)."""
+    from refsim.engines import RESTITUTION, declarations
+
+    law = declarations(engine).contact_law
+    if outcome is None or law == RESTITUTION:
+        return outcome
+    example["contact_law"] = law
+    return "law"
+
+
 def apex_tolerance(scene) -> float:
     """Relative apex-ratio tolerance of a drop (module docstring)."""
     h_K = scene.height * scene.e ** (2 * R.BOUNCES)
@@ -141,22 +173,30 @@ def apex_tolerance(scene) -> float:
 def check_rigid_apex_ratio(engine, cases) -> CheckResult:
     """``rigid.apex_ratio``: apex ratio e^2 in every drop (module docstring)."""
     start = time.perf_counter()
-    outcomes, examples, measured = [], [], {}
-    for scene in cases.of_kind("drop"):
-        ratio, heights = R.apex_ratio(scene, cases.run(engine, scene))
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("drop",), outcomes, examples):
+        ratio, heights = R.apex_ratio(scene, trajectory)
         ideal = analytic.apex_ratio(scene.e)
-        error = (ratio - ideal) / ideal if math.isfinite(ratio) else math.nan
+        error = (ratio - ideal) / ideal
         tol = apex_tolerance(scene)
         measured[scene.name] = {"ratio": ratio, "relative_error": error, "tolerance": tol}
-        outcome = classify_miss(abs(error), tol) if math.isfinite(error) else "bug"
+        example = {"apex_ratio": ratio, "ideal": ideal, "relative_error": error,
+                   "tolerance": tol, "apex_heights": heights,
+                   "analytic_heights": analytic.apex_heights(scene.height, scene.e,
+                                                             R.BOUNCES).tolist()}
+        if math.isfinite(error):
+            outcome = classify_miss(abs(error), tol)
+        else:
+            outcome = "unmeasurable"
+            example["reason"] = (f"{max(len(heights) - 1, 0)} apexes after the release, "
+                                 f"{R.BOUNCES} needed (the body bounced fewer times in "
+                                 f"{float(trajectory.t[-1]):g} s)")
+        outcome = _law(engine, outcome, example)
         outcomes.append(outcome)
         if outcome is not None:
-            examples.append({"class": outcome, "apex_ratio": ratio, "ideal": ideal,
-                             "relative_error": error, "tolerance": tol,
-                             "apex_heights": heights,
-                             "analytic_heights": analytic.apex_heights(
-                                 scene.height, scene.e, R.BOUNCES).tolist(),
-                             **scene.to_dict()})
+            examples.append({"class": outcome, **example, **scene.to_dict()})
     return tally("rigid", "apex_ratio", outcomes, examples=examples, measured=measured,
                  seconds=time.perf_counter() - start)
 
@@ -165,9 +205,10 @@ def check_rigid_no_spin(engine, cases) -> CheckResult:
     """``rigid.no_spin``: a frictionless drop landing straight below the
     centre of mass does not start the body turning (module docstring)."""
     start = time.perf_counter()
-    outcomes, examples, measured = [], [], {}
-    for scene in cases.of_kind("drop"):
-        trajectory = cases.run(engine, scene)
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("drop",), outcomes, examples):
         vertices, _, _ = R._body(R._model(scene))
         reach = float(np.sqrt((vertices ** 2).sum(axis=1)).max())
         spin = float(np.sqrt((np.asarray(trajectory.angular_velocity)[:, 0] ** 2)
@@ -202,9 +243,10 @@ def check_rigid_oblique_bounce(engine, cases) -> CheckResult:
     """``rigid.oblique_bounce``: Coulomb's lateral velocity and spin after an
     oblique impact, in every regime (module docstring)."""
     start = time.perf_counter()
-    outcomes, examples, measured = [], [], {}
-    for scene in cases.of_kind("oblique"):
-        trajectory = cases.run(engine, scene)
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("oblique",), outcomes, examples):
         k = _after_impact(trajectory)
         body = scene.scene.bodies[0]
         v_n, coulomb, coulomb_spin = R.oblique_answer(scene)
@@ -230,17 +272,17 @@ def check_rigid_oblique_bounce(engine, cases) -> CheckResult:
         outcome = classify_miss(error, 1.0) if math.isfinite(error) else "bug"
         if outcome is not None and abs(got - seed_law) <= tol:
             outcome = "known-divergence"
+        example = {"lateral_velocity": got, "coulomb": coulomb, "spin": spin,
+                   "coulomb_spin": coulomb_spin, "seed_law": seed_law,
+                   "impact_normal_speed": v_n, "tolerance": tol, "spin_tolerance": spin_tol}
+        outcome = _law(engine, outcome, example)
         measured[scene.name] = {"lateral_velocity": got, "coulomb": coulomb,
                                 "spin": spin, "coulomb_spin": coulomb_spin,
                                 "seed_law": seed_law, "tolerance": tol,
                                 "spin_tolerance": spin_tol}
         outcomes.append(outcome)
         if outcome is not None:
-            examples.append({"class": outcome, "lateral_velocity": got, "coulomb": coulomb,
-                             "spin": spin, "coulomb_spin": coulomb_spin,
-                             "seed_law": seed_law, "impact_normal_speed": v_n,
-                             "tolerance": tol, "spin_tolerance": spin_tol,
-                             **scene.to_dict()})
+            examples.append({"class": outcome, **example, **scene.to_dict()})
     return tally("rigid", "oblique_bounce", outcomes, examples=examples, measured=measured,
                  seconds=time.perf_counter() - start)
 
@@ -262,9 +304,10 @@ def check_rigid_spin_to_rest(engine, cases) -> CheckResult:
     """``rigid.spin_to_rest``: the spinning cube is at rest by
     :func:`spin_rest_time` (module docstring)."""
     start = time.perf_counter()
-    outcomes, examples, measured = [], [], {}
-    for scene in cases.of_kind("spin"):
-        trajectory = cases.run(engine, scene)
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("spin",), outcomes, examples):
         t = np.asarray(trajectory.t)
         speed = np.sqrt((np.asarray(trajectory.angular_velocity)[:, 0] ** 2).sum(axis=1))
         w0 = float(np.abs(scene.scene.bodies[0].angular_velocity).max())
@@ -307,9 +350,11 @@ def check_rigid_energy(engine, cases) -> CheckResult:
     """``rigid.energy``: with restitution <= 1 and no driving force the
     mechanical energy never rises beyond :func:`energy_tolerance`."""
     start = time.perf_counter()
-    outcomes, examples, measured = [], [], {}
-    for scene in cases.of_kind("drop", "oblique", "spin", "rest"):
-        trajectory = cases.run(engine, scene)
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("drop", "oblique", "spin", "rest"),
+                                   outcomes, examples):
         energy = R.energy(scene, trajectory)
         rise = float((energy - energy[0]).max())
         tol = energy_tolerance(scene)
@@ -331,9 +376,10 @@ def check_rigid_resting_contact(engine, cases) -> CheckResult:
     within ``REST_PENETRATION_STEPS g h^2`` (the spinning cube from its
     rest-time limit on)."""
     start = time.perf_counter()
-    outcomes, examples, measured = [], [], {}
-    for scene in cases.of_kind("rest", "spin"):
-        trajectory = cases.run(engine, scene)
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("rest", "spin"), outcomes, examples):
         t = np.asarray(trajectory.t)
         heights = R.lowest_height(scene, trajectory)
         since = spin_rest_time(scene) if scene.kind == "spin" else 0.0
@@ -359,10 +405,14 @@ def _same(a, b) -> bool:
 def check_rigid_determinism(engine, cases) -> CheckResult:
     """``rigid.determinism``: a second run gives the same frames, bit for bit."""
     start = time.perf_counter()
-    outcomes, examples = [], []
-    for scene in cases.of_kind("oblique", "spin"):
-        first = cases.run(engine, scene)
-        second = cases.rerun(engine, scene)
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    for scene, first in _runs(engine, cases, ("oblique", "spin"), outcomes, examples):
+        second = attempt(cases.rerun, engine, scene)
+        if isinstance(second, Crash):
+            outcomes.append("crash")
+            examples.append(second.example(run="the second", **scene.to_dict()))
+            continue
         same = _same(first, second)
         outcomes.append(None if same else "bug")
         if not same:
@@ -378,9 +428,10 @@ def check_rigid_free_rotation(engine, cases) -> CheckResult:
     """``rigid.free_rotation``: the free brick flips as Euler's equations say,
     and keeps its energy (module docstring)."""
     start = time.perf_counter()
-    outcomes, examples, measured = [], [], {}
-    for scene in cases.of_kind("free"):
-        trajectory = cases.run(engine, scene)
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("free",), outcomes, examples):
         t = np.asarray(trajectory.t)
         closed = R.free_body(scene)
         W = R.body_angular_velocity(trajectory)

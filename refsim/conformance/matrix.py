@@ -18,7 +18,6 @@ Cost: the sum of the engines' runs, with each case set built once.
 
 from __future__ import annotations
 
-import json
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -92,9 +91,9 @@ class Matrix:
                 "seconds": dict(self.seconds)}
 
     def to_json(self) -> str:
-        from refsim.conformance.results import _jsonable
+        from refsim.conformance.results import strict_json
 
-        return json.dumps(self.to_dict(), indent=1, default=_jsonable) + "\n"
+        return strict_json(self.to_dict())
 
     def table(self) -> str:
         """Plain text: a row per check, a column per engine, each cell

@@ -25,7 +25,8 @@ th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; vertic
 td.n { text-align: right; font-variant-numeric: tabular-nums; }
 .passed { background: #e3f4e1; } .failed { background: #f9d6d5; }
 .xfailed { background: #fbefd0; } .xpassed { background: #e6eef9; } .na { background: #eee; }
-pre { background: #f6f6f6; padding: 0.6em; overflow-x: auto; font-size: 12px; }
+pre { background: #f6f6f6; padding: 0.6em; font-size: 12px; white-space: pre-wrap;
+      overflow-wrap: anywhere; }
 .meta { color: #555; }
 """
 
@@ -40,13 +41,14 @@ def _e(text) -> str:
 
 def _json(value) -> str:
     """A record as JSON, one top-level key a line (its value on that line)."""
-    from refsim.conformance.results import _jsonable
+    from refsim.conformance.results import plain
 
+    value = plain(value)
     if isinstance(value, dict):
-        text = "{\n" + ",\n".join(f" {json.dumps(k)}: {json.dumps(v, default=_jsonable)}"
+        text = "{\n" + ",\n".join(f" {json.dumps(k)}: {json.dumps(v, allow_nan=False)}"
                                   for k, v in value.items()) + "\n}"
     else:
-        text = json.dumps(value, default=_jsonable)
+        text = json.dumps(value, allow_nan=False)
     if len(text) > EXAMPLE_CHARS:
         text = text[:EXAMPLE_CHARS] + "\n... (cut; conformance.json has it all)"
     return _e(text)
@@ -61,6 +63,7 @@ def _document(title: str, body: str) -> str:
 def engine_page(result) -> str:
     """The page of one :class:`~refsim.conformance.results.ConformanceResult`."""
     from refsim.conformance.registry import CHECKS
+    from refsim.conformance.results import CLASS_DEFINITIONS
 
     docs = {c.key: c.doc for c in CHECKS}
     expected = sum(c.status == "xfailed" for c in result.checks)
@@ -81,6 +84,11 @@ def engine_page(result) -> str:
                      f"<td class=\"n\">{c.passed}</td><td class=\"n\">{c.failed}</td>"
                      f"<td>{_e(classes)}</td><td>{_e(c.status)}</td><td>{_e(c.reason)}</td></tr>")
     parts.append("</table>")
+    occurring = [k for k in CLASS_DEFINITIONS if any(k in c.classes for c in result.checks)]
+    if occurring:
+        parts.append("<p>Classes of the failing cases:</p><dl>" + "".join(
+            f"<dt>{_e(k)}</dt><dd>{_e(CLASS_DEFINITIONS[k])}</dd>" for k in occurring)
+            + "</dl>")
     for c in result.checks:
         parts.append(f"<h2 id=\"{_e(c.key)}\">{_e(c.key)}: {_e(c.status)}</h2>")
         parts.append(f"<p>{_e(docs.get(c.key, ''))}</p>")

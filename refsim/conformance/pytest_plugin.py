@@ -5,7 +5,11 @@
            [--refsim-expected-failures FILE]
 
 adds, to whatever else pytest collects, a test per check the engine's
-capabilities call for (``-k refsim-conformance`` runs them alone). A check
+capabilities call for (``-k refsim-conformance`` runs them alone), counted
+in pytest's "collected N items" and named on the line after it. ``MODULE``
+is looked up in the current directory and the rootdir first, as ``refsim
+conform`` does, so the plain ``pytest`` script finds a ``myengine.py``
+beside the user. A check
 that fails shows its counts, classes and minimal example; a declared
 expected failure (:mod:`refsim.conformance.expected`) is an ``xfail`` with
 its reason; a check the engine does not support (``ode.stability`` without
@@ -28,12 +32,15 @@ built once per session and shared by the tests that need it.
 
 from __future__ import annotations
 
-import json
+import os
+import sys
 
 import pytest
 
 #: Where the session's results are kept for the terminal summary.
 _RESULTS = pytest.StashKey[list]()
+#: The line naming the checks collected.
+_COLLECTED = pytest.StashKey[str]()
 
 
 def pytest_addoption(parser):
@@ -81,7 +88,7 @@ class CheckItem(pytest.Item):
 
     def repr_failure(self, excinfo, style=None):
         if isinstance(excinfo.value, ConformanceFailure):
-            from refsim.conformance.results import _jsonable
+            from refsim.conformance.results import strict_json
 
             r = excinfo.value.result
             classes = ", ".join(f"{k} {v}" for k, v in r.classes.items())
@@ -90,7 +97,7 @@ class CheckItem(pytest.Item):
                 lines.append(f"declared: {r.reason}")
             for example in r.examples[:3]:
                 label = "minimal example (shrunk)" if example.get("shrunk") else "example"
-                lines.append(f"{label}: {json.dumps(example, default=_jsonable)[:2000]}")
+                lines.append(f"{label}: {strict_json(example, indent=None)[:2000].rstrip()}")
             return "\n".join(lines)
         return super().repr_failure(excinfo, style=style)
 
@@ -115,6 +122,12 @@ class ConformanceSuite(pytest.Collector):
         from refsim.errors import RefsimError
         from refsim.oracles import OracleUnavailable
 
+        # MODULE is looked up in the current directory and the rootdir first,
+        # as `refsim conform` and `python -m pytest` do: under the plain
+        # `pytest` script neither is on sys.path
+        for folder in (str(self.config.rootpath), os.getcwd()):
+            if folder not in sys.path:
+                sys.path.insert(0, folder)
         try:
             self.engine = load_engine(self.spec)
             file = self.options["expected"]
@@ -157,7 +170,23 @@ def pytest_collection_modifyitems(session, config, items):
                "expected": config.getoption("refsim_expected_failures")}
     suite = ConformanceSuite.from_parent(session, name=f"refsim-conformance[{spec}]",
                                          spec=spec, options=options)
-    items.extend(suite.collect())
+    checks = list(suite.collect())
+    items.extend(checks)
+    # counted in pytest's "collected N items" line, and named
+    config.hook.pytest_collectreport(report=pytest.CollectReport(
+        suite.nodeid, "passed", None, checks))
+    config.stash[_COLLECTED] = (f"refsim conformance: {len(checks)} checks of "
+                                f"{suite.engine.name} ({spec}): "
+                                f"{', '.join(c.check.key for c in checks)}")
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_finish(session):
+    """The checks collected, named after pytest's "collected N items"."""
+    line = session.config.stash.get(_COLLECTED, None)
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    if line is not None and reporter is not None:
+        reporter.write_line(line)
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config):

@@ -2,29 +2,11 @@
 :class:`ConformanceResult` per engine.
 
 Every failing case of a check is put in exactly one class, by the check that
-found it (never by a human after the fact), and the classes are counted:
-
-=====================  ======================================================
-class                  meaning
-=====================  ======================================================
-``touching``           the exact answer turns on an exact contact: the two
-                       sets share a point, but nothing crosses transversally
-                       (a vertex on a face or an edge, edges meeting, a
-                       shared boundary). A float engine may answer either way.
-``coplanar``           all the triangles' vertices lie on one plane, exactly.
-``tolerance``          explained by rounding or by a documented accuracy
-                       bound: a near-degenerate decision (the orientation
-                       margins of :func:`refsim.studies.triangles.decision_margin`
-                       below ``NEAR_DEGENERATE_MARGIN``), a box off by no more
-                       than float32 rounding, a pose rounded to float32, a
-                       measured quantity within twice its tolerance.
-``known-divergence``   the engine follows a different, documented law, which
-                       the check recognises (e.g. the seed's lateral friction
-                       ``(1 - friction) v_t`` instead of Coulomb's; a solid
-                       engine finding one body inside another).
-``bug``                none of the above: a well-conditioned case answered
-                       wrongly.
-=====================  ======================================================
+found it (never by a human after the fact), and the classes are counted.
+Their definitions are :data:`CLASS_DEFINITIONS` (the README's conformance
+section shows the same table). Lengths are in the scene's unit (metres),
+and every reported number names its unit in its field name (``gap_metres``,
+``excess_metres``, ``excess_rounding_bounds``).
 
 A check's **status** is ``passed`` (no failing case), ``failed``,
 ``xfailed`` (failing cases, all of them in classes an expected-failures
@@ -39,11 +21,48 @@ Cost: plain records; building them is O(checks).
 from __future__ import annotations
 
 import json
+import math
+import traceback
 from dataclasses import asdict, dataclass, field, replace
 
-#: The classes of a failing case, from the most to the least serious (a case
-#: with several disagreements, e.g. a mesh pose, takes the first that applies).
-CLASSES = ("bug", "known-divergence", "tolerance", "touching", "coplanar")
+#: What each class of failing case means, from the most to the least serious
+#: (a case with several disagreements, e.g. a mesh pose, takes the first that
+#: applies). The one place these are defined; the README repeats the table
+#: (tests/conformance/test_classes.py keeps the two equal).
+CLASS_DEFINITIONS: dict[str, str] = {
+    "crash": "the engine raised an exception on the case, or returned an answer the kit "
+             "cannot read (wrong type or shape); the example holds the case's input and "
+             "the traceback's last line. Never accepted by a class-wide declaration: only "
+             "an explicit [crash] in the expected-failures file accepts it.",
+    "bug": "a well-conditioned case answered wrongly: a gap or excess beyond both the "
+           "rounding bound and the engine's declared tolerances, or a measured quantity "
+           "more than twice its tolerance.",
+    "unmeasurable": "the engine's answer is well formed but the quantity the check measures "
+                    "cannot be read from it (e.g. fewer bounces than the apex ratio needs); "
+                    "the example's reason says what is missing.",
+    "law": "the engine declares a contact law other than a restitution coefficient "
+           "(contact_law, e.g. hunt-crossley) and the check assumes one; the example names "
+           "the law.",
+    "known-divergence": "the check recognises, in the answer itself, a documented other law "
+                        "(the seed's lateral friction (1 - friction) v_t instead of "
+                        "Coulomb's; a solid engine finding one body inside another).",
+    "loose": "a box that encloses every point but stands outside the exact box by more "
+             "than the rounding bound and the distance tolerance, and no more than the "
+             "engine's declared box_slack (metres).",
+    "tolerance": "the gap or excess (metres) is within the rounding bound of a float64 "
+                 "evaluation or within the engine's declared distance_tolerance; or a "
+                 "measured quantity misses its tolerance by at most a factor of two.",
+    "touching": "the exact answer turns on an exact contact: the two sets share a point but "
+                "nothing crosses transversally (gap exactly 0). A float engine may answer "
+                "either way.",
+    "coplanar": "all the triangles' vertices lie on one plane, exactly.",
+}
+
+CLASSES = tuple(CLASS_DEFINITIONS)
+
+#: Classes an expected-failures declaration without a class list accepts:
+#: all but "crash" (see :mod:`refsim.conformance.expected`).
+DECLARABLE_WITHOUT_NAMING = tuple(c for c in CLASSES if c != "crash")
 
 STATUSES = ("passed", "failed", "xfailed", "xpassed", "n/a")
 
@@ -61,6 +80,37 @@ def classify_miss(miss: float, tolerance: float) -> str | None:
     if miss <= tolerance:
         return None
     return "tolerance" if miss <= MARGINAL_FACTOR * tolerance else "bug"
+
+
+@dataclass(frozen=True)
+class Crash:
+    """An exception raised while a case was run: the traceback's last line
+    (``"ValueError: ..."``, the exception's type and message) and the
+    traceback itself (its innermost frames)."""
+
+    error: str
+    traceback: str
+
+    def example(self, **case) -> dict:
+        """A failing-case example of class "crash" with the case's input."""
+        return {"class": "crash", "error": self.error, **case, "traceback": self.traceback}
+
+
+#: Innermost frames of a crash's traceback kept in its example.
+CRASH_FRAMES = 6
+
+
+def attempt(function, *args):
+    """``function(*args)``, or a :class:`Crash` recording the exception it
+    raised: a call of the engine together with the reading of its answer, so
+    that an answer of the wrong type or shape is the engine's crash too."""
+    try:
+        return function(*args)
+    except Exception as exc:  # noqa: BLE001 - recorded as the case's crash
+        last = traceback.format_exception_only(type(exc), exc)[-1].strip()
+        return Crash(error=last, traceback="".join(
+            traceback.format_exception(type(exc), exc, exc.__traceback__,
+                                       limit=-CRASH_FRAMES)))
 
 
 def worst_class(classes) -> str:
@@ -96,6 +146,10 @@ class CheckResult:
     measured : dict
         Numbers the check measured that a reader wants besides pass/fail
         (observed orders, evaluations per step, largest errors).
+    largest_miss_metres : dict of str -> float
+        Per class, the largest gap or excess (metres) of its failing cases,
+        for the checks that measure one (triangles, pairs, collide, aabb):
+        what a bounded declaration (``class <= bound``) is compared with.
     seconds : float
         Wall time of the check (a timing: differs per machine and run).
     """
@@ -110,6 +164,7 @@ class CheckResult:
     status: str = "passed"
     reason: str = ""
     measured: dict = field(default_factory=dict)
+    largest_miss_metres: dict = field(default_factory=dict)
     seconds: float = 0.0
 
     @property
@@ -130,22 +185,29 @@ class CheckResult:
 
 
 def tally(capability: str, check: str, outcomes, *, examples=(), measured=None,
-          seconds: float = 0.0) -> CheckResult:
+          misses=None, seconds: float = 0.0) -> CheckResult:
     """A :class:`CheckResult` from per-case outcomes: ``None`` for a passing
-    case, a class name (:data:`CLASSES`) for a failing one."""
+    case, a class name (:data:`CLASSES`) for a failing one. ``misses``, when
+    given, holds each case's gap or excess in metres (None where it has none)."""
     outcomes = list(outcomes)
     classes: dict[str, int] = {}
-    for outcome in outcomes:
+    largest: dict[str, float] = {}
+    for n, outcome in enumerate(outcomes):
         if outcome is not None:
             if outcome not in CLASSES:
                 raise ValueError(f"unknown class {outcome!r}")
             classes[outcome] = classes.get(outcome, 0) + 1
+            miss = None if misses is None else misses[n]
+            if miss is not None:
+                largest[outcome] = max(largest.get(outcome, 0.0), abs(float(miss)))
     failed = sum(classes.values())
     return CheckResult(capability=capability, check=check, cases=len(outcomes),
                        passed=len(outcomes) - failed, failed=failed,
                        classes={c: classes[c] for c in CLASSES if c in classes},
                        examples=list(examples), status="failed" if failed else "passed",
-                       measured=dict(measured or {}), seconds=seconds)
+                       measured=dict(measured or {}),
+                       largest_miss_metres={c: largest[c] for c in CLASSES if c in largest},
+                       seconds=seconds)
 
 
 def not_applicable(capability: str, check: str, reason: str) -> CheckResult:
@@ -201,7 +263,9 @@ class ConformanceResult:
         return data
 
     def to_json(self) -> str:
-        return json.dumps(self.to_dict(), indent=1, sort_keys=False, default=_jsonable) + "\n"
+        """Strict JSON (:func:`strict_json`), valid against the schema
+        shipped beside this module (``conformance.schema.json``)."""
+        return strict_json(self.to_dict())
 
     @classmethod
     def from_dict(cls, data: dict) -> ConformanceResult:
@@ -214,15 +278,43 @@ class ConformanceResult:
         return cls(**data)
 
 
-def _jsonable(value):
-    """numpy scalars and arrays, tuples of them, as plain JSON values."""
+#: How a number that is not finite is written in the JSON records: strict
+#: JSON has no NaN or infinity, so each is a string that ``float()`` reads
+#: back. "NaN": not measured or not a number; "Infinity", "-Infinity": unbounded.
+NON_FINITE = {"nan": "NaN", "inf": "Infinity", "-inf": "-Infinity"}
+
+
+def plain(value):
+    """``value`` as plain JSON data: numpy scalars and arrays as numbers and
+    lists, tuples as lists, every non-finite float as its
+    :data:`NON_FINITE` string."""
     import numpy as np
 
-    if isinstance(value, np.generic):
-        return value.item()
+    if isinstance(value, dict):
+        return {str(k): plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [plain(v) for v in value]
     if isinstance(value, np.ndarray):
-        return value.tolist()
-    raise TypeError(f"not JSON-able: {type(value).__name__}")
+        return plain(value.tolist())
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return NON_FINITE[repr(value)]
+    return value
+
+
+def conformance_schema() -> dict:
+    """The JSON Schema of ``conformance.json`` (draft 2020-12), shipped
+    beside this module as ``conformance.schema.json``."""
+    from importlib.resources import files
+
+    return json.loads(files("refsim.conformance").joinpath("conformance.schema.json")
+                      .read_text(encoding="utf-8"))
+
+
+def strict_json(data, indent: int | None = 1) -> str:
+    """``data`` (:func:`plain`) as strict JSON text, a newline at the end."""
+    return json.dumps(plain(data), indent=indent, allow_nan=False) + "\n"
 
 
 def summary_table(result: ConformanceResult) -> str:

@@ -7,10 +7,12 @@ those checks need (or takes them ready-made, so that several engines share
 one set of exact answers), runs each check, and applies the declared
 expected failures (:mod:`refsim.conformance.expected`).
 
-An exception raised inside a check (the engine crashed, or returned
-something of the wrong shape) is that check's failure, class "bug", with the
-exception and its traceback as the example: one broken capability does not
-hide the others.
+An exception raised while a case is run (the engine crashed, or returned
+something of the wrong type or shape) is that case's failure, class
+"crash", with the case's input and the traceback's last line; the other
+cases run on. An exception outside any one case (reading an attribute the
+check needs, say ``ode_order``) is the whole check's one "crash": one
+broken capability does not hide the others.
 
 Cost: the sum of the checks' costs plus the case sets' (see each module).
 """
@@ -18,11 +20,10 @@ Cost: the sum of the checks' costs plus the case sets' (see each module).
 from __future__ import annotations
 
 import time
-import traceback
 
 from refsim.conformance.expected import apply_expected, read_expected
 from refsim.conformance.registry import CHECKS, build_cases, checks_for
-from refsim.conformance.results import CheckResult, ConformanceResult
+from refsim.conformance.results import CheckResult, ConformanceResult, Crash, attempt
 from refsim.errors import OptionError, check_count
 
 #: Cases in each generated set unless told otherwise: enough to meet the
@@ -34,8 +35,9 @@ DEFAULT_CASES = 200
 def select_capabilities(engine, only=None) -> tuple[str, ...]:
     """The engine's capabilities, or those of ``only`` (a name or a list of
     names) after checking the engine has them."""
-    from refsim.engines import CAPABILITIES, capabilities, engine_name
+    from refsim.engines import CAPABILITIES, capabilities, declarations, engine_name
 
+    declarations(engine)                       # a bad declaration: one line, before any case
     has = capabilities(engine)
     if not has:
         raise OptionError(f"engine {engine_name(engine)!r} provides none of the "
@@ -57,21 +59,20 @@ def needed_case_sets(capabilities) -> tuple[str, ...]:
     return tuple(dict.fromkeys(c.cases for c in checks_for(capabilities)))
 
 
-def _crashed(check, exc: BaseException, seconds: float) -> CheckResult:
+def _crashed(check, crash: Crash, seconds: float) -> CheckResult:
     return CheckResult(capability=check.capability, check=check.name, cases=1, passed=0,
-                       failed=1, classes={"bug": 1}, status="failed", seconds=seconds,
-                       examples=[{"class": "bug",
-                                  "error": f"{type(exc).__name__}: {exc}",
-                                  "traceback": traceback.format_exc(limit=8)}])
+                       failed=1, classes={"crash": 1}, status="failed", seconds=seconds,
+                       examples=[crash.example(case="none: the check itself")])
 
 
 def run_check(check, engine, case_set) -> CheckResult:
-    """One check; an exception inside it becomes its failure (module docstring)."""
+    """One check; an exception outside its cases becomes its failure (module
+    docstring)."""
     start = time.perf_counter()
-    try:
-        return check.run(engine, case_set)
-    except Exception as exc:  # noqa: BLE001 - recorded as the check's failure
-        return _crashed(check, exc, time.perf_counter() - start)
+    result = attempt(check.run, engine, case_set)
+    if isinstance(result, Crash):
+        return _crashed(check, result, time.perf_counter() - start)
+    return result
 
 
 def check_engine(engine, *, cases: int = DEFAULT_CASES, seed: int = 0, only=None,

@@ -44,6 +44,15 @@ class TrimeshEngine:
 
     name = "trimesh"
 
+    #: Metres (:func:`refsim.engines.declarations`). The CollisionManager tests
+    #: convex meshes as GJK solids, and FCL's GJK stops at a tolerance of 1e-6
+    #: (its default ``gjk_tolerance``); it also rounds both poses to float32
+    #: (6e-8 relative: below 3e-7 m at the kit's coordinates of a few metres).
+    #: The boxes skip a transform within 1e-8 of the identity
+    #: (:data:`refsim.oracles.trimesh_adapter.TRIMESH_IDENTITY_ATOL`), off by
+    #: at most 1e-8 (|x| + |y| + |z| + 1), within the same tolerance.
+    distance_tolerance = 1e-6
+
     def __init__(self):
         from refsim.oracles.trimesh_adapter import TrimeshOracle
         from refsim.oracles.trimesh_collision import TrimeshCollisionOracle

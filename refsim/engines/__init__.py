@@ -37,11 +37,40 @@ capability         method
 
 An engine is named on the command line and in pytest as ``module:factory``,
 a callable returning the engine (:func:`load_engine`).
+
+What an engine declares about itself, as attributes (each optional, with
+the default shown; :func:`declarations` reads and validates them), decides
+how the conformance kit classes its misses:
+
+=======================  ==================================================
+attribute                meaning
+=======================  ==================================================
+``distance_tolerance``   metres (the scene's length unit; 0.0): the engine
+                         may call sets this far apart touching, and miss an
+                         overlap this deep (GJK and EPA stop at a
+                         tolerance: FCL's ``gjk_tolerance`` is 1e-6). A
+                         triangle, mesh or box answer wrong by no more is
+                         class "tolerance"; beyond it and the rounding
+                         bound, "bug".
+``box_slack``            metres (0.0): each side of the engine's ``aabb``
+                         may stand this far outside the tight box (a
+                         fattened box: Bullet's collision margin, Box2D's
+                         AABB margin). A box that encloses and is wider by
+                         no more is class "loose".
+``contact_law``          ``"restitution"`` (the default): a coefficient of
+                         restitution ``e`` sets the bounce, the law the
+                         apex-ratio and oblique-bounce checks assume. Any
+                         other name (``"hunt-crossley"``, ``"soft"``,
+                         ``"hydroelastic"``) declares another law: those
+                         checks' misses are class "law", naming it.
+=======================  ==================================================
 """
 
 from __future__ import annotations
 
 import importlib
+import math
+from dataclasses import dataclass
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -132,6 +161,43 @@ def capabilities(engine) -> tuple[str, ...]:
     """The capabilities ``engine`` provides, in :data:`CAPABILITIES` order."""
     return tuple(key for key, (_, protocol) in CAPABILITIES.items()
                  if isinstance(engine, protocol))
+
+
+#: The contact law the rigid checks' analytic answers assume.
+RESTITUTION = "restitution"
+
+
+@dataclass(frozen=True)
+class Declarations:
+    """What an engine declares about itself (module docstring): lengths in
+    metres, the contact law by name."""
+
+    distance_tolerance: float = 0.0
+    box_slack: float = 0.0
+    contact_law: str = RESTITUTION
+
+
+def declarations(engine) -> Declarations:
+    """The engine's :class:`Declarations`, defaults where it declares none;
+    :class:`OptionError` naming the engine and the attribute for a value that
+    is not a finite length >= 0 or a non-empty law name."""
+    found = {}
+    for name in ("distance_tolerance", "box_slack"):
+        value = getattr(engine, name, 0.0)
+        try:
+            length = float(value)
+        except (TypeError, ValueError):
+            length = math.nan
+        if isinstance(value, bool) or not (math.isfinite(length) and length >= 0.0):
+            raise OptionError(f"engine {getattr(engine, 'name', '?')!r}: {name} must be a "
+                              f"finite number of metres >= 0, got {value!r}")
+        found[name] = length
+    law = getattr(engine, "contact_law", RESTITUTION)
+    if not isinstance(law, str) or not law.strip():
+        raise OptionError(f"engine {getattr(engine, 'name', '?')!r}: contact_law must be a "
+                          f"non-empty name, e.g. 'restitution' or 'hunt-crossley', "
+                          f"got {law!r}")
+    return Declarations(contact_law=law.strip(), **found)
 
 
 def engine_name(engine) -> str:

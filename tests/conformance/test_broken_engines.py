@@ -78,3 +78,6 @@ def test_box_that_ignores_the_translation_fails_both_box_checks():
         assert minimal["R"] == np.eye(3).tolist()
         assert sum(x != 0.0 for x in minimal["t"]) == 1
         assert minimal["lo"] == minimal["hi"] == [0.0, 0.0, 0.0]
+        # the excess in metres: the translation the box forgot
+        assert minimal["excess_metres"] == max(abs(x) for x in minimal["t"])
+        assert check.largest_miss_metres["bug"] == check.measured["largest_excess_metres"]

@@ -1,21 +1,36 @@
 """How a disagreement is classified: by exact geometry where the answer is
-exact, by a documented law where the engine follows one."""
+exact, by its gap or excess in metres against the rounding bound and what
+the engine declares (refsim.engines.declarations), by a documented law where
+the engine follows one."""
 
 from __future__ import annotations
 
-import numpy as np
+import math
 
-from refsim.conformance.cases_boxes import exact_box, rounding_bound
-from refsim.conformance.cases_meshes import PoseCase, _exact_pairs
+import numpy as np
+import pytest
+
+from refsim.conformance.cases_boxes import BoxCase, exact_box, rounding_bound
+from refsim.conformance.cases_meshes import PoseCase, PoseCases, _exact_pairs
 from refsim.conformance.checks_geometry import (
-    _classify_box,
     box_excess,
+    check_aabb_encloses,
+    check_aabb_tight,
+    check_collide_agreement,
+    classify_box,
     classify_collide,
     classify_pairs,
     classify_triangles,
 )
+from refsim.conformance.gaps import penetration_depth, triangle_distance
+from refsim.engines import Declarations, declarations
+from refsim.errors import OptionError
+from tests.conformance.broken_engines import BoxIgnoresRotation, GjkLikeCollide, PaddedBox
 
 IDENTITY = (np.eye(3), np.zeros(3))
+TRIANGLE = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
+#: A quarter turn about z, exact in binary: (x, y, z) -> (-y, x, z).
+QUARTER_TURN = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
 
 
 def _case(model_a, pose_a, model_b, pose_b, gap=None):
@@ -23,14 +38,50 @@ def _case(model_a, pose_a, model_b, pose_b, gap=None):
                     _exact_pairs(model_a, pose_a, model_b, pose_b))
 
 
+def _box_case(vertices, pose, family="random"):
+    vertices = np.asarray(vertices, dtype=np.float64)
+    return BoxCase(vertices, pose, family, exact_box(vertices, pose),
+                   rounding_bound(vertices, pose))
+
+
 def test_triangle_classes():
-    a = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 2.0, 0.0]])
     touching = np.array([[0.5, 0.5, 0.0], [0.5, 0.5, 1.0], [1.0, 0.0, 1.0]])   # a vertex on a
     coplanar = np.array([[3.0, 3.0, 0.0], [4.0, 3.0, 0.0], [3.0, 4.0, 0.0]])
     crossing = np.array([[0.5, 0.5, -1.0], [0.5, 0.5, 1.0], [1.0, 0.0, 1.0]])
-    assert classify_triangles(a, touching) == "touching"
-    assert classify_triangles(a, coplanar) == "coplanar"
-    assert classify_triangles(a, crossing) == "bug"     # well conditioned: no excuse
+    assert classify_triangles(TRIANGLE, touching)["class"] == "touching"
+    assert classify_triangles(TRIANGLE, touching)["gap_metres"] == 0.0
+    assert classify_triangles(TRIANGLE, coplanar)["class"] == "coplanar"
+    verdict = classify_triangles(TRIANGLE, crossing)
+    assert verdict["class"] == "bug"                  # well conditioned: no excuse
+    # B spans y in [0, 0.5] over A (y >= 0): moved 0.5 along -y it only
+    # touches A's edge y = 0; no shorter move frees it
+    assert verdict["gap_metres"] == -0.5
+
+
+def test_a_near_parallel_pair_is_classed_by_its_gap_not_its_margin():
+    # B in a plane 1e-11 above A: a GJK-like engine calls it touching
+    lifted = np.array([[0.2, 0.2, 1e-11], [1.0, 0.2, 1e-11], [0.2, 1.0, 1e-11]])
+    default = classify_triangles(TRIANGLE, lifted)
+    assert default["class"] == "bug"                  # 1e-11 m: beyond 2^14 u * 2 m
+    assert default["gap_metres"] == pytest.approx(1e-11, rel=1e-6)
+    assert default["rounding_bound_metres"] == pytest.approx(2.0 ** 14 * 2.0 ** -53 * 2.0)
+    declared = classify_triangles(TRIANGLE, lifted, distance_tolerance=1e-6)
+    assert declared["class"] == "tolerance"
+    assert declared["distance_tolerance_metres"] == 1e-6
+    rounding = np.array([[0.2, 0.2, 1e-16], [1.0, 0.2, 1e-16], [0.2, 1.0, 1e-16]])
+    assert classify_triangles(TRIANGLE, rounding)["class"] == "tolerance"
+
+
+def test_gaps_against_closed_forms():
+    # a unit right triangle, and one 0.25 above its plane over it
+    above = TRIANGLE + np.array([0.0, 0.0, 0.25])
+    assert triangle_distance(TRIANGLE, above) == 0.25
+    # B's corner (3, 4, 0) to A's edge x + y = 2 (its foot (0.5, 1.5) on the edge)
+    beside = TRIANGLE + np.array([3.0, 4.0, 0.0])
+    assert triangle_distance(TRIANGLE, beside) == pytest.approx(5.0 / math.sqrt(2.0), rel=1e-15)
+    # B pierces A's interior 0.1 deep below A's plane and 0.3 above: out by 0.1
+    spike = np.array([[0.5, 0.5, -0.1], [0.5, 0.5, 0.3], [0.7, 0.5, 0.3]])
+    assert penetration_depth(TRIANGLE, spike) == pytest.approx(0.1, rel=1e-12)
 
 
 def test_a_body_inside_a_convex_one_is_a_known_divergence():
@@ -38,37 +89,104 @@ def test_a_body_inside_a_convex_one_is_a_known_divergence():
     # a solid engine (trimesh's GJK on convex meshes) says they collide
     case = _case("sphere-2k.ac", IDENTITY, "tetrahedron.ac", (np.eye(3), np.array([0.1, 0.05, 0])))
     assert len(case.truth) == 0
-    assert classify_collide(case, True) == "known-divergence"
+    assert classify_collide(case, True)["class"] == "known-divergence"
 
 
-def test_a_grazing_gap_within_the_pose_tolerance_is_tolerance():
-    pose_b = (np.eye(3), np.array([1.0 + 1e-9, 0.0, 0.0]))      # cubes 1e-9 apart
-    case = _case("cube.ac", IDENTITY, "cube.ac", pose_b, gap=1e-9)
-    assert len(case.truth) == 0
-    assert classify_collide(case, True) == "tolerance"
+def test_a_grazing_gap_is_tolerance_only_within_the_declared_distance():
+    near = _case("cube.ac", IDENTITY, "cube.ac", (np.eye(3), np.array([1.0 + 1e-9, 0.0, 0.0])))
+    assert len(near.truth) == 0
+    assert classify_collide(near, True, 1e-6)["class"] == "tolerance"
+    verdict = classify_collide(near, True)                  # nothing declared
+    assert verdict["class"] == "bug"
+    assert verdict["gap_metres"] == pytest.approx(1e-9, rel=1e-6)
+    assert verdict["gap_is_lower_bound"] is False
     far = _case("cube.ac", IDENTITY, "cube.ac", (np.eye(3), np.array([1.5, 0.0, 0.0])))
-    assert classify_collide(far, True) == "bug"                 # 0.5 apart: a bug
-    assert classify_pairs(far, np.array([[0, 0]])) == "bug"
+    assert classify_collide(far, True, 1e-6)["class"] == "bug"     # 0.5 apart
+    assert classify_collide(far, True, 1e-6)["gap_metres"] == 0.5
+    assert classify_pairs(far, np.array([[0, 0]]), 1e-6)["class"] == "bug"
 
 
-def test_touching_faces_missed_are_touching_or_coplanar():
-    case = _case("cube.ac", IDENTITY, "cube.ac", (np.eye(3), np.array([1.0, 0.25, 0.0])))
-    assert len(case.truth) > 0
-    assert classify_collide(case, False) in ("touching", "coplanar")
-    assert classify_pairs(case, np.zeros((0, 2), dtype=np.int64)) in ("touching", "coplanar")
+def test_gjk_like_engine_within_and_beyond_its_declared_tolerance():
+    # an engine that calls bodies within 1e-5 m touching, as GJK stopping at
+    # a tolerance does, declaring 1e-6: right at 1e-7, a bug at 5e-6
+    apart = [_case("cube.ac", IDENTITY, "cube.ac", (np.eye(3), np.array([1.0 + gap, 0.0, 0.0])))
+             for gap in (1e-7, 5e-6, 0.25)]
+    engine = GjkLikeCollide(reach=1e-5, distance_tolerance=1e-6)
+    result = check_collide_agreement(engine, PoseCases(cases=tuple(apart), seed=0))
+    assert (result.cases, result.passed) == (3, 1)          # 0.25 apart: it says apart
+    assert result.classes == {"bug": 1, "tolerance": 1}
+    seeded = {e["case"]: e for e in result.examples if not e.get("shrunk")}
+    assert seeded[0]["class"] == "tolerance"
+    assert seeded[0]["gap_metres"] == pytest.approx(1e-7, rel=1e-6)
+    assert seeded[1]["class"] == "bug"
+    assert seeded[1]["gap_metres"] == pytest.approx(5e-6, rel=1e-6)
+    assert result.largest_miss_metres["bug"] == pytest.approx(5e-6, rel=1e-6)
 
 
-def test_box_classes():
-    vertices = np.array([[1.0, -1.0, 0.5]])
-    pose = (np.eye(3), np.array([1e-9, 0.0, 0.0]))
-    from refsim.conformance.cases_boxes import BoxCase
-
-    case = BoxCase(vertices, pose, "near-identity", exact_box(vertices, pose),
-                   rounding_bound(vertices, pose))
-    lo = hi = vertices[0]                                  # the untransformed box
+def test_box_excess_is_in_metres():
+    # (1, 0, 0) turned a quarter about z is (0, 1, 0); a box that ignores
+    # the rotation is (1, 0, 0): 1 m inside the exact box on x and on y
+    case = _box_case([[1.0, 0.0, 0.0]], (QUARTER_TURN, np.zeros(3)))
+    lo, hi = BoxIgnoresRotation().aabb(case.vertices, case.pose)
     short, wide = box_excess(case, lo, hi)
-    assert short[0] > 1 and short[1] == short[2] == 0.0
-    assert _classify_box(case, float(short.max()), lo, hi) == "tolerance"
-    shifted = vertices[0] + np.array([0.1, 0.0, 0.0])
-    excess = float(box_excess(case, shifted, shifted)[0].max())
-    assert _classify_box(case, excess, shifted, shifted) == "bug"
+    assert short.tolist() == [1.0, 1.0, 0.0]
+    assert wide.tolist() == [1.0, 1.0, 0.0]
+    verdict = classify_box(case, lo, hi, 0, Declarations(distance_tolerance=1e-6))
+    assert verdict["class"] == "bug"
+    assert verdict["excess_metres"] == 1.0
+    # the bound of a coordinate that rounds nothing is a few subnormals: the
+    # ratio overflows; the metres say what is wrong
+    assert verdict["excess_rounding_bounds"] == math.inf
+
+
+def test_box_ignoring_rotation_is_a_bug_with_its_excess_in_metres():
+    cases = [_box_case([[1.0, 0.0, 0.0], [0.0, 0.5, 0.0]], (QUARTER_TURN, np.array([2.0, 0, 0]))),
+             _box_case([[1.0, 2.0, 3.0]], (np.eye(3), np.array([0.5, 0.0, 0.0])))]
+    from refsim.conformance.cases_boxes import BoxCases
+
+    result = check_aabb_encloses(BoxIgnoresRotation(), BoxCases(cases=tuple(cases), seed=0))
+    assert (result.passed, result.classes) == (1, {"bug": 1})     # no rotation: right
+    seeded = [e for e in result.examples if not e.get("shrunk")]
+    # exact box x [1.5, 2], y [0, 1]; the engine's x [2, 3], y [0, 0.5]
+    assert seeded[0]["excess_metres"] == 0.5
+    assert result.largest_miss_metres == {"bug": 0.5}
+
+
+def test_padded_box_is_loose_within_its_declared_slack():
+    from refsim.conformance.cases_boxes import BoxCases
+
+    cases = BoxCases(cases=(_box_case([[1.0, 2.0, 3.0], [-1.0, 0.0, 0.5]],
+                                      (QUARTER_TURN, np.array([0.25, 0.0, 0.0]))),), seed=0)
+    within = PaddedBox(pad=0.01, box_slack=0.02)
+    assert check_aabb_encloses(within, cases).status == "passed"
+    tight = check_aabb_tight(within, cases)
+    assert tight.classes == {"loose": 1}
+    assert tight.examples[-1]["excess_metres"] == pytest.approx(0.01, rel=1e-12)
+    assert tight.examples[-1]["box_slack_metres"] == 0.02
+    beyond = check_aabb_tight(PaddedBox(pad=0.05, box_slack=0.02), cases)
+    assert beyond.classes == {"bug": 1}
+
+
+class _Declaring:
+    name = "declaring"
+
+    def __init__(self, **attributes):
+        self.__dict__.update(attributes)
+
+
+@pytest.mark.parametrize("attributes, phrase", [
+    ({"distance_tolerance": -1e-6}, "distance_tolerance must be a finite number of metres >= 0"),
+    ({"box_slack": math.inf}, "box_slack must be a finite number of metres >= 0"),
+    ({"distance_tolerance": "small"}, "got 'small'"),
+    ({"contact_law": ""}, "contact_law must be a non-empty name"),
+])
+def test_bad_declarations_are_one_clear_error(attributes, phrase):
+    with pytest.raises(OptionError) as info:
+        declarations(_Declaring(**attributes))
+    assert str(info.value).startswith("engine 'declaring': ") and phrase in str(info.value)
+
+
+def test_declarations_default_to_exact_and_restitution():
+    assert declarations(_Declaring()) == Declarations(0.0, 0.0, "restitution")
+    assert declarations(_Declaring(distance_tolerance=1e-6, contact_law="hunt-crossley")) == \
+        Declarations(1e-6, 0.0, "hunt-crossley")

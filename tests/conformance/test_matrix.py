@@ -6,7 +6,10 @@ from __future__ import annotations
 
 import json
 
+import jsonschema
+
 from refsim.conformance.registry import CHECK_KEYS
+from refsim.conformance.results import conformance_schema
 from refsim.conformance.shipped import SHIPPED_ENGINES
 
 SIX = ("refsim-seed", "refsim-corrected", "fcl", "trimesh", "pybullet", "mujoco")
@@ -132,8 +135,13 @@ def test_divergences_are_the_xfails_with_their_reasons(shipped_run):
         assert sum(d.classes.values()) > 0 and d.example is not None
 
 
+def _not_strict(token):
+    raise AssertionError(f"{token} in a JSON record: not strict JSON")
+
+
 def test_pages_and_json_are_written_and_self_contained(shipped_run):
     matrix, results, out = shipped_run
+    schema = conformance_schema()
     data = json.loads((out / "matrix.json").read_text())
     assert data["engines"] == list(SIX) and data["checks"] == list(CHECK_KEYS)
     assert data["cells"]["rigid.energy"]["mujoco"]["status"] == "passed"
@@ -141,7 +149,9 @@ def test_pages_and_json_are_written_and_self_contained(shipped_run):
     for engine in SIX:
         assert matrix.pages[engine] == f"{engine}/index.html"
         assert f'href="{engine}/index.html"' in page
-        record = json.loads((out / engine / "conformance.json").read_text())
+        record = json.loads((out / engine / "conformance.json").read_text(),
+                            parse_constant=_not_strict)
+        jsonschema.validate(record, schema)
         assert record["engine"] == engine and record["seed"] == 0
         assert record["refsim"] == results[engine].refsim
         for check in record["checks"]:

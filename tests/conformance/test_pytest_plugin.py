@@ -9,6 +9,9 @@ from __future__ import annotations
 # at its first compile (its typing registries), so one small function is
 # compiled here too: otherwise a later test in the same process fails with
 # numba's "duplicate registration".
+import sys
+from pathlib import Path
+
 import hypothesis  # noqa: F401
 import numba
 import numpy  # noqa: F401
@@ -33,6 +36,9 @@ def test_plugin_runs_one_test_per_check_of_a_shipped_engine(pytester):
     # divergences (S9 three times, S5/S7, C12) are xfails with their reasons
     result.assert_outcomes(passed=13, xfailed=5)
     result.stdout.fnmatch_lines([
+        "*collected 18 items",
+        "refsim conformance: 17 checks of refsim-seed (refsim.engines.refsim_engines:seed): "
+        "triangles.reference, triangles.agreement, *, rigid.free_rotation",
         "*refsim-conformance*triangles.agreement PASSED*",
         "*refsim-conformance*rigid.spin_to_rest XFAIL*",
         "*refsim conformance: refsim.engines.refsim_engines:seed*",
@@ -73,6 +79,35 @@ def test_without_the_option_nothing_changes(pytester):
     assert "refsim conformance" not in result.stdout.str()
     help_text = pytester.runpytest("--help").stdout.str()
     assert "--refsim-engine=MODULE:FACTORY" in help_text
+
+
+def test_plain_pytest_finds_the_plugin_and_the_users_module(pytester):
+    # the `pytest` script itself (not `python -m pytest`, which puts the
+    # current directory on sys.path): the entry point loads the plugin, and
+    # the plugin finds myengine.py beside the user
+    pytester.makepyfile(myengine="""
+        class Heun:
+            name = "heun"
+            ode_order = 2
+
+            def ode_step(self, f, t, y, h):
+                k1 = f(t, y)
+                return y + h / 2 * (k1 + f(t + h, y + h * k1))
+
+
+        def make_engine():
+            return Heun()
+    """)
+    script = Path(sys.executable).parent / "pytest"
+    result = pytester.run(str(script), "-p", "no:cacheprovider",
+                          "--refsim-engine=myengine:make_engine", "-v")
+    assert result.ret == 0, result.stdout.str() + result.stderr.str()
+    result.stdout.fnmatch_lines([
+        "*collected 2 items",
+        "refsim conformance: 2 checks of heun (myengine:make_engine): ode.order, ode.evaluations",
+        "*ode.order PASSED*",
+        "*ode.evaluations PASSED*",
+    ])
 
 
 def test_a_bad_engine_is_a_usage_error(pytester):
