@@ -1,6 +1,6 @@
 """Rigid-body scenes with analytic answers (seeds S5, S7, S9; capability ``rigid``).
 
-What: a fixed set of one-body scenes in the world cube (half size 5 m,
+What: a fixed set of scenes of one or two bodies in the world cube (half size 5 m,
 g = 9.81, step 1e-3 s, RK4 where the engine uses the scene's solver, no
 drag), each with the answer :mod:`refsim.dynamics.analytic` gives for it:
 
@@ -38,6 +38,20 @@ free-brick             the brick (1 x 0.6 x 0.3 m, three different moments)
                        2.436 s (Euler's equations in closed form,
                        :class:`refsim.dynamics.free_body.FreeBody`), 5 times
                        in 12 s, with constant energy
+strike-e1, strike-e0.5 a ball (the sphere-2k model scaled to radius 0.25)
+                       falling at 2 m/s on a free rod (long-box, 4 x 0.25 x
+                       0.25 m) 1.5 m from its centre, no gravity, no
+                       friction: one impact at one point, whose impulse
+                       ``J = (1 + e) v / (1/m + 1/M + d^2 / I)`` gives the
+                       rod's velocity and spin and the ball's velocity
+                       (:func:`strike_answer`); the ball does not spin, and
+                       the angular momentum about any fixed point is kept
+offset-stack           resting contact between bodies, e 0.5, mu 0.5, 1 s:
+cantilever             a cube on a cube 0.3 m off its centre; a rod on a cube
+board                  overhanging it by 1.9 m with its centre 0.4 m from the
+                       cube's; a cube on a rod lying on the floor, 1.5 m from
+                       the rod's centre. Each is statically stable (every
+                       centre of mass over its support): nothing moves
 =====================  =====================================================
 
 Two choices keep the answers exact for every reasonable engine:
@@ -126,11 +140,39 @@ BRICK = "brick.ac"
 FREE_SPIN = (0.1, 10.0, 0.1)
 FREE_DURATION = 12.0
 
+#: The strike (module docstring): the rod, the ball's scale (radius, m), its
+#: closing speed (m/s), its distance from the rod's centre (m), the gap it
+#: falls first (m), the run (s, the impact at about 5 ms) and its e.
+ROD = "long-box.ac"
+ROD_HALF_WIDTH = 0.125
+BALL_SCALE = 0.25
+STRIKE_SPEED = 2.0
+STRIKE_OFFSET = 1.5
+STRIKE_GAP = 0.01
+STRIKE_DURATION = 0.1
+STRIKE_RESTITUTIONS = (1.0, 0.5)
+
+#: The resting stacks (module docstring): restitution, friction, run (s),
+#: and the bodies, each lowest face on the floor or on the body below.
+STACK_E = 0.5
+STACK_MU = 0.5
+STACK_DURATION = 1.0
+_FLOOR = -HALF_SIZE
+STACKS = (
+    ("offset-stack", ({"name": "base", "model": CUBE, "position": [0.0, _FLOOR + 0.5, 0.0]},
+                      {"name": "top", "model": CUBE, "position": [0.3, _FLOOR + 1.5, 0.0]})),
+    ("cantilever", ({"name": "base", "model": CUBE, "position": [0.0, _FLOOR + 0.5, 0.0]},
+                    {"name": "top", "model": ROD, "position": [0.4, _FLOOR + 1.125, 0.0]})),
+    ("board", ({"name": "base", "model": ROD, "position": [0.0, _FLOOR + 0.125, 0.0]},
+               {"name": "top", "model": CUBE, "position": [1.5, _FLOOR + 0.75, 0.0]})),
+)
+
 
 @dataclass(frozen=True)
 class RigidScene:
     """One scene of the set: its name, kind ("drop", "oblique", "spin",
-    "rest"), the scene, and the parameters its answer needs."""
+    "rest", "free", "strike", "stack"), the scene, and the parameters its
+    answer needs."""
 
     name: str
     kind: str
@@ -140,6 +182,15 @@ class RigidScene:
     height: float = 0.0
 
     def to_dict(self) -> dict:
+        if len(self.scene.bodies) > 1:
+            return {"scene": self.name, "kind": self.kind, "restitution": self.e,
+                    "friction": self.friction,
+                    "bodies": [{"model": b.model.name, "scale": b.scale,
+                                "position": list(b.position), "velocity": list(b.velocity),
+                                "angular_velocity": list(b.angular_velocity)}
+                               for b in self.scene.bodies],
+                    "step": self.scene.integration.step,
+                    "duration": self.scene.integration.duration}
         body = self.scene.bodies[0]
         return {"scene": self.name, "kind": self.kind, "model": body.model.name,
                 "restitution": self.e, "friction": self.friction,
@@ -225,7 +276,86 @@ def rigid_scenes() -> tuple[RigidScene, ...]:
                              _scene(CUBE, SPIN_E, SPIN_FRICTION, 0.0, REST_DURATION),
                              SPIN_E, SPIN_FRICTION))
     scenes.append(RigidScene("free-brick", "free", _free_scene(), 1.0))
+    for e in STRIKE_RESTITUTIONS:
+        scenes.append(RigidScene(f"strike-e{e:g}", "strike", _strike_scene(e), e))
+    for name, bodies in STACKS:
+        scenes.append(RigidScene(name, "stack", _bodies_scene(bodies, GRAVITY, STACK_E, STACK_MU,
+                                                              STACK_DURATION),
+                                 STACK_E, STACK_MU))
     return tuple(scenes)
+
+
+def _bodies_scene(bodies, gravity: float, e: float, mu: float, duration: float):
+    """A scene of several bodies (``[[body]]`` tables) at the exact level."""
+    from refsim.scenes.loader import scene_from_dict
+    from refsim.solvers.integrate import covering_duration
+
+    return scene_from_dict({
+        "world": {"half_size": HALF_SIZE, "gravity": gravity, "drag": 0.0,
+                  "restitution": e, "friction": mu},
+        "integration": {"solver": SOLVER, "step": STEP,
+                        "duration": covering_duration(duration, STEP)},
+        "collision": {"level": "exact"},
+        "body": [dict(b) for b in bodies]})
+
+
+def _strike_scene(e: float):
+    """The ball above the rod's top face, STRIKE_OFFSET from its centre,
+    1 cm apart, falling at STRIKE_SPEED; no gravity, no friction."""
+    return _bodies_scene([
+        {"name": "rod", "model": ROD},
+        {"name": "ball", "model": SPHERE, "scale": BALL_SCALE,
+         "position": [STRIKE_OFFSET, ROD_HALF_WIDTH + BALL_SCALE + STRIKE_GAP, 0.0],
+         "velocity": [0.0, -STRIKE_SPEED, 0.0]}], 0.0, e, 0.0, STRIKE_DURATION)
+
+
+def strike_answer(scene: RigidScene) -> dict[str, float]:
+    """The strike's velocities after the impact: Newton's impact law at one
+    frictionless point (Stronge, *Impact Mechanics*, 2000, ch. 2; Mirtich
+    1996, 3.3), normal impulse ``J = (1 + e) v / (1/m + 1/M + d^2 / I)``
+    with the closing speed v, the rod's mass M, its moment I about the
+    axis across its length and the face normal, and the lever d; the
+    ball's lever lies along the normal (its lowest vertex is straight below
+    its centre), so it takes no spin. From the uniform solids' mass
+    properties of the meshes (the ball's scaled)."""
+    _, _, rod_inertia = _body(ROD)
+    rod, ball = scene.scene.bodies
+    inertia = rod.mass * float(rod_inertia[2, 2])
+    J = ((1.0 + scene.e) * STRIKE_SPEED
+         / (1.0 / ball.mass + 1.0 / rod.mass + STRIKE_OFFSET ** 2 / inertia))
+    return {"rod_velocity": -J / rod.mass, "rod_spin": -J * STRIKE_OFFSET / inertia,
+            "ball_velocity": -STRIKE_SPEED + J / ball.mass}
+
+
+def angular_momentum(scene: RigidScene, trajectory) -> np.ndarray:
+    """(F, 3) the total angular momentum about the world origin, ``sum m c x
+    v + R I R^T w`` with the uniform solids' mass properties (scaled) and
+    the recorded velocity (the centre of mass's)."""
+    total = np.zeros((len(np.asarray(trajectory.t)), 3))
+    for i, body in enumerate(scene.scene.bodies):
+        _, center, inertia = _body(body.model.name)
+        R = np.asarray(trajectory.orientation)[:, i]
+        c = np.einsum("fij,j->fi", R, center * body.scale)
+        x = np.asarray(trajectory.position)[:, i] + c
+        w = np.asarray(trajectory.angular_velocity)[:, i]
+        Iw = np.einsum("fij,jk,fkl,fl->fi", R, inertia * body.mass * body.scale ** 2,
+                       np.transpose(R, (0, 2, 1)), w)
+        total += body.mass * np.cross(x, np.asarray(trajectory.velocity)[:, i]) + Iw
+    return total
+
+
+def largest_vertex_travel(scene: RigidScene, trajectory) -> float:
+    """The farthest any vertex of any body gets from where it started
+    (metres): a body that turns in place moves its vertices too."""
+    travel = 0.0
+    for i, body in enumerate(scene.scene.bodies):
+        vertices, _, _ = _body(body.model.name)
+        vertices = vertices * body.scale
+        R = np.asarray(trajectory.orientation)[:, i]
+        x = np.asarray(trajectory.position)[:, i]
+        world = np.einsum("fij,vj->fvi", R, vertices) + x[:, None, :]
+        travel = max(travel, float(np.sqrt(((world - world[0]) ** 2).sum(axis=2)).max()))
+    return travel
 
 
 def _free_scene():
@@ -307,16 +437,18 @@ class RigidCases:
         return read_trajectory(engine.simulate(scene.scene), scene)
 
 
-#: The arrays a trajectory holds, each's shape after the frame count F (one body).
-TRAJECTORY_SHAPES = {"position": (1, 3), "velocity": (1, 3), "angular_velocity": (1, 3),
-                     "orientation": (1, 3, 3)}
+#: The arrays a trajectory holds, each's shape after the frame count F and
+#: the body count B.
+TRAJECTORY_SHAPES = {"position": (3,), "velocity": (3,), "angular_velocity": (3,),
+                     "orientation": (3, 3)}
 
 
 def read_trajectory(trajectory, scene: RigidScene) -> SimpleNamespace:
     """The engine's answer as float64 arrays ``t`` (F,) and those of
-    :data:`TRAJECTORY_SHAPES`; ValueError naming the field and its shape for
-    an answer that has not the contract's (:mod:`refsim.engines`), so that
-    the check records what is wrong with it."""
+    :data:`TRAJECTORY_SHAPES` (F, B, ...) for the scene's B bodies;
+    ValueError naming the field and its shape for an answer that has not
+    the contract's (:mod:`refsim.engines`), so that the check records what
+    is wrong with it."""
     read = {}
     for name in ("t", *TRAJECTORY_SHAPES):
         if not hasattr(trajectory, name):
@@ -325,10 +457,11 @@ def read_trajectory(trajectory, scene: RigidScene) -> SimpleNamespace:
     frames = read["t"].shape
     if len(frames) != 1 or frames[0] < 2:
         raise ValueError(f"{scene.name}: trajectory.t has shape {frames}, expected (F,), F >= 2")
+    bodies = (len(scene.scene.bodies),)
     for name, shape in TRAJECTORY_SHAPES.items():
-        if read[name].shape != frames + shape:
+        if read[name].shape != frames + bodies + shape:
             raise ValueError(f"{scene.name}: trajectory.{name} has shape {read[name].shape}, "
-                             f"expected {frames + shape}")
+                             f"expected {frames + bodies + shape}")
     return SimpleNamespace(**read)
 
 

@@ -68,6 +68,22 @@ meet them within these bounds.
   :data:`FREE_ENERGY_TOL` of its start, and so does the world angular
   momentum (no contact, no force: any change is the integrator's).
 
+- ``rigid.off_centre`` (the ball striking the free rod 1.5 m off its centre,
+  frictionless, e = 1 and 0.5): after the impact the rod's velocity and
+  spin and the ball's velocity are the impulse solution
+  (:func:`refsim.conformance.cases_rigid.strike_answer`), the rod does not
+  slide sideways and the ball does not spin, each within
+  :data:`OFF_CENTRE_TOL` of the closing speed (a spin as the speed it gives
+  at its lever: the strike's offset for the rod, the radius for the ball);
+  and the angular momentum about the world origin stays within
+  :data:`MOMENTUM_TOL` of its start (no force but the contact's, whose
+  impulses are equal and opposite at one point).
+- ``rigid.stack`` (a cube resting 0.3 m off the centre of another; a rod
+  overhanging a cube, its centre of mass over the cube; a cube on a rod
+  lying on the floor, 1.5 m from the rod's centre): every vertex of every
+  body stays within :data:`STACK_TRAVEL` of where it started (each body is
+  statically stable: the answer is that nothing moves).
+
 A failure within twice its tolerance is "tolerance"; beyond, "bug" (unless
 recognised as above). An engine that declares a contact law other than a
 restitution coefficient (``contact_law``, :func:`refsim.engines.declarations`)
@@ -136,6 +152,26 @@ FLIP_INTERVAL_TOL = 0.01
 #: when W changes fastest. 1e-3 lies between the two. (The flip interval alone
 #: does not catch a uniform scaling of W, which keeps the orbit's shape.)
 FREE_ENERGY_TOL = 1e-3
+
+#: The strike's velocities, as a fraction of the closing speed (2 m/s): the
+#: impulse solution holds for an impact at one instant; an engine that
+#: spreads it over a few steps (soft contact) lets the rod turn meanwhile and
+#: its contact point move, by ``h |w| d`` per step (2e-3 of the lever here).
+#: 2 % allows ten such steps and shows any lever wrong by more than 2 %.
+OFF_CENTRE_TOL = 0.02
+
+#: The strike's angular momentum about the world origin, relative to its
+#: start (|L| = 3 kg m^2/s): conserved by any impulse pair at one point, so
+#: only rounding and an engine's own integration of the free motion change
+#: it; 1e-3 is far above the first and far below a lever arm gone wrong
+#: (10 cm of lever is 7 % of it).
+MOMENTUM_TOL = 1e-3
+
+#: How far a vertex of a resting stack may travel in its 1 s (m): 1 mm in
+#: 2 s is creep a reader would see in a long run, at the same rate. Resting
+#: contact settles within ``g h^2`` = 1e-5 m per step; a stable solver stays
+#: within a few times that.
+STACK_TRAVEL = 5e-4
 
 
 def _runs(engine, cases, kinds, outcomes: list, examples: list):
@@ -466,4 +502,61 @@ def check_rigid_free_rotation(engine, cases) -> CheckResult:
                              "drift_tolerance": FREE_ENERGY_TOL,
                              "interval_tolerance": FLIP_INTERVAL_TOL, **scene.to_dict()})
     return tally("rigid", "free_rotation", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
+def check_rigid_off_centre(engine, cases) -> CheckResult:
+    """``rigid.off_centre``: the strike's impulse solution and its angular
+    momentum (module docstring)."""
+    start = time.perf_counter()
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("strike",), outcomes, examples):
+        answer = R.strike_answer(scene)
+        v = np.asarray(trajectory.velocity)[-1]
+        w = np.asarray(trajectory.angular_velocity)[-1]
+        got = {"rod_velocity": float(v[0, 1]), "rod_spin": float(w[0, 2]),
+               "ball_velocity": float(v[1, 1])}
+        # each miss as a speed: spins times their lever
+        lever = {"rod_velocity": 1.0, "rod_spin": R.STRIKE_OFFSET, "ball_velocity": 1.0}
+        misses = {k: abs(got[k] - answer[k]) * lever[k] for k in answer}
+        misses["rod_sideways"] = float(math.hypot(v[0, 0], v[0, 2]))
+        misses["ball_spin"] = float(np.sqrt((w[1] ** 2).sum())) * R.BALL_SCALE
+        L = R.angular_momentum(scene, trajectory)
+        drift = float(np.sqrt(((L - L[0]) ** 2).sum(axis=1)).max()
+                      / np.sqrt((L[0] ** 2).sum()))
+        worst = max(misses.values()) / R.STRIKE_SPEED
+        measured[scene.name] = {**{f"{k}_answer": answer[k] for k in answer}, **got,
+                                "largest_miss_of_closing_speed": worst,
+                                "momentum_drift": drift}
+        parts = [classify_miss(worst, OFF_CENTRE_TOL), classify_miss(drift, MOMENTUM_TOL)]
+        outcome = ("bug" if "bug" in parts else next((p for p in parts if p), None))
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, **got,
+                             **{f"{k}_answer": answer[k] for k in answer},
+                             "misses_m_per_s": misses, "tolerance_of_closing_speed":
+                             OFF_CENTRE_TOL, "momentum_drift": drift,
+                             "momentum_tolerance": MOMENTUM_TOL, **scene.to_dict()})
+    return tally("rigid", "off_centre", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
+def check_rigid_stack(engine, cases) -> CheckResult:
+    """``rigid.stack``: statically stable stacks stay (module docstring)."""
+    start = time.perf_counter()
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("stack",), outcomes, examples):
+        travel = R.largest_vertex_travel(scene, trajectory)
+        measured[scene.name] = {"largest_vertex_travel_metres": travel,
+                                "tolerance_metres": STACK_TRAVEL}
+        outcome = classify_miss(travel, STACK_TRAVEL) if math.isfinite(travel) else "bug"
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, "largest_vertex_travel_metres": travel,
+                             "tolerance_metres": STACK_TRAVEL, **scene.to_dict()})
+    return tally("rigid", "stack", outcomes, examples=examples, measured=measured,
                  seconds=time.perf_counter() - start)

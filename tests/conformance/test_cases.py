@@ -144,7 +144,8 @@ def test_rigid_scenes_and_their_tolerances():
     assert names == ["drop-sphere-e0.5", "drop-sphere-e0.8", "drop-cube-e0.5", "drop-cube-e0.8",
                      "drop-icosahedron-e0.8", "oblique-sphere", "oblique-rolling",
                      "oblique-spin-e1", "oblique-backspin", "oblique-e0", "spin-cube", "rest-cube",
-                     "free-brick"]
+                     "free-brick", "strike-e1", "strike-e0.5", "offset-stack", "cantilever",
+                     "board"]
     for scene in cases.of_kind("drop"):
         body = scene.scene.bodies[0]
         vertices = R._body(body.model.name)[0]
@@ -161,6 +162,36 @@ def test_rigid_scenes_and_their_tolerances():
                                                  rel=1e-6)
     rest = cases.of_kind("rest")[0]
     assert energy_tolerance(rest) == pytest.approx(2 * 9.81 * 9.81e-3 * 1e-3)
+
+
+def test_the_strike_and_its_impulse_solution():
+    """J = (1 + e) v / (1/m + 1/M + d^2 / I), the rod's I = M (4^2 +
+    0.25^2) / 12 about z, masses 1, d = 1.5, v = 2; the ball 1 cm above the
+    face, its lowest vertex straight below its centre."""
+    strike = {s.name: s for s in R.rigid_cases().of_kind("strike")}
+    inertia = (16.0 + 0.0625) / 12.0
+    for name, e in (("strike-e1", 1.0), ("strike-e0.5", 0.5)):
+        J = (1.0 + e) * 2.0 / (2.0 + 2.25 / inertia)
+        answer = R.strike_answer(strike[name])
+        assert answer == pytest.approx({"rod_velocity": -J, "rod_spin": -1.5 * J / inertia,
+                                        "ball_velocity": -2.0 + J}, rel=1e-12)
+        rod, ball = strike[name].scene.bodies
+        lowest = ball.position[1] + ball.scale * R._body(ball.model.name)[0][:, 1].min()
+        assert lowest - 0.125 == pytest.approx(0.01)
+        assert strike[name].scene.world.gravity == 0.0
+        assert strike[name].scene.world.friction == 0.0
+
+
+def test_the_stacks_rest_on_each_other_with_their_centres_over_the_support():
+    for stack in R.rigid_cases().of_kind("stack"):
+        base, top = stack.scene.bodies
+        v_base = R._body(base.model.name)[0] + base.position
+        v_top = R._body(top.model.name)[0] + top.position
+        assert v_base[:, 1].min() == pytest.approx(-R.HALF_SIZE)          # on the floor
+        assert v_top[:, 1].min() == pytest.approx(v_base[:, 1].max())     # on the base
+        # the top's centre of mass (its mesh origin) over the base's top face
+        assert v_base[:, 0].min() < top.position[0] < v_base[:, 0].max()
+        assert stack.scene.integration.duration == pytest.approx(1.0)
 
 
 def test_free_brick_and_its_closed_form():
