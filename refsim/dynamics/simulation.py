@@ -70,7 +70,7 @@ from refsim.bounds.tracker import AABBTracker, make_aabb_tracker
 from refsim.bounds.world_cube import world_cube_test
 from refsim.collision.bodies import bodies_collide
 from refsim.collision.broad_phase import overlapping_pairs
-from refsim.collision.contact import contact_polygon, intersection_points
+from refsim.collision.contact import contact_points
 from refsim.dynamics import impulse
 from refsim.dynamics.body_response import (
     WALL_TOUCH,
@@ -695,9 +695,8 @@ class Simulation:
             # the impulses act over the corners of the region where the
             # meshes overlap (an offset stack is held along its whole strip);
             # at a coarse level the meshes may not meet: the normal's point
-            points = contact_polygon(
-                intersection_points(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
-                                    self.pose(b), kernel=self.kernel), geometry.n)
+            points = contact_points(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
+                                    self.pose(b), geometry.n, kernel=self.kernel)
             if not len(points):
                 points = geometry.point[None, :]
             contacts.append((a, b, points, geometry))

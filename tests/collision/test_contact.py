@@ -9,8 +9,11 @@ import pytest
 
 import refsim
 from refsim.collision.contact import (
+    contact_points,
     contact_polygon,
+    deepest_points,
     edge_crossings,
+    exit_distances,
     intersection_points,
     winding_numbers,
 )
@@ -90,3 +93,37 @@ def test_degenerate_polygons(points, expected):
     """Collinear points (the y offsets are along n) give the two ends; one
     point repeated gives itself."""
     assert len(contact_polygon(np.array(points), [0.0, 1.0, 0.0])) == expected
+
+
+def test_exit_distances_along_a_direction():
+    """From inside the unit cube, along +y: to the top face; from a point
+    on the top face going up: 0; going down from it: the whole cube; from
+    outside: no exit (inf)."""
+    triangles = CUBE.vertices[CUBE.faces]
+    points = np.array([[0.1, 0.2, 0.0], [0.1, 0.5, 0.3], [3.0, 0.0, 0.0]])
+    np.testing.assert_allclose(exit_distances(points, [0.0, 1.0, 0.0], triangles),
+                               [0.3, 0.0, np.inf])
+    np.testing.assert_allclose(exit_distances(points[:2], [0.0, -1.0, 0.0], triangles),
+                               [0.7, 1.0])
+
+
+def test_the_deepest_points_of_a_cap_and_of_a_slab():
+    """A cube corner pushed 0.1 into another cube's top face, its diagonal
+    along the normal: the overlap is a tetrahedral cap, thick at the corner
+    (chord 0.1) and thin at its rim on the face (chord 0): the corner alone
+    is the contact. Two cubes overlapping in a slab keep all its corners."""
+    from scipy.spatial.transform import Rotation
+
+    # the corner (0.5, 0.5, 0.5) turned to point straight down
+    turn = Rotation.align_vectors([[0.0, -1.0, 0.0]], [[1.0, 1.0, 1.0]])[0].as_matrix()
+    tip = turn @ np.array([0.5, 0.5, 0.5])
+    pose_a = (turn, np.array([0.0, 0.5 - 0.1, 0.0]) - tip)
+    pose_b = (IDENTITY, np.zeros(3))
+    n = np.array([0.0, 1.0, 0.0])
+    points = contact_points(CUBE, pose_a, CUBE, pose_b, n)
+    np.testing.assert_allclose(points, [[0.0, 0.4, 0.0]], atol=1e-12)
+    slab_pose = (IDENTITY, np.array([0.3, 0.99, 0.0]))
+    region = intersection_points(CUBE, slab_pose, CUBE, pose_b)
+    tri = CUBE.vertices[CUBE.faces]
+    kept = deepest_points(region, n, tri + slab_pose[1], tri)
+    assert len(kept) == len(region)
