@@ -209,7 +209,7 @@ def section_json(section: Section, timings: set | None = None) -> dict:
         "results": to_json(section.results, ("sections", section.key, "results"), timings),
         "tables": [{"id": t.id, "title": t.title, "columns": list(t.columns),
                     "rows": [[str(cell) for cell in row] for row in t.rows],
-                    "column_links": list(t.column_links),
+                    "column_links": list(t.column_links), "empty": t.empty,
                     "timing": t.timing, "part": part_of(t.id)}
                    for t in section.tables],
         "figures": [{"id": f.id, "title": f.title, "part": part_of(f.id)}
