@@ -86,8 +86,8 @@ def c1(study: UpdateCostStudy) -> ClaimResult:
         "against_parity": {n: large[n] for n in sorted(large)},
         "against_band": {n: band[n] for n in sorted(band)},
         "spreads": {n: spread(repeats.get(n, ())) for n in sorted(ratios)},
-        "open": [n for n, c in large.items() if c["side"] == "within spread"]
-                + [n for n, side in band.items() if side == "within spread"],
+        "open": sorted({n for n, c in large.items() if c["side"] == "within spread"}
+                       | {n for n, side in band.items() if side == "within spread"}),
     }, timing=True)
 
 

@@ -89,11 +89,12 @@ class Verdict:
     """A measured verdict on one of the seed's claims C1..C12."""
 
     claim: str          # "C1"
-    measured: str       # what refsim measured, in a sentence with the figures
+    measured: str       # what refsim measured, with the figures (one click away on the page)
     verdict: str        # one of VERDICTS
     evidence: str       # id of the figure or table that shows it
     command: str = ""   # the one command that reproduces the figure
     timing: bool = False  # rests on wall-clock measurements (varies run to run)
+    summary: str = ""   # the finding in one short sentence, shown beside the verdict
 
 
 @dataclass(frozen=True)

@@ -519,7 +519,23 @@ def _c11(result) -> Verdict:
              + (", ".join(f["impulse_persistent"]) if f["impulse_persistent"] else "no case")
              + ".")
     return Verdict("C11", measured=text, verdict=result.verdict, evidence="dynamics-c11",
-                   command=CMD_C11, timing=result.timing)
+                   command=CMD_C11, timing=result.timing, summary=_c11_summary(f))
+
+
+def _c11_summary(f: dict) -> str:
+    """C11 in a sentence: the case where overlap lasts longest, and the
+    corrected response."""
+    persistent = f["persistent"]
+    corrected = ("; the corrected response lets none persist." if not f["impulse_persistent"]
+                 else "; so does the corrected response in "
+                 + ", ".join(f["impulse_persistent"]) + ".")
+    if not persistent:
+        return "With the seed's response no overlap lasts beyond the frame that detects it."
+    worst = max(persistent, key=lambda c: f["seed"][c]["longest_run"])
+    r = f["seed"][worst]
+    return (f"With the seed's response bodies stay interpenetrated in "
+            f"{len(persistent)} of {len(f['seed'])} cases (up to {r['longest_run']} of "
+            f"{r['frames']} frames in a row, {worst})" + corrected)
 
 
 def _c12(result) -> Verdict:
@@ -538,8 +554,14 @@ def _c12(result) -> Verdict:
         f"{'yes' if f['corrected_at_rest'] else 'no'})"
         + (f" and pybullet at {f['pybullet_final_spin']:.3g} rad/s"
            if f["pybullet_final_spin"] is not None else "") + ".")
+    summary = (f"The seed's rotation model still spins at {f['seed_final_spin']:.2g} rad/s "
+               "at the end" if not f["seed_at_rest"] else
+               "The seed's rotation model comes to rest")
+    summary += ("; the corrected model comes to rest." if f["corrected_at_rest"] else
+                "; the corrected model does not come to rest either.")
     return Verdict("C12", measured=measured, verdict=result.verdict,
-                   evidence="dynamics-c12-spin", command=CMD_SPIN, timing=result.timing)
+                   evidence="dynamics-c12-spin", command=CMD_SPIN, timing=result.timing,
+                   summary=summary)
 
 
 def _agreements(apex_rows, oblique_rows) -> list[Agreement]:
