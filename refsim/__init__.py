@@ -1,6 +1,6 @@
 """refsim: a validated reference implementation of a 1997 rigid-body N-body
 simulation (Kenny Hoff, COMP-205, UNC Chapel Hill), checked against python-fcl,
-trimesh, scipy and pybullet.
+trimesh, scipy, pybullet and MuJoCo.
 
 The public names below are a contract (DESIGN.md, Public API). They are
 imported lazily, on first use, so that ``import refsim`` and the command line

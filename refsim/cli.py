@@ -670,7 +670,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="refsim",
         description="Reference implementation of a 1997 rigid-body N-body simulation, "
-                    "checked against FCL, trimesh, scipy and pybullet.")
+                    "checked against FCL, trimesh, scipy, pybullet and MuJoCo.")
     parser.add_argument("--debug", action="store_true",
                         help="show the full traceback on errors")
     parser.add_argument("--version", action="version", version=f"refsim {version()}",

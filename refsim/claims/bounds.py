@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from refsim.claims.result import ClaimResult, by_parts
+from refsim.claims.result import ClaimResult, by_timed_parts, comparison, spread
 from refsim.studies.bounds import IncrementalError, UpdateCostStudy
 
 #: "Nearly equal" in the seed's C1: a scan / incremental time ratio within a
@@ -32,25 +32,62 @@ COMPILED = ("coherent", "incremental-numba", "scan-numba")
 INTERPRETED = ("coherent", "incremental-python", "scan-numpy")
 
 
+#: The scan/incremental time ratio at which the incremental update is faster.
+PARITY = 1.0
+
+
+def _band_side(ratio: float, repeats) -> str:
+    """Where a ratio lies against the :data:`ABOUT_EQUAL` band, with its
+    run-to-run spread: "inside", "outside" or "within spread" of an edge."""
+    low, high = (comparison(ratio, edge, repeats)["side"] for edge in ABOUT_EQUAL)
+    if low in ("above", "at") and high in ("below", "at"):     # the band is closed
+        return "inside"
+    if low == "below" or high == "above":
+        return "outside"
+    return "within spread"
+
+
 def c1(study: UpdateCostStudy) -> ClaimResult:
-    """C1 from the measured crossovers and speed-ups. Its two parts: the
-    incremental update is faster from :data:`SEED_LARGE_MODEL` triangles on
-    (the compiled crossover is at or below it), and below the crossover the
-    two cost about the same (every ratio within :data:`ABOUT_EQUAL`)."""
+    """C1 from the measured speed-ups, each against its run-to-run spread
+    (the interquartile range of the per-repeat ratios,
+    :func:`refsim.claims.result.comparison`). Its two parts: the incremental
+    update is faster (scan/incremental ratio above :data:`PARITY`) at every
+    size from :data:`SEED_LARGE_MODEL` triangles on, and below the compiled
+    crossover the two cost about the same (every ratio inside
+    :data:`ABOUT_EQUAL`). A part is open when a ratio it rests on lies within
+    its spread of the threshold and none clearly breaks it; the verdict is
+    "undecided" when the open parts could turn it
+    (:func:`refsim.claims.result.by_timed_parts`)."""
     compiled = study.crossovers.get(COMPILED)
     ratios = dict(study.speedups.get(COMPILED, []))   # size -> scan time / incremental time
+    repeats = dict(study.speedup_repeats.get(COMPILED, []))   # size -> per-repeat ratios
     below = [r for n, r in ratios.items() if compiled is None or n < compiled]
-    equal_below = bool(below) and all(ABOUT_EQUAL[0] <= r <= ABOUT_EQUAL[1] for r in below)
-    faster_at_large = compiled is not None and compiled <= SEED_LARGE_MODEL
-    return ClaimResult("C1", by_parts(faster_at_large + equal_below, 2), {
+    large = {n: comparison(r, PARITY, repeats.get(n, ())) for n, r in ratios.items()
+             if n >= SEED_LARGE_MODEL}
+    band = {n: _band_side(r, repeats.get(n, ())) for n, r in ratios.items()
+            if compiled is None or n < compiled}
+    sides = [c["side"] for c in large.values()]
+    faster = ("failed" if not sides or "below" in sides or "at" in sides  # a tie is not faster
+              else "open" if "within spread" in sides else "held")
+    equal = ("failed" if not band or "outside" in band.values()
+             else "open" if "within spread" in band.values() else "held")
+    parts = (faster, equal)
+    return ClaimResult("C1", by_timed_parts(parts.count("held"), parts.count("open"), 2), {
         "compiled_crossover": compiled,
         "interpreted_crossover": study.crossovers.get(INTERPRETED),
         "large_model": SEED_LARGE_MODEL,
         "ratio_at_large_model": ratios.get(SEED_LARGE_MODEL),
         "ratios_below_crossover": below,
         "about_equal": ABOUT_EQUAL,
-        "equal_below_crossover": equal_below,
-        "faster_at_large_model": faster_at_large,
+        "equal_below_crossover": equal == "held",
+        "faster_at_large_model": faster == "held",
+        "faster_part": faster,
+        "equal_part": equal,
+        "against_parity": {n: large[n] for n in sorted(large)},
+        "against_band": {n: band[n] for n in sorted(band)},
+        "spreads": {n: spread(repeats.get(n, ())) for n in sorted(ratios)},
+        "open": sorted({n for n, c in large.items() if c["side"] == "within spread"}
+                       | {n for n, side in band.items() if side == "within spread"}),
     }, timing=True)
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sys
 
-from refsim.claims.result import ClaimResult, by_parts
+from refsim.claims.result import ClaimResult, by_timed_parts, comparison
 from refsim.studies.levels import HierarchySpeed, LevelsResult
 from refsim.studies.triangles import C4Result, C4Sweep
 
@@ -30,19 +30,35 @@ C4_TOUCHING = ("touch", "shared-edge")
 C3_SLOWEST_SHOWN = 2
 
 
+#: A coarser level's median time over a finer one's: at most this, the
+#: coarser level is no slower.
+PARITY_TIME = 1.0
+
+
 def c3(levels: LevelsResult) -> ClaimResult:
     """C3 from the measured levels (``levels.levels``, coarsest first). Its
     two halves: accuracy (no level misses a contact, and false positives do
     not fall from a finer to a coarser level) and speed (median times do not
     fall from a coarser to a finer level: coarser is faster). Confirmed when
-    both hold, partly when one does, refuted when neither."""
+    both hold, partly when one does, refuted when neither. The speed half is
+    a timing: each coarser/finer time ratio is compared with
+    :data:`PARITY_TIME` against the spread of its per-repeat ratios
+    (:func:`refsim.claims.result.comparison`); the half is open when a ratio
+    lies within it and none is clearly above, and the verdict then
+    "undecided" (:func:`refsim.claims.result.by_timed_parts`)."""
     order = tuple(levels.levels)
     summary = {s.level: s for s in levels.summary}
     fp = {lv: summary[lv].false_positive_rate for lv in order}
     median = {lv: summary[lv].median_seconds for lv in order}
     pairs = list(zip(order, order[1:], strict=False))
     fp_ordered = all(fp[a] >= fp[b] for a, b in pairs)
-    speed_ordered = all(median[a] <= median[b] for a, b in pairs)
+    speed = {f"{a} / {b}": comparison(
+        median[a] / median[b], PARITY_TIME,
+        [x / y for x, y in zip(summary[a].seconds_by_repeat, summary[b].seconds_by_repeat,
+                               strict=True)]) for a, b in pairs}
+    sides = [c["side"] for c in speed.values()]
+    speed_ordered = all(side in ("below", "at") for side in sides)
+    speed_open = not speed_ordered and "above" not in sides
     conservative = levels.false_negatives == 0
     missed = [f"{c.name} ({lv})" for c in levels.configurations for lv in order
               if c.false_negative(lv)]
@@ -51,7 +67,8 @@ def c3(levels: LevelsResult) -> ClaimResult:
     slowest = sorted(levels.configurations, key=lambda c: c.seconds["exact"],
                      reverse=True)[:C3_SLOWEST_SHOWN]
     coarse, box = order[0], order[1]
-    return ClaimResult("C3", by_parts((conservative and fp_ordered) + speed_ordered, 2), {
+    return ClaimResult("C3", by_timed_parts((conservative and fp_ordered) + speed_ordered,
+                                            speed_open, 2), {
         "levels": list(order),
         "configurations": len(levels.configurations),
         "random_poses": sum(r.n for r in levels.random),
@@ -63,6 +80,8 @@ def c3(levels: LevelsResult) -> ClaimResult:
         "false_positives_ordered": fp_ordered,
         "median_seconds": median,
         "speed_ordered": speed_ordered,
+        "speed_open": speed_open,
+        "speed_against_parity": speed,
         "exact_over_box": median["exact"] / median[box],
         "exact_over_coarsest": median["exact"] / median[coarse],
         "slowest_exact": [{"name": c.name, "kind": c.kind, "seconds": c.seconds["exact"]}

@@ -14,8 +14,8 @@ A1 ``w += T``, not ``w += h T`` (rotation_seed.contact_spin_seed). "The
    contacts would leave w practically untouched (h = 1e-3).
 A2 Units of w (rotation_seed). The seed's w is in "revolutions / time", but
    its Euler step ``X += h (w x X)`` is the derivative of a rotating vector
-   only when |w| is in radians per time; refsim uses rad/s throughout
-   (DESIGN.md), which is what the seed's formula computes.
+   only when |w| is in radians per time; refsim uses rad/s throughout,
+   which is what the seed's formula computes.
 A3 Re-orthonormalization (rotation_seed.orientation_step_seed). The Euler
    step of the axes is not a rotation (it stretches each axis by
    ``sqrt(1 + h^2 |w|^2 sin^2)`` per step); the seed's axes are "normalized

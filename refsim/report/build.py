@@ -159,6 +159,7 @@ def claim_rows(sections: list[Section]) -> list[dict]:
         v = verdicts.get(claim)
         rows.append({
             "claim": claim, "area": area, "text": text,
+            "summary": v.summary if v else "",
             "measured": v.measured if v else "",
             "verdict": v.verdict if v else "not measured yet",
             "evidence": v.evidence if v else "",
@@ -186,12 +187,14 @@ def divergence_rows(sections: list[Section]) -> list[dict]:
         seed_issue = claim["claim"] in SEED_ISSUES and claim["verdict"] == "confirmed"
         if claim["verdict"] in DIVERGENT_VERDICTS or seed_issue:
             rows.append({"section": claim["area"], "title": f"{claim['claim']}: {claim['text']}",
-                         "kind": ("seed issue (the seed's own list), confirmed" if seed_issue
+                         "kind": ("a problem the seed lists itself, confirmed" if seed_issue
                                   else f"seed claim {claim['verdict']}"),
-                         "finding": claim["measured"], "evidence": claim["evidence"],
+                         "finding": claim["summary"] or claim["measured"],
+                         "details": claim["measured"] if claim["summary"] else "",
+                         "evidence": claim["evidence"],
                          "timing": claim["timing"]})
     for s in sections:
-        rows += [{"section": s.key, **asdict(d)} for d in s.divergences]
+        rows += [{"section": s.key, "details": "", **asdict(d)} for d in s.divergences]
     return rows
 
 
@@ -209,7 +212,7 @@ def section_json(section: Section, timings: set | None = None) -> dict:
         "results": to_json(section.results, ("sections", section.key, "results"), timings),
         "tables": [{"id": t.id, "title": t.title, "columns": list(t.columns),
                     "rows": [[str(cell) for cell in row] for row in t.rows],
-                    "column_links": list(t.column_links),
+                    "column_links": list(t.column_links), "empty": t.empty,
                     "timing": t.timing, "part": part_of(t.id)}
                    for t in section.tables],
         "figures": [{"id": f.id, "title": f.title, "part": part_of(f.id)}

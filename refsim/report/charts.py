@@ -61,14 +61,14 @@ def line_chart(series: Sequence[Series], *, xlabel: str, ylabel: str, title: str
     for s in series:
         ax.plot(np.asarray(s.x, float), np.asarray(s.y, float), s.style, label=s.label,
                 markersize=4, linewidth=1.2)
-    for x, label in vlines:
-        ax.axvline(x, color="0.3", linestyle=":", linewidth=1)
-        ax.annotate(label, (x, 1.0), xycoords=("data", "axes fraction"),
-                    xytext=(3, -12), textcoords="offset points", fontsize=8)
     if logx:
         ax.set_xscale("log")
     if logy:
         ax.set_yscale("log")
+    for x, label in vlines:
+        ax.axvline(x, color="0.3", linestyle=":", linewidth=1)
+        _mark(ax, x, label)
+    _readable_ticks(ax)
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     if title:
@@ -76,6 +76,54 @@ def line_chart(series: Sequence[Series], *, xlabel: str, ylabel: str, title: str
     if any(s.label for s in series):
         ax.legend(fontsize=8)
     return to_svg(fig)
+
+
+def _mark(ax, x: float, label: str) -> None:
+    """``label`` beside the vertical line at ``x``, at the foot of the plot
+    and on the side with more room, so that it stays inside the axes."""
+    ax.autoscale_view()
+    fraction = ax.transAxes.inverted().transform(ax.transData.transform((x, 0)))[0]
+    left = fraction > 0.5
+    ax.annotate(label, (x, 0.0), xycoords=("data", "axes fraction"),
+                xytext=(-4 if left else 4, 4), textcoords="offset points", fontsize=8,
+                ha="right" if left else "left", va="bottom",
+                bbox={"boxstyle": "square,pad=0.15", "facecolor": "white", "edgecolor": "none",
+                      "alpha": 0.8})
+
+
+#: A log axis spanning fewer decades than this is labelled in plain numbers
+#: at 1, 2 and 5 times each power of ten (1 to 9 where those are too few);
+#: a longer one at the powers alone. matplotlib's default labels a short log
+#: axis at linear steps in full scientific notation, and those labels run
+#: into each other.
+SHORT_LOG_AXIS = 2.0
+
+
+def _short_log_ticks(lo: float, hi: float) -> list[float]:
+    """Ticks for a log axis from ``lo`` to ``hi`` (few decades): 1, 2, 5 per
+    decade, or every integer multiple when that gives fewer than two."""
+    decades = range(int(np.floor(np.log10(lo))), int(np.ceil(np.log10(hi))) + 1)
+    for multiples in ((1, 2, 5), range(1, 10)):
+        ticks = [m * 10.0**k for k in decades for m in multiples if lo <= m * 10.0**k <= hi]
+        if len(ticks) >= 2:
+            return ticks
+    return []
+
+
+def _readable_ticks(ax) -> None:
+    """Tick labels that do not overlap on a log axis: none on minor ticks,
+    and on a short axis plain numbers at a few round values."""
+    from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter
+
+    ax.autoscale_view()
+    for axis, (lo, hi) in ((ax.xaxis, ax.get_xlim()), (ax.yaxis, ax.get_ylim())):
+        if axis.get_scale() != "log" or not (0 < lo < hi):
+            continue
+        axis.set_minor_formatter(NullFormatter())
+        ticks = _short_log_ticks(lo, hi) if np.log10(hi / lo) < SHORT_LOG_AXIS else []
+        if ticks:
+            axis.set_major_locator(FixedLocator(ticks))
+            axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
 
 
 def contour_chart(x: np.ndarray, y: np.ndarray, fields: Sequence[tuple[str, np.ndarray]],
@@ -105,7 +153,8 @@ def bar_chart(labels: Sequence[str], values: Sequence[float], *, ylabel: str,
     plt = _pyplot()
     fig, ax = plt.subplots(figsize=size)
     ax.bar(range(len(values)), values, color="#4477aa")
-    ax.set_xticks(range(len(values)), labels, rotation=30, ha="right")
+    ax.set_xticks(range(len(values)), labels, rotation=45, ha="right",
+                  rotation_mode="anchor")
     if logy:
         ax.set_yscale("log")
     ax.set_ylabel(ylabel)

@@ -43,6 +43,18 @@ class Figure:
 
 
 @dataclass(frozen=True)
+class Cell:
+    """A table cell shown in the colour of its ``status`` (one of a table's
+    ``legend`` keys); results.json records its text, as for any cell."""
+
+    text: str
+    status: str
+
+    def __str__(self) -> str:
+        return self.text
+
+
+@dataclass(frozen=True)
 class Table:
     id: str
     title: str
@@ -52,6 +64,10 @@ class Table:
     timing: bool = False  # some cells are timings (they vary run to run)
     # a link per column heading (a path relative to the page, "" for none)
     column_links: tuple[str, ...] = ()
+    # the sentence the page shows in the table's place when it has no rows
+    empty: str = ""
+    # (status, what it means) for the colours of the table's Cells, in order
+    legend: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -73,11 +89,12 @@ class Verdict:
     """A measured verdict on one of the seed's claims C1..C12."""
 
     claim: str          # "C1"
-    measured: str       # what refsim measured, in a sentence with the figures
+    measured: str       # what refsim measured, with the figures (one click away on the page)
     verdict: str        # one of VERDICTS
     evidence: str       # id of the figure or table that shows it
     command: str = ""   # the one command that reproduces the figure
     timing: bool = False  # rests on wall-clock measurements (varies run to run)
+    summary: str = ""   # the finding in one short sentence, shown beside the verdict
 
 
 @dataclass(frozen=True)

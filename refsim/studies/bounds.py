@@ -113,7 +113,9 @@ class UpdateCost:
 
     ``seconds_per_update`` is the median over repeats of (block time / frames)
     of the unchecked update (the pose check, the same for every method, is
-    :attr:`UpdateCostStudy.pose_check_seconds`). ``visits_per_update`` and
+    :attr:`UpdateCostStudy.pose_check_seconds`); ``seconds_by_repeat`` each
+    repeat's block time / frames, in order (repeat ``k`` of every method
+    times the same poses). ``visits_per_update`` and
     ``evaluations_per_update`` are means over the timed frames, ``max_visits``
     their maximum; the first update (a full scan for the tracker) is not timed
     or counted.
@@ -128,6 +130,7 @@ class UpdateCost:
     visits_per_update: float
     max_visits: int
     evaluations_per_update: float
+    seconds_by_repeat: tuple[float, ...] = field(default=(), metadata=TIMED)
 
 
 @dataclass(frozen=True)
@@ -137,7 +140,9 @@ class UpdateCostStudy:
     ``crossovers[(motion, incremental, scan)]`` is the smallest triangle count
     of the sweep from which ``incremental`` is faster than ``scan`` at that
     size and every larger one (None if never). ``speedups`` gives, per the same
-    key, the list of (n_triangles, scan seconds / incremental seconds).
+    key, the list of (n_triangles, scan seconds / incremental seconds);
+    ``speedup_repeats`` the list of (n_triangles, the ratio of each repeat's
+    times), whose spread is the ratio's run-to-run spread.
     """
 
     rows: tuple[UpdateCost, ...]
@@ -148,6 +153,7 @@ class UpdateCostStudy:
     pose_check_seconds: float = field(metadata=TIMED)
     crossovers: dict = field(default_factory=dict, metadata=TIMED)
     speedups: dict = field(default_factory=dict, metadata=TIMED)
+    speedup_repeats: dict = field(default_factory=dict, metadata=TIMED)
 
     def row(self, mesh: str, motion: str, method: str) -> UpdateCost:
         for r in self.rows:
@@ -217,7 +223,8 @@ def _time_method(mesh, method, motion, poses, frames, repeats) -> UpdateCost:
                       motion=motion, method=method,
                       seconds_per_update=statistics.median(block_times),
                       visits_per_update=float(np.mean(visits)), max_visits=int(max(visits)),
-                      evaluations_per_update=float(np.mean(evaluations)))
+                      evaluations_per_update=float(np.mean(evaluations)),
+                      seconds_by_repeat=tuple(block_times))
 
 
 def _time_pose_check(pose, repeats: int = 2000) -> float:
@@ -233,11 +240,13 @@ def _fill_crossovers(study, meshes, motions, methods):
     for motion in motions:
         for inc in (m for m in methods if m.startswith("incremental")):
             for scan in (m for m in methods if m.startswith("scan")):
-                ratios = []
+                ratios, repeats = [], []
                 for s in sizes:
-                    t_scan = study.row(by_size[s], motion, scan).seconds_per_update
-                    t_inc = study.row(by_size[s], motion, inc).seconds_per_update
-                    ratios.append((s, t_scan / t_inc))
+                    r_scan = study.row(by_size[s], motion, scan)
+                    r_inc = study.row(by_size[s], motion, inc)
+                    ratios.append((s, r_scan.seconds_per_update / r_inc.seconds_per_update))
+                    repeats.append((s, tuple(a / b for a, b in zip(
+                        r_scan.seconds_by_repeat, r_inc.seconds_by_repeat, strict=True))))
                 crossover = None
                 for i, (s, _) in enumerate(ratios):
                     if all(r > 1.0 for _, r in ratios[i:]):
@@ -245,6 +254,7 @@ def _fill_crossovers(study, meshes, motions, methods):
                         break
                 study.crossovers[(motion, inc, scan)] = crossover
                 study.speedups[(motion, inc, scan)] = ratios
+                study.speedup_repeats[(motion, inc, scan)] = repeats
 
 
 # -- C2: error on non-convex meshes ----------------------------------------------------

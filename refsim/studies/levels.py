@@ -232,8 +232,8 @@ def random_poses(mesh_a, mesh_b, n: int, rng: np.random.Generator, reach: float 
     return poses
 
 
-def _median_seconds(call: Callable[[], object], repeats: int) -> float:
-    """Median wall time of ``repeats`` calls (time.perf_counter), after one
+def _repeat_seconds(call: Callable[[], object], repeats: int) -> tuple[float, ...]:
+    """Wall time of each of ``repeats`` calls (time.perf_counter), after one
     untimed call."""
     call()
     times = []
@@ -241,7 +241,12 @@ def _median_seconds(call: Callable[[], object], repeats: int) -> float:
         start = time.perf_counter()
         call()
         times.append(time.perf_counter() - start)
-    return float(np.median(times))
+    return tuple(times)
+
+
+def _median_seconds(call: Callable[[], object], repeats: int) -> float:
+    """Median wall time of ``repeats`` calls, after one untimed call."""
+    return float(np.median(_repeat_seconds(call, repeats)))
 
 
 # --------------------------------------------------------------------------
@@ -265,6 +270,8 @@ class ConfigurationLevels:
     # "bvh", "seed" -> median seconds of intersecting_pairs at the exact level
     pairs_seconds: dict = field(metadata=TIMED)
     seed_answers_equal: bool        # method "seed" gave the same answers and pairs
+    # level -> each repeat's seconds per boolean query ("bvh"), whose median is ``seconds``
+    seconds_by_repeat: dict = field(default_factory=dict, metadata=TIMED)
 
     @property
     def pair_false_positives(self) -> int:
@@ -299,6 +306,9 @@ class LevelSummary:
     false_positives: int            # configurations + random poses
     negatives: int                  # queries where exact says no (the most FPs possible)
     false_negatives: int
+    # for each repeat k, the median over the configurations of their k-th time:
+    # the run-to-run spread of median_seconds
+    seconds_by_repeat: tuple[float, ...] = field(default=(), metadata=TIMED)
 
     @property
     def false_positive_rate(self) -> float:
@@ -352,8 +362,9 @@ def measure_levels(configurations: tuple[Configuration, ...] = CONFIGURATIONS,
 
         # bool(): the sphere level returns a numpy bool (see the report)
         answers = {level: bool(ask(level)) for level in LEVELS}
-        seconds = {level: _median_seconds(functools.partial(ask, level), repeats)
-                   for level in LEVELS}
+        by_repeat = {level: _repeat_seconds(functools.partial(ask, level), repeats)
+                     for level in LEVELS}
+        seconds = {level: float(np.median(times)) for level, times in by_repeat.items()}
         seed_seconds = {level: _median_seconds(functools.partial(ask, level, "seed"),
                                                max(3, repeats // 4))
                         for level in ("triangle-aabb", "exact")}
@@ -368,7 +379,7 @@ def measure_levels(configurations: tuple[Configuration, ...] = CONFIGURATIONS,
             pairs_seconds={"bvh": _median_seconds(functools.partial(pairs, "exact"), repeats),
                            "seed": _median_seconds(functools.partial(pairs, "exact", "seed"),
                                                    max(3, repeats // 4))},
-            seed_answers_equal=bool(same)))
+            seed_answers_equal=bool(same), seconds_by_repeat=by_repeat))
 
     rng = np.random.default_rng(seed)
     randoms = []
@@ -408,7 +419,9 @@ def measure_levels(configurations: tuple[Configuration, ...] = CONFIGURATIONS,
                              + sum(r.false_positives[level] for r in randoms)),
             negatives=negatives,
             false_negatives=(sum(c.false_negative(level) for c in done)
-                             + sum(r.false_negatives[level] for r in randoms))))
+                             + sum(r.false_negatives[level] for r in randoms)),
+            seconds_by_repeat=tuple(float(np.median(times)) for times in zip(
+                *(c.seconds_by_repeat[level] for c in done), strict=True)) if done else ()))
     return LevelsResult(levels=LEVELS, kernel=kernel, repeats=repeats, seed=seed,
                         configurations=tuple(done), random=tuple(randoms),
                         summary=tuple(summary))

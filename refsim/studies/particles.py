@@ -180,6 +180,9 @@ class DragComparison:
     cost_ratio : float
         Wall time per particle-system step, quadratic over linear (Euler,
         ``count`` particles, best of ``repeats``).
+    cost_ratios : tuple of float
+        The same ratio for each repeat (the ``k``-th quadratic step over the
+        ``k``-th linear one): its run-to-run spread.
     """
 
     terminal_speed: float
@@ -189,6 +192,7 @@ class DragComparison:
     same_terminal_distance: float
     same_k_difference: float
     cost_ratio: float = field(metadata=TIMED)
+    cost_ratios: tuple[float, ...] = field(default=(), metadata=TIMED)
 
 
 def _trajectory(config: ParticleConfig, x0, v0, t_eval, oracle):
@@ -222,21 +226,21 @@ def measure_drag_models(oracle, terminal_speed: float = 10.0, launch_speed: floa
                               t_eval, oracle)
     distance = float(np.linalg.norm(np.diff(linear, axis=0), axis=1).sum())
 
-    times = {}
+    times: dict[str, list[float]] = {}
     for model, k in (("linear", k_linear), ("quadratic", k_quadratic)):
         system = ParticleSystem(ParticleConfig(count=count, drag=k, drag_model=model,
                                                solver="euler", walls=False, step=1e-3))
-        best = math.inf
+        times[model] = []
         for _ in range(repeats):
             start = time.perf_counter()
             system.step()
-            best = min(best, time.perf_counter() - start)
-        times[model] = best
+            times[model].append(time.perf_counter() - start)
     return DragComparison(
         terminal_speed, k_linear, k_quadratic,
         float(np.linalg.norm(quad - linear, axis=1).max()), distance,
         float(np.linalg.norm(quad_same_k - linear, axis=1).max()),
-        times["quadratic"] / times["linear"])
+        min(times["quadratic"]) / min(times["linear"]),
+        tuple(q / lin for q, lin in zip(times["quadratic"], times["linear"], strict=True)))
 
 
 # --------------------------------------------------------------------------

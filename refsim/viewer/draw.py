@@ -57,15 +57,24 @@ CAMERA_MARGIN = 1.1
 #: A box this many times wider than high is fitted to the window's width.
 WIDE = 1.5
 
+#: The live viewer's control panel floats over the right of the window, a
+#: replay's settings panel over its left (each about a quarter of a laptop's
+#: width): the camera is panned so that the scene sits this fraction of the
+#: view's width off centre, away from the panel, in the clear part.
+PANEL_PAN = 0.12
+
 
 def place_camera(camera, width: float, height: float, depth: float | None = None,
                  center=(0.0, 0.0, 0.0), direction=VIEW_DIRECTION,
-                 margin: float = CAMERA_MARGIN) -> None:
+                 margin: float = CAMERA_MARGIN, pan: float = 0.0) -> None:
     """Point viser's camera (``server.initial_camera``) at a box of
     ``width`` (x), ``height`` (y) and ``depth`` (z, default the height)
     about ``center``, from VIEW_DIRECTION, far enough that the box's
     bounding sphere fits the view of a window about 1.6 times as wide as high
-    (a sphere, since the view is oblique), with a margin for the panels."""
+    (a sphere, since the view is oblique), with a margin for the panels.
+    ``pan``: move the camera and its target to the right by this fraction of
+    the view's width, so that the box appears that much left of centre
+    (:data:`PANEL_PAN` keeps it clear of a panel on the right)."""
     import math
 
     depth = height if depth is None else depth
@@ -77,9 +86,13 @@ def place_camera(camera, width: float, height: float, depth: float | None = None
     d = margin * radius / math.sin(half)
     direction = np.asarray(direction, dtype=np.float64)
     direction /= np.sqrt(direction @ direction)
+    # the screen's right: the view direction (-direction) crossed with up
+    right = np.array([direction[2], 0.0, -direction[0]])
+    right /= np.sqrt(right @ right)
+    target = np.asarray(center, dtype=np.float64) + pan * 2.0 * d * math.tan(half_h) * right
     camera.fov = math.radians(FOV_DEGREES)
-    camera.look_at = tuple(np.asarray(center, dtype=np.float64))
-    camera.position = tuple(np.asarray(center) + d * direction)
+    camera.look_at = tuple(target)
+    camera.position = tuple(target + d * direction)
     camera.up = (0.0, 1.0, 0.0)
 
 

@@ -179,7 +179,7 @@ class Viewer:
     def _build_scene(self) -> None:
         s = self.server.scene
         H = self.scene.world.half_size
-        draw.place_camera(self.server.initial_camera, 2.0 * H, 2.0 * H)
+        draw.place_camera(self.server.initial_camera, 2.0 * H, 2.0 * H, pan=draw.PANEL_PAN)
         self.cube = draw.add_cube(s, "/world/cube", H)
         self.bodies = []
         for b, (cfg, mesh) in enumerate(zip(self.scene.bodies, self.meshes, strict=True)):
@@ -229,7 +229,9 @@ class Viewer:
             self.show_hits = gui.add_checkbox("Wall hits: normal, impulse", bodies,
                                               disabled=not bodies)
             self.show_energy = gui.add_checkbox("Energy chart", bodies, disabled=not bodies)
-        with gui.add_folder("Energy (J)"):
+        # particles have no energy chart: no folder for it either (an empty box)
+        self.energy_folder = gui.add_folder("Energy (J)", visible=bodies)
+        with self.energy_folder:
             self.chart = gui.add_uplot(
                 (np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(2)),
                 ({"label": "t (s)"},
@@ -250,7 +252,7 @@ class Viewer:
                                                        event.target.value))
         for box in (self.show_boxes, self.show_contacts, self.show_hits):
             box.on_update(lambda _: self.show_frame(self.frame))
-        self.show_energy.on_update(lambda event: setattr(self.chart, "visible",
+        self.show_energy.on_update(lambda event: setattr(self.energy_folder, "visible",
                                                          event.target.value))
 
     def _control_changed(self, name: str):

@@ -66,13 +66,23 @@ START_RTOL = 1e-9
 #: perspective between runs side by side, and room for the settings panel.
 REPLAY_CAMERA_MARGIN = 1.4
 
+#: Where a run's label stands, in half sizes of its cube from its centre:
+#: just below the middle of the front bottom edge (above the cube it sat on
+#: the top edges, seen from above).
+LABEL_AT = (0.0, -1.08, 1.0)
+
 #: Opacity of the bodies when runs are overlaid, so that both show where
 #: they coincide.
 OVERLAY_OPACITY = 0.65
 
-#: Settings shown first on the page, in this order (others follow, sorted).
-SETTINGS_ORDER = ("scene", "engine", "solver", "step", "rotation", "body_response",
-                  "collision_level", "aabb", "every", "steps", "wall_speed", "boxes")
+#: The settings a run records, as the page names them, in the page's order
+#: (others follow, sorted, their underscores as spaces).
+SETTING_NAMES = {"scene": "scene", "engine": "engine", "solver": "solver",
+                 "step": "step h (s)", "rotation": "rotation",
+                 "body_response": "body response", "collision_level": "collision level",
+                 "aabb": "box update", "every": "stored every (steps)",
+                 "steps": "steps", "wall_speed": "wall speed", "wall_response": "wall response",
+                 "boxes": "boxes", "kernel": "kernels"}
 
 #: The settings entry that holds the text of the run's scene file (beside
 #: ``scene``, its path); not shown on the page.
@@ -392,10 +402,11 @@ class _Page:
         server = start_server()
         try:
             n = 1 if self.overlay else len(self.runs)
+            # the page's panel floats over the left of the window: the runs to its right
             draw.place_camera(server.initial_camera, 2.0 * self.H * (n + GAP * (n - 1)),
                               2.0 * self.H,
                               direction=draw.VIEW_DIRECTION if n == 1 else draw.FRONT_DIRECTION,
-                              margin=REPLAY_CAMERA_MARGIN)
+                              margin=REPLAY_CAMERA_MARGIN, pan=-draw.PANEL_PAN)
             s = server.scene
             serializer = server.get_scene_serializer()
             nodes = self._add_nodes(s, draw)
@@ -425,9 +436,10 @@ class _Page:
                 cubes.add(key)
                 draw.add_cube(s, f"/run{r}/world-cube", run.half_size, off)
             if not self.overlay:
+                # below the cube's front bottom edge, where no edge or body is drawn
                 s.add_label(f"/run{r}/label", run.label,
-                            position=off + np.array([0.0, run.half_size * 1.08, 0.0]),
-                            anchor="bottom-center", font_screen_scale=1.2)
+                            position=off + run.half_size * np.array(LABEL_AT),
+                            anchor="top-center", font_screen_scale=1.2)
             bodies = []
             for b, mesh in enumerate(run.meshes):
                 rgb = draw.color(r if self.overlay else b)
@@ -463,7 +475,7 @@ class _Page:
                      f"{traj.n_frames} frames, t = {traj.t[0]:g} to {traj.t[-1]:g} s"]
             settings = "".join(f"<tr><td>{html.escape(str(k))}</td>"
                                f"<td>{html.escape(_value(v))}</td></tr>"
-                               for k, v in _ordered(run.settings))
+                               for k, v in named_settings(run.settings))
             rows.append(f"<details open><summary>{swatches}<b>{html.escape(run.label)}</b>"
                         f"</summary><div>{html.escape('; '.join(facts))}</div>"
                         f"<table>{settings}</table></details>")
@@ -477,9 +489,13 @@ class _Page:
                 f'simulated second per second.</div>{"".join(rows)}</details></div>')
 
 
-def _ordered(settings: dict):
-    first = [(k, settings[k]) for k in SETTINGS_ORDER if k in settings]
-    rest = sorted((k, v) for k, v in settings.items() if k not in SETTINGS_ORDER)
+def named_settings(settings: dict) -> list[tuple[str, object]]:
+    """A run's settings as the page lists them: (name in words, value), the
+    :data:`SETTING_NAMES` first in their order, then the others sorted; the
+    scene file's text is left out (its path is shown)."""
+    first = [(SETTING_NAMES[k], settings[k]) for k in SETTING_NAMES if k in settings]
+    rest = sorted((k.replace("_", " "), v) for k, v in settings.items()
+                  if k not in SETTING_NAMES and k != SCENE_TEXT)
     return first + rest
 
 
@@ -492,16 +508,16 @@ def _value(v) -> str:
 
 
 PANEL_STYLE = """<style>
-#refsim-replay { position: fixed; top: 8px; left: 8px; z-index: 1000; max-width: 22em;
+#refsim-replay { position: fixed; top: 8px; left: 8px; z-index: 1000; max-width: 25em;
   max-height: 70vh; overflow: auto; font: 12px/1.35 system-ui, sans-serif; color: #222;
   background: rgba(255, 255, 255, 0.92); border: 1px solid #ccc; border-radius: 6px;
   padding: 6px 8px; }
 #refsim-replay details details { margin-top: 6px; }
 #refsim-replay summary { cursor: pointer; }
 #refsim-replay table { border-collapse: collapse; margin-top: 2px; }
-#refsim-replay table { table-layout: fixed; width: 100%; }
-#refsim-replay td { padding: 0 6px 0 0; vertical-align: top; overflow-wrap: anywhere; }
-#refsim-replay td:first-child { color: #666; }
+#refsim-replay td { padding: 0 6px 0 0; vertical-align: top; }
+#refsim-replay td:first-child { color: #666; white-space: nowrap; }
+#refsim-replay td + td { overflow-wrap: break-word; }
 #refsim-replay .sw { display: inline-block; width: 10px; height: 10px; margin-right: 3px;
   border-radius: 2px; vertical-align: baseline; }
 </style>"""

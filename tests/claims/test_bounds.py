@@ -14,13 +14,20 @@ from refsim.claims.bounds import ABOUT_EQUAL, COMPILED, INTERPRETED, SEED_LARGE_
 from refsim.studies.bounds import IncrementalError, UpdateCostStudy
 
 
-def cost_study(crossover, ratios, interpreted=20480) -> UpdateCostStudy:
+def cost_study(crossover, ratios, interpreted=20480, repeats=None) -> UpdateCostStudy:
     """A cost study whose compiled crossover and scan/incremental ratios
-    (size -> ratio) are given; C1 reads nothing else."""
+    (size -> ratio) are given, and the ratios of each repeat (size -> tuple;
+    none: no spread); C1 reads nothing else."""
     return UpdateCostStudy(rows=(), degrees_per_frame=1.0, frames=50, repeats=3, seed=0,
                            pose_check_seconds=1e-5,
                            crossovers={COMPILED: crossover, INTERPRETED: interpreted},
-                           speedups={COMPILED: sorted(ratios.items())})
+                           speedups={COMPILED: sorted(ratios.items())},
+                           speedup_repeats={COMPILED: sorted((repeats or {}).items())})
+
+
+def around(ratio, iqr):
+    """Five repeats with median ``ratio`` and interquartile range ``iqr``."""
+    return (ratio - iqr, ratio - iqr / 2, ratio, ratio + iqr / 2, ratio + iqr)
 
 
 LOW, HIGH = ABOUT_EQUAL
@@ -44,6 +51,30 @@ ABOVE = 1 + 1e-9       # and just outside
 def test_c1_verdict_at_its_thresholds(crossover, ratios, verdict):
     result = c1(cost_study(crossover, ratios))
     assert result.claim == "C1" and result.verdict == verdict and result.timing
+
+
+@pytest.mark.parametrize(("ratios", "repeats", "verdict", "open_sizes"), [
+    # 2000 triangles: 1.05 against a spread of 0.1: it may be slower next run
+    ({80: 1.0, 2000: 1.05}, {80: around(1.0, 0.1), 2000: around(1.05, 0.1)},
+     "undecided", [2000]),
+    # the same ratio with repeats that agree to 0.01: faster
+    ({80: 1.0, 2000: 1.05}, {80: around(1.0, 0.1), 2000: around(1.05, 0.01)},
+     "confirmed", []),
+    # clearly slower at 2000 and clearly outside the band below it
+    ({80: 0.3, 2000: 0.7}, {80: around(0.3, 0.05), 2000: around(0.7, 0.1)}, "refuted", []),
+    # 1.95 below the crossover against a spread of 0.1: at the band's edge
+    ({80: 1.95, 2000: 1.5}, {80: around(1.95, 0.1), 2000: around(1.5, 0.1)},
+     "undecided", [80]),
+    # 2.3 is three spreads outside the band: only the speed part holds
+    ({80: 2.3, 2000: 1.5}, {80: around(2.3, 0.1), 2000: around(1.5, 0.1)}, "partly", []),
+])
+def test_c1_is_undecided_within_the_run_to_run_spread(ratios, repeats, verdict, open_sizes):
+    crossover = 2000 if verdict != "refuted" else None
+    result = c1(cost_study(crossover, ratios, repeats=repeats))
+    assert result.verdict == verdict
+    assert result.facts["open"] == open_sizes
+    at_large = result.facts["against_parity"][2000]
+    assert at_large["spread"] == pytest.approx(repeats[2000][3] - repeats[2000][1])
 
 
 def test_c1_facts_are_the_quoted_numbers():

@@ -39,11 +39,14 @@ def configuration(name, kind, answers, exact_seconds=1e-4) -> ConfigurationLevel
 
 
 def levels_result(false_positives, medians, false_negatives=(0, 0, 0, 0),
-                  configurations=None) -> LevelsResult:
+                  configurations=None, repeats=None) -> LevelsResult:
     """Four levels with these false-positive counts (of 10 negatives), median
-    times and false negatives."""
-    summary = tuple(LevelSummary(lv, t, fp, 10, fn) for lv, fp, t, fn
-                    in zip(LEVELS, false_positives, medians, false_negatives, strict=True))
+    times and false negatives, and each level's per-repeat times (none: no
+    spread)."""
+    repeats = repeats or ((),) * len(LEVELS)
+    summary = tuple(LevelSummary(lv, t, fp, 10, fn, r) for lv, fp, t, fn, r
+                    in zip(LEVELS, false_positives, medians, false_negatives, repeats,
+                           strict=True))
     configurations = configurations or (
         configuration("far", "separated-far", (False,) * 4),
         configuration("cubes-face", "touching", (True,) * 4, exact_seconds=9e-3),
@@ -67,6 +70,27 @@ ORDERED_TIMES = (1e-6, 2e-6, 1e-5, 1e-4)
 def test_c3_verdict_at_its_thresholds(fp, times, fn, verdict):
     result = c3(levels_result(fp, times, fn))
     assert result.verdict == verdict and result.timing
+
+
+def test_c3_speed_is_undecided_within_the_run_to_run_spread():
+    """The sphere level at 1.05 times the box level's time, over repeats
+    whose ratio spreads by 0.2: another run may find it faster, so the speed
+    half is open and C3 (accuracy half holding) is undecided; with repeats
+    that agree, the same medians make it clearly slower: partly."""
+    medians = (1.05e-6, 1e-6, 1e-5, 1e-4)
+    noisy = ((0.9e-6, 1.0e-6, 1.05e-6, 1.2e-6, 1.3e-6),) + tuple((t,) * 5 for t in medians[1:])
+    steady = tuple((t,) * 5 for t in medians)
+    undecided = c3(levels_result((6, 6, 5, 0), medians, repeats=noisy))
+    assert undecided.verdict == "undecided" and undecided.facts["speed_open"]
+    assert undecided.facts["speed_against_parity"]["sphere / aabb"]["side"] == "within spread"
+    decided = c3(levels_result((6, 6, 5, 0), medians, repeats=steady))
+    assert decided.verdict == "partly" and not decided.facts["speed_open"]
+    assert decided.facts["speed_against_parity"]["sphere / aabb"]["side"] == "above"
+    # far apart against the same spread: clearly ordered
+    ordered = c3(levels_result((6, 6, 5, 0), (0.5e-6, 1e-6, 1e-5, 1e-4),
+                               repeats=((0.4e-6, 0.45e-6, 0.5e-6, 0.55e-6, 0.6e-6),)
+                               + tuple((t,) * 5 for t in medians[1:])))
+    assert ordered.verdict == "confirmed"
 
 
 def test_c3_facts():

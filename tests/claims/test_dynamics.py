@@ -2,7 +2,7 @@
 
 C11 counts a case when its longest run of interpenetrating frames is longer
 than the one frame any discrete detection sees; C12 turns on the at-rest
-flags of the seed's and the corrected model; the findings on the issue's
+flags of the seed's and the corrected model; the findings on refsim's own
 targets (apex ratio, step cost) and on pybullet's cube tipping.
 """
 

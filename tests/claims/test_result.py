@@ -8,10 +8,21 @@ import math
 import pytest
 
 from refsim.claims import CLAIMS
-from refsim.claims.result import ClaimResult, by_parts, lower, rank, relative_difference, tied
+from refsim.claims.result import (
+    ClaimResult,
+    against,
+    by_parts,
+    by_timed_parts,
+    comparison,
+    lower,
+    rank,
+    relative_difference,
+    spread,
+    tied,
+)
 
 
-def test_a_verdict_outside_the_three_is_refused():
+def test_a_verdict_outside_the_four_is_refused():
     with pytest.raises(ValueError, match="C1"):
         ClaimResult("C1", "not measured yet")
 
@@ -20,6 +31,46 @@ def test_a_verdict_outside_the_three_is_refused():
     (2, 2, "confirmed"), (1, 2, "partly"), (0, 2, "refuted"), (3, 5, "partly")])
 def test_by_parts(held, parts, verdict):
     assert by_parts(held, parts) == verdict
+
+
+def test_spread_is_the_interquartile_range_of_the_repeats():
+    assert spread([1.0, 2.0, 3.0, 4.0, 5.0]) == 2.0          # quartiles 2 and 4
+    assert spread([5.0, 1.0, 3.0, 2.0, 4.0]) == 2.0          # order does not matter
+    assert spread([1.5]) == 0.0 and spread([]) == 0.0        # one repeat: no spread known
+    assert spread([1.0, math.nan, 3.0]) == 1.0               # a lost repeat is left out
+
+
+@pytest.mark.parametrize(("value", "threshold", "value_spread", "side"), [
+    (1.3, 1.0, 0.1, "above"),            # three spreads above
+    (0.7, 1.0, 0.1, "below"),
+    (1.05, 1.0, 0.1, "within spread"),   # half a spread off: another run may fall below
+    (1.1, 1.0, 0.1 + 1e-12, "within spread"),   # exactly one spread off is not clear
+    (1.0, 1.0, 0.0, "at"),               # a tie without spread: the claim says which side
+    (1.0 + 1e-12, 1.0, 0.0, "above"),    # no spread: any difference decides
+    (math.nan, 1.0, 0.0, "within spread"),
+])
+def test_against_decides_only_beyond_the_spread(value, threshold, value_spread, side):
+    assert against(value, threshold, value_spread) == side
+
+
+def test_comparison_states_the_distance_in_spreads():
+    facts = comparison(1.3, 1.0, [1.1, 1.2, 1.3, 1.4, 1.5])
+    assert facts["spread"] == pytest.approx(0.2) and facts["spreads"] == pytest.approx(1.5)
+    assert facts["side"] == "above"
+    assert comparison(1.0, 1.0, [1.0])["spreads"] == 0.0
+    assert comparison(2.0, 1.0, [2.0])["spreads"] == math.inf
+
+
+@pytest.mark.parametrize(("held", "open_parts", "parts", "verdict"), [
+    (2, 0, 2, "confirmed"), (1, 0, 2, "partly"), (0, 0, 2, "refuted"),
+    (1, 1, 2, "undecided"),     # confirmed or partly, by where the open part falls
+    (0, 1, 2, "undecided"),     # partly or refuted
+    (0, 1, 1, "undecided"),
+    (0, 0, 1, "refuted"),
+])
+def test_by_timed_parts_is_undecided_when_the_open_parts_could_turn_it(
+        held, open_parts, parts, verdict):
+    assert by_timed_parts(held, open_parts, parts) == verdict
 
 
 def test_tied_at_its_tolerance():

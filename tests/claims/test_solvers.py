@@ -38,10 +38,11 @@ METHODS = ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4")
 HAIR = 1 + 1e-9        # a factor that moves a value just past a threshold
 
 
-def drag(difference, cost_ratio) -> DragComparison:
+def drag(difference, cost_ratio, cost_ratios=()) -> DragComparison:
     return DragComparison(terminal_speed=10.0, k_linear=0.981, k_quadratic=0.0981,
                           same_terminal_difference=difference, same_terminal_distance=10.0,
-                          same_k_difference=7.0, cost_ratio=cost_ratio)
+                          same_k_difference=7.0, cost_ratio=cost_ratio,
+                          cost_ratios=cost_ratios)
 
 
 ON_EDGE = DRAG_SIGNIFICANT_FRACTION * 10.0       # the largest insignificant difference
@@ -58,6 +59,21 @@ def test_c5_verdict_at_its_thresholds(difference, cost_ratio, verdict):
     assert result.verdict == verdict and result.timing
     assert result.facts["significant"] is (difference > ON_EDGE)
     assert result.facts["cost_ratio"] == cost_ratio
+
+
+@pytest.mark.parametrize(("cost_ratio", "repeats", "verdict", "side"), [
+    # 1.25 against repeats spread over 0.1: within the spread of 1.2
+    (1.25, (1.1, 1.15, 1.25, 1.25, 1.3), "undecided", "within spread"),
+    # the same ratio with repeats that agree to 0.02: an extra cost
+    (1.25, (1.23, 1.24, 1.25, 1.26, 1.27), "confirmed", "above"),
+    # 1.0 against the same spread of 0.1: clearly no extra cost
+    (1.0, (0.9, 0.95, 1.0, 1.05, 1.1), "partly", "below"),
+])
+def test_c5_cost_is_undecided_within_the_run_to_run_spread(cost_ratio, repeats, verdict,
+                                                           side):
+    result = c5(drag(ON_EDGE, cost_ratio, repeats))
+    assert result.verdict == verdict
+    assert result.facts["cost_against_threshold"]["side"] == side
 
 
 def jitter(method, h, gh2, drag=0.0) -> Jitter:

@@ -45,10 +45,30 @@ def test_every_claim_has_a_row_and_a_verdict(quick_report):
     for claim in CLAIMS:
         assert f'id="claim-{claim}"' in html
     for row in results["claims"]:
-        assert row["verdict"] in {"confirmed", "refuted", "partly", "not measured yet"}
+        assert row["verdict"] in {"confirmed", "refuted", "partly", "undecided",
+                                  "not measured yet"}
         if row["verdict"] != "not measured yet":
             assert row["measured"] and row["evidence"]
             assert f'id="{row["evidence"]}"' in html  # the evidence exists on the page
+
+
+#: Words of the project's own planning that have no place in the page's
+#: prose (a reader of the report knows no issue tracker, design notes or
+#: goals the project set itself).
+INTERNAL_WORDS = re.compile(r"\bissues?\b|\bDESIGN\b|DESIGN\.md|\btargets?\b", re.IGNORECASE)
+
+
+def _prose(html: str) -> str:
+    """The page's text as a reader sees it: no charts, style or markup."""
+    text = re.sub(r"<svg.*?</svg>|<style>.*?</style>", " ", html, flags=re.S)
+    return re.sub(r"<[^>]+>", " ", text)
+
+
+def test_the_prose_has_no_project_internal_words(quick_report):
+    _, html, _ = quick_report
+    prose = _prose(html)
+    assert "refsim accuracy report" in prose and "The seed's claims" in prose
+    assert INTERNAL_WORDS.findall(prose) == []
 
 
 def test_page_is_self_contained(quick_report):
@@ -160,7 +180,8 @@ def test_divergence_catalogue_rules():
     from refsim.report.section import Divergence, Section, Verdict
 
     a = Section("bounds", "A", verdicts=[Verdict("C1", "m1", "confirmed", "fig-a"),
-                                         Verdict("C2", "m2", "partly", "fig-b")],
+                                         Verdict("C2", "m2", "partly", "fig-b",
+                                                 summary="s2")],
                 divergences=[Divergence("oracle differs", "oracle disagreement: tolerance",
                                         "3 of 9", "tab-a")])
     b = Section("dynamics", "B", verdicts=[Verdict("C12", "m12", "confirmed", "fig-c"),
@@ -170,8 +191,12 @@ def test_divergence_catalogue_rules():
     assert titles == ["C2", "C11", "C12", "oracle differs"]
     kinds = {r["title"].split(":")[0]: r["kind"] for r in rows}
     assert kinds["C2"] == "seed claim partly" and kinds["C11"] == "seed claim refuted"
-    assert kinds["C12"].startswith("seed issue")
+    assert kinds["C12"] == "a problem the seed lists itself, confirmed"
     assert rows[0]["timing"] is False
+    # a claim's sentence is the finding, its numbers the details; without a
+    # sentence the numbers are the finding
+    assert (rows[0]["finding"], rows[0]["details"]) == ("s2", "m2")
+    assert (rows[1]["finding"], rows[1]["details"]) == ("m11", "")
     assert rows[-1] == {"section": "bounds", "title": "oracle differs",
                         "kind": "oracle disagreement: tolerance", "finding": "3 of 9",
-                        "evidence": "tab-a"}
+                        "evidence": "tab-a", "details": ""}

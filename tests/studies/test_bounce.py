@@ -130,13 +130,13 @@ def simulate():
 #: (DEVIATION D1) and RK4 integrates free fall (a quadratic in t) exactly, so
 #: the apex ratio equals e^2 up to rounding: a few ulps per step over a few
 #: thousand steps is far below 1e-9 relative. The report says "to rounding";
-#: this is that claim, not only the issue's 0.5% target.
+#: this is that claim, not only the 0.5% tolerance (APEX_RATIO_TARGET).
 ROUNDING_LEVEL = 1e-9
 
 
 @pytest.mark.parametrize("e", [0.5, 0.8, 0.9])
 def test_refsim_apex_ratio_meets_the_target(simulate, e):
-    """The issue's target: with RK4 at h = 1e-3, the mean apex ratio over the
+    """refsim's accuracy goal: with RK4 at h = 1e-3, the mean apex ratio over the
     first BOUNCES bounces is within APEX_RATIO_TARGET (0.5%) of e^2."""
     row = measure_apex_row(SPHERE, e, step=STEP, solver="rk4")
     print(f"refsim e={e}: apex ratio {row.refsim_ratio:.6f} (e^2 {e * e:.6f}), "

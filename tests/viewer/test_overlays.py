@@ -195,3 +195,31 @@ def test_quaternions_of_rotations():
     back = Rotation.from_quat(np.column_stack([q[:, 1:], q[:, 0]])).as_matrix()
     assert np.abs(back - matrices).max() < ROUND_TRIP_TOL * 10
     assert np.abs(np.linalg.norm(q, axis=1) - 1.0).max() < ROUND_TRIP_TOL * 10
+
+
+@pytest.mark.parametrize("direction", [(0.45, 0.5, 1.0), (0.12, 0.3, 1.0)])
+def test_a_panned_camera_shows_the_box_off_centre_away_from_the_panel(direction):
+    """pan > 0 (the live viewer's panel on the right) moves the camera and its
+    target along the screen's right: the box appears left of centre, by the
+    same view as without the pan; pan < 0 (a replay's panel on the left) the
+    other way."""
+    from types import SimpleNamespace
+
+    from refsim.viewer import draw
+
+    def placed(pan):
+        camera = SimpleNamespace()
+        draw.place_camera(camera, 4.0, 4.0, direction=direction, pan=pan)
+        return np.array(camera.position), np.array(camera.look_at)
+
+    position, target = placed(0.0)
+    assert np.array_equal(target, np.zeros(3))
+    forward = -position / np.linalg.norm(position)
+    right = np.cross(forward, (0.0, 1.0, 0.0))
+    right /= np.linalg.norm(right)
+    for pan in (draw.PANEL_PAN, -draw.PANEL_PAN):
+        moved_position, moved_target = placed(pan)
+        shift = moved_target - target
+        assert np.allclose(moved_position - position, shift)      # the same view, moved
+        assert np.allclose(shift, (shift @ right) * right)        # along the screen's right
+        assert np.sign(shift @ right) == np.sign(pan)             # the box the other way

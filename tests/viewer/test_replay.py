@@ -4,6 +4,7 @@ the runs' duration, the settings on the page, and one-line errors."""
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from refsim.viewer.replay import (
     frame_at,
     kept_frames,
     load_runs,
+    named_settings,
     read_recording,
     run_from_scene,
     timeline,
@@ -63,6 +65,19 @@ def test_side_by_side_replay(spin_runs, tmp_path):
     for shown in ("seed", "impulse", "rk4", "spinning-cube.toml", "side by side"):
         assert shown in text
     assert "wrote" in info.summary() and "stride 1" in info.summary()
+    # the panel names the settings in words: no snake_case key is shown
+    panel = text.split('<div id="refsim-replay">', 1)[1]
+    keys = re.findall(r"<tr><td>([^<]*)</td>", panel)
+    assert "body response" in keys and "collision level" in keys and "box update" in keys
+    assert not [k for k in keys if "_" in k]
+
+
+def test_settings_are_named_in_words_in_a_fixed_order():
+    settings = {"wall_speed": "wall", "aabb": "auto", "solver": "rk4", "zeta_extra": 1,
+                "body_response": "seed", "scene_toml": "[world]", "scene": "a.toml"}
+    assert named_settings(settings) == [
+        ("scene", "a.toml"), ("solver", "rk4"), ("body response", "seed"),
+        ("box update", "auto"), ("wall speed", "wall"), ("zeta extra", 1)]
 
 
 def test_a_tight_budget_widens_the_stride(spin_runs, tmp_path):

@@ -218,6 +218,18 @@ def test_particles_are_a_point_cloud():
         v.show_frame(run.n_frames - 1)
         assert np.allclose(v.points.points, run.particles.position[-1], atol=1e-2)
         assert v.controls["rotation"].disabled and not v.controls["solver"].disabled
+        # no energy for particles: neither the chart nor an empty box for it
+        assert not v.energy_folder.visible and v.show_energy.disabled
+
+
+def test_bodies_have_their_energy_chart_and_its_checkbox_hides_it(viewer):
+    assert viewer.energy_folder.visible and viewer.show_energy.value
+    viewer.show_energy.value = False
+    try:
+        assert not viewer.energy_folder.visible
+    finally:
+        viewer.show_energy.value = True
+    assert viewer.energy_folder.visible
 
 
 def test_overlays_at_a_contact_and_at_a_wall_hit():

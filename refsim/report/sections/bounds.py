@@ -9,6 +9,7 @@ from __future__ import annotations
 from refsim.report.charts import Series, line_chart
 from refsim.report.plan import command
 from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Timing, Verdict
+from refsim.report.words import against_spread, listing
 
 STYLES = {"scan-numpy": "s--", "scan-numba": "s-", "incremental-python": "o--",
           "incremental-numba": "o-"}
@@ -170,16 +171,33 @@ def _c1_verdict(c1) -> Verdict:
     below = f["ratios_below_crossover"]
     band = (f"{min(below):.2f}x to {max(below):.2f}x" if below else "no smaller size")
     at_large = f["ratio_at_large_model"]
+    crossover = f["compiled_crossover"]
     sentence = (f"Compiled kernels (the seed's setting): the incremental update is faster "
-                f"than the scan from {f['compiled_crossover']} triangles on"
+                f"than the scan from {crossover} triangles on"
                 + (f" ({at_large:.2f}x at {f['large_model']})" if at_large else "")
                 + f"; below that the scan/incremental time ratio is {band} "
-                f"({'within' if f['equal_below_crossover'] else 'outside'} the factor-of-two "
-                f"band of 'nearly equal'). Readable Python against numpy's scan: faster only "
-                f"from {f['interpreted_crossover']} triangles, because each vertex the walk "
-                "visits costs interpreter time.")
+                f"(the factor-of-two band of 'nearly equal': {f['equal_part']}). Readable "
+                f"Python against numpy's scan: faster only from {f['interpreted_crossover']} "
+                "triangles, because each vertex the walk visits costs interpreter time. "
+                "Each ratio against its threshold, with the interquartile range of its "
+                "repeats: "
+                + "; ".join(f"{n} triangles {against_spread(c)}"
+                            for n, c in f["against_parity"].items())
+                + ".")
+    if c1.verdict == "undecided":
+        summary = ("Too close to call in this run: at "
+                   + listing([str(n) for n in sorted(f["open"])])
+                   + " triangles the time ratio lies within its run-to-run spread of its "
+                     "threshold.")
+    elif crossover is None:
+        summary = "Compiled, the incremental update is never faster than the scan."
+    else:
+        summary = (f"Compiled, the incremental update is faster from {crossover} triangles "
+                   "on; " + ("below that the two cost about the same."
+                             if f["equal_below_crossover"] else
+                             "below that the two do not cost about the same."))
     return Verdict("C1", sentence, c1.verdict, "bounds-cost-coherent", C1_COMMAND,
-                   timing=c1.timing)
+                   timing=c1.timing, summary=summary)
 
 
 def _c2_verdict(c2) -> Verdict:
@@ -189,4 +207,12 @@ def _c2_verdict(c2) -> Verdict:
                 f"{', '.join(f['nonconvex_never_wrong']) or 'none'}.")
     if f["sufficient_not_necessary"]:
         sentence += " Convexity is sufficient but not necessary."
-    return Verdict("C2", sentence, c2.verdict, "bounds-c2", C2_COMMAND, timing=c2.timing)
+    wrong, never = f["nonconvex_wrong"], f["nonconvex_never_wrong"]
+    if f["convex_wrong_frames"]:
+        summary = "The incremental box is wrong even on convex meshes."
+    else:
+        summary = (f"Never wrong on convex meshes; wrong on {len(wrong)} of "
+                   f"{len(wrong) + len(never)} non-convex ones"
+                   + (", so convexity is sufficient, not necessary." if never else "."))
+    return Verdict("C2", sentence, c2.verdict, "bounds-c2", C2_COMMAND, timing=c2.timing,
+                   summary=summary)

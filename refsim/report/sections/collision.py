@@ -24,6 +24,7 @@ from refsim.report.section import (
     Verdict,
     fields_of,
 )
+from refsim.report.words import against_spread
 
 LEVELS_COMMAND = command("collision-levels")
 BODY_ORACLES_COMMAND = command("collision-body-oracles")
@@ -286,7 +287,12 @@ def _c3_verdict(c3) -> Verdict:
     text += (" Median time per boolean query: "
              + ", ".join(f"{lv} {median[lv] * 1e6:.0f} us" for lv in levels)
              + (": each coarser level is no slower" if f["speed_ordered"] else
-                ": some coarser level is slower than a finer one")
+                ": too close to call whether each coarser level is faster"
+                if f["speed_open"] else ": some coarser level is slower than a finer one")
+             + " (coarser / finer time ratio against 1, with the interquartile range of "
+               "its repeats: "
+             + "; ".join(f"{pair} {against_spread(c)}"
+                         for pair, c in f["speed_against_parity"].items()) + ")"
              + f"; exact costs {f['exact_over_box']:.2g}x the "
              f"{levels[1]} level and {f['exact_over_coarsest']:.2g}x the "
              f"{levels[0]} level.")
@@ -305,9 +311,18 @@ def _c3_verdict(c3) -> Verdict:
     else:
         text += (f" On the constructed configurations the {coarse} level says 'collide' "
                  f"wherever the {box} level does.")
+    accuracy = ("no level misses a contact" if f["conservative"] else
+                f"levels miss {f['false_negatives']} contacts")
+    accuracy += (" and false positives fall at each finer level"
+                 if f["false_positives_ordered"] else
+                 ", but a finer level has more false positives than a coarser one")
+    speed = ("each coarser level is faster" if f["speed_ordered"] else
+             "whether each coarser level is faster is within the timings' spread"
+             if f["speed_open"] else "coarser levels are not always faster")
+    summary = accuracy[0].upper() + accuracy[1:] + "; " + speed + "."
     return Verdict(claim="C3", measured=text, verdict=c3.verdict,
                    evidence="collision-levels-tradeoff", command=LEVELS_COMMAND,
-                   timing=c3.timing)
+                   timing=c3.timing, summary=summary)
 
 
 def _speed_findings(found: dict) -> str:
@@ -418,5 +433,14 @@ def _c4_verdict(c4) -> Verdict:
         measured += f" Exact contacts go wrong from {f['touching_worst']:g} rad."
     else:
         measured += " Exact contacts never went wrong."
+    if worst is None:
+        planes = "Near-parallel planes never made the float test wrong"
+    elif f["at_rounding"]:
+        planes = "Near-parallel planes are harmless until the tilt is at rounding level"
+    else:
+        planes = f"Near-parallel planes make the float test wrong from {worst:g} rad"
+    contacts = ("; exact contacts never went wrong." if f["touching_worst"] is None else
+                "; but triangles that touch exactly break the float test.")
     return Verdict(claim="C4", measured=measured, verdict=c4.verdict,
-                   evidence="collision-c4-sweep", command=C4_COMMAND, timing=c4.timing)
+                   evidence="collision-c4-sweep", command=C4_COMMAND, timing=c4.timing,
+                   summary=planes + contacts)

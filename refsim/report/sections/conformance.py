@@ -16,33 +16,60 @@ arranges it.
 from __future__ import annotations
 
 from refsim.report.plan import command
-from refsim.report.section import Agreement, Divergence, Section, Table, Timing
+from refsim.report.section import Agreement, Cell, Divergence, Section, Table, Timing
 
 #: Column headings of the shipped engines (the engines' own names otherwise).
 ENGINE_TITLES = {"refsim-seed": "refsim seed", "refsim-corrected": "refsim corrected",
                  "fcl": "FCL", "trimesh": "trimesh", "pybullet": "pybullet",
                  "mujoco": "MuJoCo"}
 
-#: What a cell says for each status (the count follows).
-STATUS_WORDS = {"passed": "pass", "failed": "FAIL", "xfailed": "expected fail",
-                "xpassed": "unexpected pass", "n/a": "n/a"}
+#: Each status in the engine summaries of the page's agreement table ("12
+#: pass; 5 fail as declared").
+STATUS_WORDS = {"passed": "pass", "failed": "FAIL", "xfailed": "fail as declared",
+                "xpassed": "pass though declared to fail", "n/a": "not run"}
+
+#: The colour of a cell by the check's status, and the legend under the
+#: matrix: (colour, what it means). A cell without the capability is "none".
+CELL_COLOURS = {"passed": "pass", "xfailed": "declared", "failed": "fail",
+                "xpassed": "declared", "n/a": "none"}
+LEGEND = (("pass", "passes every case"),
+          ("declared", "fails as the engine declares (a known divergence)"),
+          ("fail", "fails, not declared"),
+          ("none", "not run: the engine lacks the capability, or the check has no case"))
 
 #: A cell of an engine without the check's capability.
-NO_CAPABILITY = "-"
+NO_CAPABILITY = "not run"
 
 
 def _classes(classes: dict) -> str:
     return ", ".join(f"{name} {count}" for name, count in classes.items())
 
 
+def _plural(n: int, word: str) -> str:
+    return f"{n} {word}" + ("" if n == 1 else "s")
+
+
 def cell_text(cell) -> str:
-    """One cell: the status, passed/cases, and the failing cases by class."""
+    """One cell in words: what passed or failed of how many cases, the
+    failing cases by class."""
     if cell is None:
         return NO_CAPABILITY
+    classes = f" ({_classes(cell.classes)})" if cell.classes else ""
     if cell.status == "n/a":
-        return STATUS_WORDS["n/a"]
-    text = f"{STATUS_WORDS.get(cell.status, cell.status)} {cell.passed}/{cell.cases}"
-    return text + (f" ({_classes(cell.classes)})" if cell.classes else "")
+        return "not run (no case)"
+    if cell.status == "passed":
+        return f"pass: {_plural(cell.cases, 'case')}"
+    if cell.status == "xfailed":
+        return (f"{cell.failed} of {_plural(cell.cases, 'case')} fail"
+                + ("s" if cell.failed == 1 else "") + f" as declared{classes}")
+    if cell.status == "xpassed":
+        return f"pass: {_plural(cell.cases, 'case')}, though declared to fail"
+    return f"FAIL: {cell.failed} of {_plural(cell.cases, 'case')}{classes}"
+
+
+def matrix_cell(cell) -> Cell:
+    """One cell as the matrix shows it: its words in its status's colour."""
+    return Cell(cell_text(cell), "none" if cell is None else CELL_COLOURS[cell.status])
 
 
 def build(ctx) -> Section:
@@ -55,15 +82,15 @@ def build(ctx) -> Section:
         id="conformance-matrix", title="The conformance matrix: checks against engines",
         columns=("check", *(title[e] for e in matrix.engines)),
         column_links=("", *links),
-        rows=tuple((check, *(cell_text(matrix.cell(check, e)) for e in matrix.engines))
+        rows=tuple((check, *(matrix_cell(matrix.cell(check, e)) for e in matrix.engines))
                    for check in matrix.checks),
-        caption=(f"Each cell: the check's status and the cases that passed of those run "
-                 f"({matrix.cases} per generated set: triangle pairs, mesh poses, boxes; "
-                 "the ODE problems and rigid-body scenes are fixed sets), the failing cases "
-                 "by class in brackets. \"expected fail\": a divergence the engine declares "
+        legend=LEGEND,
+        caption=(f"Each cell: how many of the check's cases pass or fail ({matrix.cases} per "
+                 "generated set: triangle pairs, mesh poses, boxes; the ODE problems and "
+                 "rigid-body scenes are fixed sets), the failing cases by class in brackets. "
+                 "\"as declared\": a divergence the engine declares "
                  "(refsim/conformance/expected/<engine>.txt), listed in the divergence "
-                 f"catalogue with its reason; \"{NO_CAPABILITY}\": the engine lacks the "
-                 "capability. Each engine's heading links to its own page "
+                 "catalogue with its reason. Each engine's heading links to its own page "
                  + (f"({record.folder}/<engine>/index.html, with conformance.json and the "
                     f"minimal failing examples; the matrix alone: {record.folder}/index.html)"
                     if record.folder else "(not written: no output directory)")
@@ -74,8 +101,8 @@ def build(ctx) -> Section:
         columns=("engine", "why"),
         rows=tuple((ENGINE_TITLES.get(name, name), reason)
                    for name, reason in matrix.unavailable.items()),
-        caption=("Their columns are left out of the matrix above."
-                 if matrix.unavailable else "None: every shipped engine ran."))
+        caption="Their columns are left out of the matrix above.",
+        empty="None: every shipped engine ran.")
     agreements = [Agreement(
         title[e], f"conformance kit: {sum(matrix.status_counts(e).values())} checks",
         "; ".join(f"{count} {STATUS_WORDS[status]}"

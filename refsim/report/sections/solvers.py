@@ -29,6 +29,7 @@ from refsim.claims.solvers import oracle_agreement
 from refsim.report.charts import Series, contour_chart, line_chart
 from refsim.report.plan import claim_command, command
 from refsim.report.section import Agreement, Figure, Section, Table, Verdict
+from refsim.report.words import against_spread, listing
 
 METHODS = ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4")
 SCIPY = ("scipy-RK45", "scipy-DOP853")
@@ -491,7 +492,11 @@ def _c10(result, failing) -> Verdict:
                    + ("; the others match." if right else ".")) if wrong
             else "all as stated.")),
         verdict=result.verdict, evidence="solvers-orders", command=claim_command("C10"),
-        timing=result.timing)
+        timing=result.timing,
+        summary=("; ".join(f"{w[0].upper()}{w[1:]} is order {f['derived_order'][w]}, not "
+                           f"{f['stated_order'][w]} as stated" for w in wrong)
+                 + ("; the others match." if right else ".") if wrong
+                 else "Every solver has the order the seed states."))
 
 
 def _c6(result) -> Verdict:
@@ -518,7 +523,11 @@ def _c6(result) -> Verdict:
                   + ", ".join(f"{v:.3g} g h^2 for {k}" for k, v in f["others_hop_gh2"].items())
                   + " (Euler gains g^2 h^2/2 of energy a step in flight)." + scaling),
         verdict=result.verdict, evidence="solvers-jitter", command=claim_command("C6"),
-        timing=result.timing)
+        timing=result.timing,
+        summary=(f"At rest on the floor Euler hops {f['euler_hop_gh2']:.3g} g h^2, "
+                 + ("far more than" if result.verdict == "confirmed" else "not far more than")
+                 + " the other solvers"
+                 + (" (a bounded jitter that shrinks as h^2)." if f["scales_as_h2"] else ".")))
 
 
 def _c7(result) -> Verdict:
@@ -544,7 +553,18 @@ def _c7(result) -> Verdict:
                       r="agree" if f["agree"]["resting hop"] else "differ",
                       otol=f["order_tol"], rtol=f["rtol"], pairs=pairs_text),
         verdict=result.verdict, evidence="solvers-stability", command=claim_command("C7"),
-        timing=result.timing)
+        timing=result.timing, summary=_c7_summary(f["agree"]))
+
+
+def _c7_summary(agree: dict) -> str:
+    """C7 in a sentence: in which respects the four solvers agree."""
+    same = [k for k, v in agree.items() if v]
+    differ = [k for k, v in agree.items() if not v]
+    if not differ:
+        return "The four solvers agree in order, stability and resting hop."
+    return (f"The four solvers differ in {listing(differ)}"
+            + (f"; they agree in {listing(same)}." if same else "."))
+
 
 
 def _c8(result, m) -> Verdict:
@@ -583,7 +603,12 @@ def _c8(result, m) -> Verdict:
                   + ("yes" if f["rk4_better_free"] else "no") + " without walls, "
                   + ("yes" if f["rk4_better_walls"] else "no") + " with walls."),
         verdict=result.verdict, evidence="solvers-c8", command=claim_command("C8"),
-        timing=result.timing)
+        timing=result.timing,
+        summary=("RK4 is " + ("" if f["rk4_better_free"] else "not ")
+                 + "better than the other solvers at equal cost without walls, and "
+                 + ("" if f["rk4_better_walls"] else "not ") + "with walls"
+                 + (" (where every method is first order)." if f["walls_first_order"]
+                    else ".")))
 
 
 #: C9's words for how backwards-euler's order compares with its peers'.
@@ -625,7 +650,15 @@ def _c9(result, m) -> Verdict:
                   + ("yes" if f["best_free"] else "no") + " without walls, "
                   + ("yes" if f["best_walls"] else "no") + " with walls."),
         verdict=result.verdict, evidence="solvers-c9", command=claim_command("C9"),
-        timing=result.timing)
+        timing=result.timing,
+        summary=(f"Backwards Euler is order {f['order']}, "
+                 f"{ORDER_RELATION[f['order_relation']]} the methods of its cost, and "
+                 + {(True, True): "best or tied-best on accuracy per cost with and without "
+                                  "walls.",
+                    (True, False): "best or tied-best on accuracy per cost only without walls.",
+                    (False, True): "best or tied-best on accuracy per cost only with walls.",
+                    (False, False): "not the best on accuracy per cost, with or without "
+                                    "walls."}[(f["best_free"], f["best_walls"])]))
 
 
 def _c5(result) -> Verdict:
@@ -644,9 +677,16 @@ def _c5(result) -> Verdict:
                     "long as a linear one in this run: "
                   + ("more" if extra else "not more")
                   + f" than {f['extra_cost_ratio']:g} times, "
-                  + ("an extra cost." if extra else "no extra cost.")),
+                  + ("an extra cost" if extra else "no extra cost")
+                  + f" (per-repeat ratios: {against_spread(f['cost_against_threshold'])})."),
         verdict=result.verdict, evidence="solvers-drag", command=claim_command("C5"),
-        timing=result.timing)
+        timing=result.timing,
+        summary=("Quadratic drag changes the path by "
+                 + ("more" if significant else "less")
+                 + f" than {f['significant_fraction']:.0%} of the distance travelled, at "
+                 + ("a step cost too close to call against the threshold in this run."
+                    if f["cost_against_threshold"]["side"] == "within spread" else
+                    f"{f['cost_ratio']:.2g} times the cost of a linear-drag step.")))
 
 
 def _verdicts(m) -> list[Verdict]:
