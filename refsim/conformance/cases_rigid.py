@@ -467,6 +467,16 @@ def read_trajectory(trajectory, scene: RigidScene) -> SimpleNamespace:
     return SimpleNamespace(**read)
 
 
+def with_step(scene: RigidScene, step: float) -> RigidScene:
+    """``scene`` at time step ``step`` (s), its duration covered by whole steps."""
+    from refsim.solvers.integrate import covering_duration
+
+    integration = scene.scene.integration
+    integration = replace(integration, step=step,
+                          duration=covering_duration(integration.duration, step))
+    return replace(scene, scene=replace(scene.scene, integration=integration))
+
+
 def rigid_cases(seed: int = 0) -> RigidCases:
     return RigidCases(scenes=rigid_scenes(), seed=seed)
 

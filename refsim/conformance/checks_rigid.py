@@ -109,6 +109,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -560,3 +562,69 @@ def check_rigid_stack(engine, cases) -> CheckResult:
                              "tolerance_metres": STACK_TRAVEL, **scene.to_dict()})
     return tally("rigid", "stack", outcomes, examples=examples, measured=measured,
                  seconds=time.perf_counter() - start)
+
+
+# -- the textbook problems, as the report shows them ----------------------------------
+
+
+@dataclass(frozen=True)
+class TextbookProblem:
+    """How one rigid check reads as a textbook problem: what it poses, the
+    unit of its error, and, from the check's ``measured`` (scene -> facts),
+    the error against the closed form and the check's tolerance for it,
+    each the worst over the check's scenes."""
+
+    check: str
+    problem: str
+    unit: str
+    error: Callable[[dict], float]
+    tolerance: Callable[[dict], float]
+
+
+def _worst(measured: dict, value: Callable[[dict], float]) -> float:
+    values = [value(m) for m in measured.values()]
+    return max(values) if values else math.nan
+
+
+def _oblique_error(m: dict) -> float:
+    return abs(m["lateral_velocity"] - m["coulomb"])
+
+
+def _free_error(m: dict) -> float:
+    if m["flips"] != m["closed_form_flips"]:
+        return math.inf
+    return max(m["energy_drift"], m["momentum_drift"])
+
+
+#: The rigid checks that pose a problem with a closed-form answer, in the
+#: order the report lists them.
+TEXTBOOK_PROBLEMS = (
+    TextbookProblem("rigid.apex_ratio", "drops: apex ratio e^2 over three bounces",
+                    "relative error",
+                    lambda m: _worst(m, lambda s: abs(s["relative_error"])),
+                    lambda m: _worst(m, lambda s: s["tolerance"])),
+    TextbookProblem("rigid.no_spin", "symmetric frictionless landings: no spin",
+                    "surface speed / impact speed",
+                    lambda m: _worst(m, lambda s: s["surface_speed_fraction"]),
+                    lambda m: NO_SPIN_FRACTION),
+    TextbookProblem("rigid.oblique_bounce",
+                    "oblique impacts, Coulomb friction over the impact (five regimes)",
+                    "lateral velocity error, m/s", lambda m: _worst(m, _oblique_error),
+                    lambda m: min((s["tolerance"] for s in m.values()), default=math.nan)),
+    TextbookProblem("rigid.spin_to_rest", "a cube spinning flat stops under friction",
+                    "spin left after the limit, rad/s",
+                    lambda m: _worst(m, lambda s: s["largest_spin_after_limit"]),
+                    lambda m: SPIN_REST_FRACTION * R.SPIN),
+    TextbookProblem("rigid.free_rotation",
+                    "torque-free brick near its middle axis: flips, energy, momentum",
+                    "relative drift (inf: wrong flips)", lambda m: _worst(m, _free_error),
+                    lambda m: FREE_ENERGY_TOL),
+    TextbookProblem("rigid.off_centre", "a ball striking a free rod off its centre",
+                    "largest miss / closing speed",
+                    lambda m: _worst(m, lambda s: s["largest_miss_of_closing_speed"]),
+                    lambda m: OFF_CENTRE_TOL),
+    TextbookProblem("rigid.stack", "stable stacks and a cantilever stay put",
+                    "largest vertex travel, m",
+                    lambda m: _worst(m, lambda s: s["largest_vertex_travel_metres"]),
+                    lambda m: STACK_TRAVEL),
+)

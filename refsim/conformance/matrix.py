@@ -32,6 +32,8 @@ class Cell:
     passed: int
     failed: int
     classes: dict
+    #: What the check measured per case or scene (CheckResult.measured).
+    measured: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -126,7 +128,7 @@ def conformance_matrix(results, pages: dict | None = None, unavailable: dict | N
     for result in results:
         for c in result.checks:
             cells[(c.key, result.engine)] = Cell(c.status, c.cases, c.passed, c.failed,
-                                                 dict(c.classes))
+                                                 dict(c.classes), dict(c.measured))
             if c.status in ("failed", "xfailed"):
                 divergences.append(Divergence(
                     engine=result.engine, check=c.key, status=c.status, classes=dict(c.classes),

@@ -94,6 +94,7 @@ import numba
 import numpy as np
 
 from refsim.bounds._numba_kernels import incremental_update_numba
+from refsim.collision.contact import DEEPEST_FRACTION
 from refsim.dynamics.impulse import solve_contacts_python
 from refsim.dynamics.rotation_impulse import free_rotation_step
 from refsim.dynamics.rotation_seed import axes_step_seed
@@ -101,7 +102,7 @@ from refsim.dynamics.rotation_seed import axes_step_seed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "011f6c394f2eb447"
+SOURCES_DIGEST = "0b4ae99efd9a62f4"
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -620,6 +621,32 @@ def _vertices_past_wall(b, k, low, wall, o_k, R, vertices_t, leaf_order, leaf_st
 
 
 @numba.njit(cache=True, nogil=True)
+def _deepest(b, k, low, wall, o_k, R, vertices_t, past, count):
+    """Mirrors the depth filter of
+    :func:`refsim.dynamics.rotation_impulse.wall_contacts`: of the ``count``
+    vertices in ``past`` (past the wall, in increasing order), those at
+    least DEEPEST_FRACTION of the deepest one's depth past it, kept in order
+    at the front of ``past``; returns how many."""
+    a0, a1, a2 = R[b, k, 0], R[b, k, 1], R[b, k, 2]
+    deepest = 0.0
+    for i in range(count):
+        q = past[i]
+        W_k = ((a0 * vertices_t[0, q] + a1 * vertices_t[1, q]) + a2 * vertices_t[2, q]) + o_k
+        depth = wall - W_k if low else W_k - wall
+        if i == 0 or depth > deepest:
+            deepest = depth
+    kept = 0
+    for i in range(count):
+        q = past[i]
+        W_k = ((a0 * vertices_t[0, q] + a1 * vertices_t[1, q]) + a2 * vertices_t[2, q]) + o_k
+        depth = wall - W_k if low else W_k - wall
+        if depth >= DEEPEST_FRACTION * deepest:
+            past[kept] = q
+            kept += 1
+    return kept
+
+
+@numba.njit(cache=True, nogil=True)
 def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, first_leaf, x,
                   center, v, w, R, half_size, gravity, restitution, friction, threshold,
                   iterations, inv_mass, I_inv, past, r_a, P, n):
@@ -639,6 +666,7 @@ def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, fir
         o = _origin(b, x, R, center)
         count = _vertices_past_wall(b, k, low, wall, o[k], R, vertices_t, leaf_order,
                                     leaf_start, leaf_spheres, first_leaf, past)
+        count = _deepest(b, k, low, wall, o[k], R, vertices_t, past, count)
         for i in range(count):
             q = past[i]
             for j in range(3):

@@ -86,6 +86,7 @@ from refsim.dynamics.mass_properties import body_mass_properties, inertia_proble
 from refsim.dynamics.products import matvec
 from refsim.dynamics.rotation_impulse import (
     free_rotation_steps,
+    past_wall,
     principal_frame,
     wall_contacts,
     world_inertia,
@@ -636,7 +637,8 @@ class Simulation:
             low = correction[k] > 0.0
             W = self.world_vertices(i)
             r_a = W[wall_contacts(W, k, -H if low else H, low)] - self.x[i]
-            self._wall_contacts[i, k, low] = r_a          # for a body contact's solve
+            # every vertex past the wall supports the body in a body contact's solve
+            self._wall_contacts[i, k, low] = W[past_wall(W, k, -H if low else H, low)] - self.x[i]
             self.x[i, k] += correction[k]                   # no interpenetration persists
             # DEVIATION (D6): the speed at the wall (energy of the push-back, as in S7), but
             # only for a real bounce: in resting contact this torque-free change

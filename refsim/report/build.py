@@ -57,6 +57,10 @@ AREAS: tuple[tuple[str, str, str], ...] = (
     ("conformance", "Engines side by side: the conformance kit",
      "The six shipped engines (refsim's seed and corrected models, python-fcl, trimesh, "
      "pybullet, MuJoCo) through the same checks against exact answers."),
+    ("textbook", "Textbook mechanics",
+     "Problems with closed-form answers (drops, oblique impacts with friction, a spin "
+     "stopped by friction, torque-free rotation, an off-centre strike, resting stacks) "
+     "on every rigid-body engine, and refsim's error as the step shrinks."),
     ("advisor", "Model no more than a scene needs: the fidelity advisor",
      "The cheapest solver, step, collision level and box update within TOL of a reference "
      "run, for each bundled scene, and how the answer moves with TOL."),

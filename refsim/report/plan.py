@@ -951,6 +951,50 @@ def _conformance_matrix(run: Run):
                      f"refsim conform --all --cases {cases} --seed {run.seed} -o DIR")
 
 
+# -- textbook problems: refsim's corrected model as the step shrinks ------------------------
+
+#: The steps (s) of the convergence table: quick, full.
+TEXTBOOK_STEPS = ((2e-3, 1e-3), (2e-3, 1e-3, 5e-4))
+
+#: The problems a quick run follows in h (a full run: every one of
+#: refsim.conformance.checks_rigid.TEXTBOOK_PROBLEMS): the cheap ones.
+TEXTBOOK_QUICK = ("rigid.oblique_bounce", "rigid.free_rotation", "rigid.off_centre")
+
+
+@dataclass(frozen=True)
+class TextbookConvergence:
+    """refsim's corrected model on the kit's textbook problems at each step:
+    ``errors[check]`` the error against the closed form at each of
+    ``steps`` (in the problem's unit), and the check's tolerance at the
+    kit's step."""
+
+    steps: tuple
+    errors: dict
+    tolerances: dict
+
+
+def _textbook_convergence(run: Run):
+    from refsim.conformance import cases_rigid as R
+    from refsim.conformance.checks_rigid import TEXTBOOK_PROBLEMS
+    from refsim.conformance.registry import check_by_key
+    from refsim.engines import load_engine
+
+    engine = load_engine("refsim.engines.refsim_engines:corrected")
+    steps = tuple(run.size(*TEXTBOOK_STEPS))
+    problems = [p for p in TEXTBOOK_PROBLEMS if not run.quick or p.check in TEXTBOOK_QUICK]
+    scenes = R.rigid_scenes()
+    errors: dict = {p.check: [] for p in problems}
+    tolerances: dict = {}
+    for h in steps:
+        cases = R.RigidCases(scenes=tuple(R.with_step(s, h) for s in scenes))
+        for p in problems:
+            measured = check_by_key(p.check).run(engine, cases).measured
+            errors[p.check].append(p.error(measured))
+            if h == R.STEP:
+                tolerances[p.check] = p.tolerance(measured)
+    return TextbookConvergence(steps, errors, tolerances)
+
+
 # -- replays (the viewer's demos) -------------------------------------------------------------
 
 #: Where the replays go, inside the report's directory.
@@ -1182,6 +1226,9 @@ def _entries() -> dict[str, Study]:
         Study("sweep-speed", "sweep: speed of each backend", _sweep_speed, in_report=False),
         Study("conformance-matrix", "conformance: the shipped engines side by side",
               _conformance_matrix),
+        Study("textbook-convergence",
+              "textbook problems: refsim's corrected model as the step shrinks",
+              _textbook_convergence),
         Study("replays", "replays: C11, C12 and wall bounces", _replays),
         Study("advisor", "advisor: every bundled scene at each tolerance", _advisor),
     )

@@ -524,5 +524,8 @@ def test_impulse_sphere_rolling_on_the_floor_bit_for_bit(monkeypatch):
         sim.run(400, every=7)
     _assert_same(readable, compiled)
     assert compiled.loop_steps == SETTLE_STEPS["sphere"] + 400
-    assert len(contacts) >= 390 and max(contacts) >= 2          # touching nearly every step
+    # touching nearly every step, at the deepest of the vertices past the
+    # floor only (rotation_impulse.wall_contacts: the others, at less than
+    # half its depth, crossed later in the step)
+    assert len(contacts) >= 390 and max(contacts) == 1
     assert np.abs(compiled.w).max() > 0.05                        # rolling, not at rest
