@@ -101,7 +101,7 @@ from refsim.dynamics.rotation_seed import axes_step_seed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "ec1cfc7d0b35f4a9"
+SOURCES_DIGEST = "4ec39905e8a24f06"
 
 #: The kernel took every step it was asked for.
 DONE = 0
