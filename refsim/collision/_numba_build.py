@@ -80,24 +80,21 @@ INSERTION_RUN = 24
 
 @numba.njit(cache=True)
 def axes_scratch(n):
-    """What :func:`covariance` works in, for up to n points: ``(sx, sy, sz)``
-    (n,) the points times 2**-e, ``acc`` (6, 8) numpy's eight partial sums
-    of the six covariance entries, ``frames`` and ``values`` the stacks of
-    :func:`pairwise_products`."""
-    return (np.empty(n), np.empty(n), np.empty(n), np.empty((6, 8)),
-            np.empty((PAIRWISE_STACK, 3), dtype=np.int64), np.empty((PAIRWISE_STACK, 6)))
+    """What :func:`covariance` works in, for up to n points: (3, n), the
+    points times 2**-e."""
+    return np.empty((3, max(n, 1)))
 
 
 @numba.njit(cache=True)
 def split_scratch(m):
-    """What a split works in, for m triangles: ``(x, y, z)`` (3m,) a set of
-    points, ``keys`` (3, m) the triangles' centroids along three axes and
+    """What a split works in, for m triangles: ``(x, y, z)`` (9m,) sets of
+    points (the six candidate halves' at once), ``keys`` (3, m) the triangles' centroids along three axes and
     ``ranked`` (3, m) their ranks along each, ``bucket`` (m,) and ``counts``
     (m + 1,) int64, and for the six candidate halves (the first and second
     of each axis, and the node itself last) their covariance matrices
     ``a``, rotations ``v``, ``done`` flags and principal ``axes`` (7, 3, 3)."""
     m = max(m, 1)
-    return (np.empty(3 * m), np.empty(3 * m), np.empty(3 * m), np.empty((3, m)),
+    return (np.empty(9 * m), np.empty(9 * m), np.empty(9 * m), np.empty((3, m)),
             np.empty((3, m), dtype=np.int64), np.empty(m, dtype=np.int64),
             np.empty(m + 1, dtype=np.int64), np.empty((7, 3, 3)), np.empty((7, 3, 3)),
             np.empty(7, dtype=np.bool_), np.empty((7, 3, 3)))
@@ -123,77 +120,60 @@ def unit_exponent(largest):
     return math.frexp(largest)[1]
 
 
-@numba.njit(cache=True, inline="always")
-def combine(r0, r1, r2, r3, r4, r5, r6, r7):
-    """numpy's eight partial sums added as numpy adds them."""
-    return ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
-
-
-@numba.njit(cache=True, inline="always")
-def block_products(sx, sy, sz, lo, n, m0, m1, m2, acc):
+@numba.njit(cache=True)
+def block_sum(u, v, lo, n, mu, mv):
     """numpy's pairwise sum of at most PAIRWISE_BLOCK terms (module
-    docstring) of each of the six products of the centred coordinates
-    (``x - m0`` and so on) of points ``lo..lo+n``: ``(xx, xy, xz, yy, yz,
-    zz)``. ``acc`` (6, 8) is scratch."""
-    s0 = s1 = s2 = s3 = s4 = s5 = 0.0
-    end = lo
-    if n >= 8:
-        for i in range(8):
-            c0, c1, c2 = sx[lo + i] - m0, sy[lo + i] - m1, sz[lo + i] - m2
-            acc[0, i], acc[1, i], acc[2, i] = c0 * c0, c0 * c1, c0 * c2
-            acc[3, i], acc[4, i], acc[5, i] = c1 * c1, c1 * c2, c2 * c2
-        end = lo + n - n % 8
-        for base in range(lo + 8, end, 8):
-            for i in range(8):
-                r = base + i
-                c0, c1, c2 = sx[r] - m0, sy[r] - m1, sz[r] - m2
-                acc[0, i] += c0 * c0
-                acc[1, i] += c0 * c1
-                acc[2, i] += c0 * c2
-                acc[3, i] += c1 * c1
-                acc[4, i] += c1 * c2
-                acc[5, i] += c2 * c2
-        s0 = combine(acc[0, 0], acc[0, 1], acc[0, 2], acc[0, 3], acc[0, 4], acc[0, 5],
-                     acc[0, 6], acc[0, 7])
-        s1 = combine(acc[1, 0], acc[1, 1], acc[1, 2], acc[1, 3], acc[1, 4], acc[1, 5],
-                     acc[1, 6], acc[1, 7])
-        s2 = combine(acc[2, 0], acc[2, 1], acc[2, 2], acc[2, 3], acc[2, 4], acc[2, 5],
-                     acc[2, 6], acc[2, 7])
-        s3 = combine(acc[3, 0], acc[3, 1], acc[3, 2], acc[3, 3], acc[3, 4], acc[3, 5],
-                     acc[3, 6], acc[3, 7])
-        s4 = combine(acc[4, 0], acc[4, 1], acc[4, 2], acc[4, 3], acc[4, 4], acc[4, 5],
-                     acc[4, 6], acc[4, 7])
-        s5 = combine(acc[5, 0], acc[5, 1], acc[5, 2], acc[5, 3], acc[5, 4], acc[5, 5],
-                     acc[5, 6], acc[5, 7])
+    docstring), of the products ``(u[r] - mu) (v[r] - mv)`` for r in
+    ``lo..lo+n``: fewer than 8 one after another; else eight partial sums
+    over the multiples of 8, added as ``((r0 + r1) + (r2 + r3)) + ((r4 + r5)
+    + (r6 + r7))``, then the rest."""
+    if n < 8:
+        total = 0.0
+        for r in range(lo, lo + n):
+            total += (u[r] - mu) * (v[r] - mv)
+        return total
+    r0 = (u[lo] - mu) * (v[lo] - mv)
+    r1 = (u[lo + 1] - mu) * (v[lo + 1] - mv)
+    r2 = (u[lo + 2] - mu) * (v[lo + 2] - mv)
+    r3 = (u[lo + 3] - mu) * (v[lo + 3] - mv)
+    r4 = (u[lo + 4] - mu) * (v[lo + 4] - mv)
+    r5 = (u[lo + 5] - mu) * (v[lo + 5] - mv)
+    r6 = (u[lo + 6] - mu) * (v[lo + 6] - mv)
+    r7 = (u[lo + 7] - mu) * (v[lo + 7] - mv)
+    end = lo + n - n % 8
+    for i in range(lo + 8, end, 8):
+        r0 += (u[i] - mu) * (v[i] - mv)
+        r1 += (u[i + 1] - mu) * (v[i + 1] - mv)
+        r2 += (u[i + 2] - mu) * (v[i + 2] - mv)
+        r3 += (u[i + 3] - mu) * (v[i + 3] - mv)
+        r4 += (u[i + 4] - mu) * (v[i + 4] - mv)
+        r5 += (u[i + 5] - mu) * (v[i + 5] - mv)
+        r6 += (u[i + 6] - mu) * (v[i + 6] - mv)
+        r7 += (u[i + 7] - mu) * (v[i + 7] - mv)
+    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
     for r in range(end, lo + n):
-        c0, c1, c2 = sx[r] - m0, sy[r] - m1, sz[r] - m2
-        s0 += c0 * c0
-        s1 += c0 * c1
-        s2 += c0 * c2
-        s3 += c1 * c1
-        s4 += c1 * c2
-        s5 += c2 * c2
-    return s0, s1, s2, s3, s4, s5
+        total += (u[r] - mu) * (v[r] - mv)
+    return total
 
 
 @numba.njit(cache=True)
-def pairwise_products(sx, sy, sz, n, m0, m1, m2, acc, frames, values):
-    """numpy's pairwise sums (module docstring) of the six products of
-    :func:`block_products` over the first n points: a range longer than
-    PAIRWISE_BLOCK is split at a multiple of 8 below its half, and the
+def pairwise_sum(u, v, n, mu, mv):
+    """``np.sum((u[:n] - mu) * (v[:n] - mv))``'s pairwise sum (module
+    docstring), before numpy adds it to 0.0: a range longer than
+    PAIRWISE_BLOCK is split at a multiple of 8 below its half and the
     halves' sums added. Written with explicit stacks (``frames`` of (start,
     length, halves done), ``values`` of sums), not by recursion: numba's
     cache reloads recursive functions wrongly (numba issue 6061)."""
     if n <= PAIRWISE_BLOCK:
-        return block_products(sx, sy, sz, 0, n, m0, m1, m2, acc)
+        return block_sum(u, v, 0, n, mu, mv)
+    frames = np.empty((PAIRWISE_STACK, 3), dtype=np.int64)
+    values = np.empty(PAIRWISE_STACK)
     frames[0, 0], frames[0, 1], frames[0, 2] = 0, n, 0
     top, stored = 1, 0
     while top > 0:
         lo, length, split = frames[top - 1, 0], frames[top - 1, 1], frames[top - 1, 2]
         if length <= PAIRWISE_BLOCK:
-            sums = block_products(sx, sy, sz, lo, length, m0, m1, m2, acc)
-            for q in range(6):
-                values[stored, q] = sums[q]
+            values[stored] = block_sum(u, v, lo, length, mu, mv)
             stored += 1
             top -= 1
         elif split == 0:
@@ -204,27 +184,24 @@ def pairwise_products(sx, sy, sz, n, m0, m1, m2, acc, frames, values):
             frames[top + 1, 0], frames[top + 1, 1], frames[top + 1, 2] = lo, half, 0
             top += 2                            # the first half on top: summed first
         else:
-            for q in range(6):                  # first half's sums + second half's
-                values[stored - 2, q] = values[stored - 2, q] + values[stored - 1, q]
+            values[stored - 2] = values[stored - 2] + values[stored - 1]   # first + second
             stored -= 1
             top -= 1
-    return (values[0, 0], values[0, 1], values[0, 2], values[0, 3], values[0, 4],
-            values[0, 5])
+    return values[0]
 
 
 @numba.njit(cache=True)
-def covariance(x, y, z, n, largest, a, work):
+def covariance(x, y, z, n, largest, a, scaled):
     """The covariance matrix that bvh_exact.principal_axes diagonalizes, of
     the first n points (largest magnitude ``largest``), into ``a`` (3, 3);
     for fewer than two points zeros (whose eigenvectors,
     :func:`symmetric_eigenvectors`, are the identity principal_axes returns
-    then). ``work`` is :func:`axes_scratch`."""
-    sx, sy, sz, acc, frames, values = work
+    then). ``scaled`` (3, n) is scratch."""
     if n < 2:
         a[:, :] = 0.0
         return
     # np.ldexp(points, -e): the points themselves when e = 0 (coordinates
-    # already in [0.5, 1), as build_tree leaves most sets), a product by
+    # already in [0.5, 1), as build_tree leaves many sets), a product by
     # 2**-e when that is a normal float (both round the exact value once),
     # else ldexp itself
     k = -unit_exponent(largest)
@@ -233,23 +210,25 @@ def covariance(x, y, z, n, largest, a, work):
         normal = -1022 <= k <= 1023
         for r in range(n):
             if normal:
-                sx[r], sy[r], sz[r] = x[r] * factor, y[r] * factor, z[r] * factor
+                scaled[0, r], scaled[1, r], scaled[2, r] = x[r] * factor, y[r] * factor, \
+                    z[r] * factor
             else:
-                sx[r], sy[r], sz[r] = math.ldexp(x[r], k), math.ldexp(y[r], k), \
-                    math.ldexp(z[r], k)
-        x, y, z = sx, sy, sz
+                scaled[0, r], scaled[1, r], scaled[2, r] = math.ldexp(x[r], k), \
+                    math.ldexp(y[r], k), math.ldexp(z[r], k)
+        x, y, z = scaled[0], scaled[1], scaled[2]
     m0 = m1 = m2 = 0.0                    # points.mean(axis=0): rows in turn, from 0.0
     for r in range(n):
         m0 += x[r]
         m1 += y[r]
         m2 += z[r]
     m0, m1, m2 = m0 / n, m1 / n, m2 / n
-    xx, xy, xz, yy, yz, zz = pairwise_products(x, y, z, n, m0, m1, m2, acc, frames, values)
     # np.sum adds the pairwise sum to 0.0 (which turns a -0.0 into 0.0)
-    a[0, 0], a[1, 1], a[2, 2] = 0.0 + xx, 0.0 + yy, 0.0 + zz
-    a[0, 1] = a[1, 0] = 0.0 + xy
-    a[0, 2] = a[2, 0] = 0.0 + xz
-    a[1, 2] = a[2, 1] = 0.0 + yz
+    a[0, 0] = 0.0 + pairwise_sum(x, x, n, m0, m0)
+    a[1, 1] = 0.0 + pairwise_sum(y, y, n, m1, m1)
+    a[2, 2] = 0.0 + pairwise_sum(z, z, n, m2, m2)
+    a[0, 1] = a[1, 0] = 0.0 + pairwise_sum(x, y, n, m0, m1)
+    a[0, 2] = a[2, 0] = 0.0 + pairwise_sum(x, z, n, m0, m2)
+    a[1, 2] = a[2, 1] = 0.0 + pairwise_sum(y, z, n, m1, m2)
 
 
 @numba.njit(cache=True)
@@ -494,19 +473,21 @@ def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
         keys[0, r] = project(c0, c1, c2, a00, a10, a20)
         keys[1, r] = project(c0, c1, c2, a01, a11, a21)
         keys[2, r] = project(c0, c1, c2, a02, a12, a22)
-    for axis in range(3):
+    for axis in range(3):                     # each half's points at 3 lo of its axis's third
         rank(keys[axis], members, k, ranked[axis], bucket, counts)
         for half, (lo, hi) in enumerate(((0, mid), (mid, k))):
-            n, largest = gather(tx, ty, tz, members, ranked[axis], lo, hi, x, y, z)
-            covariance(x, y, z, n, largest, a[2 * axis + half], axes_work)
+            at = 3 * (axis * k + lo)
+            n, largest = gather(tx, ty, tz, members, ranked[axis], lo, hi, x[at:], y[at:],
+                                z[at:])
+            covariance(x[at:], y[at:], z[at:], n, largest, a[2 * axis + half], axes_work)
     symmetric_eigenvectors(a, v, axes, 6, done)
     best_volume = np.inf
     chosen = 0
     for axis in range(3):
         volume = 0.0
         for half, (lo, hi) in enumerate(((0, mid), (mid, k))):
-            n, _ = gather(tx, ty, tz, members, ranked[axis], lo, hi, x, y, z)
-            low, high = extents(x, y, z, n, axes[2 * axis + half])
+            at, n = 3 * (axis * k + lo), 3 * (hi - lo)
+            low, high = extents(x[at:], y[at:], z[at:], n, axes[2 * axis + half])
             part = ((high[0] - low[0]) * (high[1] - low[1])) * (high[2] - low[2])
             volume = part if half == 0 else volume + part     # box_volume + box_volume
         if volume < best_volume:              # ties keep the lower axis
