@@ -30,11 +30,24 @@ bundled meshes and on generated ones; numba compiles without fast-math, so
 each operation is rounded once and nothing is fused. No BLAS or LAPACK is
 called, so the tree is the same on every machine, as the readable one.
 
-Cost: the least-volume split computes, at each node of k triangles, the
-covariance of its 3k vertices and of each of its six candidate halves, each
-a few passes over the points: O(k) a node, O(m log m) for the tree of m
-triangles, plus O(m log^2 m) for sorting; the node boxes add O(k log k) a
-node. Each function here says which readable function it mirrors.
+How it is made cheaper than the readable build without changing a bit:
+the six candidate halves of a node have their covariances formed first and
+their eigenvectors found together (:func:`symmetric_eigenvectors`: the
+processor overlaps six chains of dependent divisions and square roots); a
+node's own principal axes are those of the half its parent chose (the same
+triangles in the same order), so each node's eigenproblem is solved once;
+keys are ranked by buckets and insertion instead of a general sort
+(:func:`rank`); a node box's vertex list is filtered from its parent's
+instead of sorted (:func:`visit_nodes`); hot loops call no helper that
+takes an array (such calls, even inlined, measured more than the loops'
+work). Measured against FCL: docs/decisions/tree-build.md.
+
+Cost: the least-volume split forms, at each node of k triangles, the
+covariances of its six candidate halves (a few passes over 9k points) and
+solves six 3 x 3 eigenproblems: O(k) a node, O(m log m) for the tree of m
+triangles (ranking is O(k) a node for keys spread evenly, O(k log k) at
+worst); the node boxes add O(k) and one eigenproblem a node. Each function
+here says which readable function it mirrors.
 
 This module imports numba at import time; import it only when the compiled
 kernel is chosen.
@@ -65,17 +78,16 @@ TINY_ROTATION = 2.0 ** -27
 #: eight interleaved partial sums.
 PAIRWISE_BLOCK = 128
 
-#: Rows of the explicit stacks of :func:`pairwise_products` (its splits halve
-#: a range: 2 log2(n / 64) + 1 frames for n terms).
+#: Rows of the explicit stacks of :func:`pairwise_sum` (its splits halve a
+#: range: 2 log2(n / 64) + 1 frames for n terms).
 PAIRWISE_STACK = 130
 
 #: Runs of at most this many keys are ranked by insertion sort.
 INSERTION_RUN = 24
 
 
-# Working arrays, allocated once a build and passed as tuples (numba passes
-# a tuple of arrays as cheaply as the arrays). Coordinates are kept one array
-# per axis, so that the loops over points read consecutive floats.
+# Working arrays, allocated once a build. Coordinates are kept one array per
+# axis, so that the loops over points read consecutive floats.
 
 
 @numba.njit(cache=True)
@@ -88,8 +100,9 @@ def axes_scratch(n):
 @numba.njit(cache=True)
 def split_scratch(m):
     """What a split works in, for m triangles: ``(x, y, z)`` (9m,) sets of
-    points (the six candidate halves' at once), ``keys`` (3, m) the triangles' centroids along three axes and
-    ``ranked`` (3, m) their ranks along each, ``bucket`` (m,) and ``counts``
+    points (the six candidate halves' at once), ``keys`` (3, m) the
+    triangles' centroids along three axes and ``ranked`` (3, m) their ranks
+    along each, ``bucket`` (m,) and ``counts``
     (m + 1,) int64, and for the six candidate halves (the first and second
     of each axis, and the node itself last) their covariance matrices
     ``a``, rotations ``v``, ``done`` flags and principal ``axes`` (7, 3, 3)."""

@@ -27,6 +27,9 @@ Two kernels do the same arithmetic: ``refit`` and ``_pairs_python`` (plain
 loops, the reference) and a numba-compiled mirror of them
 (:mod:`refsim.collision._numba_kernels`), selected by ``kernel=``
 (:mod:`refsim.kernels`: "readable" or "compiled").
+The build too: :func:`build_tree` (the reference) and
+:func:`build_tree_compiled` (:mod:`refsim.collision._numba_build`), the same
+tree bit for bit, chosen by :func:`tree_of`'s ``kernel=``.
 
 This path serves level "triangle-aabb", whose answer is test 2's pairs. The
 exact level only needs a superset of the intersecting pairs and uses the

@@ -104,7 +104,13 @@ constant arrays travel packed in two (:func:`pack_frame_tree`, built once),
 since numba unboxes every array argument at every call; the boolean query's
 kernel returns one number, and its poses go to numba unchecked, its one
 compiled signature refusing any other layout (then :func:`as_pose` converts).
-Cost: O(m log m) once per mesh for the boxes (a 3x3 eigenproblem per node);
+Building the tree: :func:`build_frame_tree` (readable) or its compiled
+twin (:func:`build_frame_tree_compiled`, :mod:`refsim.collision._numba_build`),
+chosen by ``kernel=`` like the query and equal to it bit for bit
+(tests/collision/test_tree_build.py); both without BLAS or LAPACK, so a
+mesh has the same tree on every machine.
+Cost: O(m log m) once per mesh for the tree and its boxes (seven 3x3
+eigenproblems per node: the six candidate halves of the split and the box);
 per query about O(k log m) node
 tests for k overlapping node pairs, plus O(1) per vertex and triangle of the
 leaves reached. The speed against FCL is measured in
