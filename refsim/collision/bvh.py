@@ -146,6 +146,15 @@ def build_tree(vertices: np.ndarray, faces: np.ndarray, leaf_size: int = LEAF_SI
     return TriangleTree(as_array(left), as_array(right), as_array(start), as_array(count), order)
 
 
+@functools.cache
+def build_kernels():
+    """The compiled build's module, :mod:`refsim.collision._numba_build`
+    (imported on first use: it imports numba)."""
+    from refsim.collision import _numba_build
+
+    return _numba_build
+
+
 #: The split rules the compiled build knows, by the names :func:`build_tree_compiled`
 #: takes: this module's :func:`least_area_split` and the exact level's
 #: :func:`refsim.collision.bvh_exact.least_volume_split`.
@@ -158,8 +167,7 @@ def build_tree_compiled(vertices: np.ndarray, faces: np.ndarray, split: str = "l
     the same tree, every array bit for bit, with the split rule named by
     ``split`` (:data:`SPLIT_RULES`)."""
     check_option("split", split, SPLIT_RULES)
-    from refsim.collision import _numba_build as nb
-
+    nb = build_kernels()
     triangles = scaled_triangles(vertices, faces)
     columns = [np.ascontiguousarray(triangles[:, :, j]).ravel() for j in range(3)]
     rule = nb.LEAST_AREA if split == "least-area" else nb.LEAST_VOLUME

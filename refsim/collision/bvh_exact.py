@@ -126,7 +126,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.boxes import triangle_boxes, world_vertices
-from refsim.collision.bvh import TriangleTree, build_tree, build_tree_compiled
+from refsim.collision.bvh import TriangleTree, build_kernels, build_tree, build_tree_compiled
 from refsim.collision.seed_levels import exact_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_numba import compiled_exact_kernels
@@ -356,11 +356,9 @@ def build_frame_tree_compiled(mesh) -> FrameTree:
     """:func:`build_frame_tree` (with its default axes) compiled
     (:func:`refsim.collision._numba_build.frame_boxes` over the compiled
     :func:`frame_topology_of`): the same FrameTree, every array bit for bit."""
-    from refsim.collision import _numba_build as nb
-
     tree = frame_topology_of(mesh, "compiled")
     columns = [np.ascontiguousarray(mesh.vertices[:, j]) for j in range(3)]
-    boxes, largest_deviation = nb.frame_boxes(
+    boxes, largest_deviation = build_kernels().frame_boxes(
         *columns, np.ascontiguousarray(mesh.faces, dtype=np.int64), tree.left, tree.right,
         tree.start, tree.count, tree.order)
     return _frame_tree(mesh, tree, boxes, float(largest_deviation))

@@ -120,8 +120,8 @@ def test_the_cases_reach_what_they_are_there_for():
     assert np.signbit(centre_z).any() and not np.signbit(centre_z).all()
     tree = bvh_exact.frame_topology_of(_mesh("coincident"), "compiled")
     faces = GENERATED["coincident"][1]
-    leaves = [tree.order[s:s + c] for s, c, left in zip(tree.start, tree.count, tree.left)
-              if left < 0]
+    leaves = [tree.order[s:s + c]
+              for s, c, left in zip(tree.start, tree.count, tree.left, strict=True) if left < 0]
     shared = sum(len({tuple(sorted(faces[i])) for i in leaf}) < len(leaf) for leaf in leaves)
     assert shared > 0                          # a leaf holds both copies of a triangle
     for name, exponent in (("torus-tiny", -1040), ("torus-huge", 1000)):
