@@ -357,10 +357,12 @@ def build_frame_tree_compiled(mesh) -> FrameTree:
     (:func:`refsim.collision._numba_build.frame_boxes` over the compiled
     :func:`frame_topology_of`): the same FrameTree, every array bit for bit."""
     tree = frame_topology_of(mesh, "compiled")
-    columns = [np.ascontiguousarray(mesh.vertices[:, j]) for j in range(3)]
+    # writable copies: numba compiles a read-only array argument (a Mesh's
+    # faces are read-only) as another type, a second compile of the kernel
+    columns = [np.array(mesh.vertices[:, j], dtype=np.float64) for j in range(3)]
+    faces = np.array(mesh.faces, dtype=np.int64, order="C")
     boxes, largest_deviation = build_kernels().frame_boxes(
-        *columns, np.ascontiguousarray(mesh.faces, dtype=np.int64), tree.left, tree.right,
-        tree.start, tree.count, tree.order)
+        *columns, faces, tree.left, tree.right, tree.start, tree.count, tree.order)
     return _frame_tree(mesh, tree, boxes, float(largest_deviation))
 
 
