@@ -437,6 +437,17 @@ def rank(key, members, k, ranked, bucket, counts):
 
 
 @numba.njit(cache=True)
+def least_axis(measures):
+    """The axis (0, 1, 2) of least ``measures``, as both readable splits
+    choose it: ``if measure < best`` from inf, so ties keep the lower axis."""
+    best, chosen = np.inf, 0
+    for axis in range(3):
+        if measures[axis] < best:
+            best, chosen = measures[axis], axis
+    return chosen
+
+
+@numba.njit(cache=True)
 def gather(tx, ty, tz, members, ranked, lo, hi, x, y, z):
     """The vertices of triangles ``members[ranked[lo:hi]]`` into x, y, z,
     three a triangle (``triangles[...].reshape(-1, 3)``): ``(their number,
@@ -494,19 +505,14 @@ def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
                                 z[at:])
             covariance(x[at:], y[at:], z[at:], n, largest, a[2 * axis + half], axes_work)
     symmetric_eigenvectors(a, v, axes, 6, done)
-    best_volume = np.inf
-    chosen = 0
+    volumes = np.empty(3)
     for axis in range(3):
-        volume = 0.0
         for half, (lo, hi) in enumerate(((0, mid), (mid, k))):
             at, n = 3 * (axis * k + lo), 3 * (hi - lo)
             low, high = extents(x[at:], y[at:], z[at:], n, axes[2 * axis + half])
             part = ((high[0] - low[0]) * (high[1] - low[1])) * (high[2] - low[2])
-            volume = part if half == 0 else volume + part     # box_volume + box_volume
-        if volume < best_volume:              # ties keep the lower axis
-            best_volume = volume
-            chosen = axis
-    return chosen
+            volumes[axis] = part if half == 0 else volumes[axis] + part   # box_volume + ...
+    return least_axis(volumes)
 
 
 @numba.njit(cache=True)
@@ -539,16 +545,12 @@ def least_area_split(tx, ty, tz, members, k, mid, work):
             keys[j, r] = (((0.0 + x0) + x1) + x2) / 3.0
             tri_lo[j, r] = min(min(x0, x1), x2)
             tri_hi[j, r] = max(max(x0, x1), x2)
-    best_area = np.inf
-    chosen = 0
+    areas = np.empty(3)
     for axis in range(3):
         rank(keys[axis], members, k, ranked[axis], bucket, counts)
-        area = (surface_area(tri_lo, tri_hi, ranked[axis], 0, mid)
-                + surface_area(tri_lo, tri_hi, ranked[axis], mid, k))
-        if area < best_area:                  # ties keep the lower axis
-            best_area = area
-            chosen = axis
-    return chosen
+        areas[axis] = (surface_area(tri_lo, tri_hi, ranked[axis], 0, mid)
+                       + surface_area(tri_lo, tri_hi, ranked[axis], mid, k))
+    return least_axis(areas)
 
 
 # -- the build ----------------------------------------------------------------------
