@@ -122,6 +122,29 @@ def _incremental(kernel):
     return out
 
 
+def _fresh(mesh):
+    """A copy of ``mesh`` with nothing derived yet (its trees unbuilt)."""
+    return refsim.Mesh(mesh.vertices.copy(), mesh.faces.copy())
+
+
+def _hierarchy_build(kernel):
+    from refsim.collision.bvh import tree_of
+    from refsim.collision.bvh_exact import frame_topology_of
+
+    out = []
+    for mesh in (TORUS, STAR, CUBE):
+        for tree in (tree_of(_fresh(mesh), kernel), frame_topology_of(_fresh(mesh), kernel)):
+            out.append((tree.left, tree.right, tree.start, tree.count, tree.order))
+    return out
+
+
+def _oriented_boxes(kernel):
+    from refsim.collision.bvh_exact import frame_tree_of
+
+    frames = [frame_tree_of(_fresh(mesh), kernel) for mesh in (TORUS, STAR, CUBE)]
+    return [(f.links, f.tree.order, f.boxes, f.reach, f.axes_deviation) for f in frames]
+
+
 def _hierarchy_boxes(kernel):
     return [refsim.intersecting_pairs(TORUS, IDENTITY, STAR, pose, level="triangle-aabb",
                                       kernel=kernel) for pose in _poses(6)]
@@ -191,6 +214,8 @@ CASES = {
     "batched boxes": _batched_boxes,
     "linear box scan": _linear_scan,
     "incremental box": _incremental,
+    "hierarchy build": _hierarchy_build,
+    "oriented node boxes": _oriented_boxes,
     "hierarchy refit": _hierarchy_boxes,
     "hierarchy traversal": _hierarchy_boxes,
     "certified triangle filter": _certified_filter,

@@ -27,6 +27,9 @@ Two kernels do the same arithmetic: ``refit`` and ``_pairs_python`` (plain
 loops, the reference) and a numba-compiled mirror of them
 (:mod:`refsim.collision._numba_kernels`), selected by ``kernel=``
 (:mod:`refsim.kernels`: "readable" or "compiled").
+The build too: :func:`build_tree` (the reference) and
+:func:`build_tree_compiled` (:mod:`refsim.collision._numba_build`), the same
+tree bit for bit, chosen by :func:`tree_of`'s ``kernel=``.
 
 This path serves level "triangle-aabb", whose answer is test 2's pairs. The
 exact level only needs a superset of the intersecting pairs and uses the
@@ -47,6 +50,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.boxes import triangle_boxes, world_vertices
+from refsim.errors import check_option
+from refsim.kernels import choose_kernel
 from refsim.types import unit_exponent
 
 #: Triangles per leaf. Small leaves prune more; each leaf-leaf visit costs
@@ -100,6 +105,12 @@ def least_area_split(triangles: np.ndarray, members: np.ndarray, mid: int) -> np
     return members[best]
 
 
+def scaled_triangles(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(m, 3, 3): each face's vertices times ``2**-e``, as :func:`build_tree`
+    chooses its splits on them."""
+    return np.ldexp(vertices, -unit_exponent(vertices))[faces]
+
+
 def build_tree(vertices: np.ndarray, faces: np.ndarray, leaf_size: int = LEAF_SIZE,
                split=least_area_split) -> TriangleTree:
     """Top-down median split: each node's triangles ranked by ``split``
@@ -109,7 +120,7 @@ def build_tree(vertices: np.ndarray, faces: np.ndarray, leaf_size: int = LEAF_SI
     # inf (and inf - inf to nan), leaving no axis "best". The tree's
     # topology is all that is built here, and scaling by a power of two
     # changes no comparison.
-    triangles = np.ldexp(vertices, -unit_exponent(vertices))[faces]
+    triangles = scaled_triangles(vertices, faces)
     order = np.arange(len(faces), dtype=np.int64)
     left, right, start, count = [], [], [], []
 
@@ -135,9 +146,44 @@ def build_tree(vertices: np.ndarray, faces: np.ndarray, leaf_size: int = LEAF_SI
     return TriangleTree(as_array(left), as_array(right), as_array(start), as_array(count), order)
 
 
-def tree_of(mesh) -> TriangleTree:
-    """The mesh's hierarchy, built on first use and kept with the mesh."""
-    return mesh.derived("triangle_tree", lambda m: build_tree(m.vertices, m.faces))
+@functools.cache
+def build_kernels():
+    """The compiled build's module, :mod:`refsim.collision._numba_build`
+    (imported on first use: it imports numba)."""
+    from refsim.collision import _numba_build
+
+    return _numba_build
+
+
+#: The split rules the compiled build knows, by the names :func:`build_tree_compiled`
+#: takes: this module's :func:`least_area_split` and the exact level's
+#: :func:`refsim.collision.bvh_exact.least_volume_split`.
+SPLIT_RULES = ("least-area", "least-volume")
+
+
+def build_tree_compiled(vertices: np.ndarray, faces: np.ndarray, split: str = "least-area",
+                        leaf_size: int = LEAF_SIZE) -> TriangleTree:
+    """:func:`build_tree` compiled (:func:`refsim.collision._numba_build.build_tree`):
+    the same tree, every array bit for bit, with the split rule named by
+    ``split`` (:data:`SPLIT_RULES`)."""
+    check_option("split", split, SPLIT_RULES)
+    nb = build_kernels()
+    triangles = scaled_triangles(vertices, faces)
+    columns = [np.ascontiguousarray(triangles[:, :, j]).ravel() for j in range(3)]
+    rule = nb.LEAST_AREA if split == "least-area" else nb.LEAST_VOLUME
+    return TriangleTree(*nb.build_tree(*columns, leaf_size, rule))
+
+
+def tree_of(mesh, kernel: str | None = None) -> TriangleTree:
+    """The mesh's hierarchy, built on first use and kept with the mesh, by
+    the readable :func:`build_tree` or its compiled twin (``kernel``, see
+    :mod:`refsim.kernels`; the same tree either way)."""
+    def build(m) -> TriangleTree:
+        if choose_kernel(kernel) == "readable":
+            return build_tree(m.vertices, m.faces)
+        return build_tree_compiled(m.vertices, m.faces, "least-area")
+
+    return mesh.derived("triangle_tree", build)
 
 
 # -- the readable kernel ---------------------------------------------------------
@@ -232,7 +278,7 @@ class PreparedBody:
 
 def prepare_body(mesh, pose, kernel: str) -> PreparedBody:
     """Transform, box and refit one body."""
-    tree = tree_of(mesh)
+    tree = tree_of(mesh, kernel)
     if kernel == "readable":
         world = world_vertices(mesh, pose)
         tri_lo, tri_hi = triangle_boxes(world, mesh.faces)

@@ -104,7 +104,13 @@ constant arrays travel packed in two (:func:`pack_frame_tree`, built once),
 since numba unboxes every array argument at every call; the boolean query's
 kernel returns one number, and its poses go to numba unchecked, its one
 compiled signature refusing any other layout (then :func:`as_pose` converts).
-Cost: O(m log m) once per mesh for the boxes (a 3x3 eigenproblem per node);
+Building the tree: :func:`build_frame_tree` (readable) or its compiled
+twin (:func:`build_frame_tree_compiled`, :mod:`refsim.collision._numba_build`),
+chosen by ``kernel=`` like the query and equal to it bit for bit
+(tests/collision/test_tree_build.py); both without BLAS or LAPACK, so a
+mesh has the same tree on every machine.
+Cost: O(m log m) once per mesh for the tree and its boxes (seven 3x3
+eigenproblems per node: the six candidate halves of the split and the box);
 per query about O(k log m) node
 tests for k overlapping node pairs, plus O(1) per vertex and triangle of the
 leaves reached. The speed against FCL is measured in
@@ -120,11 +126,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.boxes import triangle_boxes, world_vertices
-from refsim.collision.bvh import TriangleTree, build_tree
+from refsim.collision.bvh import TriangleTree, build_kernels, build_tree, build_tree_compiled
 from refsim.collision.seed_levels import exact_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_numba import compiled_exact_kernels
 from refsim.errors import StateError
+from refsim.kernels import choose_kernel
 from refsim.types import ORTHONORMAL_TOL, as_pose, unit_exponent
 
 #: The node test's margin, relative to the scene's size S (see the module
@@ -299,18 +306,34 @@ def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int) -> 
     return members[best]
 
 
-def frame_topology_of(mesh) -> TriangleTree:
-    """The exact level's tree (:func:`least_volume_split`), built once per mesh."""
-    return mesh.derived("frame_topology", lambda m: build_tree(
-        m.vertices, m.faces, split=least_volume_split))
+def frame_topology_of(mesh, kernel: str | None = None) -> TriangleTree:
+    """The exact level's tree (:func:`least_volume_split`), built once per
+    mesh, by the readable :func:`refsim.collision.bvh.build_tree` or its
+    compiled twin (``kernel``, :mod:`refsim.kernels`: the same tree)."""
+    def build(m) -> TriangleTree:
+        if choose_kernel(kernel) == "readable":
+            return build_tree(m.vertices, m.faces, split=least_volume_split)
+        return build_tree_compiled(m.vertices, m.faces, "least-volume")
+
+    return mesh.derived("frame_topology", build)
+
+
+def axes_deviation(axes: np.ndarray) -> float:
+    """:func:`deviation` of node axes without BLAS: each entry of ``A^T A``
+    summed as ``(a0i a0j + a1i a1j) + a2i a2j``, so that the tree's margin
+    term is the same on every machine (``A.T @ A`` gave other last bits
+    under other OpenBLAS kernels)."""
+    gram = ((axes[0][:, None] * axes[0][None, :] + axes[1][:, None] * axes[1][None, :])
+            + axes[2][:, None] * axes[2][None, :])
+    return float(np.abs(gram - np.eye(3)).max())
 
 
 def build_frame_tree(mesh, choose_axes=principal_axes) -> FrameTree:
     """The mesh's :class:`FrameTree`, each node's box along
     ``choose_axes(points)`` (the tests pass axes off orthonormal)."""
-    tree = frame_topology_of(mesh)
+    tree = frame_topology_of(mesh, "readable")
     boxes = np.empty((tree.n_nodes, 15))
-    axes_deviation = 0.0
+    largest_deviation = 0.0
     for node in range(tree.n_nodes):
         members = tree.order[tree.start[node]:tree.start[node] + tree.count[node]]
         points = mesh.vertices[np.unique(mesh.faces[members])]
@@ -318,16 +341,41 @@ def build_frame_tree(mesh, choose_axes=principal_axes) -> FrameTree:
         boxes[node] = np.concatenate([centre, half, axes.ravel()])
         # (a non-finite deviation, from coordinates near 1e154, makes the
         # margin infinite: nothing is dropped, every answer still exact)
-        off = deviation(axes)
-        axes_deviation = max(axes_deviation, off if np.isfinite(off) else np.inf)
+        off = axes_deviation(axes)
+        largest_deviation = max(largest_deviation, off if np.isfinite(off) else np.inf)
+    return _frame_tree(mesh, tree, boxes, largest_deviation)
+
+
+def _frame_tree(mesh, tree: TriangleTree, boxes: np.ndarray, largest_deviation: float):
     links = np.column_stack([tree.left, tree.right, tree.start, tree.count]).astype(np.int64)
     return FrameTree(tree, np.ascontiguousarray(links), boxes,
-                     float(np.abs(mesh.vertices).max()), axes_deviation)
+                     float(np.abs(mesh.vertices).max()), largest_deviation)
 
 
-def frame_tree_of(mesh) -> FrameTree:
-    """The mesh's :class:`FrameTree`, built on first use and kept with the mesh."""
-    return mesh.derived("frame_tree", build_frame_tree)
+def build_frame_tree_compiled(mesh) -> FrameTree:
+    """:func:`build_frame_tree` (with its default axes) compiled
+    (:func:`refsim.collision._numba_build.frame_boxes` over the compiled
+    :func:`frame_topology_of`): the same FrameTree, every array bit for bit."""
+    tree = frame_topology_of(mesh, "compiled")
+    # writable copies: numba compiles a read-only array argument (a Mesh's
+    # faces are read-only) as another type, a second compile of the kernel
+    columns = [np.array(mesh.vertices[:, j], dtype=np.float64) for j in range(3)]
+    faces = np.array(mesh.faces, dtype=np.int64, order="C")
+    boxes, largest_deviation = build_kernels().frame_boxes(
+        *columns, faces, tree.left, tree.right, tree.start, tree.count, tree.order)
+    return _frame_tree(mesh, tree, boxes, float(largest_deviation))
+
+
+def frame_tree_of(mesh, kernel: str | None = None) -> FrameTree:
+    """The mesh's :class:`FrameTree`, built on first use and kept with the
+    mesh, by :func:`build_frame_tree` or its compiled twin (``kernel``,
+    :mod:`refsim.kernels`: the same tree)."""
+    def build(m) -> FrameTree:
+        if choose_kernel(kernel) == "readable":
+            return build_frame_tree(m)
+        return build_frame_tree_compiled(m)
+
+    return mesh.derived("frame_tree", build)
 
 
 # -- the readable kernel ------------------------------------------------------------
@@ -397,20 +445,23 @@ def boxes_apart(M, T, half_a, half_b, margin: float) -> bool:
 
 def candidate_pairs(mesh_a, pose_a, mesh_b, pose_b, *,
                     margin_rounding: float = MARGIN_ROUNDING,
-                    margin_per_deviation: float = MARGIN_PER_DEVIATION) -> np.ndarray:
+                    margin_per_deviation: float = MARGIN_PER_DEVIATION,
+                    kernel: str | None = None) -> np.ndarray:
     """The triangle pairs the traversal hands to the exact test: their leaves'
     node boxes are not separated and their world triangle boxes overlap.
     A superset of the intersecting pairs. (k, 2) int64, rows sorted; poses
-    already checked."""
+    already checked. ``kernel`` builds trees not yet built."""
     return descend(mesh_a, pose_a, mesh_b, pose_b, margin_rounding=margin_rounding,
-                   margin_per_deviation=margin_per_deviation)[0]
+                   margin_per_deviation=margin_per_deviation, kernel=kernel)[0]
 
 
 def descend(mesh_a, pose_a, mesh_b, pose_b, *,
             margin_rounding: float = MARGIN_ROUNDING,
-            margin_per_deviation: float = MARGIN_PER_DEVIATION) -> tuple[np.ndarray, int]:
-    """The readable traversal: ``(candidate pairs, node pairs visited)``."""
-    fa, fb = frame_tree_of(mesh_a), frame_tree_of(mesh_b)
+            margin_per_deviation: float = MARGIN_PER_DEVIATION,
+            kernel: str | None = None) -> tuple[np.ndarray, int]:
+    """The readable traversal: ``(candidate pairs, node pairs visited)``;
+    ``kernel`` builds the trees not yet built (:func:`frame_tree_of`)."""
+    fa, fb = frame_tree_of(mesh_a, kernel), frame_tree_of(mesh_b, kernel)
     M, u = relative_frame(pose_a, pose_b)
     margin = node_margin(fa, pose_a, fb, pose_b, margin_rounding, margin_per_deviation)
     lo_a, hi_a = triangle_boxes(world_vertices(mesh_a, pose_a), mesh_a.faces)
@@ -470,7 +521,7 @@ def pack_frame_tree(mesh) -> tuple[np.ndarray, np.ndarray]:
       the tree's links (nodes, 4) and order (m,), flattened likewise.
 
     :func:`refsim.collision._numba_kernels.unpack` takes them apart again."""
-    tree = frame_tree_of(mesh)
+    tree = frame_tree_of(mesh, "compiled")
     floats = np.concatenate([[tree.reach, tree.axes_deviation], mesh.vertices.ravel(),
                              tree.boxes.ravel()]).astype(np.float64)
     ints = np.concatenate([[mesh.n_vertices, mesh.n_faces, tree.tree.n_nodes],
@@ -579,7 +630,7 @@ def intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> np.nd
     docs/decisions/query-fixed-cost.md)."""
     if kernel == "readable":
         pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
-        candidates = candidate_pairs(mesh_a, pose_a, mesh_b, pose_b)
+        candidates = candidate_pairs(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel)
         return exact_pairs(world_vertices(mesh_a, pose_a), mesh_a.faces,
                            world_vertices(mesh_b, pose_b), mesh_b.faces, candidates, "readable")
     answer, pose_a, pose_b = _collide_code(mesh_a, pose_a, mesh_b, pose_b)

@@ -430,18 +430,25 @@ def test_symmetric_eigenvectors_diagonalize_and_are_orthonormal():
 TREE_DIGEST = """
 import hashlib, refsim
 from refsim.collision.bvh_exact import frame_tree_of
-tree = frame_tree_of(refsim.load_model("sphere-2k.ac"))
-print(hashlib.sha256(tree.boxes.tobytes()).hexdigest())
+from refsim.models.mesh import Mesh
+model = refsim.load_model("sphere-2k.ac")
+for kernel in ("compiled", "readable"):
+    tree = frame_tree_of(Mesh(model.vertices, model.faces), kernel)
+    digest = hashlib.sha256(tree.boxes.tobytes() + tree.links.tobytes()
+                            + tree.tree.order.tobytes() + repr(tree.axes_deviation).encode())
+    print(digest.hexdigest())
 """
 
 
 def test_the_exact_levels_tree_does_not_depend_on_the_blas_core():
-    """The tree (its splits and its node boxes, to the bit) is built without
-    BLAS or LAPACK, so OpenBLAS's kernels for other processors give the same
-    one (with numpy.linalg.eigh they did not: another tree, and another count
-    of node pairs visited). The default kernels are compared with every core
-    type this processor can run (tests.helpers.openblas_core_types): on
-    x86-64 at least Prescott, elsewhere the default alone."""
+    """The tree (its splits, its node boxes and its axes' deviation, to the
+    bit) is built without BLAS or LAPACK, so OpenBLAS's kernels for other
+    processors give the same one (with numpy.linalg.eigh they did not:
+    another tree, and another count of node pairs visited; with ``A.T @ A``
+    the axes' deviation differed in its last bits), by the compiled build
+    as by the readable one. The default kernels are compared with every
+    core type this processor can run (tests.helpers.openblas_core_types):
+    on x86-64 at least Prescott, elsewhere the default alone."""
     import os
     import platform
     import subprocess
@@ -458,7 +465,9 @@ def test_the_exact_levels_tree_does_not_depend_on_the_blas_core():
         env = default if core is None else dict(default, OPENBLAS_CORETYPE=core)
         result = subprocess.run([sys.executable, "-c", TREE_DIGEST], env=env,
                                 capture_output=True, text=True, timeout=300, check=True)
-        digests[core or "default"] = result.stdout.strip()
+        compiled, readable = result.stdout.split()
+        assert compiled == readable, core
+        digests[core or "default"] = compiled
     assert len(digests) == 1 + len(cores)
     assert len(set(digests.values())) == 1, digests
     assert len(digests["default"]) == 64

@@ -1,0 +1,753 @@
+"""Compiled twin of the hierarchies' build (seed S4's "more levels of
+hierarchy"): the triangle tree of :func:`refsim.collision.bvh.build_tree`
+under either split rule, and the oriented node boxes of
+:func:`refsim.collision.bvh_exact.build_frame_tree`, as plain loops.
+
+What: the same arrays, bit for bit, as the readable build. Every float the
+readable build computes is computed here by the same operations in the same
+order, including the order numpy sums in, which the readable code leaves
+implicit:
+
+- ``x.mean(axis=0)`` of an (n, 3) array and ``x.mean(axis=1)`` of a
+  (k, 3, 3) one add the rows one after another, starting from 0.0, and then
+  divide by the count;
+- ``np.sum`` of a contiguous 1-d array is numpy's pairwise summation
+  (``pairwise_sum`` in numpy's ``loops_utils.h.src``): fewer than 8 terms
+  one after another; up to 128 in eight interleaved partial sums added as
+  ``((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))`` and then the rest;
+  more, split in two at a multiple of 8 below the half and the halves'
+  sums added; the reduction then adds that to 0.0;
+- ``x.max(axis=0)`` and ``x.min(axis=0)`` of an (n, 3) array take the rows
+  one after another, and of two equal values (0.0 and -0.0) keep the later
+  (``np.maximum(a, b)`` returns ``b`` then). Only the sign of a zero
+  depends on this, and only a node box's centre can carry it;
+- ``np.lexsort((members, key))`` orders by key, then by triangle index;
+  keys that compare equal (0.0 and -0.0 among them) are ties;
+- ``np.ldexp`` is a product by a power of two, rounded once.
+
+tests/collision/test_tree_build.py checks every array of both trees on the
+bundled meshes and on generated ones; numba compiles without fast-math, so
+each operation is rounded once and nothing is fused. No BLAS or LAPACK is
+called, so the tree is the same on every machine, as the readable one.
+
+How it is made cheaper than the readable build without changing a bit:
+the six candidate halves of a node have their covariances formed first and
+their eigenvectors found together (:func:`symmetric_eigenvectors`: the
+processor overlaps six chains of dependent divisions and square roots); a
+node's own principal axes are those of the half its parent chose (the same
+triangles in the same order), so each node's eigenproblem is solved once;
+keys are ranked by buckets and insertion instead of a general sort
+(:func:`rank`); a node box's vertex list is filtered from its parent's
+instead of sorted (:func:`visit_nodes`); hot loops call no helper that
+takes an array (such calls, even inlined, measured more than the loops'
+work). Measured against FCL: docs/decisions/tree-build.md.
+
+Cost: the least-volume split forms, at each node of k triangles, the
+covariances of its six candidate halves (a few passes over 9k points) and
+solves six 3 x 3 eigenproblems: O(k) a node, O(m log m) for the tree of m
+triangles (ranking is O(k) a node for keys spread evenly, O(k log k) at
+worst); the node boxes add O(k) and one eigenproblem a node. Each function
+here says which readable function it mirrors.
+
+This module imports numba at import time; import it only when the compiled
+kernel is chosen.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+#: Split rules of :func:`build_tree` (the readable split functions they mirror:
+#: ``bvh.least_area_split``, ``bvh_exact.least_volume_split``).
+LEAST_AREA, LEAST_VOLUME = 0, 1
+
+#: Most sweeps of :func:`symmetric_eigenvectors` (bvh_exact.JACOBI_SWEEPS).
+JACOBI_SWEEPS = 50
+
+#: A rotation with ``|t| <= 2**-27`` has ``c = 1.0`` and ``s = t`` exactly:
+#: ``t * t <= 2**-54`` is below half an ulp of 1, so ``1.0 + t * t`` rounds to
+#: 1.0, whose square root and reciprocal are 1.0 (the later rotations of a
+#: sweep, once the off-diagonal entries are small, are all such: this skips
+#: a square root and a division on their chain of dependent operations).
+TINY_ROTATION = 2.0 ** -27
+
+#: numpy's pairwise summation: blocks of at most this many terms, summed in
+#: eight interleaved partial sums.
+PAIRWISE_BLOCK = 128
+
+#: Rows of the explicit stacks of :func:`pairwise_sum` (its splits halve a
+#: range: 2 log2(n / 64) + 1 frames for n terms).
+PAIRWISE_STACK = 130
+
+#: Runs of at most this many keys are ranked by insertion sort.
+INSERTION_RUN = 24
+
+
+# Working arrays, allocated once a build. Coordinates are kept one array per
+# axis, so that the loops over points read consecutive floats.
+
+
+@numba.njit(cache=True)
+def axes_scratch(n):
+    """What :func:`covariance` works in, for up to n points: (3, n), the
+    points times 2**-e."""
+    return np.empty((3, max(n, 1)))
+
+
+@numba.njit(cache=True)
+def split_scratch(m):
+    """What a split works in, for m triangles: ``(x, y, z)`` (9m,) sets of
+    points (the six candidate halves' at once), ``keys`` (3, m) the
+    triangles' centroids along three axes and ``ranked`` (3, m) their ranks
+    along each, ``bucket`` (m,) and ``counts``
+    (m + 1,) int64, and for the six candidate halves (the first and second
+    of each axis, and the node itself last) their covariance matrices
+    ``a``, rotations ``v``, ``done`` flags and principal ``axes`` (7, 3, 3)."""
+    m = max(m, 1)
+    return (np.empty(9 * m), np.empty(9 * m), np.empty(9 * m), np.empty((3, m)),
+            np.empty((3, m), dtype=np.int64), np.empty(m, dtype=np.int64),
+            np.empty(m + 1, dtype=np.int64), np.empty((7, 3, 3)), np.empty((7, 3, 3)),
+            np.empty(7, dtype=np.bool_), np.empty((7, 3, 3)))
+
+
+# -- the principal axes ---------------------------------------------------------------
+
+
+@numba.njit(cache=True, inline="always")
+def largest_of(largest, x0, x1, x2):
+    """The largest of ``largest`` and the magnitudes of x0, x1, x2 (finite)."""
+    for c in (abs(x0), abs(x1), abs(x2)):
+        if c > largest:
+            largest = c
+    return largest
+
+
+@numba.njit(cache=True)
+def unit_exponent(largest):
+    """Mirrors: refsim.types.unit_exponent, given the largest magnitude."""
+    if largest == 0.0:
+        return -1075
+    return math.frexp(largest)[1]
+
+
+@numba.njit(cache=True)
+def block_sum(u, v, lo, n, mu, mv):
+    """numpy's pairwise sum of at most PAIRWISE_BLOCK terms (module
+    docstring), of the products ``(u[r] - mu) (v[r] - mv)`` for r in
+    ``lo..lo+n``: fewer than 8 one after another; else eight partial sums
+    over the multiples of 8, added as ``((r0 + r1) + (r2 + r3)) + ((r4 + r5)
+    + (r6 + r7))``, then the rest."""
+    if n < 8:
+        total = 0.0
+        for r in range(lo, lo + n):
+            total += (u[r] - mu) * (v[r] - mv)
+        return total
+    r0 = (u[lo] - mu) * (v[lo] - mv)
+    r1 = (u[lo + 1] - mu) * (v[lo + 1] - mv)
+    r2 = (u[lo + 2] - mu) * (v[lo + 2] - mv)
+    r3 = (u[lo + 3] - mu) * (v[lo + 3] - mv)
+    r4 = (u[lo + 4] - mu) * (v[lo + 4] - mv)
+    r5 = (u[lo + 5] - mu) * (v[lo + 5] - mv)
+    r6 = (u[lo + 6] - mu) * (v[lo + 6] - mv)
+    r7 = (u[lo + 7] - mu) * (v[lo + 7] - mv)
+    end = lo + n - n % 8
+    for i in range(lo + 8, end, 8):
+        r0 += (u[i] - mu) * (v[i] - mv)
+        r1 += (u[i + 1] - mu) * (v[i + 1] - mv)
+        r2 += (u[i + 2] - mu) * (v[i + 2] - mv)
+        r3 += (u[i + 3] - mu) * (v[i + 3] - mv)
+        r4 += (u[i + 4] - mu) * (v[i + 4] - mv)
+        r5 += (u[i + 5] - mu) * (v[i + 5] - mv)
+        r6 += (u[i + 6] - mu) * (v[i + 6] - mv)
+        r7 += (u[i + 7] - mu) * (v[i + 7] - mv)
+    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    for r in range(end, lo + n):
+        total += (u[r] - mu) * (v[r] - mv)
+    return total
+
+
+@numba.njit(cache=True)
+def pairwise_sum(u, v, n, mu, mv):
+    """``np.sum((u[:n] - mu) * (v[:n] - mv))``'s pairwise sum (module
+    docstring), before numpy adds it to 0.0: a range longer than
+    PAIRWISE_BLOCK is split at a multiple of 8 below its half and the
+    halves' sums added. Written with explicit stacks (``frames`` of (start,
+    length, halves done), ``values`` of sums), not by recursion: numba's
+    cache reloads recursive functions wrongly (numba issue 6061)."""
+    if n <= PAIRWISE_BLOCK:
+        return block_sum(u, v, 0, n, mu, mv)
+    frames = np.empty((PAIRWISE_STACK, 3), dtype=np.int64)
+    values = np.empty(PAIRWISE_STACK)
+    frames[0, 0], frames[0, 1], frames[0, 2] = 0, n, 0
+    top, stored = 1, 0
+    while top > 0:
+        lo, length, split = frames[top - 1, 0], frames[top - 1, 1], frames[top - 1, 2]
+        if length <= PAIRWISE_BLOCK:
+            values[stored] = block_sum(u, v, lo, length, mu, mv)
+            stored += 1
+            top -= 1
+        elif split == 0:
+            half = length // 2
+            half -= half % 8
+            frames[top - 1, 2] = 1
+            frames[top, 0], frames[top, 1], frames[top, 2] = lo + half, length - half, 0
+            frames[top + 1, 0], frames[top + 1, 1], frames[top + 1, 2] = lo, half, 0
+            top += 2                            # the first half on top: summed first
+        else:
+            values[stored - 2] = values[stored - 2] + values[stored - 1]   # first + second
+            stored -= 1
+            top -= 1
+    return values[0]
+
+
+@numba.njit(cache=True)
+def covariance(x, y, z, n, largest, a, scaled):
+    """The covariance matrix that bvh_exact.principal_axes diagonalizes, of
+    the first n points (largest magnitude ``largest``), into ``a`` (3, 3);
+    for fewer than two points zeros (whose eigenvectors,
+    :func:`symmetric_eigenvectors`, are the identity principal_axes returns
+    then). ``scaled`` (3, n) is scratch."""
+    if n < 2:
+        a[:, :] = 0.0
+        return
+    # np.ldexp(points, -e): the points themselves when e = 0 (coordinates
+    # already in [0.5, 1), as build_tree leaves many sets), a product by
+    # 2**-e when that is a normal float (both round the exact value once),
+    # else ldexp itself
+    k = -unit_exponent(largest)
+    if k != 0:
+        factor = math.ldexp(1.0, k)
+        normal = -1022 <= k <= 1023
+        for r in range(n):
+            if normal:
+                scaled[0, r], scaled[1, r], scaled[2, r] = x[r] * factor, y[r] * factor, \
+                    z[r] * factor
+            else:
+                scaled[0, r], scaled[1, r], scaled[2, r] = math.ldexp(x[r], k), \
+                    math.ldexp(y[r], k), math.ldexp(z[r], k)
+        x, y, z = scaled[0], scaled[1], scaled[2]
+    m0 = m1 = m2 = 0.0                    # points.mean(axis=0): rows in turn, from 0.0
+    for r in range(n):
+        m0 += x[r]
+        m1 += y[r]
+        m2 += z[r]
+    m0, m1, m2 = m0 / n, m1 / n, m2 / n
+    # np.sum adds the pairwise sum to 0.0 (which turns a -0.0 into 0.0)
+    a[0, 0] = 0.0 + pairwise_sum(x, x, n, m0, m0)
+    a[1, 1] = 0.0 + pairwise_sum(y, y, n, m1, m1)
+    a[2, 2] = 0.0 + pairwise_sum(z, z, n, m2, m2)
+    a[0, 1] = a[1, 0] = 0.0 + pairwise_sum(x, y, n, m0, m1)
+    a[0, 2] = a[2, 0] = 0.0 + pairwise_sum(x, z, n, m0, m2)
+    a[1, 2] = a[2, 1] = 0.0 + pairwise_sum(y, z, n, m1, m2)
+
+
+@numba.njit(cache=True)
+def symmetric_eigenvectors(a, v, axes, count, done):
+    """Mirrors: bvh_exact.symmetric_eigenvectors, of ``count`` matrices at
+    once: ``a`` (count, 3, 3) is overwritten, ``v`` (count, 3, 3) and
+    ``done`` (count,) are scratch, the eigenvectors (columns) go to ``axes``
+    (count, 3, 3).
+
+    Each matrix takes the readable function's steps, in its order; the
+    matrices take them in turns (rotation (p, q) of a sweep for each, then
+    the next), so that the processor overlaps their chains of dependent
+    divisions and square roots, which a single 3 x 3 problem waits on."""
+    for m in range(count):
+        done[m] = False
+        for i in range(3):
+            for j in range(3):
+                v[m, i, j] = 1.0 if i == j else 0.0
+    for _ in range(JACOBI_SWEEPS):
+        remaining = 0
+        for m in range(count):
+            if not done[m]:
+                done[m] = abs(a[m, 0, 1]) + abs(a[m, 0, 2]) + abs(a[m, 1, 2]) == 0.0
+                remaining += not done[m]
+        if remaining == 0:
+            break
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            for m in range(count):
+                if done[m] or a[m, p, q] == 0.0:
+                    continue
+                tau = (a[m, q, q] - a[m, p, p]) / (2.0 * a[m, p, q])
+                t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+                if abs(t) <= TINY_ROTATION:
+                    c, s = 1.0, t                 # what the next two lines give then
+                else:
+                    c = 1.0 / math.sqrt(1.0 + t * t)
+                    s = t * c
+                for r in range(3):                # a <- a J (columns p, q)
+                    arp, arq = a[m, r, p], a[m, r, q]
+                    a[m, r, p], a[m, r, q] = c * arp - s * arq, s * arp + c * arq
+                for r in range(3):                # a <- J^T a (rows p, q)
+                    apr, aqr = a[m, p, r], a[m, q, r]
+                    a[m, p, r], a[m, q, r] = c * apr - s * aqr, s * apr + c * aqr
+                a[m, p, q] = a[m, q, p] = 0.0
+                for r in range(3):                # v <- v J
+                    vrp, vrq = v[m, r, p], v[m, r, q]
+                    v[m, r, p], v[m, r, q] = c * vrp - s * vrq, s * vrp + c * vrq
+    for m in range(count):
+        # columns by increasing eigenvalue, ties by index (a stable sort of three)
+        o0, o1, o2 = 0, 1, 2
+        if a[m, o1, o1] < a[m, o0, o0]:
+            o0, o1 = o1, o0
+        if a[m, o2, o2] < a[m, o1, o1]:
+            o1, o2 = o2, o1
+            if a[m, o1, o1] < a[m, o0, o0]:
+                o0, o1 = o1, o0
+        for column, i in enumerate((o0, o1, o2)):
+            big = 0                                   # np.argmax: the first largest
+            for r in range(1, 3):
+                if abs(v[m, r, i]) > abs(v[m, big, i]):
+                    big = r
+            flip = v[m, big, i] < 0.0
+            for r in range(3):
+                axes[m, r, column] = -v[m, r, i] if flip else v[m, r, i]
+
+
+@numba.njit(cache=True, inline="always")
+def project(p0, p1, p2, a0, a1, a2):
+    """Mirrors: bvh_exact.project, one entry: ``(p0 a0j + p1 a1j) + p2 a2j``
+    for the axis column ``(a0, a1, a2)``."""
+    return (p0 * a0 + p1 * a1) + p2 * a2
+
+
+@numba.njit(cache=True)
+def extents(x, y, z, n, axes):
+    """``(lo, hi)``: ``project(points, axes).min(axis=0)`` and ``.max(axis=0)``
+    of the first n points, three floats each; of two equal values (0.0 and
+    -0.0) the later, as numpy's."""
+    a00, a01, a02 = axes[0, 0], axes[0, 1], axes[0, 2]
+    a10, a11, a12 = axes[1, 0], axes[1, 1], axes[1, 2]
+    a20, a21, a22 = axes[2, 0], axes[2, 1], axes[2, 2]
+    lo0 = hi0 = project(x[0], y[0], z[0], a00, a10, a20)
+    lo1 = hi1 = project(x[0], y[0], z[0], a01, a11, a21)
+    lo2 = hi2 = project(x[0], y[0], z[0], a02, a12, a22)
+    for r in range(1, n):
+        p0 = project(x[r], y[r], z[r], a00, a10, a20)
+        p1 = project(x[r], y[r], z[r], a01, a11, a21)
+        p2 = project(x[r], y[r], z[r], a02, a12, a22)
+        lo0 = lo0 if lo0 < p0 else p0
+        lo1 = lo1 if lo1 < p1 else p1
+        lo2 = lo2 if lo2 < p2 else p2
+        hi0 = hi0 if hi0 > p0 else p0
+        hi1 = hi1 if hi1 > p1 else p1
+        hi2 = hi2 if hi2 > p2 else p2
+    return (lo0, lo1, lo2), (hi0, hi1, hi2)
+
+
+# -- ranking ------------------------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def insertion_sort(key, members, ranked, lo, hi):
+    """``ranked[lo:hi]`` put in ``np.lexsort((members, key))`` order (keys
+    without NaN): by key, ties by member."""
+    for r in range(lo + 1, hi):
+        p = ranked[r]
+        kp, mp = key[p], members[p]
+        s = r
+        while s > lo:
+            q = ranked[s - 1]
+            if not (kp < key[q] or (kp == key[q] and mp < members[q])):
+                break
+            ranked[s] = q
+            s -= 1
+        ranked[s] = p
+
+
+@numba.njit(cache=True)
+def sort_by_argsort(key, members, ranked, lo, hi):
+    """``ranked[lo:hi]`` put in ``np.lexsort((members, key))`` order by a
+    stable sort of the keys and a sort by member of each run of ties (keys
+    equal, or both NaN)."""
+    run = ranked[lo:hi].copy()
+    by_key = np.argsort(key[run], kind="mergesort")
+    for i in range(hi - lo):
+        ranked[lo + i] = run[by_key[i]]
+    first = lo
+    for r in range(lo + 1, hi + 1):
+        if r < hi:
+            x, y = key[ranked[r]], key[ranked[first]]
+            if x == y or (x != x and y != y):
+                continue
+        if r - first > 1:
+            insertion_by_member = ranked[first:r].copy()
+            order = np.argsort(members[insertion_by_member])
+            for i in range(r - first):
+                ranked[first + i] = insertion_by_member[order[i]]
+        first = r
+
+
+@numba.njit(cache=True)
+def rank(key, members, k, ranked, bucket, counts):
+    """Positions ``0..k-1`` into ``ranked[:k]`` in the order of
+    ``np.lexsort((members[:k], key[:k]))``: by key, ties by member.
+
+    The order is unique (members differ), so any sort that compares the same
+    pairs gives it: the keys are dealt into k buckets by ``(key - lo) *
+    (k / (hi - lo))`` rounded down, which never decreases as the key grows
+    (each operation is monotone) and puts equal keys together, and each
+    bucket is then sorted by comparisons. Keys with a NaN, or too close for
+    the buckets, go to :func:`sort_by_argsort`. ``bucket`` (k,) and
+    ``counts`` (k + 1,) are scratch."""
+    for i in range(k):
+        ranked[i] = i
+    if k <= INSERTION_RUN:
+        for i in range(k):
+            if key[i] != key[i]:
+                sort_by_argsort(key, members, ranked, 0, k)
+                return
+        insertion_sort(key, members, ranked, 0, k)
+        return
+    lo, hi = np.inf, -np.inf
+    for i in range(k):
+        if key[i] != key[i]:
+            sort_by_argsort(key, members, ranked, 0, k)
+            return
+        lo, hi = min(lo, key[i]), max(hi, key[i])
+    scale = k / (hi - lo) if hi > lo else np.inf
+    if not scale < np.inf:
+        sort_by_argsort(key, members, ranked, 0, k)
+        return
+    counts[:k + 1] = 0
+    for i in range(k):
+        b = min(int((key[i] - lo) * scale), k - 1)
+        bucket[i] = b
+        counts[b + 1] += 1
+    for b in range(k):
+        counts[b + 1] += counts[b]
+    for i in range(k):
+        ranked[counts[bucket[i]]] = i
+        counts[bucket[i]] += 1
+    first = 0                                   # counts[b]: now the end of bucket b
+    for b in range(k):
+        end = counts[b]
+        if end - first > INSERTION_RUN:
+            sort_by_argsort(key, members, ranked, first, end)
+        elif end - first > 1:
+            insertion_sort(key, members, ranked, first, end)
+        first = end
+
+
+# -- the split rules ----------------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def least_axis(measures):
+    """The axis (0, 1, 2) of least ``measures``, as both readable splits
+    choose it: ``if measure < best`` from inf, so ties keep the lower axis."""
+    best, chosen = np.inf, 0
+    for axis in range(3):
+        if measures[axis] < best:
+            best, chosen = measures[axis], axis
+    return chosen
+
+
+@numba.njit(cache=True)
+def gather(tx, ty, tz, members, ranked, lo, hi, x, y, z):
+    """The vertices of triangles ``members[ranked[lo:hi]]`` into x, y, z,
+    three a triangle (``triangles[...].reshape(-1, 3)``): ``(their number,
+    their largest magnitude)``."""
+    n = 0
+    largest = 0.0
+    for r in range(lo, hi):
+        t = 3 * members[ranked[r]]
+        for v in range(t, t + 3):
+            x[n], y[n], z[n] = tx[v], ty[v], tz[v]
+            largest = largest_of(largest, tx[v], ty[v], tz[v])
+            n += 1
+    return n, largest
+
+
+#: Where :func:`split_scratch` keeps the node's own principal axes.
+NODE = 6
+
+
+@numba.njit(cache=True)
+def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
+    """Mirrors: bvh_exact.least_volume_split, of ``members[:k]``: returns the
+    chosen axis; its order (positions in members) is ``ranked[axis]``, the
+    principal axes of its halves ``axes[2 axis]`` and ``axes[2 axis + 1]``.
+
+    The node's own principal axes are those of the half its parent chose
+    (the same triangles in the same order): given in ``axes[NODE]`` when
+    ``known``, else (at the root) computed. The six halves' covariances are
+    formed first and their eigenvectors found together
+    (:func:`symmetric_eigenvectors`), then their volumes compared."""
+    x, y, z, keys, ranked, bucket, counts, a, v, done, axes = work
+    if not known:
+        for i in range(k):
+            ranked[0, i] = i
+        n, largest = gather(tx, ty, tz, members, ranked[0], 0, k, x, y, z)
+        covariance(x, y, z, n, largest, a[NODE], axes_work)
+        symmetric_eigenvectors(a[NODE:], v[NODE:], axes[NODE:], 1, done[NODE:])
+    node = axes[NODE]
+    a00, a01, a02 = node[0, 0], node[0, 1], node[0, 2]
+    a10, a11, a12 = node[1, 0], node[1, 1], node[1, 2]
+    a20, a21, a22 = node[2, 0], node[2, 1], node[2, 2]
+    for r in range(k):
+        t = 3 * members[r]                    # mean(axis=1): from 0.0, then / 3
+        c0 = (((0.0 + tx[t]) + tx[t + 1]) + tx[t + 2]) / 3.0
+        c1 = (((0.0 + ty[t]) + ty[t + 1]) + ty[t + 2]) / 3.0
+        c2 = (((0.0 + tz[t]) + tz[t + 1]) + tz[t + 2]) / 3.0
+        keys[0, r] = project(c0, c1, c2, a00, a10, a20)
+        keys[1, r] = project(c0, c1, c2, a01, a11, a21)
+        keys[2, r] = project(c0, c1, c2, a02, a12, a22)
+    for axis in range(3):                     # each half's points at 3 lo of its axis's third
+        rank(keys[axis], members, k, ranked[axis], bucket, counts)
+        for half, (lo, hi) in enumerate(((0, mid), (mid, k))):
+            at = 3 * (axis * k + lo)
+            n, largest = gather(tx, ty, tz, members, ranked[axis], lo, hi, x[at:], y[at:],
+                                z[at:])
+            covariance(x[at:], y[at:], z[at:], n, largest, a[2 * axis + half], axes_work)
+    symmetric_eigenvectors(a, v, axes, 6, done)
+    volumes = np.empty(3)
+    for axis in range(3):
+        for half, (lo, hi) in enumerate(((0, mid), (mid, k))):
+            at, n = 3 * (axis * k + lo), 3 * (hi - lo)
+            low, high = extents(x[at:], y[at:], z[at:], n, axes[2 * axis + half])
+            part = ((high[0] - low[0]) * (high[1] - low[1])) * (high[2] - low[2])
+            volumes[axis] = part if half == 0 else volumes[axis] + part   # box_volume + ...
+    return least_axis(volumes)
+
+
+@numba.njit(cache=True)
+def surface_area(tri_lo, tri_hi, ranked, lo, hi):
+    """Mirrors: bvh._surface_area, of the boxes ``ranked[lo:hi]`` (columns
+    of ``tri_lo``, ``tri_hi`` (3, k))."""
+    top0 = top1 = top2 = -np.inf
+    bottom0 = bottom1 = bottom2 = np.inf
+    for r in range(lo, hi):
+        t = ranked[r]
+        top0, top1, top2 = max(top0, tri_hi[0, t]), max(top1, tri_hi[1, t]), \
+            max(top2, tri_hi[2, t])
+        bottom0, bottom1, bottom2 = min(bottom0, tri_lo[0, t]), min(bottom1, tri_lo[1, t]), \
+            min(bottom2, tri_lo[2, t])
+    d0, d1, d2 = top0 - bottom0, top1 - bottom1, top2 - bottom2
+    return (d0 * d1 + d1 * d2) + d2 * d0
+
+
+@numba.njit(cache=True)
+def least_area_split(tx, ty, tz, members, k, mid, work):
+    """Mirrors: bvh.least_area_split, of ``members[:k]``: returns the chosen
+    axis; its order (positions in members) is ``ranked[axis]``."""
+    x, y, _, keys, ranked, bucket, counts, _, _, _, _ = work
+    tri_lo = x[:3 * k].reshape((3, k))       # scratch: (3, k) each
+    tri_hi = y[:3 * k].reshape((3, k))
+    for r in range(k):
+        t = 3 * members[r]
+        for j, c in enumerate((tx, ty, tz)):
+            x0, x1, x2 = c[t], c[t + 1], c[t + 2]
+            keys[j, r] = (((0.0 + x0) + x1) + x2) / 3.0
+            tri_lo[j, r] = min(min(x0, x1), x2)
+            tri_hi[j, r] = max(max(x0, x1), x2)
+    areas = np.empty(3)
+    for axis in range(3):
+        rank(keys[axis], members, k, ranked[axis], bucket, counts)
+        areas[axis] = (surface_area(tri_lo, tri_hi, ranked[axis], 0, mid)
+                       + surface_area(tri_lo, tri_hi, ranked[axis], mid, k))
+    return least_axis(areas)
+
+
+# -- the build ----------------------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def build_tree(tx, ty, tz, leaf_size, rule):
+    """Mirrors: bvh.build_tree, with its split ``bvh.least_area_split``
+    (``rule`` LEAST_AREA) or ``bvh_exact.least_volume_split`` (LEAST_VOLUME).
+
+    tx, ty, tz : (3m,) the coordinates of the faces' vertices as build_tree
+        scales them (times ``2**-unit_exponent(vertices)``), three a face.
+
+    Returns ``(left, right, start, count, order)``, int64 arrays as
+    :class:`refsim.collision.bvh.TriangleTree` holds them."""
+    m = len(tx) // 3
+    capacity = max(2 * m, 1)
+    left = np.full(capacity, -1, dtype=np.int64)
+    right = np.full(capacity, -1, dtype=np.int64)
+    start = np.zeros(capacity, dtype=np.int64)
+    count = np.zeros(capacity, dtype=np.int64)
+    order = np.arange(m, dtype=np.int64)
+    members = np.empty(max(m, 1), dtype=np.int64)
+    work, axes_work = split_scratch(m), axes_scratch(3 * max(m, 1))
+    ranked, axes = work[4], work[10]
+    count[0] = m
+    nodes = 1
+    # pending nodes, (node, lo, hi, axes known), each with its principal axes
+    stack = np.empty((capacity, 4), dtype=np.int64)
+    stack_axes = np.empty((capacity, 3, 3))
+    stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = 0, 0, m, 0
+    top = 1
+    while top > 0:
+        top -= 1
+        node, lo, hi, known = stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3]
+        if hi - lo <= leaf_size:
+            continue
+        k, mid = hi - lo, (hi - lo) // 2
+        members[:k] = order[lo:hi]
+        if rule == LEAST_AREA:
+            chosen = least_area_split(tx, ty, tz, members, k, mid, work)
+        else:
+            axes[NODE] = stack_axes[top]
+            chosen = least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work)
+        for r in range(k):
+            order[lo + r] = members[ranked[chosen, r]]
+        a, b = nodes, nodes + 1
+        nodes += 2
+        start[a], count[a] = lo, mid
+        start[b], count[b] = lo + mid, k - mid
+        left[node], right[node] = a, b
+        known = rule == LEAST_VOLUME          # the children's axes: their halves'
+        stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3] = b, lo + mid, hi, known
+        stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2], stack[top + 1, 3] = \
+            a, lo, lo + mid, known
+        stack_axes[top] = axes[2 * chosen + 1]
+        stack_axes[top + 1] = axes[2 * chosen]
+        top += 2                              # a, then its subtree, before b
+    return (left[:nodes].copy(), right[:nodes].copy(), start[:nodes].copy(),
+            count[:nodes].copy(), order)
+
+
+# -- the oriented node boxes --------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def axes_deviation(axes):
+    """Mirrors: bvh_exact.axes_deviation."""
+    worst = 0.0
+    for i in range(3):
+        for j in range(3):
+            gram = (axes[0, i] * axes[0, j] + axes[1, i] * axes[1, j]) + axes[2, i] * axes[2, j]
+            off = abs(gram - (1.0 if i == j else 0.0))
+            if off > worst or off != off:     # np.max: a NaN wins
+                worst = off
+    return worst
+
+
+#: Nodes whose axes :func:`frame_boxes` finds together.
+BOX_BATCH = 16
+
+
+@numba.njit(cache=True)
+def node_points(vx, vy, vz, vertices, n, x, y, z):
+    """The mesh vertices whose indices are ``vertices[:n]`` into x, y, z;
+    returns their largest magnitude."""
+    largest = 0.0
+    for r in range(n):
+        x[r], y[r], z[r] = vx[vertices[r]], vy[vertices[r]], vz[vertices[r]]
+        largest = largest_of(largest, x[r], y[r], z[r])
+    return largest
+
+
+@numba.njit(cache=True)
+def oriented_box(x, y, z, n, axes, box):
+    """Mirrors: bvh_exact.oriented_box, of the first n points along
+    ``axes``; writes ``box`` (15,), a row of
+    :class:`refsim.collision.bvh_exact.FrameTree`'s boxes."""
+    lo, hi = extents(x, y, z, n, axes)
+    mid0, mid1, mid2 = (lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2
+    for i in range(3):
+        box[i] = (axes[i, 0] * mid0 + axes[i, 1] * mid1) + axes[i, 2] * mid2
+    a00, a01, a02 = axes[0, 0], axes[0, 1], axes[0, 2]
+    a10, a11, a12 = axes[1, 0], axes[1, 1], axes[1, 2]
+    a20, a21, a22 = axes[2, 0], axes[2, 1], axes[2, 2]
+    c0, c1, c2 = box[0], box[1], box[2]
+    h0 = h1 = h2 = 0.0
+    for r in range(n):
+        d0, d1, d2 = x[r] - c0, y[r] - c1, z[r] - c2
+        p0 = abs(project(d0, d1, d2, a00, a10, a20))
+        p1 = abs(project(d0, d1, d2, a01, a11, a21))
+        p2 = abs(project(d0, d1, d2, a02, a12, a22))
+        h0, h1, h2 = h0 if h0 > p0 else p0, h1 if h1 > p1 else p1, h2 if h2 > p2 else p2
+    box[3], box[4], box[5] = h0, h1, h2
+    for i in range(3):
+        for j in range(3):
+            box[6 + 3 * i + j] = axes[i, j]
+
+
+@numba.njit(cache=True)
+def visit_nodes(vx, vy, vz, faces, left, right, start, count, order, boxing, a, axes, boxes):
+    """Each node's points, ``vertices[np.unique(faces[members])]`` (its
+    vertex indices in increasing order), in turn: their covariance into
+    ``a[node]`` (``boxing`` False), or their box along ``axes[node]`` into
+    ``boxes[node]`` (True).
+
+    The root's indices are every vertex a face uses, and a child's are
+    those of its parent's that its own faces use, in the same order; so
+    the nodes are visited depth first, each child's list filtered from its
+    parent's (``marks`` flags a child's vertices) and kept on a stack of
+    lists while its subtree is done: O(k) a node of k triangles, no sort."""
+    m = len(order)
+    x, y, z = np.empty(3 * m), np.empty(3 * m), np.empty(3 * m)
+    axes_work = axes_scratch(3 * m)
+    marks = np.full(len(vx), -1, dtype=np.int64)
+    lists = np.empty(6 * m + 3, dtype=np.int64)      # a path's lists: at most 3 (2m) long
+    for t in range(m):
+        for v in range(3):
+            marks[faces[t, v]] = 0
+    length = 0
+    for i in range(len(vx)):
+        if marks[i] == 0:
+            lists[length] = i
+            length += 1
+    stack = np.empty((len(left) + 1, 4), dtype=np.int64)  # node, list start, length, phase
+    stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = 0, 0, length, 0
+    top = 1
+    while top > 0:
+        node, at, length, phase = stack[top - 1, 0], stack[top - 1, 1], stack[top - 1, 2], \
+            stack[top - 1, 3]
+        if phase == 0:
+            largest = node_points(vx, vy, vz, lists[at:at + length], length, x, y, z)
+            if boxing:
+                oriented_box(x, y, z, length, axes[node], boxes[node])
+            else:
+                covariance(x, y, z, length, largest, a[node], axes_work)
+            if left[node] < 0:
+                top -= 1
+                continue
+        if phase == 2:
+            top -= 1
+            continue
+        child = left[node] if phase == 0 else right[node]
+        stack[top - 1, 3] = phase + 1
+        for r in range(start[child], start[child] + count[child]):
+            for v in range(3):
+                marks[faces[order[r], v]] = child
+        kept = at + length
+        for i in range(at, at + length):
+            if marks[lists[i]] == child:
+                lists[kept] = lists[i]
+                kept += 1
+        stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3] = \
+            child, at + length, kept - at - length, 0
+        top += 1
+
+
+@numba.njit(cache=True)
+def frame_boxes(vx, vy, vz, faces, left, right, start, count, order):
+    """Mirrors: bvh_exact.build_frame_tree (with its default axes,
+    bvh_exact.principal_axes), its boxes and axes deviation: ``(boxes
+    (nodes, 15), axes_deviation)`` for the tree of ``left``, ``right``,
+    ``start``, ``count``, ``order``; vx, vy, vz (n,) the mesh's vertex
+    coordinates. Each node's covariance is formed (:func:`visit_nodes`), the
+    eigenvectors found BOX_BATCH nodes at a time, then each box formed."""
+    n_nodes = len(left)
+    a, axes = np.empty((n_nodes, 3, 3)), np.empty((n_nodes, 3, 3))
+    v, done = np.empty((BOX_BATCH, 3, 3)), np.empty(BOX_BATCH, dtype=np.bool_)
+    boxes = np.empty((n_nodes, 15))
+    visit_nodes(vx, vy, vz, faces, left, right, start, count, order, False, a, axes, boxes)
+    worst = 0.0
+    for first in range(0, n_nodes, BOX_BATCH):
+        last = min(first + BOX_BATCH, n_nodes)
+        symmetric_eigenvectors(a[first:last], v, axes[first:last], last - first, done)
+        for node in range(first, last):
+            off = axes_deviation(axes[node])
+            if not (off <= worst):            # max(worst, off), a NaN counted as inf
+                worst = off if off < np.inf else np.inf
+    visit_nodes(vx, vy, vz, faces, left, right, start, count, order, True, a, axes, boxes)
+    return boxes, worst

@@ -1,0 +1,145 @@
+"""The compiled build of the hierarchies (refsim.collision._numba_build)
+gives the readable build's trees bit for bit: every array of the
+triangle-aabb level's TriangleTree (least-area split) and of the exact
+level's FrameTree (least-volume split, oriented node boxes, axes
+deviation), on the bundled meshes and on generated ones: trimesh's
+primitives, random convex hulls, a noisy blob, a flat mesh (signed zeros
+in the node boxes), coincident triangles (ties in every ranking), and
+meshes scaled far from 1 (the power-of-two scaling of the splits and the
+axes)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from refsim.bundled import models_dir
+from refsim.collision import bvh, bvh_exact
+from refsim.models.loading import load_model
+from refsim.models.mesh import Mesh
+
+#: Bundled meshes, all but sphere-20k.ac, whose readable build alone takes
+#: tens of seconds (its compiled build is compared in the benchmarks'
+#: answers, tests/benchmarks/test_bench_tree_build.py).
+BUNDLED = sorted(p.name for p in models_dir().glob("*.ac") if p.name != "sphere-20k.ac")
+
+SEED = 20261202
+
+
+def _blob(rng) -> trimesh.Trimesh:
+    """An icosphere with each vertex moved radially by seeded noise."""
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    radii = 1.0 + 0.15 * rng.standard_normal(len(sphere.vertices))
+    return trimesh.Trimesh(sphere.vertices * radii[:, None], sphere.faces, process=False)
+
+
+def _flat_grid() -> trimesh.Trimesh:
+    """A 7 x 5 grid of squares in the plane z = -0.0, two triangles each, at
+    x <= 0: the nodes' points project to zeros of both signs along their
+    normal, and some node boxes' centres get z = -0.0, others 0.0."""
+    xs, ys = np.meshgrid(np.linspace(-2.0, 0.0, 8), np.linspace(-0.5, 0.5, 6), indexing="ij")
+    vertices = np.column_stack([xs.ravel(), ys.ravel(), np.full(xs.size, -0.0)])
+    index = np.arange(xs.size).reshape(xs.shape)
+    a, b, c, d = index[:-1, :-1], index[1:, :-1], index[1:, 1:], index[:-1, 1:]
+    faces = np.concatenate([np.column_stack([a.ravel(), b.ravel(), c.ravel()]),
+                            np.column_stack([a.ravel(), c.ravel(), d.ravel()])])
+    return trimesh.Trimesh(vertices, faces, process=False)
+
+
+def _generated() -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    rng = np.random.default_rng(SEED)
+    meshes = {f"icosphere-{s}": trimesh.creation.icosphere(subdivisions=s) for s in range(4)}
+    meshes.update({
+        "torus": trimesh.creation.torus(major_radius=1.0, minor_radius=0.3),
+        "capsule": trimesh.creation.capsule(height=2.0, radius=0.5),
+        "cylinder": trimesh.creation.cylinder(radius=0.5, height=2.0, sections=17),
+        "box": trimesh.creation.box(extents=(1.0, 2.0, 3.0)),
+        "blob": _blob(rng),
+        "flat-grid": _flat_grid(),
+    })
+    for n in (8, 60, 400):
+        meshes[f"hull-{n}"] = trimesh.convex.convex_hull(rng.standard_normal((n, 3)))
+    out = {name: (np.asarray(m.vertices, dtype=np.float64), np.asarray(m.faces, dtype=np.int64))
+           for name, m in meshes.items()}
+    # every triangle twice: equal centroids, ties broken by face index
+    v, f = out["icosphere-1"]
+    out["coincident"] = (v, np.concatenate([f, f[::-1]]))
+    torus = out["torus"]
+    # subnormal coordinates (the axes' scaling, 2**1040 or so, is beyond one
+    # product by a normal power of two) and coordinates near 2**1000
+    out["torus-tiny"] = (torus[0] * 2.0 ** -1040, torus[1])
+    out["torus-huge"] = (torus[0] * 2.0 ** 1000, torus[1])
+    return out
+
+
+GENERATED = _generated()
+
+
+def _mesh(name: str) -> Mesh:
+    """A new Mesh each call: nothing built yet."""
+    if name in GENERATED:
+        vertices, faces = GENERATED[name]
+        return Mesh(vertices, faces)
+    model = load_model(models_dir() / name)
+    return Mesh(model.vertices, model.faces)
+
+
+def _arrays(tree: bvh.TriangleTree) -> list[np.ndarray]:
+    return [tree.left, tree.right, tree.start, tree.count, tree.order]
+
+
+def _assert_same_bits(readable, compiled, what):
+    for r, c in zip(readable, compiled, strict=True):
+        r, c = np.asarray(r), np.asarray(c)
+        assert r.dtype == c.dtype and r.shape == c.shape, what
+        assert r.tobytes() == c.tobytes(), what
+
+
+@pytest.mark.parametrize("name", BUNDLED + sorted(GENERATED))
+def test_compiled_build_equals_readable_build_bit_for_bit(name):
+    readable_mesh, compiled_mesh = _mesh(name), _mesh(name)
+    for tree_of in (bvh.tree_of, bvh_exact.frame_topology_of):
+        _assert_same_bits(_arrays(tree_of(readable_mesh, "readable")),
+                          _arrays(tree_of(compiled_mesh, "compiled")), (name, tree_of.__name__))
+    readable = bvh_exact.frame_tree_of(readable_mesh, "readable")
+    compiled = bvh_exact.frame_tree_of(compiled_mesh, "compiled")
+    _assert_same_bits([*_arrays(readable.tree), readable.links, readable.boxes,
+                       readable.reach, readable.axes_deviation],
+                      [*_arrays(compiled.tree), compiled.links, compiled.boxes,
+                       compiled.reach, compiled.axes_deviation], name)
+
+
+def test_the_cases_reach_what_they_are_there_for():
+    """The flat grid's node boxes have centres with zeros of both signs; the
+    coincident triangles tie in every ranking; the tori lie at the ends of
+    float64's exponents."""
+    boxes = bvh_exact.frame_tree_of(_mesh("flat-grid"), "compiled").boxes
+    centre_z = boxes[:, 2]
+    assert (centre_z == 0.0).all()
+    assert np.signbit(centre_z).any() and not np.signbit(centre_z).all()
+    tree = bvh_exact.frame_topology_of(_mesh("coincident"), "compiled")
+    faces = GENERATED["coincident"][1]
+    leaves = [tree.order[s:s + c]
+              for s, c, left in zip(tree.start, tree.count, tree.left, strict=True) if left < 0]
+    shared = sum(len({tuple(sorted(faces[i])) for i in leaf}) < len(leaf) for leaf in leaves)
+    assert shared > 0                          # a leaf holds both copies of a triangle
+    for name, exponent in (("torus-tiny", -1040), ("torus-huge", 1000)):
+        reach = bvh_exact.frame_tree_of(_mesh(name), "compiled").reach
+        assert np.frexp(reach)[1] - exponent in (0, 1)
+
+
+def test_the_default_kernel_builds_the_compiled_tree_and_keeps_it():
+    mesh = _mesh("torus.ac")
+    frame = bvh_exact.frame_tree_of(mesh)
+    assert bvh_exact.frame_tree_of(mesh, "readable") is frame      # built once per mesh
+    assert bvh_exact.frame_topology_of(mesh) is frame.tree
+    assert bvh.tree_of(mesh) is bvh.tree_of(mesh, "readable")
+
+
+def test_an_unknown_split_rule_is_refused():
+    from refsim.errors import OptionError
+
+    vertices, faces = GENERATED["box"]
+    with pytest.raises(OptionError, match="split must be one of"):
+        bvh.build_tree_compiled(vertices, faces, "longest-axis")
