@@ -46,7 +46,7 @@ strike-e1, strike-e0.5 a ball (the sphere-2k model scaled to radius 0.25)
                        rod's velocity and spin and the ball's velocity
                        (:func:`strike_answer`); the ball does not spin, and
                        the angular momentum about any fixed point is kept
-offset-stack           resting contact between bodies, e 0.5, mu 0.5, 1 s:
+offset-stack           resting contact between bodies, e 0.5, mu 0.5, 0.5 s:
 cantilever             a cube on a cube 0.3 m off its centre; a rod on a cube
 board                  overhanging it by 1.9 m with its centre 0.4 m from the
                        cube's; a cube on a rod lying on the floor, 1.5 m from
@@ -158,7 +158,7 @@ STRIKE_RESTITUTIONS = (1.0, 0.5)
 #: and the bodies, each lowest face on the floor or on the body below.
 STACK_E = 0.5
 STACK_MU = 0.5
-STACK_DURATION = 1.0
+STACK_DURATION = 0.5
 _FLOOR = -HALF_SIZE
 STACKS = (
     ("offset-stack", ({"name": "base", "model": CUBE, "position": [0.0, _FLOOR + 0.5, 0.0]},

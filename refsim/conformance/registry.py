@@ -38,7 +38,7 @@ problems and the rigid scenes are fixed sets.
 
 Cost: building a case set is the cost its module states (the exact answers
 dominate it; measured times in docs/decisions/conformance.md); the rigid set
-is about 31,000 steps per engine; the registry itself is O(checks).
+is about 30,000 steps per engine; the registry itself is O(checks).
 """
 
 from __future__ import annotations

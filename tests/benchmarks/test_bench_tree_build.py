@@ -109,12 +109,28 @@ def _face_count(name: str) -> int:
     return len(load_model(models_dir() / name).faces)
 
 
-def _build_cases():
+#: Without timing (make test's --benchmark-disable, each benchmark run once
+#: to check its answers) the meshes stop here: the two largest, 82k and
+#: 200k faces, take 20 s of the suite and check nothing the others do not.
+SMOKE_FACES = 20480
+
+
+def pytest_generate_tests(metafunc):
+    """The meshes of this run: all when timing, up to SMOKE_FACES otherwise."""
+    timing = not metafunc.config.getoption("benchmark_disable", False)
+    meshes = [n for n in MESHES if timing or _face_count(n) <= SMOKE_FACES]
+    if metafunc.function.__name__ == "test_tree_build":
+        metafunc.parametrize("engine, level, name", _build_cases(meshes))
+    elif metafunc.function.__name__ == "test_first_query":
+        metafunc.parametrize("name", meshes)
+
+
+def _build_cases(meshes):
     """(engine, level, mesh) of every build timed: refsim's compiled build at
     both levels; its readable one up to READABLE_FACES faces; FCL's once per
     mesh (its BVHModel serves every query), as level "exact"."""
     cases = []
-    for name in MESHES:
+    for name in meshes:
         faces = _face_count(name)
         for level in ("exact", "aabb"):
             cases.append(("refsim-compiled", level, name))
@@ -124,7 +140,6 @@ def _build_cases():
     return cases
 
 
-@pytest.mark.parametrize("engine, level, name", _build_cases())
 def test_tree_build(benchmark, fcl, name, level, engine):
     vertices, faces = _arrays(name)
     benchmark.group = f"tree build: {name} ({len(faces)} faces)"
@@ -155,7 +170,6 @@ def test_tree_build(benchmark, fcl, name, level, engine):
 OFFSET = 0.5
 
 
-@pytest.mark.parametrize("name", MESHES)
 @pytest.mark.parametrize("engine", ["refsim", "fcl"])
 def test_first_query(benchmark, fcl, name, engine):
     vertices, faces = _arrays(name)

@@ -191,7 +191,7 @@ def test_the_stacks_rest_on_each_other_with_their_centres_over_the_support():
         assert v_top[:, 1].min() == pytest.approx(v_base[:, 1].max())     # on the base
         # the top's centre of mass (its mesh origin) over the base's top face
         assert v_base[:, 0].min() < top.position[0] < v_base[:, 0].max()
-        assert stack.scene.integration.duration == pytest.approx(1.0)
+        assert stack.scene.integration.duration == pytest.approx(0.5)
 
 
 def test_free_brick_and_its_closed_form():
