@@ -211,20 +211,13 @@ def _touch_y(model: str) -> float:
 
 def _scene(model: str, e: float, friction: float, height: float, duration: float,
            velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0)):
-    from refsim.scenes.loader import scene_from_dict
-    from refsim.solvers.integrate import covering_duration
-
-    return scene_from_dict({
-        "world": {"half_size": HALF_SIZE, "gravity": GRAVITY, "drag": 0.0,
-                  "restitution": e, "friction": friction},
-        "integration": {"solver": SOLVER, "step": STEP,
-                        "duration": covering_duration(duration, STEP)},
-        "collision": {"level": "aabb"},
-        "body": [{"name": "body", "model": model,
-                  "position": [0.0, _touch_y(model) + height, 0.0],
-                  "velocity": [float(c) for c in velocity],
-                  "angular_velocity": [float(c) for c in angular_velocity]}],
-    })
+    """One body, its lowest vertex ``height`` above the floor, level "aabb"
+    (one body: no body contact to find)."""
+    return _bodies_scene([{"name": "body", "model": model,
+                           "position": [0.0, _touch_y(model) + height, 0.0],
+                           "velocity": [float(c) for c in velocity],
+                           "angular_velocity": [float(c) for c in angular_velocity]}],
+                         GRAVITY, e, friction, duration, level="aabb")
 
 
 def oblique_impact_speed(v_y: float = OBLIQUE_VELOCITY[1],
@@ -287,8 +280,10 @@ def rigid_scenes() -> tuple[RigidScene, ...]:
     return tuple(scenes)
 
 
-def _bodies_scene(bodies, gravity: float, e: float, mu: float, duration: float):
-    """A scene of several bodies (``[[body]]`` tables) at the exact level."""
+def _bodies_scene(bodies, gravity: float, e: float, mu: float, duration: float,
+                  level: str = "exact"):
+    """A scene of the given bodies (``[[body]]`` tables), by default at the
+    exact level."""
     from refsim.scenes.loader import scene_from_dict
     from refsim.solvers.integrate import covering_duration
 
@@ -297,7 +292,7 @@ def _bodies_scene(bodies, gravity: float, e: float, mu: float, duration: float):
                   "restitution": e, "friction": mu},
         "integration": {"solver": SOLVER, "step": STEP,
                         "duration": covering_duration(duration, STEP)},
-        "collision": {"level": "exact"},
+        "collision": {"level": level},
         "body": [dict(b) for b in bodies]})
 
 
