@@ -102,7 +102,7 @@ from refsim.dynamics.rotation_seed import axes_step_seed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "19bac1ea9b12daa0"
+SOURCES_DIGEST = "d000e77ab0b1c6ac"
 
 #: The kernel took every step it was asked for.
 DONE = 0

@@ -475,17 +475,3 @@ def wall_impulses(r_a, n, inv_mass: float, I_inv, v, w, restitution: float,
     solve_contacts(r_a, None, n, inv_mass, I_inv, v, w, 0.0, None, None, None, restitution,
                    friction, RESTITUTION_THRESHOLD, ITERATIONS, P, kernel=kernel)
     return P
-
-
-def body_impulses(r_a, r_b, n, inv_mass_a: float, I_inv_a, v_a, w_a, inv_mass_b: float,
-                  I_inv_b, v_b, w_b, restitution: float, friction: float, *,
-                  kernel: str | None = None) -> np.ndarray:
-    """The impulses between bodies A and B at contact points ``r_a``, ``r_b``
-    (k, 3) (the same points, from each centre of mass), ``n`` from B into
-    A; the (3,) velocities updated in place. Returns the (k, 4) impulses."""
-    r_a = np.ascontiguousarray(r_a, dtype=np.float64)
-    P = np.empty((len(r_a), 4))
-    solve_contacts(r_a, np.ascontiguousarray(r_b, dtype=np.float64), n, inv_mass_a, I_inv_a,
-                   v_a, w_a, inv_mass_b, I_inv_b, v_b, w_b, restitution, friction,
-                   RESTITUTION_THRESHOLD, ITERATIONS, P, kernel=kernel)
-    return P
