@@ -92,12 +92,27 @@ def _cross(a, b):
     return out
 
 
+#: Points per block of the point-by-triangle arrays (:func:`winding_numbers`,
+#: :func:`exit_distances`): a block holds at most this many point-triangle
+#: pairs, so memory stays bounded (tens of MB) for meshes of any size.
+PAIRS_PER_BLOCK = 200_000
+
+
+def _blocks(points: np.ndarray, triangles: int):
+    """Slices of ``points`` holding at most PAIRS_PER_BLOCK point-triangle pairs."""
+    step = max(1, PAIRS_PER_BLOCK // max(triangles, 1))
+    return [slice(i, i + step) for i in range(0, len(points), step)]
+
+
 def winding_numbers(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """(k,) winding numbers of ``points`` (k, 3) about the closed surface of
     ``triangles`` (m, 3, 3): 1 inside, 0 outside (module docstring)."""
     points = np.asarray(points, dtype=np.float64)
     if not len(points):
         return np.zeros(0)
+    if len(points) * len(triangles) > PAIRS_PER_BLOCK:
+        return np.concatenate([winding_numbers(points[s], triangles)
+                               for s in _blocks(points, len(triangles))])
     t = triangles[None, :, :, :] - points[:, None, None, :]          # (k, m, 3, 3)
     a, b, c = t[..., 0, :], t[..., 1, :], t[..., 2, :]
     la, lb, lc = (np.sqrt(_dot(x, x)) for x in (a, b, c))
@@ -144,7 +159,7 @@ def intersection_points(mesh_a, pose_a, mesh_b, pose_b, kernel: str | None = Non
         parts += [edge_crossings(tri_a[pairs[:, 0]], tri_b[pairs[:, 1]]),
                   edge_crossings(tri_b[pairs[:, 1]], tri_a[pairs[:, 0]])]
     parts += [_vertices_within(world_a, world_b, tri_b), _vertices_within(world_b, world_a, tri_a)]
-    return np.concatenate(parts) if parts else np.empty((0, 3))
+    return np.concatenate(parts)
 
 
 #: A point of the intersection region counts as a contact when the region
@@ -158,11 +173,15 @@ def exit_distances(points: np.ndarray, direction, triangles: np.ndarray) -> np.n
     (m, 3, 3), wound counter-clockwise seen from outside, or on it) goes
     along the unit ``direction`` before it leaves the solid: the nearest
     crossing of a triangle facing along ``direction`` (0 for a point on
-    such a triangle; inf when the ray meets none, a point outside).
+    such a triangle; inf when the ray meets none; a point outside gets the
+    far side's distance, or inf).
     Moeller and Trumbore's ray-triangle test ("Fast, minimum storage
     ray-triangle intersection", J. Graphics Tools 2(1), 1997), element-wise;
     barycentric weights down to -:data:`CROSSING_SLACK`."""
     d = np.asarray(direction, dtype=np.float64)
+    if len(points) * len(triangles) > PAIRS_PER_BLOCK:
+        return np.concatenate([exit_distances(points[s], d, triangles)
+                               for s in _blocks(points, len(triangles))])
     a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
     e1, e2 = b - a, c - a
     leaving = _dot(_cross(e1, e2), d) > 0.0                       # (m,) faces along d
@@ -189,13 +208,13 @@ def deepest_points(points: np.ndarray, n, triangles_a: np.ndarray,
 
     A contact found after the bodies overlapped (by up to a step's approach)
     is a region whose thickness tells when each part of it began to touch:
-    the thickest part first. A faceted ball found 1.4 mm into a rod's face
-    overlaps it in a cap, thick at the ball's lowest vertex and thin where
-    the cap's rim crosses the face; impulses stopping the approach at the
-    rim's points, which the face's triangulation places unevenly, turned the
-    frictionless ball at 0.3 rad/s; at the thick part they act on its centre
-    line. Two faces resting on each other overlap in a slab of even
-    thickness: every corner stays."""
+    the thickest part first. A faceted ball found a millimetre into a rod's
+    face overlaps it in a cap, thick at the ball's lowest vertex and thin
+    where the cap's rim crosses the face; impulses stopping the approach at
+    the rim's points, which the face's triangulation places unevenly, turn
+    a frictionless ball; at the thick part they act on its centre line
+    (docs/decisions/body-contact.md). Two faces resting on each other
+    overlap in a slab of even thickness: every corner stays."""
     n = np.asarray(n, dtype=np.float64)
     if len(points) <= 1:
         return points
@@ -220,11 +239,11 @@ def contact_polygon(points: np.ndarray, n) -> np.ndarray:
     in pairs a depth apart along ``n`` (the top and bottom of the slab where
     two faces overlap) and with points on its faces between the corners
     (two cubes offset on each other: 50 points, 4 corners); the solve over
-    the corners costs less and leaves the same motion (measured: an offset
-    stack, a cantilever and a board moved 4e-5 to 1.4e-4 m in 2 s either
-    way, docs/decisions/body-contact.md). The in-plane component of a lever
+    the corners costs less and leaves the same motion
+    (docs/decisions/body-contact.md). The in-plane component of a lever
     arm is all a normal impulse's torque depends on, so which point of a
-    pair is kept does not matter for it.
+    pair is kept does not matter for the normal impulse; a friction
+    impulse's torque differs by the slab's depth times it.
 
     Points closer than 1e-12 of the set's span in the plane count as one;
     collinear points give the two ends; one point gives itself. Andrew's

@@ -143,7 +143,7 @@ FREE_DURATION = 12.0
 #: The strike (module docstring): the rod, the ball's scale (radius, m), its
 #: closing speed (m/s), its distance from the rod's centre (m), the gap it
 #: falls first (m; not a whole number of steps' travel, so that an engine
-#: finds the contact with the ball 1.4 mm into the rod, as it would any
+#: finds the contact with the ball 1.3 mm into the rod, as it would any
 #: impact), the run (s, the impact at about 5 ms) and its e.
 ROD = "long-box.ac"
 ROD_HALF_WIDTH = 0.125

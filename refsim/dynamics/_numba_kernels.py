@@ -94,15 +94,14 @@ import numba
 import numpy as np
 
 from refsim.bounds._numba_kernels import incremental_update_numba
-from refsim.collision.contact import DEEPEST_FRACTION
 from refsim.dynamics.impulse import solve_contacts_python
-from refsim.dynamics.rotation_impulse import free_rotation_step
+from refsim.dynamics.rotation_impulse import WALL_DEEPEST_FRACTION, free_rotation_step
 from refsim.dynamics.rotation_seed import axes_step_seed
 
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "d000e77ab0b1c6ac"
+SOURCES_DIGEST = "ef12449d83608703"
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -625,7 +624,7 @@ def _deepest(b, k, low, wall, o_k, R, vertices_t, past, count):
     """Mirrors the depth filter of
     :func:`refsim.dynamics.rotation_impulse.wall_contacts`: of the ``count``
     vertices in ``past`` (past the wall, in increasing order), those at
-    least DEEPEST_FRACTION of the deepest one's depth past it, kept in order
+    least WALL_DEEPEST_FRACTION of the deepest one's depth past it, kept in order
     at the front of ``past``; returns how many."""
     a0, a1, a2 = R[b, k, 0], R[b, k, 1], R[b, k, 2]
     deepest = 0.0
@@ -640,7 +639,7 @@ def _deepest(b, k, low, wall, o_k, R, vertices_t, past, count):
         q = past[i]
         W_k = ((a0 * vertices_t[0, q] + a1 * vertices_t[1, q]) + a2 * vertices_t[2, q]) + o_k
         depth = wall - W_k if low else W_k - wall
-        if depth >= DEEPEST_FRACTION * deepest:
+        if depth >= WALL_DEEPEST_FRACTION * deepest:
             past[kept] = q
             kept += 1
     return kept

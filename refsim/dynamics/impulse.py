@@ -372,12 +372,15 @@ def _restitution(r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
 
 def solve_island_python(starts, body_a, body_b, r_a, r_b, normals, m_inv, I_inv, v, w,
                         e, mu, threshold, iterations, P):
-    """The contact solve of several contact sets at once, in place: the sets
-    of one step that share bodies (a stack on the floor: the floor's
-    contacts with the lower body, the two bodies' contacts), so that each
-    impulse is answered by the others within the step, as a resting
-    contact needs (a lower body pressed down off its centre is held by the
-    floor under that side, instead of turning and walking away).
+    """The contact solve of several contact sets at once, in place: the
+    contact sets of one step (a stack on the floor: the floor's contacts
+    with the lower body, the two bodies' contacts), so that each impulse is
+    answered by the others within the step, as a resting contact needs (a
+    lower body pressed down off its centre is held by the floor under that
+    side, instead of turning and walking away). The simulation passes all
+    of a step's body contacts as one solve, whether or not they share
+    bodies: sets that share none converge each on its own, but share the
+    count of sweeps.
 
     Phase 1 runs its Gauss-Seidel sweeps over every contact of every set,
     until a sweep changes nothing or ``iterations`` sweeps; phases 2 and 3

@@ -84,7 +84,6 @@ import math
 
 import numpy as np
 
-from refsim.collision.contact import DEEPEST_FRACTION
 from refsim.dynamics.products import jitable, matmul, orthonormalize_columns
 
 #: Below this ``|theta|^2`` (``|theta| < 1e-4``) :func:`rotation_exp_into`
@@ -241,24 +240,30 @@ def world_inertia(R: np.ndarray, I_body: np.ndarray) -> np.ndarray:
     return matmul(matmul(R, I_body), np.swapaxes(R, -1, -2))
 
 
+#: A vertex past a wall is a contact when it is at least this fraction as
+#: deep as the deepest (:func:`wall_contacts`): it crossed within the first
+#: half of the time the deepest has been across, about the same instant.
+WALL_DEEPEST_FRACTION = 0.5
+
+
 def wall_contacts(world_vertices: np.ndarray, axis: int, wall: float, low_wall: bool
                   ) -> np.ndarray:
     """Indices of the vertices past the wall ``x_axis = wall`` (strictly) by
-    at least :data:`refsim.collision.contact.DEEPEST_FRACTION` of the
-    deepest one's depth, in index order.
+    at least :data:`WALL_DEEPEST_FRACTION` of the deepest one's depth, in
+    index order.
 
     A contact found after the body crossed the wall began at its deepest
     vertex; those much shallower crossed later in the step. A sphere mesh
-    found 12.6 mm into the floor (a 2 m drop at h = 2e-3) has its lowest
-    vertex and a ring of others past it, and the ring, uneven, turned the
-    frictionless sphere at 11 % of its impact speed over its reach; a face
+    found a step's fall into the floor has its lowest vertex and a ring of
+    others past it, and the ring, unevenly placed, turns a frictionless
+    sphere that lands straight (docs/decisions/body-contact.md); a face
     landing flat or resting has every vertex of the face equally deep."""
     past = past_wall(world_vertices, axis, wall, low_wall)
     if not len(past):
         return past
     column = world_vertices[past, axis]
     depth = wall - column if low_wall else column - wall
-    return past[depth >= DEEPEST_FRACTION * depth.max()]
+    return past[depth >= WALL_DEEPEST_FRACTION * depth.max()]
 
 
 def past_wall(world_vertices: np.ndarray, axis: int, wall: float, low_wall: bool

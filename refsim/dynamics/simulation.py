@@ -712,15 +712,18 @@ class Simulation:
 
     def _solve_island(self, contacts) -> None:
         """One impulse solve (:func:`refsim.dynamics.impulse.solve_island`)
-        over the step's body contacts and the walls the bodies in them touch:
-        the vertices the wall stage found past a wall in this step (a body
-        resting on the floor sinks into it by ``g h^2`` each step, all its
-        supporting vertices at once), else those the wall stage left on it."""
+        over all of the step's body contacts and, with the corrected wall
+        response, the walls the bodies in them touch: the vertices the wall
+        stage found past a wall in this step (a body resting on the floor
+        sinks into it by ``g h^2`` each step, all its supporting vertices at
+        once), else those the wall stage left on it. With the seed's wall
+        response the walls keep the seed's law and are not in the solve."""
         world = self.scene.world
         H = world.half_size
         B = len(self.bodies)
         sets = []                                  # (a, b, r_a, r_b, n)
-        for i in sorted({c[0] for c in contacts} | {c[1] for c in contacts}):
+        touched = sorted({c[0] for c in contacts} | {c[1] for c in contacts})
+        for i in touched if self.wall_response == "impulse" else ():
             W = self.world_vertices(i)
             for k in range(3):
                 for low in (True, False):

@@ -2,10 +2,10 @@
 
 Arranges two records.
 
-- From the plan's ``conformance-matrix``: each rigid-body engine's error on
-  each of the kit's problems that have a closed-form answer
-  (:data:`refsim.conformance.checks_rigid.TEXTBOOK_PROBLEMS`, worst over the
-  problem's scenes), in the colour of the check's status.
+- From the plan's ``conformance-matrix``: each rigid-body engine's largest
+  miss over its tolerance on each of the kit's problems that have a
+  closed-form answer (:data:`refsim.conformance.checks_rigid.TEXTBOOK_PROBLEMS`,
+  worst over the problem's scenes), in the colour of the check's status.
 - From ``textbook-convergence``: refsim's corrected model on the same
   problems at several steps.
 
@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 
+from refsim.conformance import cases_rigid as R
 from refsim.conformance.checks_rigid import TEXTBOOK_PROBLEMS
 from refsim.report.plan import command
 from refsim.report.section import Cell, Section, Table
@@ -41,55 +42,55 @@ def build(ctx) -> Section:
         cells = []
         for engine in engines:
             cell = matrix.cell(problem.check, engine)
-            if cell is None or not cell.measured:
+            if cell is None:
                 cells.append(Cell("not run", "none"))
-                continue
-            cells.append(Cell(_number(problem.error(cell.measured)),
-                              CELL_COLOURS[cell.status]))
-        tolerance = next((problem.tolerance(matrix.cell(problem.check, e).measured)
-                          for e in engines if matrix.cell(problem.check, e) is not None
-                          and matrix.cell(problem.check, e).measured), math.nan)
-        rows.append((problem.problem, problem.unit, _number(tolerance), *cells))
+            elif not cell.measured:      # every scene crashed or none was read
+                cells.append(Cell("no value", CELL_COLOURS[cell.status]))
+            else:
+                cells.append(Cell(_number(problem.ratio(cell.measured)),
+                                  CELL_COLOURS[cell.status]))
+        rows.append((problem.problem, *cells))
     engines_table = Table(
-        id="textbook-engines", title="Error against the closed form, by engine",
-        columns=("problem", "error measured as", "tolerance",
-                 *(ENGINE_TITLES.get(e, e) for e in engines)),
+        id="textbook-engines", title="Error against the closed form over its tolerance, by "
+                                     "engine",
+        columns=("problem", *(ENGINE_TITLES.get(e, e) for e in engines)),
         rows=tuple(rows), legend=LEGEND,
-        caption="Each cell: the engine's largest error over the problem's scenes (step "
-                "1e-3 s), in the colour of the kit's verdict on it. The closed forms, the "
+        caption="Each cell: the engine's largest miss over the problem's scenes, as a "
+                "multiple of the kit's tolerance for it (every quantity the check tests; "
+                "at most 1 passes), at the kit's step of "
+                f"{R.STEP:g} s, in the colour of the kit's verdict. The closed forms, the "
                 "scenes and the reason for each tolerance are in the kit's documentation "
-                "(refsim conform --help, refsim/conformance/checks_rigid.py). Reproduce: "
+                "(refsim/conformance/checks_rigid.py). Reproduce: "
                 f"{command('conformance-matrix')}")
     steps = convergence.steps
     steps_rows = tuple(
         (problem.problem, problem.unit,
-         _number(convergence.tolerances.get(problem.check, math.nan)),
+         _number(convergence.ratios.get(problem.check, math.nan)),
          *(_number(x) for x in convergence.errors[problem.check]))
         for problem in TEXTBOOK_PROBLEMS if problem.check in convergence.errors)
     steps_table = Table(
         id="textbook-convergence", title="refsim's corrected model as the step shrinks",
-        columns=("problem", "error measured as", "tolerance at 1e-3 s",
+        columns=("problem", "error measured as", f"over its tolerance at {R.STEP:g} s",
                  *(f"h = {h:g} s" for h in steps)),
         rows=steps_rows,
-        caption="The same problems and errors, refsim's corrected model only, at each "
-                "step. Impacts resolved by impulses are exact to rounding at any step; "
-                "what remains shrinks with h. Reproduce: "
+        caption="refsim's corrected model alone: each problem's headline error against "
+                "the closed form (the worst scene's) at each step. Reproduce: "
                 f"{command('textbook-convergence')}")
     intro = ("Problems whose answer mechanics gives in closed form: drops and their apex "
              "ratios, oblique impacts with Coulomb friction in every regime, a spin stopped "
              "by friction, a torque-free body flipping about its middle axis, a ball "
              "striking a free rod off its centre, and stacks that must not move. Every "
              "rigid-body engine runs them through the conformance kit; the first table "
-             "shows each engine's error, the second how refsim's own error shrinks with "
-             "the step.")
+             "shows each engine's misses against the kit's tolerances, the second how "
+             "refsim's own error changes with the step.")
     results = {"engines": list(engines),
-               "errors": {p.check: {e: p.error(matrix.cell(p.check, e).measured)
+               "ratios": {p.check: {e: p.ratio(matrix.cell(p.check, e).measured)
                                     for e in engines if matrix.cell(p.check, e) is not None
                                     and matrix.cell(p.check, e).measured}
                           for p in TEXTBOOK_PROBLEMS},
                "steps": list(steps),
                "convergence": {k: list(v) for k, v in convergence.errors.items()},
-               "tolerances": dict(convergence.tolerances)}
+               "ratios_at_kit_step": dict(convergence.ratios)}
     return Section(key="textbook", title="Textbook mechanics", intro=intro,
                    tables=[engines_table, steps_table], results=_finite(results))
 
