@@ -176,7 +176,7 @@ def pairwise_sum(u, v, n, mu, mv):
     PAIRWISE_BLOCK is split at a multiple of 8 below its half and the
     halves' sums added. Written with explicit stacks (``frames`` of (start,
     length, halves done), ``values`` of sums), not by recursion: numba's
-    cache reloads recursive functions wrongly (numba issue 6061)."""
+    cache reloads recursive functions wrongly (numba bug report 6061, github.com/numba/numba)."""
     if n <= PAIRWISE_BLOCK:
         return block_sum(u, v, 0, n, mu, mv)
     frames = np.empty((PAIRWISE_STACK, 3), dtype=np.int64)
