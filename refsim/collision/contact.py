@@ -151,6 +151,11 @@ def intersection_points(mesh_a, pose_a, mesh_b, pose_b, kernel: str | None = Non
     ``mesh_a`` and ``mesh_b`` at their poses overlap or touch, its corners
     among them (module docstring); empty when their surfaces neither cross nor touch and
     neither holds a vertex of the other."""
+    return _region(mesh_a, pose_a, mesh_b, pose_b, kernel)[0]
+
+
+def _region(mesh_a, pose_a, mesh_b, pose_b, kernel):
+    """:func:`intersection_points`, and the two meshes' world triangles."""
     world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
     tri_a, tri_b = world_a[mesh_a.faces], world_b[mesh_b.faces]
     pairs = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level="exact", kernel=kernel)
@@ -159,7 +164,7 @@ def intersection_points(mesh_a, pose_a, mesh_b, pose_b, kernel: str | None = Non
         parts += [edge_crossings(tri_a[pairs[:, 0]], tri_b[pairs[:, 1]]),
                   edge_crossings(tri_b[pairs[:, 1]], tri_a[pairs[:, 0]])]
     parts += [_vertices_within(world_a, world_b, tri_b), _vertices_within(world_b, world_a, tri_a)]
-    return np.concatenate(parts)
+    return np.concatenate(parts), tri_a, tri_b
 
 
 #: A point of the intersection region counts as a contact when the region
@@ -289,11 +294,9 @@ def contact_points(mesh_a, pose_a, mesh_b, pose_b, n, kernel: str | None = None
     corners (:func:`contact_polygon`) of the thickest part
     (:func:`deepest_points`) of the meshes' intersection region
     (:func:`intersection_points`); empty when the meshes do not meet."""
-    points = intersection_points(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel)
+    points, tri_a, tri_b = _region(mesh_a, pose_a, mesh_b, pose_b, kernel)
     if not len(points):
         return points
-    tri_a = world_vertices(mesh_a, pose_a)[mesh_a.faces]
-    tri_b = world_vertices(mesh_b, pose_b)[mesh_b.faces]
     return contact_polygon(deepest_points(points, n, tri_a, tri_b), n)
 
 
