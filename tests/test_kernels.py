@@ -85,7 +85,8 @@ def _island_impulses(kernel):
         P = np.empty((starts[-1], 4))
         m_inv = np.array([1.0, 0.5, 2.0, 0.0])
         count = impulse.solve_island(starts, body_a, body_b, r_a, r_b, normals, m_inv, I_inv,
-                                     v, w, 0.7, 0.4, impulse.RESTITUTION_THRESHOLD,
+                                     v, w, np.full(4, 0.7), np.full(4, 0.4),
+                                     impulse.RESTITUTION_THRESHOLD,
                                      impulse.ITERATIONS, P, kernel=kernel)
         out.append((count, P, v, w))
     return out

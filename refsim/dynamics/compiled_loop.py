@@ -50,13 +50,26 @@ def loop_support(sim: Simulation) -> str | None:
 
     It covers every rotation model ("off", "seed", "impulse"), both wall
     responses (the seed's, with either wall speed, and the corrected
-    impulses), any solver, linear or quadratic drag, and body-body contacts
-    at every level but "sphere" (the seed's exchange at level "aabb" in the
-    loop; any other level or response hands the steps with overlapping
-    boxes back).
+    impulses), any solver, linear or quadratic drag, ``world.mu`` and the
+    restitution threshold, and body-body contacts at every level but
+    "sphere" (the seed's exchange at level "aabb" in the loop; any other
+    level or response hands the steps with overlapping boxes back). The
+    loads of :mod:`refsim.dynamics.loads` beyond these (a tilted gravity,
+    forces, torques, fixed bodies, missing walls, coefficients per body)
+    run on the readable step.
     """
     if sim.body_body and sim.level == "sphere":
         return "collision level 'sphere' (its broad phase is not the boxes')"
+    loads, world = sim.loads, sim.scene.world
+    if not loads.uniform:
+        return "a field other than gravity along -y (gravity_direction, force or fixed)"
+    if loads.torque.any():
+        return "a torque"
+    if not loads.all_walls:
+        return "a world without some of its walls"
+    if ((loads.wall_e != world.restitution).any()
+            or (loads.wall_mu != world.coulomb_mu).any()):
+        return "restitution or mu per body"
     return None
 
 
@@ -275,9 +288,10 @@ class CompiledLoop:
         start = time.perf_counter()
         done, n_events, stop = self.kernels.advance(
             n_steps, sim.h, self.hA, self.hb, world.gravity, self.drag_rate, self.quadratic,
-            self.rotation_mode, world.restitution, world.friction,
+            self.rotation_mode, world.restitution,
+            world.coulomb_mu if sim.wall_response == "impulse" else world.friction,
             sim.wall_speed == "wall", sim.wall_response == "impulse",
-            impulse.RESTITUTION_THRESHOLD, impulse.ITERATIONS, world.half_size,
+            sim.loads.threshold, impulse.ITERATIONS, world.half_size,
             self.vertices_t, self.first_vertex, sim._centred, self.center, sim._lambda_max,
             sim.mass, sim.inv_mass, self.Q, self.moments, self.I_body_inv, sim._energy_limit,
             self.leaf_order, self.leaf_start, self.leaf_spheres, self.first_leaf,

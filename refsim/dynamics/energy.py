@@ -86,13 +86,11 @@ def trajectory_energy(scene, trajectory) -> EnergyParts:
     the recorded velocity is the centre of mass's, as
     :meth:`refsim.Simulation.record` writes it.
     """
-    from refsim.dynamics.simulation import Simulation  # it imports this module
+    from refsim.dynamics.simulation import Simulation, body_energy  # it imports this module
 
     sim = Simulation(scene)
     R = np.asarray(trajectory.orientation, dtype=np.float64)
     center_of_mass = (np.asarray(trajectory.position, dtype=np.float64)
                       + np.einsum("fbij,bj->fbi", R, sim.center))
-    world = scene.world
-    return mechanical_energy(sim.mass, sim.I_body, world.gravity, -world.half_size,
-                             center_of_mass, R, trajectory.velocity,
-                             trajectory.angular_velocity)
+    return body_energy(sim, center_of_mass, R, trajectory.velocity,
+                       trajectory.angular_velocity)

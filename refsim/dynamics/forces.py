@@ -115,3 +115,22 @@ def translational_rhs(gravity: float, drag: float, mass: np.ndarray, drag_model:
         return dY.reshape(-1)
 
     return f
+
+
+def field_rhs(accel: np.ndarray, drag: float, mass: np.ndarray, drag_model: str):
+    """:func:`translational_rhs` in per-body uniform fields: ``accel`` (B, 3)
+    is each body's constant acceleration (gravity along any direction and an
+    applied force over the mass, :mod:`refsim.dynamics.loads`) in place of
+    ``(0, -g, 0)``."""
+    check_option("drag model", drag_model, DRAG_MODELS)
+    n = len(mass)
+    accel = np.asarray(accel, dtype=np.float64)
+
+    def f(t, y):
+        Y = y.reshape(2, n, 3)
+        dY = np.empty_like(Y)
+        dY[0] = Y[1]
+        dY[1] = acceleration(Y[1], 0.0, drag, mass, drag_model) + accel
+        return dY.reshape(-1)
+
+    return f

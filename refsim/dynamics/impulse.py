@@ -403,7 +403,10 @@ def solve_island_python(starts, body_a, body_b, r_a, r_b, normals, m_inv, I_inv,
     m_inv : (N,); I_inv : (N, 3, 3); v, w : (N, 3) float64
         Inverse masses, world-frame inverse inertia, and velocities of the
         bodies (the velocities updated in place).
-    e, mu, threshold, iterations : as :func:`solve_contacts_python`.
+    e, mu : (S,) float64
+        Each set's restitution and Coulomb coefficient (a body's with a
+        wall, a pair's: :meth:`refsim.Scene.coefficients`).
+    threshold, iterations : as :func:`solve_contacts_python`.
     P : (C, 4) float64 output, as there.
 
     Returns
@@ -429,7 +432,7 @@ def solve_island_python(starts, body_a, body_b, r_a, r_b, normals, m_inv, I_inv,
             lo, hi, a, b = starts[s], starts[s + 1], body_a[s], body_b[s]
             changed, dE1[s] = _compression_sweep(
                 r_a[lo:hi], r_b[lo:hi], normals[s, 0], normals[s, 1], normals[s, 2], m_inv[a],
-                I_inv[a], v[a], w[a], m_inv[b], I_inv[b], v[b], w[b], mu, Kn[lo:hi],
+                I_inv[a], v[a], w[a], m_inv[b], I_inv[b], v[b], w[b], mu[s], Kn[lo:hi],
                 P[lo:hi], dE1[s])
             moved = moved or changed
         if not moved:
@@ -437,8 +440,8 @@ def solve_island_python(starts, body_a, body_b, r_a, r_b, normals, m_inv, I_inv,
     for s in range(S):
         lo, hi, a, b = starts[s], starts[s + 1], body_a[s], body_b[s]
         _restitution(r_a[lo:hi], r_b[lo:hi], normals[s, 0], normals[s, 1], normals[s, 2],
-                     m_inv[a], I_inv[a], v[a], w[a], m_inv[b], I_inv[b], v[b], w[b], e, mu,
-                     threshold, iterations, vn0[lo:hi], P[lo:hi], dE1[s])
+                     m_inv[a], I_inv[a], v[a], w[a], m_inv[b], I_inv[b], v[b], w[b], e[s],
+                     mu[s], threshold, iterations, vn0[lo:hi], P[lo:hi], dE1[s])
     return approaching
 
 
@@ -468,13 +471,15 @@ def solve_contacts(*args, kernel: str | None = None):
 
 
 def wall_impulses(r_a, n, inv_mass: float, I_inv, v, w, restitution: float,
-                  friction: float, *, kernel: str | None = None) -> np.ndarray:
+                  friction: float, threshold: float = RESTITUTION_THRESHOLD, *,
+                  kernel: str | None = None) -> np.ndarray:
     """Impulses of one body against a wall at contacts ``r_a`` (k, 3) (from
     its centre of mass), wall normal ``n`` (into the body); ``v``, ``w`` (3,)
-    updated in place. The wall is body B of the solve: static (no mass, no
-    inertia, at rest), passed as None. Returns the (k, 4) impulses."""
+    updated in place; ``friction`` is Coulomb's mu, ``threshold`` the
+    restitution threshold (m/s). The wall is body B of the solve: static (no
+    mass, no inertia, at rest), passed as None. Returns the (k, 4) impulses."""
     r_a = np.ascontiguousarray(r_a, dtype=np.float64)
     P = np.empty((len(r_a), 4))
     solve_contacts(r_a, None, n, inv_mass, I_inv, v, w, 0.0, None, None, None, restitution,
-                   friction, RESTITUTION_THRESHOLD, ITERATIONS, P, kernel=kernel)
+                   friction, threshold, ITERATIONS, P, kernel=kernel)
     return P

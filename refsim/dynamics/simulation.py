@@ -81,7 +81,8 @@ from refsim.dynamics.body_response import (
 from refsim.dynamics.boxes import boxes_kernel
 from refsim.dynamics.compiled_loop import CompiledLoop, loop_support
 from refsim.dynamics.energy import EnergyParts, mechanical_energy
-from refsim.dynamics.forces import translational_rhs
+from refsim.dynamics.forces import field_rhs, translational_rhs
+from refsim.dynamics.loads import apply_torques, field_potential, keep_walls, scene_loads
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
 from refsim.dynamics.products import matvec
 from refsim.dynamics.rotation_impulse import (
@@ -277,6 +278,11 @@ class Simulation:
             raise StateError("the scene has no [[body]] to simulate (a particle-only "
                              "scene runs with refsim.ParticleSystem)")
         self.body_body = B >= 2 and col.level != "none" and dyn.body_response != "off"
+        # what acts beyond the seed's world (refsim.dynamics.loads); refuses a
+        # key these choices cannot honour
+        self.loads = scene_loads(scene, rotation=self.rotation,
+                                 body_response=self.body_response,
+                                 wall_response=self.wall_response)
 
         bodies = []
         for cfg in scene.bodies:
@@ -298,11 +304,13 @@ class Simulation:
         self.bodies = tuple(bodies)
         self.names = tuple(b.name for b in bodies)
         self.mass = np.array([b.mass for b in bodies])
-        self.inv_mass = 1.0 / self.mass
+        self.inv_mass = np.where(self.loads.fixed, 0.0, 1.0 / self.mass)   # fixed: no push
         self.center = np.array([b.center for b in bodies])                  # (B, 3)
         self._centred = not self.center.any()          # every centroid at the mesh origin
         self.I_body = np.array([b.inertia for b in bodies])                 # (B, 3, 3)
         self.I_body_inv = np.linalg.inv(self.I_body)
+        self.I_body_inv[self.loads.fixed] = 0.0           # fixed: no turn either
+        self._torqued = bool(self.loads.torque.any())
         # the principal axes (mesh frame) and moments of the corrected
         # rotation step (rotation_impulse.free_rotation_step)
         self.Q = np.zeros((B, 3, 3))
@@ -344,7 +352,9 @@ class Simulation:
                 and np.isfinite(self.w).all()):
             raise StateError("initial state has a non-finite value")
 
-        self._f = translational_rhs(world.gravity, world.drag, self.mass, world.drag_model)
+        self._f = (translational_rhs(world.gravity, world.drag, self.mass, world.drag_model)
+                   if self.loads.uniform else
+                   field_rhs(self.loads.accel, world.drag, self.mass, world.drag_model))
         self.lo = np.empty((B, 3))
         self.hi = np.empty((B, 3))
         self.events: list[Event] = []
@@ -420,10 +430,9 @@ class Simulation:
         return self.energy_parts().total
 
     def energy_parts(self) -> EnergyParts:
-        """The (B,) kinetic, rotational and potential parts of :meth:`energy`."""
-        world = self.scene.world
-        return mechanical_energy(self.mass, self.I_body, world.gravity, -world.half_size,
-                                 self.x, self.R, self.v, self.w)
+        """The (B,) kinetic, rotational and potential parts of :meth:`energy`
+        (the potential of each body's field, :mod:`refsim.dynamics.loads`)."""
+        return body_energy(self, self.x, self.R, self.v, self.w)
 
     def _energy_bound(self) -> np.ndarray:
         """(B,) the energy with the rotational part bounded by
@@ -432,12 +441,16 @@ class Simulation:
         world = self.scene.world
         kinetic = 0.5 * (self.mass * np.einsum("bi,bi->b", self.v, self.v)
                          + self._lambda_max * np.einsum("bi,bi->b", self.w, self.w))
-        return kinetic + self.mass * world.gravity * (self.x[:, 1] + world.half_size)
+        if self.loads.uniform:
+            return kinetic + self.mass * world.gravity * (self.x[:, 1] + world.half_size)
+        return kinetic + field_potential(self.mass, self.loads.accel, self.x, world.half_size)
 
     def _energy_scale(self) -> float:
         world = self.scene.world
         span = 2.0 * world.half_size
-        return float((self.mass * (world.gravity * span + 0.5 * span * span)).sum())
+        field = (world.gravity if self.loads.uniform
+                 else np.sqrt(np.einsum("bi,bi->b", self.loads.accel, self.loads.accel)))
+        return float((self.mass * (field * span + 0.5 * span * span)).sum())
 
     # -- the step ---------------------------------------------------------------------
 
@@ -458,6 +471,8 @@ class Simulation:
         timer.lap("integrate")
         if self._rotate is not None:
             self._rotate()
+            if self._torqued:
+                apply_torques(self.w, self.R, self.I_body_inv, self.loads.torque, self.h)
             timer.lap("rotation")
         self._check()
         timer.lap("check")
@@ -596,9 +611,14 @@ class Simulation:
     # 5. walls (S3, S7, S9 or corrected)
     def _walls(self, touching: set) -> None:
         H = self.scene.world.half_size
+        loads = self.loads
         beyond = np.flatnonzero(((self.lo < -H) | (self.hi > H)).any(axis=1))
         for i in beyond.tolist():
             correction = world_cube_test(self.lo[i], self.hi[i], H).correction
+            if not loads.all_walls:
+                correction = keep_walls(correction, loads.low, loads.high)
+            if loads.fixed[i] or not correction.any():
+                continue                  # a fixed body stays; a missing wall does not push
             self._wall(i, correction)
             self.lo[i] += correction
             self.hi[i] += correction
@@ -645,16 +665,15 @@ class Simulation:
             # at the centroid would cancel gravity by itself and leave the
             # contact impulses (and with them friction and the torque that
             # topples a body balanced on an edge) with nothing to do.
-            if self.v[i, k] * correction[k] < -impulse.RESTITUTION_THRESHOLD * abs(
-                    correction[k]):
-                self.v[i, k] = wall_speed(self.v[i, k],
-                                          -world.gravity if k == 1 else 0.0, correction[k])
+            if self.v[i, k] * correction[k] < -self.loads.threshold * abs(correction[k]):
+                self.v[i, k] = wall_speed(self.v[i, k], self.loads.accel[i, k], correction[k])
             if not len(r_a):
                 continue
             n = np.zeros(3)
             n[k] = 1.0 if low else -1.0
             impulse.wall_impulses(r_a, n, self.inv_mass[i], I_inv, self.v[i], self.w[i],
-                                  world.restitution, world.friction, kernel=self.kernel)
+                                  self.loads.wall_e[i], self.loads.wall_mu[i],
+                                  self.loads.threshold, kernel=self.kernel)
 
     # 6. broad phase (S4 test 1)
     def _broad_phase(self) -> np.ndarray:
@@ -685,6 +704,8 @@ class Simulation:
         contacts = []
         for a, b in pairs:
             a, b = int(a), int(b)
+            if self.loads.fixed[a] and self.loads.fixed[b]:
+                continue                  # two fixed bodies: nothing can move
             touching.add(Contact("body", self.names[a], self.names[b]))
             if self.body_response == "seed":
                 self.v[a], self.v[b], _ = exchange_velocities_seed(
@@ -721,12 +742,17 @@ class Simulation:
         world = self.scene.world
         H = world.half_size
         B = len(self.bodies)
-        sets = []                                  # (a, b, r_a, r_b, n)
+        loads = self.loads
+        sets = []                                  # (a, b, r_a, r_b, n, e, mu)
         touched = sorted({c[0] for c in contacts} | {c[1] for c in contacts})
         for i in touched if self.wall_response == "impulse" else ():
+            if loads.fixed[i]:
+                continue                  # no wall impulse can move it
             W = self.world_vertices(i)
             for k in range(3):
                 for low in (True, False):
+                    if not (loads.low[k] if low else loads.high[k]):
+                        continue                              # a missing wall
                     r = self._wall_contacts.get((i, k, low))
                     if r is None or not len(r):
                         column = W[:, k]
@@ -736,22 +762,24 @@ class Simulation:
                     if len(r):
                         n = np.zeros(3)
                         n[k] = 1.0 if low else -1.0
-                        sets.append((i, B, r, np.zeros_like(r), n))
+                        sets.append((i, B, r, np.zeros_like(r), n, loads.wall_e[i],
+                                     loads.wall_mu[i]))
         for a, b, points, geometry in contacts:
-            sets.append((a, b, points - self.x[a], points - self.x[b], geometry.n))
+            sets.append((a, b, points - self.x[a], points - self.x[b], geometry.n,
+                         loads.pair_e[a, b], loads.pair_mu[a, b]))
         starts = np.cumsum([0] + [len(s[2]) for s in sets]).astype(np.int64)
         static = np.zeros((1, 3))
         v, w = np.concatenate([self.v, static]), np.concatenate([self.w, static])
         I_inv = np.zeros((B + 1, 3, 3))
         if self.rotation != "off":
-            I_inv[:B] = world_inertia(self.R, self.I_body_inv)
+            I_inv[:B] = world_inertia(self.R, self.I_body_inv)     # 0 for a fixed body
         P = np.empty((int(starts[-1]), 4))
         impulse.solve_island(
             starts, np.array([s[0] for s in sets], dtype=np.int64),
             np.array([s[1] for s in sets], dtype=np.int64),
             np.concatenate([s[2] for s in sets]), np.concatenate([s[3] for s in sets]),
             np.array([s[4] for s in sets]), np.concatenate([self.inv_mass, [0.0]]), I_inv, v, w,
-            world.restitution, world.friction, impulse.RESTITUTION_THRESHOLD,
+            np.array([s[5] for s in sets]), np.array([s[6] for s in sets]), loads.threshold,
             impulse.ITERATIONS, P, kernel=self.kernel)
         self.v[...] = v[:B]
         self.w[...] = w[:B]
@@ -830,6 +858,22 @@ class Simulation:
                 "wall_response": self.wall_response, "collision_level": self.level,
                 "aabb": s.collision.aabb, "wall_speed": self.wall_speed, "boxes": self.boxes,
                 "kernel": self.kernel, "steps": self.steps}
+
+
+def body_energy(sim: Simulation, center_of_mass, orientation, velocity,
+                angular_velocity) -> EnergyParts:
+    """The energy parts of ``sim``'s bodies in states of any leading shape
+    (..., B, ...): :func:`refsim.dynamics.energy.mechanical_energy` with the
+    seed's gravity, else with each body's field (:mod:`refsim.dynamics.loads`)."""
+    world = sim.scene.world
+    if sim.loads.uniform:
+        return mechanical_energy(sim.mass, sim.I_body, world.gravity, -world.half_size,
+                                 center_of_mass, orientation, velocity, angular_velocity)
+    parts = mechanical_energy(sim.mass, sim.I_body, 0.0, -world.half_size, center_of_mass,
+                              orientation, velocity, angular_velocity)
+    return EnergyParts(kinetic=parts.kinetic, rotational=parts.rotational,
+                       potential=field_potential(sim.mass, sim.loads.accel, center_of_mass,
+                                                 world.half_size))
 
 
 def default_every(n_steps: int) -> int:

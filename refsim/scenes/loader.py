@@ -43,15 +43,18 @@ from refsim.limits import (
 from refsim.models.loading import load_model
 from refsim.scenes.schema import (
     BODY_FIELDS,
+    PAIR_FIELDS,
     PARTICLE_FIELDS_FROM,
     PARTICLE_KEYS,
     START_INSIDE_RTOL,
     TABLES,
     BodyConfig,
     Field,
+    PairConfig,
     ParticleConfig,
     Scene,
 )
+from refsim.scenes.world import DOWN, WALL_NAMES
 from refsim.solvers.integrate import STEP_COUNT_RTOL, whole_steps
 from refsim.types import transform_points
 
@@ -189,7 +192,7 @@ def scene_from_dict(data: dict, path: Path | None = None, *,
     resolving relative model paths; None resolves against the bundled
     models; ``max_steps`` as for :func:`load_scene`)."""
     max_steps = check_count("max_steps", max_steps, 1, MAX_STEPS)
-    known = set(TABLES) | {"body", "particles"}
+    known = set(TABLES) | {"body", "pair", "particles"}
     for key in data:
         if key not in known:
             raise SceneError(f"unknown key (expected one of {', '.join(sorted(known))})",
@@ -218,15 +221,27 @@ def scene_from_dict(data: dict, path: Path | None = None, *,
             raise SceneError("must be a table", path, where)
         values = _read_fields(raw, BODY_FIELDS, where, path)
         values["name"] = values.get("name") or f"body{i}"
-        values["model"] = _resolve_model(values["model"], path, f"{where}.model")
+        _check_shape_keys(values, path, where)
+        if "shape" in values:
+            values["model"] = shape_name(values)
+        else:
+            values["model"] = _resolve_model(values["model"], path, f"{where}.model")
+        _check_fixed(values, path, where)
         bodies.append(BodyConfig(**values))
     names = [b.name for b in bodies]
     for i, name in enumerate(names):
         if name in names[:i]:
             raise SceneError(f"duplicate body name {name!r}", path, f"body[{i}].name")
+    pairs = _pairs(data.get("pair", []), names, path)
+    _check_coefficients(bodies, pairs, path)
     particles = None
     if "particles" in data:
         particles = _particle_config(data["particles"], configs, path)
+        world = configs["world"]
+        for key, default in (("gravity_direction", DOWN), ("walls", WALL_NAMES)):
+            if getattr(world, key) != default:
+                raise SceneError("is read by the rigid bodies only: a scene with [particles] "
+                                 "keeps the default", path, f"world.{key}")
     if not bodies and particles is None:
         raise SceneError("a scene needs at least one [[body]] or a [particles] table",
                          path, "body")
@@ -236,7 +251,89 @@ def scene_from_dict(data: dict, path: Path | None = None, *,
     for i, body in enumerate(bodies):
         _check_body(body, meshes[body.model], configs["world"], path, f"body[{i}]")
     return Scene(path=path, bodies=tuple(bodies), meshes=meshes, particles=particles,
-                 **configs)
+                 pairs=pairs, **configs)
+
+
+def shape_name(values: dict) -> Path:
+    """The name a ``[[body]] shape`` is known by, its key in ``Scene.meshes``
+    (a relative path that no resolved model file, always absolute, can be)."""
+    if values["shape"] == "box":
+        size = values.get("size", BodyConfig.size)
+        return Path("<box " + " x ".join(f"{x:g}" for x in size) + ">")
+    radius = values.get("radius", BodyConfig.radius)
+    frequency = values.get("frequency", BodyConfig.frequency)
+    return Path(f"<sphere r {radius:g} f {frequency}>")
+
+
+#: The keys only one shape reads.
+SHAPE_KEYS = {"size": "box", "radius": "sphere", "frequency": "sphere"}
+
+
+def _check_shape_keys(values: dict, path, where: str) -> None:
+    """A body has a model file or a shape, not both, and only its shape's keys."""
+    shape = values.get("shape")
+    if shape is None and "model" not in values:
+        raise SceneError("required key is missing (or give a shape: shape = \"box\" "
+                         "with size, or \"sphere\" with radius)", path, f"{where}.model")
+    if shape is not None and "model" in values:
+        raise SceneError(f"a body has a model file or a shape, not both (shape = {shape!r})",
+                         path, f"{where}.model")
+    for key, owner in SHAPE_KEYS.items():
+        if key in values and shape != owner:
+            raise SceneError(f"is read only with shape = {owner!r}", path, f"{where}.{key}")
+
+
+def _check_fixed(values: dict, path, where: str) -> None:
+    """A fixed body starts and stays at rest, with nothing to push it."""
+    if not values.get("fixed"):
+        return
+    for key in ("velocity", "angular_velocity", "force", "torque"):
+        if any(values.get(key, (0.0, 0.0, 0.0))):
+            raise SceneError("a fixed body never moves: leave it out or make it 0", path,
+                             f"{where}.{key}")
+
+
+def _pairs(raw_pairs, names: list[str], path) -> tuple[PairConfig, ...]:
+    """The ``[[pair]]`` entries: two distinct bodies of the scene each, every
+    pair once."""
+    if not isinstance(raw_pairs, list):
+        raise SceneError("must be an array of tables ([[pair]])", path, "pair")
+    pairs: list[PairConfig] = []
+    for i, raw in enumerate(raw_pairs):
+        where = f"pair[{i}]"
+        if not isinstance(raw, dict):
+            raise SceneError("must be a table", path, where)
+        values = _read_fields(raw, PAIR_FIELDS, where, path)
+        a, b = values["bodies"]
+        for name in (a, b):
+            if name not in names:
+                raise SceneError(f"no body is named {name!r} (bodies: "
+                                 f"{', '.join(names) or 'none'})", path, f"{where}.bodies")
+        if a == b:
+            raise SceneError(f"names {a!r} twice: a pair is two bodies", path,
+                             f"{where}.bodies")
+        if any({a, b} == set(p.bodies) for p in pairs):
+            raise SceneError(f"the pair {a!r}, {b!r} is given twice", path, f"{where}.bodies")
+        pairs.append(PairConfig(**values))
+    return tuple(pairs)
+
+
+def _check_coefficients(bodies, pairs, path) -> None:
+    """Two bodies that give different values of a coefficient need a
+    ``[[pair]]`` that gives their contacts' value (Scene.coefficients)."""
+    for key in ("restitution", "mu"):
+        given = [(i, b) for i, b in enumerate(bodies) if getattr(b, key) is not None]
+        for n, (_, a) in enumerate(given):
+            for j, b in given[n + 1:]:
+                if getattr(a, key) == getattr(b, key):
+                    continue
+                pair = next((p for p in pairs if set(p.bodies) == {a.name, b.name}), None)
+                if pair is None or getattr(pair, key) is None:
+                    raise SceneError(
+                        f"bodies {a.name!r} and {b.name!r} give different {key} "
+                        f"({getattr(a, key):g}, {getattr(b, key):g}): add a [[pair]] with "
+                        f"bodies = [{a.name!r}, {b.name!r}] and the {key} of their contacts",
+                        path, f"body[{j}].{key}")
 
 
 def _particle_config(raw, configs: dict, path) -> ParticleConfig:
@@ -314,6 +411,24 @@ def _number(value, path, key) -> float:
 def _convert(value, kind: str, path, key):
     if kind == "float":
         return _number(value, path, key)
+    if kind == "int":
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise SceneError(f"must be a whole number, got {type(value).__name__} {value!r}",
+                             path, key)
+        if abs(value) > 1_000_000:
+            raise SceneError(f"must be at most 1000000 in magnitude, got {value!r}", path, key)
+        return value
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise SceneError(f"must be true or false, got {type(value).__name__} {value!r}",
+                             path, key)
+        return value
+    if kind in ("walls", "names2"):
+        count = "2 " if kind == "names2" else ""
+        if (not isinstance(value, list) or not all(isinstance(x, str) for x in value)
+                or (kind == "names2" and len(value) != 2)):
+            raise SceneError(f"must be a list of {count}strings, got {value!r}", path, key)
+        return tuple(value)
     if kind == "str":
         if not isinstance(value, str):
             raise SceneError(f"must be a string, got {type(value).__name__} {value!r}",
@@ -365,9 +480,15 @@ def _resolve_model(name: str, scene_path: Path | None, key: str) -> Path:
 
 def _load_meshes(bodies, scene_path) -> dict:
     """Each distinct model once; a model's error names the scene and the
-    first body that uses it, then the model file and its line."""
+    first body that uses it, then the model file and its line. A shape's
+    mesh is built from its keys (refsim.models.shapes)."""
+    from refsim.models import shapes
+
     meshes = {}
     for i, body in enumerate(bodies):
+        if body.shape and body.model not in meshes:
+            meshes[body.model] = (shapes.box(body.size) if body.shape == "box" else
+                                  shapes.geodesic_sphere(body.frequency, body.radius))
         if body.model not in meshes:
             try:
                 meshes[body.model] = load_model(body.model)
@@ -417,12 +538,14 @@ def _check_body(body: BodyConfig, mesh, world, path, where: str) -> None:
         lo, hi = world_vertices.min(axis=0), world_vertices.max(axis=0)
         span = hi - lo                        # inf for a box wider than float64's range
     slack = START_INSIDE_RTOL * H
-    if (span > 2.0 * H + slack).any():
+    low = [f"{'xyz'[k]}-" in world.walls for k in range(3)]
+    high = [f"{'xyz'[k]}+" in world.walls for k in range(3)]
+    if any(span[k] > 2.0 * H + slack and low[k] and high[k] for k in range(3)):
         raise SceneError(f"model {name} at scale {body.scale:g} is larger than the world "
                          f"cube: its box spans {_spans(span)}, the cube {2.0 * H:g}",
                          path, f"{where}.scale" if body.scale != 1.0 else f"{where}.model")
     for k in range(3):
-        if lo[k] < -H - slack or hi[k] > H + slack:
+        if (low[k] and lo[k] < -H - slack) or (high[k] and hi[k] > H + slack):
             raise SceneError(
                 f"the body starts outside the world cube: its box spans {'xyz'[k]} = "
                 f"{lo[k]:.6g} to {hi[k]:.6g}, the cube -{H:g} to {H:g}", path,

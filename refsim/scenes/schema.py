@@ -35,7 +35,7 @@ import numpy as np
 from refsim.dynamics.forces import DRAG_MODELS
 from refsim.limits import MIN_POSITIVE
 from refsim.particles.config import ParticleConfig
-from refsim.scenes.world import IntegrationConfig, WorldConfig
+from refsim.scenes.world import WALL_NAMES, IntegrationConfig, WorldConfig
 
 SOLVER_NAMES = ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4")
 COLLISION_LEVELS = ("none", "sphere", "aabb", "triangle-aabb", "exact")
@@ -44,6 +44,8 @@ ROTATION_MODELS = ("off", "seed", "impulse")
 RESPONSE_MODELS = ("off", "seed", "impulse")
 WALL_RESPONSES = ("auto", "seed", "impulse")
 WALL_SPEEDS = ("wall", "seed")
+#: ``[[body]] shape``: a model file (""), or a shape built from its keys.
+SHAPES = ("", "box", "sphere")
 
 #: A body's starting box may stick out of the world cube by this fraction of
 #: the cube's half size: the rounding of a position written as
@@ -69,7 +71,19 @@ class DynamicsConfig:
 
 @dataclass(frozen=True)
 class BodyConfig:
-    """One ``[[body]]`` entry; ``model`` is resolved to an existing file."""
+    """One ``[[body]]`` entry; ``model`` is resolved to an existing file, or,
+    for a ``shape``, is the shape's name (``<box 1 x 0.6 x 0.3>``), the key
+    of its generated mesh in :attr:`Scene.meshes`.
+
+    ``shape``: "" (the mesh of the file ``model``), "box" (edges ``size``,
+    centred) or "sphere" (a geodesic sphere of ``radius`` with ``20
+    frequency^2`` triangles, its vertices on the sphere). ``fixed``: the
+    body never moves (infinite mass; the corrected body response only).
+    ``force``, ``torque``: constant, world frame, N and N m; the force acts
+    at the centre of mass. ``restitution``, ``mu``: this body's
+    coefficients at its contacts (None: the world's), see
+    :meth:`Scene.coefficients`.
+    """
 
     name: str
     model: Path
@@ -80,6 +94,25 @@ class BodyConfig:
                                                   (0.0, 0.0, 1.0))
     mass: float = 1.0
     scale: float = 1.0
+    shape: str = ""
+    size: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    radius: float = 0.5
+    frequency: int = 8
+    fixed: bool = False
+    force: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    torque: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    restitution: float | None = None
+    mu: float | None = None
+
+
+@dataclass(frozen=True)
+class PairConfig:
+    """One ``[[pair]]`` entry: the coefficients at the contacts of two named
+    bodies (None: as :meth:`Scene.coefficients` resolves them without it)."""
+
+    bodies: tuple[str, str]
+    restitution: float | None = None
+    mu: float | None = None
 
 
 @dataclass(frozen=True)
@@ -99,10 +132,36 @@ class Scene:
     bodies: tuple[BodyConfig, ...] = ()
     meshes: dict = field(default_factory=dict, compare=False, repr=False)
     particles: ParticleConfig | None = None
+    pairs: tuple[PairConfig, ...] = ()
 
     def mesh(self, body: BodyConfig):
         """The loaded mesh of ``body`` (shared between bodies of one model)."""
         return self.meshes[body.model]
+
+    def coefficients(self, a: BodyConfig, b: BodyConfig | None = None) -> tuple[float, float]:
+        """Restitution e and Coulomb's mu at the contacts of body ``a`` with
+        body ``b``, or with a wall (``b`` None), for the corrected responses.
+
+        With a wall: the body's own values, else the world's (``restitution``,
+        :attr:`WorldConfig.coulomb_mu`). Between two bodies: a ``[[pair]]``
+        entry naming both; else the value the two bodies give (one of them,
+        or both alike); else the world's. Two bodies that give different
+        values and no ``[[pair]]`` are refused by the loader: no combination
+        rule is guessed (engines differ on it; Bullet multiplies).
+        """
+        world = self.world
+        if b is None:
+            return (world.restitution if a.restitution is None else a.restitution,
+                    world.coulomb_mu if a.mu is None else a.mu)
+        pair = next((p for p in self.pairs if set(p.bodies) == {a.name, b.name}), None)
+        values = []
+        for key, default in (("restitution", world.restitution), ("mu", world.coulomb_mu)):
+            given = getattr(pair, key) if pair is not None else None
+            if given is None:
+                given = next((getattr(c, key) for c in (a, b) if getattr(c, key) is not None),
+                             default)
+            values.append(given)
+        return values[0], values[1]
 
 
 # -- the schema rows -------------------------------------------------------------
@@ -139,6 +198,29 @@ def unit_interval(value) -> str | None:
     return None if 0.0 <= value <= 1.0 else "must be in [0, 1]"
 
 
+def nonzero(value) -> str | None:
+    return None if any(value) else "must not be the zero vector"
+
+
+def at_least(low: int) -> Check:
+    def check(value):
+        return None if value >= low else f"must be at least {low}"
+    return check
+
+
+def wall_names(value) -> str | None:
+    unknown = [w for w in value if w not in WALL_NAMES]
+    if unknown:
+        return f"names {unknown[0]!r}: walls are " + ", ".join(repr(w) for w in WALL_NAMES)
+    if len(set(value)) != len(value):
+        return "names a wall twice"
+    return None
+
+
+def positive_vec3(value) -> str | None:
+    return None if all(x > 0 for x in value) else "must have every component > 0"
+
+
 def one_of(*choices: str) -> Check:
     def check(value):
         return None if value in choices else "must be one of " + ", ".join(
@@ -166,6 +248,10 @@ TABLES: dict[str, tuple[type, tuple[Field, ...]]] = {
         Field("restitution", "float", unit_interval),
         Field("friction", "float", unit_interval),
         Field("wall_speed", "str", one_of(*WALL_SPEEDS)),
+        Field("gravity_direction", "vec3", nonzero),
+        Field("walls", "walls", wall_names),
+        Field("mu", "float", non_negative),
+        Field("restitution_threshold", "float", non_negative),
     )),
     "integration": (IntegrationConfig, (
         Field("solver", "str", one_of(*SOLVER_NAMES)),
@@ -185,13 +271,28 @@ TABLES: dict[str, tuple[type, tuple[Field, ...]]] = {
 
 BODY_FIELDS: tuple[Field, ...] = (
     Field("name", "str"),
-    Field("model", "str", required=True),
+    Field("model", "str"),
     Field("position", "vec3"),
     Field("velocity", "vec3"),
     Field("angular_velocity", "vec3"),
     Field("orientation", "mat3", orthonormal),
     Field("mass", "float", positive),
     Field("scale", "float", positive),
+    Field("shape", "str", one_of(*SHAPES[1:])),
+    Field("size", "vec3", positive_vec3),
+    Field("radius", "float", positive),
+    Field("frequency", "int", at_least(1)),
+    Field("fixed", "bool"),
+    Field("force", "vec3"),
+    Field("torque", "vec3"),
+    Field("restitution", "float", unit_interval),
+    Field("mu", "float", non_negative),
+)
+
+PAIR_FIELDS: tuple[Field, ...] = (
+    Field("bodies", "names2", required=True),
+    Field("restitution", "float", unit_interval),
+    Field("mu", "float", non_negative),
 )
 
 #: ParticleConfig fields that other tables set, and the scene key of each.

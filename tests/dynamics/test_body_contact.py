@@ -129,7 +129,8 @@ def test_one_set_of_the_island_solve_is_the_single_solve_bit_for_bit():
                                       impulse.RESTITUTION_THRESHOLD, impulse.ITERATIONS, P1)
         P2 = np.empty((4, 4))
         impulse.solve_island_python(np.array([0, 4]), np.array([0]), np.array([1]), r_a, r_b,
-                                    n[None, :], np.array([1.0, 0.5]), I_inv, v, w, 0.8, 0.3,
+                                    n[None, :], np.array([1.0, 0.5]), I_inv, v, w, np.array([0.8]),
+                                    np.array([0.3]),
                                     impulse.RESTITUTION_THRESHOLD, impulse.ITERATIONS, P2)
         assert P1.tobytes() == P2.tobytes()
         assert (single_v.tobytes(), single_w.tobytes()) == (v.tobytes(), w.tobytes())
@@ -152,7 +153,8 @@ def test_a_wall_as_a_row_of_zeros_solves_as_the_wall_solve(kernel):
         P2 = np.empty((4, 4))
         impulse.solve_island(np.array([0, 4]), np.array([0]), np.array([1]), r_a,
                              np.zeros((4, 3)), n[None, :], np.array([0.7, 0.0]),
-                             np.stack([I_inv, np.zeros((3, 3))]), v2, w2, 0.6, 0.4,
+                             np.stack([I_inv, np.zeros((3, 3))]), v2, w2, np.array([0.6]),
+                             np.array([0.4]),
                              impulse.RESTITUTION_THRESHOLD, impulse.ITERATIONS, P2,
                              kernel=kernel)
         assert np.array_equal(P1, P2)

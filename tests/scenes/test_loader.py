@@ -105,6 +105,38 @@ BAD = [
     ('[[body]]\nmodel = "cube.ac"\nname = "a"\n[[body]]\nmodel = "cube.ac"\nname = "a"\n',
      "body[1].name", "duplicate"),
     ("[world]\nhalf_size = 5.0\n", "body", "at least one [[body]] or a [particles] table"),
+    # the keys that pose textbook problems (refsim.dynamics.loads)
+    ("[world]\ngravity_direction = [0, 0, 0]\n" + MINIMAL, "world.gravity_direction",
+     "zero vector"),
+    ('[world]\nwalls = ["floor"]\n' + MINIMAL, "world.walls", "names 'floor': walls are"),
+    ('[world]\nwalls = ["y-", "y-"]\n' + MINIMAL, "world.walls", "names a wall twice"),
+    ("[world]\nwalls = \"y-\"\n" + MINIMAL, "world.walls", "list of strings"),
+    ("[world]\nmu = -1\n" + MINIMAL, "world.mu", "must be >= 0"),
+    ("[world]\nrestitution_threshold = -0.1\n" + MINIMAL, "world.restitution_threshold",
+     ">= 0"),
+    ('[[body]]\nshape = "cone"\n', "body[0].shape", "one of 'box', 'sphere'"),
+    ('[[body]]\nshape = "box"\nmodel = "cube.ac"\n', "body[0].model", "not both"),
+    ('[[body]]\nshape = "box"\nradius = 1.0\n', "body[0].radius", "shape = 'sphere'"),
+    ('[[body]]\nmodel = "cube.ac"\nsize = [1, 1, 1]\n', "body[0].size", "shape = 'box'"),
+    ('[[body]]\nshape = "box"\nsize = [1, 0, 1]\n', "body[0].size", "every component > 0"),
+    ('[[body]]\nshape = "sphere"\nfrequency = 1.5\n', "body[0].frequency", "whole number"),
+    ('[[body]]\nshape = "sphere"\nfrequency = 0\n', "body[0].frequency", "at least 1"),
+    ('[[body]]\nshape = "box"\nfixed = 1\n', "body[0].fixed", "true or false"),
+    ('[[body]]\nshape = "box"\nfixed = true\nvelocity = [1, 0, 0]\n', "body[0].velocity",
+     "a fixed body never moves"),
+    ('[[body]]\nshape = "box"\nmu = -0.5\n', "body[0].mu", ">= 0"),
+    ('[[body]]\nshape = "box"\nrestitution = 2\n', "body[0].restitution", "[0, 1]"),
+    ('[[body]]\nshape = "box"\nname = "a"\nposition = [2, 0, 0]\nrestitution = 0.5\n'
+     '[[body]]\nshape = "box"\nname = "b"\nrestitution = 0.7\n', "body[1].restitution",
+     "add a [[pair]] with bodies = ['a', 'b']"),
+    ('[[body]]\nshape = "box"\nname = "a"\n[[pair]]\nbodies = ["a", "c"]\n', "pair[0].bodies",
+     "no body is named 'c'"),
+    ('[[body]]\nshape = "box"\nname = "a"\n[[pair]]\nbodies = ["a", "a"]\n', "pair[0].bodies",
+     "twice"),
+    ('[[body]]\nshape = "box"\nname = "a"\n[[pair]]\nmu = 0.5\n', "pair[0].bodies",
+     "required"),
+    ('[world]\nwalls = ["y-"]\n[particles]\ncount = 10\n', "world.walls",
+     "rigid bodies only"),
 ]
 
 
@@ -320,3 +352,49 @@ def test_a_scene_beyond_the_default_step_limit_needs_max_steps(tmp_path):
         load_scene(path, max_steps=19_999_999)
     with pytest.raises(StateError, match=f"max_steps must be at least 1 and at most {MAX_STEPS}"):
         load_scene(path, max_steps=MAX_STEPS + 1)
+
+
+def test_the_textbook_keys_load_into_the_scene(tmp_path):
+    """Every key of refsim.dynamics.loads, read and resolved: shapes become
+    meshes of the given size, coefficients resolve pair first, then body,
+    then world."""
+    scene = load_scene(write(tmp_path, """
+[world]
+gravity_direction = [1, -2, 0]
+walls = ["y-", "x+"]
+mu = 1.5
+restitution_threshold = 0.1
+[[body]]
+name = "table"
+shape = "box"
+size = [4, 0.5, 3]
+position = [0, -4.75, 0]
+fixed = true
+restitution = 0.3
+[[body]]
+name = "ball"
+shape = "sphere"
+radius = 0.25
+frequency = 3
+position = [0, -3, 0]
+force = [1, 0, 0]
+torque = [0, 0, 0.5]
+[[pair]]
+bodies = ["ball", "table"]
+mu = 0.2
+"""))
+    table, ball = scene.bodies
+    assert scene.world.walls == ("y-", "x+") and scene.world.coulomb_mu == 1.5
+    assert scene.world.restitution_threshold == 0.1
+    g = scene.world.gravity_vector
+    assert g[0] == pytest.approx(9.81 / 5 ** 0.5) and g[1] == pytest.approx(-2 * 9.81 / 5 ** 0.5)
+    box = scene.mesh(table)
+    assert box.n_faces == 12 and tuple(box.vertices.max(axis=0)) == (2.0, 0.25, 1.5)
+    sphere = scene.mesh(ball)
+    assert sphere.n_faces == 20 * 3 ** 2
+    assert abs(sum(c * c for c in sphere.vertices.T) ** 0.5 - 0.25).max() < 1e-15
+    assert table.fixed and ball.force == (1.0, 0.0, 0.0) and ball.torque == (0.0, 0.0, 0.5)
+    assert scene.coefficients(table, ball) == (0.3, 0.2)      # e: the table's; mu: the pair's
+    assert scene.coefficients(ball) == (0.8, 1.5)             # with a wall: the world's
+    assert scene.coefficients(table) == (0.3, 1.5)
+
