@@ -2,7 +2,7 @@
 simulation (Kenny Hoff, COMP-205, UNC Chapel Hill), checked against python-fcl,
 trimesh, scipy, pybullet and MuJoCo.
 
-The public names below are a contract (DESIGN.md, Public API). They are
+The public names below are a contract (docs/design.md, Public API). They are
 imported lazily, on first use, so that ``import refsim`` and the command line
 stay quick and an area's heavy imports are paid only by those who use it.
 """

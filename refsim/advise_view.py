@@ -3,7 +3,7 @@ as text, as a TOML snippet to paste into the scene, as one JSON document,
 and as a work-precision chart (SVG with matplotlib, or text).
 
 It arranges what the advisor measured and computes nothing of its own
-(DESIGN.md, Architecture: views). matplotlib is the ``report`` extra: it is
+(docs/design.md, Architecture: views). matplotlib is the ``report`` extra: it is
 imported only to draw the SVG, and :func:`svg_available` says whether it
 can be.
 

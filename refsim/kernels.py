@@ -3,7 +3,7 @@
 Every algorithm is written once as a plain, readable kernel. Where the
 interpreter's overhead dominates (tree traversals, hill climbing, per-contact
 loops, many small steps), numba compiles a twin that does the same arithmetic
-in the same order, so the two agree bit for bit (DESIGN.md, Speed). Each
+in the same order, so the two agree bit for bit (docs/design.md, Speed). Each
 public function that has both takes ``kernel=`` with one vocabulary:
 
 - ``"readable"``: the plain kernel, always available;

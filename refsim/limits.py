@@ -1,7 +1,7 @@
 """The limits refsim sets on its inputs, in one place, each with its reason.
 
 Every input enters through a validation that refuses values beyond these with
-one error naming the file and key or the argument (DESIGN.md, Errors), so that
+one error naming the file and key or the argument (docs/design.md, Errors), so that
 no input can overflow the arithmetic, allocate without bound or run for days.
 """
 

@@ -15,7 +15,7 @@ It differs from ``savez`` in two ways, both deliberate:
   SpilledArray`, anything with ``shape``, ``dtype`` and ``chunks(size)``),
   so writing costs O(chunk) memory whatever the array's size;
 - every entry carries the same fixed date (:data:`ZIP_DATE`), so the same
-  arrays give the same bytes (DESIGN.md, Conventions: reproducible output).
+  arrays give the same bytes (docs/design.md, Conventions: reproducible output).
 
 Cost: one pass over the data (plus CRC-32, plus deflate when compressed);
 memory O(:data:`CHUNK_BYTES`) and zlib's window.

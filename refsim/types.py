@@ -3,7 +3,7 @@
 A pose is a pair ``(rotation, translation)``: a (3, 3) orthonormal matrix whose
 columns are the body's axes in world coordinates, and a (3,) translation. A
 point ``p`` in body space is at ``rotation @ p + translation`` in world space
-(DESIGN.md, Conventions).
+(docs/design.md, Conventions).
 """
 
 from __future__ import annotations

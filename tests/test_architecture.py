@@ -1,4 +1,4 @@
-"""The import rules of DESIGN.md's Architecture, checked on every module.
+"""The import rules of docs/design.md's Architecture, checked on every module.
 
 Data flows one way: algorithms -> engines -> studies and conformance ->
 claims -> report, viewer, command line; each layer imports only the layers
@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: Source folders and the package they are installed as.
 SOURCES = ((ROOT / "refsim", "refsim"), (ROOT / "oracles", "refsim.oracles"))
 
-#: The algorithm modules (DESIGN.md: "Algorithms"): one package per area, and
+#: The algorithm modules (docs/design.md, Architecture: "Algorithms"): one package per area, and
 #: the shared modules of plain types, errors, limits and input/output.
 ALGORITHMS = tuple(f"refsim.{name}" for name in (
     "models", "bounds", "collision", "solvers", "dynamics", "particles", "scenes",

@@ -1,6 +1,6 @@
 """The error contract of the public API: a user's mistake raises a RefsimError
 that is also the ValueError or TypeError Python code expects, with a message
-naming the argument; nothing else escapes (DESIGN.md, Errors)."""
+naming the argument; nothing else escapes (docs/design.md, Errors)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Hypothesis strategies of the API fuzzer (tests/fuzz, DESIGN.md Errors):
+"""Hypothesis strategies of the API fuzzer (tests/fuzz, docs/design.md Errors):
 hostile arguments to refsim's public functions, one probe at a time."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from hypothesis.strategies import SearchStrategy as _SearchStrategy
 from tests.fuzz.api_worker import Probe as _Probe
 
 # ===========================================================================
-# Fuzz: hostile arguments to the public API (tests/fuzz, DESIGN.md Errors)
+# Fuzz: hostile arguments to the public API (tests/fuzz, docs/design.md Errors)
 # ===========================================================================
 # A probe is one Python expression over the fixtures of
 # tests.fuzz.api_worker.PRELUDE (CUBE, SPHERE, ID, BOUNCE, FIFO_TOML, ...), so

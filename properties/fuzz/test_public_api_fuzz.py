@@ -1,4 +1,4 @@
-"""Laws of the public API under hostile arguments (DESIGN.md, Errors and Public API).
+"""Laws of the public API under hostile arguments (docs/design.md, Errors and Public API).
 
 For every public function (``properties.fuzz.strategies.API_FUNCTIONS``), calls
 drawn from ``api_probes`` either return or raise a ``RefsimError`` that is

@@ -5,7 +5,7 @@ Line for line the same algorithms as the readable kernels in
 written as plain loops over arrays so that numba can compile them. The
 interpreter's overhead per vertex (a few hundred nanoseconds) would otherwise
 hide the point of the incremental update, which is to examine a few dozen
-vertices instead of all of them (DESIGN.md, Speed).
+vertices instead of all of them (docs/design.md, Speed).
 
 Arithmetic: numba compiles without fast-math, so LLVM neither reassociates
 the sums nor fuses a multiply and an add; each operation is rounded once, as in

@@ -16,7 +16,7 @@ is defined), the same record feeds the report's tables, and a test builds
 one with the real constructor. Where a claim rests on a property of an
 algorithm rather than a measurement (a solver's derived order, its
 stability polynomial) the caller passes it as a plain mapping, so that this
-package imports nothing of refsim but study records (DESIGN.md,
+package imports nothing of refsim but study records (docs/design.md,
 Architecture; tests/test_architecture.py).
 
 Beside the claim functions, a few *findings* judge what is not a seed claim

@@ -1,6 +1,6 @@
 """The seed's claims C1-C12 and its terminology, as the report lists them.
 
-The wording follows DESIGN.md's summary of the seed. Each claim is judged by
+The wording follows the seed's own text. Each claim is judged by
 one function of this package (``refsim.claims.<area>.c<N>``); a claim
 nobody has measured is shown as "not measured yet", never guessed.
 """

@@ -1,5 +1,5 @@
 """Bounding spheres about the centroid: the coarsest of the seed's four types
-of body-body collision test (seed S4; DESIGN.md names it the fourth type).
+of body-body collision test (seed S4: the fourth type of test).
 
 Each body gets the sphere centred at the seed's centroid (the average of its
 vertices, S9) with radius the largest distance from there to a vertex. Two

@@ -124,7 +124,7 @@ def orientation_step_seed(R: np.ndarray, w: np.ndarray, h: float) -> np.ndarray:
 
     AMBIGUITY (A2): the seed gives w's magnitude in "revolutions / time", but
     ``dX/dt = w x X`` holds only with w in radians per time; refsim's w is in
-    rad/s (DESIGN.md), which is what the seed's own formula computes.
+    rad/s (docs/design.md, Conventions): what the seed's own formula computes.
 
     AMBIGUITY: the seed's axes are "normalized and orthogonal", but its Euler
     step is not a rotation: it lengthens every axis by a factor

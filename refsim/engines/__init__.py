@@ -5,7 +5,7 @@ below; refsim's seed model and corrected model are engines
 (:mod:`refsim.engines.refsim_engines`), so is every adapter in
 :mod:`refsim.oracles`, and so is any user's own code. Studies and the
 conformance kit receive engines as arguments; only a composition root (the
-command line, the report build, a test fixture) chooses them (DESIGN.md,
+command line, the report build, a test fixture) chooses them (docs/design.md,
 Architecture).
 
 The contract uses plain arrays, so that an engine needs nothing of refsim

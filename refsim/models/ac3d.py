@@ -29,7 +29,7 @@ What the reader does with it:
   content) and the Blender 2.4 importer: the numbers are read row by row into
   a matrix ``M`` that multiplies *row* vectors, ``p' = p M``. So the first
   three numbers are the image of the x axis, the next three of y, the last
-  three of z: in our column-vector convention (DESIGN.md: columns are the
+  three of z: in our column-vector convention (docs/design.md: columns are the
   body's axes) the file lists ``R = M.T`` column by column (column-major).
   ``rot 0 1 0  -1 0 0  0 0 1`` turns x into y (+90 degrees about z).
   Any finite matrix is applied as given (AC3D may store a scale in it).

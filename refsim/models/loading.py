@@ -32,7 +32,7 @@ from refsim.files import as_path, bundled_if_bare, read_regular_file, refuse_mis
 from refsim.models.ac3d import read_ac3d
 from refsim.models.mesh import Mesh
 
-#: Suffixes read by trimesh (the formats DESIGN.md names for the trimesh oracle).
+#: Suffixes read by trimesh (the formats trimesh reads).
 TRIMESH_SUFFIXES = (".obj", ".stl", ".ply", ".off")
 SUFFIXES = (".ac",) + TRIMESH_SUFFIXES
 

@@ -6,7 +6,7 @@ which engines (the oracle adapters of :mod:`refsim.oracles`, chosen here and
 nowhere else) and with which sizes for the quick and the full report. The
 report's sections ask a :class:`Run` for an entry's records and arrange
 them; ``refsim study NAME`` runs the same entry and prints them, so the
-command printed under a figure reproduces that figure (DESIGN.md,
+command printed under a figure reproduces that figure (docs/design.md,
 Architecture: an engine is chosen only at a composition root).
 
 An entry that backs a seed claim names the claim and the function of

@@ -65,7 +65,7 @@ def load_scene(path, *, max_steps: int = DEFAULT_MAX_STEPS) -> Scene:
     Parameters
     ----------
     path : str or PathLike
-        A TOML scene file (keys: DESIGN.md, Scene files; every key but
+        A TOML scene file (keys: docs/design.md, Scene files; every key but
         ``[[body]] model`` has a default). A bare file name that is not in
         the current directory names a bundled scene
         (``refsim.bundled.scenes_dir()``), e.g. ``"bounce.toml"``.

@@ -1,7 +1,7 @@
 """The scene file schema (seed S11: "fully configurable simulation script files").
 
 A scene is a TOML file with the tables ``[world]``, ``[integration]``,
-``[collision]``, ``[dynamics]``, an array ``[[body]]`` (DESIGN.md, Scene
+``[collision]``, ``[dynamics]``, an array ``[[body]]`` (docs/design.md, Scene
 files) and an optional ``[particles]`` table (S10); it needs at least one
 body or the particles table. This module declares every key once: its type, default and allowed
 range, as :class:`Field` rows. :mod:`refsim.scenes.loader` walks a parsed file

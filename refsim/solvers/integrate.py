@@ -4,7 +4,7 @@ What: repeat a solver's step from ``t0`` to ``t1`` with a constant step ``h``,
 the way the seed's simulation advances its state vector, and count the
 evaluations of ``f`` (``nfev``) as scipy's ``solve_ivp`` does.
 
-Seed section: S6 (DESIGN.md, Public API: ``refsim.integrate``).
+Seed section: S6 (docs/design.md, Public API: ``refsim.integrate``).
 
 Reference: E. Hairer, S. P. Norsett, G. Wanner, *Solving Ordinary Differential
 Equations I*, 2nd ed., section II.3 (convergence of one-step methods with a
@@ -224,7 +224,7 @@ def solve_fixed_step(f, y0, t0: float, t1: float, h: float, method="rk4", *,
 def integrate(f, y0, t0: float, t1: float, h: float, method="rk4", *,
               last_step: str = "error") -> tuple[np.ndarray, np.ndarray]:
     """Integrate ``y' = f(t, y)`` from ``t0`` to ``t1`` with a fixed step ``h``
-    by one of the seed's solvers (S6; DESIGN.md, Public API).
+    by one of the seed's solvers (S6; docs/design.md, Public API).
 
     Parameters
     ----------

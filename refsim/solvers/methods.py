@@ -5,7 +5,7 @@ What: the tableaux of "Euler", "Two-Step Averaged Euler", "Backwards Euler",
 "Differential Equation Solvers" defines them, plus the seed's RK4 weights
 read literally (:data:`SEED_LITERAL_VARIANTS`), which are a typo.
 
-Seed section: S6 (DESIGN.md); claim C10 is each method's ``seed_order``
+Seed section: S6; claim C10 is each method's ``seed_order``
 against its derived ``order``.
 
 Reference: E. Hairer, S. P. Norsett, G. Wanner, *Solving Ordinary Differential

@@ -6,7 +6,7 @@ plain result records: numbers, counts and classified disagreements, with
 timings marked as timings. It prints nothing and decides no verdict: the
 claims (:mod:`refsim.claims`) judge the records, and the views (the report,
 the command line) show them. Studies import algorithms and engines, never the
-report, the claims or a particular oracle (DESIGN.md, Architecture).
+report, the claims or a particular oracle (docs/design.md, Architecture).
 
 - ``bounds``: box update cost and visits, the incremental box's error,
   agreement with an AABB oracle (C1, C2);
@@ -33,7 +33,7 @@ from typing import Any
 #: time, or a figure derived from wall times (a rate, a ratio of times, a
 #: crossover size). Timings vary from run to run and from machine to machine;
 #: every other field of a study record is the same bytes on every run with the
-#: same inputs (DESIGN.md, Conventions), and the report's determinism test
+#: same inputs (docs/design.md, Conventions), and the report's determinism test
 #: compares those exactly.
 TIMING = "timing"
 

@@ -1,5 +1,5 @@
 """Sweeps: many independent runs, here, on local processes or on a Dask
-cluster, with the same results on each (DESIGN.md, Sweeps).
+cluster, with the same results on each (docs/design.md, Architecture).
 
     from refsim.sweep import Task, run_sweep
     from refsim.sweep.examples import bounce

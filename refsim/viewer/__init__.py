@@ -13,7 +13,7 @@
   network (:mod:`refsim.viewer.replay`); :mod:`refsim.viewer.demos` writes
   the replays of claims C11 and C12 and of a wall bounce beside pybullet.
 
-The viewer is a view layer (DESIGN.md, Architecture): it imports the
+The viewer is a view layer (docs/design.md, Architecture): it imports the
 algorithms and runs simulations, and computes no verdicts. What it draws
 beyond the recorded poses (boxes, contacting triangles, wall impulses,
 energy) comes from refsim's own functions, in :mod:`refsim.viewer.overlays`.

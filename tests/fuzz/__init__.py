@@ -1,6 +1,6 @@
 """The fuzz campaign: hostile files and arguments against refsim's laws of errors.
 
-DESIGN.md, Errors: bad input raises a refsim exception naming the file, line
+docs/design.md, Errors: bad input raises a refsim exception naming the file, line
 or key; the command line prints one line and exits non-zero, never shows a
 traceback for a user's mistake, and never leaves a half-written output file.
 This package checks those laws by mutation and by hostile arguments:

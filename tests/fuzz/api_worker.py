@@ -1,6 +1,6 @@
 """Hostile calls of refsim's public API, each in a supervised worker process.
 
-The law (DESIGN.md, Errors and Public API; ``refsim/errors.py``): a call
+The law (docs/design.md, Errors and Public API; ``refsim/errors.py``): a call
 either returns or raises a :class:`refsim.errors.RefsimError`; an error about
 a value is also a ValueError, one about a type also a TypeError (a plain
 RefsimError is neither, which ``except ValueError`` code misses); a

@@ -5,7 +5,7 @@ returns a mutant; the same bytes and the same seed give the same mutant. Text
 formats are handled as Latin-1 text (one character per byte, so any byte
 survives the round trip, and a mutator can insert bytes that are not UTF-8).
 
-The mutators aim at what a reader can get wrong (DESIGN.md, Errors; the AC3D
+The mutators aim at what a reader can get wrong (docs/design.md, Errors; the AC3D
 reader's "Strictness" list in ``refsim/models/ac3d.py``; the scene schema):
 
 =================  ==========================================================
