@@ -19,6 +19,7 @@ _EXPORTS = {
     "RefsimError": "refsim.errors",
     "ModelError": "refsim.errors",
     "SceneError": "refsim.errors",
+    "UnposableKey": "refsim.errors",
     "StateError": "refsim.errors",
     "DivergenceError": "refsim.errors",
     "OptionError": "refsim.errors",

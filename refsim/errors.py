@@ -84,6 +84,14 @@ class SceneError(RefsimError, ValueError):
         super().__init__(f"{where}: {message}")
 
 
+class UnposableKey(SceneError):
+    """A valid scene key that the engine, or the model chosen, cannot pose
+    (a torque for the seed's rotation, a tilted gravity for an engine
+    without one): ``key`` names the scene's key. The conformance kit reports
+    such a scene as not posed, with this message as the reason, never as the
+    engine's failure."""
+
+
 class NpzFileError(RefsimError, ValueError):
     """An .npz that cannot be read as the expected content: missing,
     unreadable, truncated, another format, an entry missing or of the wrong

@@ -52,6 +52,14 @@ board                  overhanging it by 1.9 m with its centre 0.4 m from the
                        cube's; a cube on a rod lying on the floor, 1.5 m from
                        the rod's centre. Each is statically stable (every
                        centre of mass over its support): nothing moves
+incline-*              a 1 x 0.5 x 1 m block (``shape = "box"``) resting on
+                       the floor under gravity tilted by the incline's
+                       angle (``world.gravity_direction``), Coulomb's mu
+                       from ``world.mu``, 1 s from rest: ``incline-slide``
+                       (30 degrees, mu 0.3) slides ``g (sin a - mu cos a)
+                       t^2 / 2`` = 1.178 m; ``incline-stick`` (10 degrees,
+                       mu 0.3) and ``incline-mu1.5`` (50 degrees, mu 1.5,
+                       above 1) stay (tan a < mu)
 =====================  =====================================================
 
 Two choices keep the answers exact for every reasonable engine:
@@ -78,7 +86,12 @@ velocity and ``w . I w / 2`` with the uniform solid's inertia.
 A run of each scene is kept per engine (:meth:`RigidCases.run`), so the
 checks share it; ``rerun`` runs a scene again for the determinism check.
 
-Cost: about 27,900 steps per engine in all (the drops are 1.8 to 3.0 s of
+The incline scenes use keys beyond the seed's world: an engine (or refsim's
+seed model) that cannot pose them refuses the scene
+(:class:`refsim.errors.UnposableKey`) and the check reports it as not
+posed, with the key.
+
+Cost: about 30,900 steps per engine in all (the drops are 1.8 to 3.0 s of
 simulated time, the free brick 12 s), and 1,700 more for the determinism
 check's reruns.
 """
@@ -170,11 +183,19 @@ STACKS = (
 )
 
 
+#: The inclines (module docstring): name, angle (degrees), mu; and the run (s).
+INCLINES = (("incline-slide", 30.0, 0.3), ("incline-stick", 10.0, 0.3),
+            ("incline-mu1.5", 50.0, 1.5))
+INCLINE_DURATION = 1.0
+INCLINE_BLOCK = (1.0, 0.5, 1.0)
+INCLINE_START_X = -3.0
+
+
 @dataclass(frozen=True)
 class RigidScene:
     """One scene of the set: its name, kind ("drop", "oblique", "spin",
-    "rest", "free", "strike", "stack"), the scene, and the parameters its
-    answer needs."""
+    "rest", "free", "strike", "stack", "incline"), the scene, and the
+    parameters its answer needs (``angle``: an incline's, degrees)."""
 
     name: str
     kind: str
@@ -182,6 +203,7 @@ class RigidScene:
     e: float
     friction: float = 0.0
     height: float = 0.0
+    angle: float = 0.0
 
     def to_dict(self) -> dict:
         if len(self.scene.bodies) > 1:
@@ -194,7 +216,11 @@ class RigidScene:
                     "step": self.scene.integration.step,
                     "duration": self.scene.integration.duration}
         body = self.scene.bodies[0]
-        return {"scene": self.name, "kind": self.kind, "model": body.model.name,
+        extra = {}
+        if self.kind == "incline":
+            extra = {"incline_degrees": self.angle, "mu": self.friction,
+                     "gravity_direction": list(self.scene.world.gravity_direction)}
+        return {"scene": self.name, "kind": self.kind, "model": body.model.name, **extra,
                 "restitution": self.e, "friction": self.friction,
                 "position": list(body.position), "velocity": list(body.velocity),
                 "angular_velocity": list(body.angular_velocity),
@@ -277,7 +303,40 @@ def rigid_scenes() -> tuple[RigidScene, ...]:
         scenes.append(RigidScene(name, "stack", _bodies_scene(bodies, GRAVITY, STACK_E, STACK_MU,
                                                               STACK_DURATION),
                                  STACK_E, STACK_MU))
+    for name, angle, mu in INCLINES:
+        scenes.append(RigidScene(name, "incline", _incline_scene(angle, mu), 0.0, mu,
+                                 angle=angle))
     return tuple(scenes)
+
+
+def _incline_scene(angle: float, mu: float):
+    """The block resting on the floor under gravity tilted by ``angle``
+    degrees about z (down the slope is +x), e = 0, Coulomb's ``mu``."""
+    from refsim.scenes.loader import scene_from_dict
+    from refsim.solvers.integrate import covering_duration
+
+    a = math.radians(angle)
+    return scene_from_dict({
+        "world": {"half_size": HALF_SIZE, "gravity": GRAVITY,
+                  "gravity_direction": [math.sin(a), -math.cos(a), 0.0], "drag": 0.0,
+                  "restitution": 0.0, "mu": mu},
+        "integration": {"solver": SOLVER, "step": STEP,
+                        "duration": covering_duration(INCLINE_DURATION, STEP)},
+        "collision": {"level": "aabb"},
+        "body": [{"name": "block", "shape": "box", "size": list(INCLINE_BLOCK),
+                  "position": [INCLINE_START_X, _FLOOR + 0.5 * INCLINE_BLOCK[1], 0.0]}]})
+
+
+def incline_answer(scene: RigidScene) -> float:
+    """How far the incline's block travels down the slope in the scene's
+    duration from rest: ``g (sin a - mu cos a) t^2 / 2`` when ``tan a > mu``
+    (sliding, Coulomb's kinetic friction), else 0 (static friction holds
+    it). Kleppner & Kolenkow, *An Introduction to Mechanics*, 2nd ed.,
+    section 3.3."""
+    a = math.radians(scene.angle)
+    along = GRAVITY * (math.sin(a) - scene.friction * math.cos(a))
+    t = scene.scene.integration.duration
+    return max(along, 0.0) * t * t / 2.0
 
 
 def _bodies_scene(bodies, gravity: float, e: float, mu: float, duration: float,

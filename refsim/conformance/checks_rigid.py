@@ -78,6 +78,16 @@ meet them within these bounds.
   and the angular momentum about the world origin stays within
   :data:`MOMENTUM_TOL` of its start (no force but the contact's, whose
   impulses are equal and opposite at one point).
+- ``rigid.incline`` (a block on an incline, sliding at 30 degrees with mu
+  0.3, sticking at 10 degrees and at 50 degrees with mu 1.5): its travel
+  down the slope in 1 s is Coulomb's
+  (:func:`refsim.conformance.cases_rigid.incline_answer`) within
+  :func:`incline_tolerance`: a first-order step's error ``a h t / 2`` in
+  ``a t^2 / 2``, and friction that acts up to :data:`CONTACT_STEPS` steps
+  late on each of the ``t / h`` steps of a resting contact, whose sliding
+  speed gains ``g h`` per step before it acts: ``CONTACT_STEPS g h t``
+  (about 2 cm at h = 1e-3, where a frictionless block would slide
+  metres). A scene the engine cannot pose is not posed, with the key.
 - ``rigid.stack`` (a cube resting 0.3 m off the centre of another; a rod
   overhanging a cube, its centre of mass over the cube; a cube on a rod
   lying on the floor, 1.5 m from the rod's centre): every vertex of every
@@ -115,7 +125,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.conformance import cases_rigid as R
-from refsim.conformance.results import CheckResult, Crash, attempt, classify_miss, tally
+from refsim.conformance.results import (
+    CheckResult,
+    Crash,
+    attempt,
+    classify_miss,
+    not_applicable,
+    tally,
+)
 from refsim.dynamics import analytic
 
 #: Steps over which an engine may find and resolve one contact (module docstring).
@@ -177,12 +194,20 @@ MOMENTUM_TOL = 1e-3
 STACK_TRAVEL = 2.5e-4
 
 
-def _runs(engine, cases, kinds, outcomes: list, examples: list):
+def _runs(engine, cases, kinds, outcomes: list, examples: list,
+          not_posed: dict | None = None):
     """Each scene of ``kinds`` with the engine's trajectory of it; a scene
     whose run crashed is recorded in ``outcomes`` and ``examples`` (class
-    "crash", the scene and the traceback's last line) and skipped."""
+    "crash", the scene and the traceback's last line) and skipped. With
+    ``not_posed``, a scene the engine refused as unposable
+    (:class:`refsim.errors.UnposableKey`) goes there instead, by name, with
+    the refusal's line."""
     for scene in cases.of_kind(*kinds):
         trajectory = attempt(cases.run, engine, scene)
+        if not_posed is not None and isinstance(trajectory, Crash) and \
+                trajectory.error.startswith(("UnposableKey:", "refsim.errors.UnposableKey:")):
+            not_posed[scene.name] = trajectory.error.split(":", 1)[1].strip()
+            continue
         if isinstance(trajectory, Crash):
             outcomes.append("crash")
             examples.append(trajectory.example(**scene.to_dict()))
@@ -565,6 +590,46 @@ def check_rigid_stack(engine, cases) -> CheckResult:
                  seconds=time.perf_counter() - start)
 
 
+def incline_tolerance(scene) -> float:
+    """Metres of travel an incline scene allows (module docstring)."""
+    a = math.radians(scene.angle)
+    along = abs(R.GRAVITY * (math.sin(a) - scene.friction * math.cos(a)))
+    h = scene.scene.integration.step
+    t = scene.scene.integration.duration
+    return (0.5 * along + CONTACT_STEPS * R.GRAVITY) * h * t
+
+
+def check_rigid_incline(engine, cases) -> CheckResult:
+    """``rigid.incline``: a block slides down an incline at Coulomb's
+    acceleration, or sticks below its friction angle (module docstring)."""
+    start = time.perf_counter()
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    not_posed: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("incline",), outcomes, examples,
+                                   not_posed):
+        travel = float(trajectory.position[-1, 0, 0] - trajectory.position[0, 0, 0])
+        answer = R.incline_answer(scene)
+        tol = incline_tolerance(scene)
+        miss = abs(travel - answer)
+        measured[scene.name] = {"travel_metres": travel, "coulomb_metres": answer,
+                                "miss_metres": miss, "tolerance_metres": tol}
+        outcome = classify_miss(miss, tol) if math.isfinite(miss) else "bug"
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, "travel_metres": travel,
+                             "coulomb_metres": answer, "tolerance_metres": tol,
+                             **scene.to_dict()})
+    if not_posed and not outcomes:
+        return not_applicable("rigid", "incline", "cannot pose: " + next(iter(
+            not_posed.values())))
+    if not_posed:
+        measured["not_posed"] = not_posed
+    return tally("rigid", "incline", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
 # -- the textbook problems, as the report shows them ----------------------------------
 
 
@@ -591,6 +656,11 @@ def _worst(measured: dict, value: Callable[[dict], float]) -> float:
     if not values or any(math.isnan(v) for v in values):
         return math.nan
     return max(values)
+
+
+def _posed(measured: dict) -> dict:
+    """``measured`` without its ``not_posed`` entry (scenes, not facts)."""
+    return {k: v for k, v in measured.items() if k != "not_posed"}
 
 
 def _oblique_ratio(m: dict) -> float:
@@ -646,6 +716,11 @@ TEXTBOOK_PROBLEMS = (
                     "largest miss / closing speed",
                     lambda m: _worst(m, lambda s: s["largest_miss_of_closing_speed"]),
                     lambda m: _worst(m, _off_centre_ratio)),
+    TextbookProblem("rigid.incline", "a block on an incline slides by Coulomb or sticks",
+                    "travel error, m",
+                    lambda m: _worst(_posed(m), lambda s: s["miss_metres"]),
+                    lambda m: _worst(_posed(m), lambda s: s["miss_metres"]
+                                     / s["tolerance_metres"])),
     TextbookProblem("rigid.stack", "stable stacks and a cantilever stay put",
                     "largest vertex travel, m",
                     lambda m: _worst(m, lambda s: s["largest_vertex_travel_metres"]),

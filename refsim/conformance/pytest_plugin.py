@@ -13,7 +13,8 @@ beside the user. A check
 that fails shows its counts, classes and minimal example; a declared
 expected failure (:mod:`refsim.conformance.expected`) is an ``xfail`` with
 its reason; a check the engine does not support (``ode.stability`` without
-``ode_stability``) is not collected. After the run the summary table of
+``ode_stability``) is not collected, and one whose scenes the engine cannot
+pose (:class:`refsim.errors.UnposableKey`) is skipped with the key. After the run the summary table of
 ``refsim conform`` is printed.
 
 It is registered as a ``pytest11`` entry point (pyproject.toml), so it loads
@@ -85,6 +86,8 @@ class CheckItem(pytest.Item):
             raise ConformanceFailure(result)
         if result.status == "xfailed":
             pytest.xfail(result.reason)
+        if result.status == "n/a":          # e.g. a scene key the engine cannot pose
+            pytest.skip(result.reason)
 
     def repr_failure(self, excinfo, style=None):
         if isinstance(excinfo.value, ConformanceFailure):

@@ -30,6 +30,7 @@ rigid.resting_contact  rigid       no interpenetration at rest
 rigid.determinism      rigid       two runs, the same bits
 rigid.free_rotation    rigid       torque-free flips and energy
 rigid.off_centre       rigid       an off-centre strike's impulse solution
+rigid.incline          rigid       Coulomb's incline: slide or stick
 rigid.stack            rigid       stable stacks stay where they are
 =====================  ==========  =========================================
 
@@ -100,6 +101,7 @@ CHECKS: tuple[Check, ...] = (
     Check("rigid", "determinism", "rigid", RB.check_rigid_determinism),
     Check("rigid", "free_rotation", "rigid", RB.check_rigid_free_rotation),
     Check("rigid", "off_centre", "rigid", RB.check_rigid_off_centre),
+    Check("rigid", "incline", "rigid", RB.check_rigid_incline, miss_unit="metres"),
     Check("rigid", "stack", "rigid", RB.check_rigid_stack, miss_unit="metres"),
 )
 

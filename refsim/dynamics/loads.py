@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from refsim.errors import SceneError
+from refsim.errors import UnposableKey
 
 #: The world keys beyond the seed's, and what the default of each is.
 WORLD_KEYS = ("gravity_direction", "walls", "mu", "restitution_threshold")
@@ -80,7 +80,7 @@ def scene_loads(scene, *, rotation: str, body_response: str, wall_response: str)
 
     Raises
     ------
-    SceneError
+    UnposableKey
         Naming the scene file and the key, for a key the chosen model cannot
         honour: a torque without the corrected rotation, a fixed body with
         the seed's body response, a tilted gravity under the seed's wall law,
@@ -91,29 +91,29 @@ def scene_loads(scene, *, rotation: str, body_response: str, wall_response: str)
     path = scene.path
     corrected = "impulse" in (body_response, wall_response)
     if world.mu is not None and not corrected:
-        raise SceneError("is the Coulomb coefficient of the corrected responses; the seed's "
+        raise UnposableKey("is the Coulomb coefficient of the corrected responses; the seed's "
                          "laws read world.friction (set dynamics.wall_response or "
                          "body_response = 'impulse')", path, "world.mu")
     if world.gravity_direction != (0.0, -1.0, 0.0) and wall_response == "seed":
-        raise SceneError("the seed's wall law assumes gravity along -y; a tilted gravity "
+        raise UnposableKey("the seed's wall law assumes gravity along -y; a tilted gravity "
                          "needs dynamics.wall_response = 'impulse'", path,
                          "world.gravity_direction")
     for i, b in enumerate(bodies):
         where = f"body[{i}]"
         if any(b.torque) and rotation != "impulse":
-            raise SceneError("a torque needs the corrected rotation (dynamics.rotation = "
+            raise UnposableKey("a torque needs the corrected rotation (dynamics.rotation = "
                              "'impulse')", path, f"{where}.torque")
         if b.fixed and body_response == "seed":
-            raise SceneError("a fixed body needs dynamics.body_response = 'impulse' (the "
+            raise UnposableKey("a fixed body needs dynamics.body_response = 'impulse' (the "
                              "seed's exchange of velocities has no infinite mass)", path,
                              f"{where}.fixed")
         for key in ("restitution", "mu"):
             if getattr(b, key) is not None and not corrected:
-                raise SceneError("is read by the corrected responses only (dynamics."
+                raise UnposableKey("is read by the corrected responses only (dynamics."
                                  "wall_response or body_response = 'impulse')", path,
                                  f"{where}.{key}")
     if scene.pairs and body_response != "impulse":
-        raise SceneError("coefficients per pair are read by the corrected body response "
+        raise UnposableKey("coefficients per pair are read by the corrected body response "
                          "only (dynamics.body_response = 'impulse')", path, "pair[0]")
 
     B = len(bodies)

@@ -25,7 +25,12 @@ from refsim.conformance.cases_ode import (
     time_dependent,
 )
 from refsim.conformance.cases_triangles import FAMILIES, triangle_cases
-from refsim.conformance.checks_rigid import apex_tolerance, energy_tolerance, spin_rest_time
+from refsim.conformance.checks_rigid import (
+    apex_tolerance,
+    energy_tolerance,
+    incline_tolerance,
+    spin_rest_time,
+)
 from refsim.conformance.draw import signed_permutations
 from refsim.types import transform_points
 
@@ -145,7 +150,7 @@ def test_rigid_scenes_and_their_tolerances():
                      "drop-icosahedron-e0.8", "oblique-sphere", "oblique-rolling",
                      "oblique-spin-e1", "oblique-backspin", "oblique-e0", "spin-cube", "rest-cube",
                      "free-brick", "strike-e1", "strike-e0.5", "offset-stack", "cantilever",
-                     "board"]
+                     "board", "incline-slide", "incline-stick", "incline-mu1.5"]
     for scene in cases.of_kind("drop"):
         body = scene.scene.bodies[0]
         vertices = R._body(body.model.name)[0]
@@ -162,6 +167,24 @@ def test_rigid_scenes_and_their_tolerances():
                                                  rel=1e-6)
     rest = cases.of_kind("rest")[0]
     assert energy_tolerance(rest) == pytest.approx(2 * 9.81 * 9.81e-3 * 1e-3)
+
+
+def test_the_inclines_and_their_answers():
+    """g (sin a - mu cos a) t^2 / 2 sliding (30 degrees, mu 0.3: 1.178 m in
+    1 s), 0 sticking; the tolerance (a / 2 + 2 g) h t, and the block rests
+    on the floor under gravity tilted by the angle."""
+    inclines = {s.name: s for s in R.rigid_cases().of_kind("incline")}
+    slide = inclines["incline-slide"]
+    a = 9.81 * (0.5 - 0.3 * math.sqrt(3) / 2)
+    assert R.incline_answer(slide) == pytest.approx(a / 2)
+    assert incline_tolerance(slide) == pytest.approx((a / 2 + 2 * 9.81) * 1e-3)
+    assert R.incline_answer(inclines["incline-stick"]) == 0.0
+    assert R.incline_answer(inclines["incline-mu1.5"]) == 0.0
+    world = slide.scene.world
+    assert world.gravity_vector == pytest.approx((9.81 / 2, -9.81 * math.sqrt(3) / 2, 0.0))
+    assert world.mu == 0.3 and inclines["incline-mu1.5"].scene.world.mu == 1.5
+    block = slide.scene.bodies[0]
+    assert block.position[1] - 0.25 == -R.HALF_SIZE
 
 
 def test_the_strike_and_its_impulse_solution():
