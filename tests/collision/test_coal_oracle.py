@@ -7,8 +7,11 @@ with the other shipped engines in tests/conformance/test_matrix.py.
 
 from __future__ import annotations
 
+import sys
+
 import numpy as np
 import pytest
+from refsim.oracles import OracleUnavailable
 from refsim.oracles.coal_adapter import CoalEngine
 
 from refsim import intersecting_pairs
@@ -124,3 +127,11 @@ def test_coals_world_box_is_too_loose_to_offer_as_aabb(coal):
     # measured 0.73 of the radius: a sphere's box under a diagonal axis can
     # be wider by sqrt(3) - 1 of it
     assert widest > 0.5
+
+
+def test_without_coal_the_error_names_its_extra(monkeypatch):
+    monkeypatch.setitem(sys.modules, "coal", None)              # import coal -> ImportError
+    with pytest.raises(OracleUnavailable) as info:
+        CoalEngine()
+    assert str(info.value).startswith("oracle engine 'coal' is not installed "
+                                      "(pip install 'refsim[coal]'): ")
