@@ -2,8 +2,9 @@
 
 One module per engine; each converts conventions (units, frames, float32,
 semantics) inside itself and nowhere else. The engines are optional
-dependencies (``pip install 'refsim[oracles]'``): an adapter imports its engine
-only when used and raises :class:`OracleUnavailable` if it is missing. Tests
+dependencies (``pip install 'refsim[oracles]'``; coal has an extra of its
+own, ``pip install 'refsim[coal]'``): an adapter imports its engine only
+when used and raises :class:`OracleUnavailable` if it is missing. Tests
 turn that into a skip that names the reason (``require`` in tests/conftest.py).
 """
 
@@ -16,24 +17,29 @@ import sys
 
 #: What ``pip`` installs for the oracles (pyproject.toml's ``oracles`` extra).
 INSTALL_HINT = "pip install 'refsim[oracles]'"
+#: What ``pip`` installs for every shipped engine of the conformance kit
+#: (:data:`refsim.conformance.shipped.SHIPPED_ENGINES`): the oracles and coal,
+#: an extra of its own.
+SHIPPED_INSTALL_HINT = "pip install 'refsim[oracles,coal]'"
 
 
 class OracleUnavailable(RuntimeError):
     """The engine behind an oracle is not installed or cannot run here."""
 
 
-def import_engine(module: str, package: str):
+def import_engine(module: str, package: str, install: str = INSTALL_HINT):
     """Import an engine's module or raise :class:`OracleUnavailable`.
 
     ``package`` is the PyPI name to tell the user (e.g. ``python-fcl`` for
-    module ``fcl``).
+    module ``fcl``); ``install`` the command that brings it, if not the
+    ``oracles`` extra's.
     """
     try:
         return importlib.import_module(module)
     except ImportError as exc:
         raise OracleUnavailable(
             f"oracle engine {package!r} is not installed "
-            f"({INSTALL_HINT}): {exc}") from None
+            f"({install}): {exc}") from None
 
 
 @contextlib.contextmanager

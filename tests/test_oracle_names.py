@@ -17,7 +17,7 @@ from refsim.conformance.shipped import SHIPPED_ENGINES
 REPO_ROOT = Path(__file__).resolve().parents[1]
 
 #: How each shipped external engine is named in prose.
-NAMES = {"fcl": r"FCL|python-fcl", "trimesh": r"trimesh", "pybullet": r"pybullet",
+NAMES = {"fcl": r"FCL|python-fcl", "coal": r"coal", "trimesh": r"trimesh", "pybullet": r"pybullet",
          "mujoco": r"MuJoCo"}
 
 

@@ -8,6 +8,8 @@ refsim-seed        refsim.engines.refsim_engines:seed              all six
 refsim-corrected   refsim.engines.refsim_engines:corrected         all six
 fcl                refsim.oracles.fcl_adapter:engine               triangles, pairs,
                                                                    collide
+coal               refsim.oracles.coal_adapter:engine              triangles, pairs,
+                                                                   collide
 trimesh            refsim.conformance.shipped:trimesh              collide, aabb
 pybullet           refsim.oracles.pybullet_adapter:engine          rigid
 mujoco             refsim.oracles.mujoco_adapter:engine            rigid
@@ -30,6 +32,7 @@ SHIPPED_ENGINES: dict[str, str] = {
     "refsim-seed": "refsim.engines.refsim_engines:seed",
     "refsim-corrected": "refsim.engines.refsim_engines:corrected",
     "fcl": "refsim.oracles.fcl_adapter:engine",
+    "coal": "refsim.oracles.coal_adapter:engine",
     "trimesh": "refsim.conformance.shipped:trimesh",
     "pybullet": "refsim.oracles.pybullet_adapter:engine",
     "mujoco": "refsim.oracles.mujoco_adapter:engine",

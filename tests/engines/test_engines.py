@@ -87,6 +87,7 @@ def test_the_cache_keys_read_only_arrays_by_identity_and_others_by_content():
 @pytest.mark.oracle
 @pytest.mark.parametrize("spec, expected", [
     ("refsim.oracles.fcl_adapter:engine", ("triangles", "pairs", "collide")),
+    ("refsim.oracles.coal_adapter:engine", ("triangles", "pairs", "collide")),
     ("refsim.oracles.trimesh_collision:engine", ("collide",)),
     ("refsim.oracles.trimesh_adapter:engine", ("aabb",)),
     ("refsim.oracles.pybullet_adapter:engine", ("rigid",)),

@@ -1,7 +1,7 @@
 """Report section: the shipped engines side by side (the conformance kit).
 
 Arranges the plan's ``conformance-matrix``: each shipped engine (refsim's
-seed and corrected models, python-fcl, trimesh, pybullet, MuJoCo) run
+seed and corrected models, python-fcl, coal, trimesh, pybullet, MuJoCo) run
 through every check its capabilities call for, against answers that depend
 on no float engine (:mod:`refsim.conformance`). One table, a row per check
 and a column per engine that could be loaded, each heading a link to the
@@ -20,7 +20,7 @@ from refsim.report.section import Agreement, Cell, Divergence, Section, Table, T
 
 #: Column headings of the shipped engines (the engines' own names otherwise).
 ENGINE_TITLES = {"refsim-seed": "refsim seed", "refsim-corrected": "refsim corrected",
-                 "fcl": "FCL", "trimesh": "trimesh", "pybullet": "pybullet",
+                 "fcl": "FCL", "coal": "coal", "trimesh": "trimesh", "pybullet": "pybullet",
                  "mujoco": "MuJoCo"}
 
 #: Each status in the engine summaries of the page's agreement table ("12
@@ -121,7 +121,7 @@ def build(ctx) -> Section:
     intro = ("The conformance kit (refsim conform) checks any engine against answers that "
              "depend on no float engine: exact rational triangle tests, refsim's exact "
              "mesh pairs, boxes in exact arithmetic, ODE problems with exact solutions and "
-             "rigid-body scenes with analytic answers. Here the six shipped engines run "
+             "rigid-body scenes with analytic answers. Here the seven shipped engines run "
              "through the same cases side by side; every disagreement is classified "
              "(touching, coplanar, tolerance, known divergence, bug) by the check that "
              "found it.")
