@@ -14,8 +14,8 @@ that fails shows its counts, classes and minimal example; a declared
 expected failure (:mod:`refsim.conformance.expected`) is an ``xfail`` with
 its reason; a check the engine does not support (``ode.stability`` without
 ``ode_stability``) is not collected, and one whose scenes the engine cannot
-pose (:class:`refsim.errors.UnposableKey`) is skipped with the key. After the run the summary table of
-``refsim conform`` is printed.
+pose (:class:`refsim.errors.UnposableKey`) is skipped with the key. After
+the run the summary table of ``refsim conform`` is printed.
 
 It is registered as a ``pytest11`` entry point (pyproject.toml), so it loads
 wherever refsim is installed. Without ``--refsim-engine`` it only adds its
