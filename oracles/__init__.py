@@ -22,18 +22,19 @@ class OracleUnavailable(RuntimeError):
     """The engine behind an oracle is not installed or cannot run here."""
 
 
-def import_engine(module: str, package: str):
+def import_engine(module: str, package: str, hint: str = INSTALL_HINT):
     """Import an engine's module or raise :class:`OracleUnavailable`.
 
     ``package`` is the PyPI name to tell the user (e.g. ``python-fcl`` for
-    module ``fcl``).
+    module ``fcl``); ``hint`` the command that installs it (an engine in an
+    extra of its own: Drake's, ``pip install 'refsim[drake]'``).
     """
     try:
         return importlib.import_module(module)
     except ImportError as exc:
         raise OracleUnavailable(
             f"oracle engine {package!r} is not installed "
-            f"({INSTALL_HINT}): {exc}") from None
+            f"({hint}): {exc}") from None
 
 
 @contextlib.contextmanager
