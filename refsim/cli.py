@@ -463,14 +463,14 @@ def _add_conform_command(commands) -> None:
                     "refsim.engines) through every check its capabilities call for, "
                     "against answers that depend on no float engine. Writes "
                     "DIR/conformance.json and a self-contained DIR/index.html, prints a "
-                    "table. --all runs the six shipped engines and writes their matrix. "
+                    "table. --all runs the shipped engines and writes their matrix. "
                     "Exit status 0: every check passed (declared expected failures "
                     "aside); 1: a check failed, or --all left out an engine whose package "
                     "is missing; 2: a usage error.")
     conform.add_argument("engine", nargs="?", metavar="MODULE:FACTORY",
                          help="the engine, e.g. refsim.engines.refsim_engines:corrected")
     conform.add_argument("--all", action="store_true",
-                         help="the six shipped engines side by side (each with its own "
+                         help="the shipped engines side by side (each with its own "
                               "expected failures)")
     conform.add_argument("-o", "--output", default="conformance", metavar="DIR",
                          help="output directory (default: conformance)")
@@ -670,7 +670,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="refsim",
         description="Reference implementation of a 1997 rigid-body N-body simulation, "
-                    "checked against FCL, trimesh, scipy, pybullet and MuJoCo.")
+                    "checked against FCL, trimesh, scipy, pybullet, MuJoCo and Drake.")
     parser.add_argument("--debug", action="store_true",
                         help="show the full traceback on errors")
     parser.add_argument("--version", action="version", version=f"refsim {version()}",

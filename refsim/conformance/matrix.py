@@ -7,7 +7,7 @@ every engine), runs each engine through its checks with its declared
 expected failures, and writes each engine's pages (``DIR/<engine>/
 conformance.json`` and ``index.html``), the matrix (``DIR/matrix.json``) and
 its page (``DIR/index.html``). ``refsim conform --all -o DIR`` calls it for
-the six shipped engines (:data:`refsim.conformance.shipped.SHIPPED_ENGINES`).
+the shipped engines (:data:`refsim.conformance.shipped.SHIPPED_ENGINES`).
 
 A :class:`Divergence` is one engine's failing or expected-failing check:
 its classes, its declared reason (or none, for a failure nobody declared)

@@ -15,7 +15,7 @@ SEED = 0
 
 @pytest.fixture(scope="session")
 def shipped_run(tmp_path_factory):
-    """The six shipped engines side by side, pages written: (matrix, results, dir)."""
+    """The shipped engines side by side, pages written: (matrix, results, dir)."""
     from refsim.conformance.matrix import run_matrix
 
     out = tmp_path_factory.mktemp("matrix")

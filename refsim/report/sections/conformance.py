@@ -121,7 +121,7 @@ def build(ctx) -> Section:
     intro = ("The conformance kit (refsim conform) checks any engine against answers that "
              "depend on no float engine: exact rational triangle tests, refsim's exact "
              "mesh pairs, boxes in exact arithmetic, ODE problems with exact solutions and "
-             "rigid-body scenes with analytic answers. Here the six shipped engines run "
+             "rigid-body scenes with analytic answers. Here the shipped engines run "
              "through the same cases side by side; every disagreement is classified "
              "(touching, coplanar, tolerance, known divergence, bug) by the check that "
              "found it.")
