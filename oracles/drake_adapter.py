@@ -281,14 +281,29 @@ def contact_parameters(scene, settings: DrakeSettings | None = None) -> ContactP
                              impact_speed=v0, restitution=e)
 
 
+def _matrix(quat_wxyz) -> np.ndarray:
+    """The rotation matrix of a quaternion ``(w, x, y, z)`` (normalised)."""
+    from refsim.types import quaternion_to_rotation
+
+    q = np.asarray(quat_wxyz, dtype=np.float64)
+    return quaternion_to_rotation(q / np.sqrt(q @ q))
+
+
+def _cross(a, b) -> np.ndarray:
+    """``a x b`` of two 3-vectors (``numpy.cross`` costs more than a step of
+    Drake's on the kit's scenes)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
+
+
 def _origin_velocity(v_com, w, r, c) -> np.ndarray:
     """The body frame origin's velocity from the centre of mass's."""
-    return np.asarray(v_com, dtype=np.float64) - np.cross(w, r @ c)
+    return np.asarray(v_com, dtype=np.float64) - _cross(w, r @ c)
 
 
 def _com_velocity(v_origin, w, r, c) -> np.ndarray:
     """The centre of mass's velocity from the body frame origin's."""
-    return np.asarray(v_origin, dtype=np.float64) + np.cross(w, r @ c)
+    return np.asarray(v_origin, dtype=np.float64) + _cross(w, r @ c)
 
 
 class DrakeEngine:
@@ -370,8 +385,7 @@ class DrakeEngine:
 
         self.bodies = []
         self.properties = []
-        #: Each collision geometry's owner: ("b", body index) or ("w", wall index).
-        self._owners: dict = {}
+        self._hulls = []
         for i, body in enumerate(scene.bodies):
             mesh = scene.mesh(body)
             props = mass_properties(mesh.vertices, mesh.faces, body.mass, body.scale)
@@ -387,9 +401,9 @@ class DrakeEngine:
                 modulus = _hydroelastic_modulus(mesh.vertices, body.scale, props, p.stiffness)
             shape = Convex(np.asarray(mesh.vertices, dtype=np.float64).T.copy(), f"b{i}",
                            float(body.scale))
-            gid = plant.RegisterCollisionGeometry(rigid, RigidTransform(), shape, f"g{i}",
-                                                  material(modulus))
-            self._owners[gid] = ("b", i)
+            plant.RegisterCollisionGeometry(rigid, RigidTransform(), shape, f"g{i}",
+                                            material(modulus))
+            self._hulls.append(np.asarray(mesh.vertices, dtype=np.float64) * body.scale)
             self.bodies.append(rigid)
         for k, wall in enumerate(WALL_NAMES):
             axis, sign = k // 2, (-1.0 if wall.endswith("-") else 1.0)
@@ -397,11 +411,9 @@ class DrakeEngine:
             point[axis] = sign * H
             normal = np.zeros(3)
             normal[axis] = -sign                          # into the cube
-            gid = plant.RegisterCollisionGeometry(plant.world_body(),
-                                                  HalfSpace.MakePose(normal, point),
-                                                  HalfSpace(), f"w{k}",
-                                                  material(wall=True))
-            self._owners[gid] = ("w", k)
+            plant.RegisterCollisionGeometry(plant.world_body(),
+                                            HalfSpace.MakePose(normal, point), HalfSpace(),
+                                            f"w{k}", material(wall=True))
         plant.Finalize()
         self.plant = plant
         with _deformable_note_dropped():
@@ -451,12 +463,19 @@ class DrakeEngine:
         self.simulator.AdvanceTo(self._step * self._scene.integration.step)
 
     def _body_state(self, i: int):
-        pose = self.plant.EvalBodyPoseInWorld(self.plant_context, self.bodies[i])
-        velocity = self.plant.EvalBodySpatialVelocityInWorld(self.plant_context, self.bodies[i])
-        r = pose.rotation().matrix()
-        w = np.array(velocity.rotational())
-        v_com = _com_velocity(velocity.translational(), w, r, self.properties[i].center)
-        return np.array(pose.translation()), v_com, w, r
+        """Body ``i``'s (x, v_com, w, R) from the plant's state vectors: a
+        free body's positions are its quaternion ``(w, x, y, z)`` and its
+        origin, its velocities ``w`` and the origin's velocity, in world
+        (``MultibodyPlant``'s free-body layout; checked against
+        ``EvalBodyPoseInWorld`` and ``EvalBodySpatialVelocityInWorld``)."""
+        q = self.plant.GetPositions(self.plant_context)
+        u = self.plant.GetVelocities(self.plant_context)
+        rigid = self.bodies[i]
+        k, j = rigid.floating_positions_start(), rigid.floating_velocities_start_in_v()
+        r = _matrix(q[k:k + 4])
+        w = np.array(u[j:j + 3])
+        v_com = _com_velocity(u[j + 3:j + 6], w, r, self.properties[i].center)
+        return np.array(q[k + 4:k + 7]), v_com, w, r
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(B, 3) positions of the mesh origins, (B, 3) velocities of the
@@ -465,33 +484,18 @@ class DrakeEngine:
         parts = [self._body_state(i) for i in range(len(self.bodies))]
         return tuple(np.array([q[k] for q in parts]) for k in range(4))
 
-    def _wall_contacts(self) -> set[tuple[int, int]]:
-        """(body, wall) pairs in contact after the step, from the contact
-        results of the step's start (what the solver used)."""
-        results = self.plant.get_contact_results_output_port().Eval(self.plant_context)
+    def _wall_contacts(self, x, r) -> set[tuple[int, int]]:
+        """(body, wall) pairs touching in the state ``x`` (B, 3), ``r`` (B,
+        3, 3): a hull meets a wall's half-space exactly when one of its
+        vertices does (Drake's contact results would say the same, at the
+        cost of a second contact query per step)."""
+        H = self._scene.world.half_size
         touching = set()
-        pairs = ([results.point_pair_contact_info(c).point_pair()
-                  for c in range(results.num_point_pair_contacts())])
-        ids = self._owners
-        for pair in pairs:
-            a, b = ids.get(pair.id_A), ids.get(pair.id_B)
-            if a is None or b is None:
-                continue
-            (ka, ia), (kb, ib) = a, b
-            if ka == "b" and kb == "w":
-                touching.add((ia, ib))
-            elif ka == "w" and kb == "b":
-                touching.add((ib, ia))
-        for c in range(results.num_hydroelastic_contacts()):
-            info = results.hydroelastic_contact_info(c).contact_surface()
-            a, b = ids.get(info.id_M()), ids.get(info.id_N())
-            if a is None or b is None:
-                continue
-            (ka, ia), (kb, ib) = a, b
-            if ka == "b" and kb == "w":
-                touching.add((ia, ib))
-            elif ka == "w" and kb == "b":
-                touching.add((ib, ia))
+        for i, vertices in enumerate(self._hulls):
+            world = vertices @ r[i].T
+            lo, hi = world.min(axis=0) + x[i], world.max(axis=0) + x[i]
+            touching.update((i, 2 * int(a)) for a in np.flatnonzero(lo <= -H))
+            touching.update((i, 2 * int(a) + 1) for a in np.flatnonzero(hi >= H))
         return touching
 
     def simulate(self, scene, *, every: int = 1):
@@ -517,12 +521,13 @@ class DrakeEngine:
             before = time.perf_counter()
             self.step()
             stepping += time.perf_counter() - before
-            now = self._wall_contacts()
+            frame = self.state()
+            now = self._wall_contacts(frame[0], frame[3])
             for i, j in sorted(now - touching):
                 events.append(Event("wall", k, k * h, names[i], WALL_NAMES[j]))
             touching = now
             if k % every == 0 or k == n:
-                frames.append(self.state())
+                frames.append(frame)
                 times.append(k * h)
         elapsed = time.perf_counter() - start
         return trajectory_of_frames(frames, times, names, events, stepping, elapsed,
