@@ -78,10 +78,12 @@ Every setting, and why (:class:`DrakeSettings` holds them)
   = 9.9``). And Drake's discrete step is implicit in the contact force, so
   a contact resolved in few steps loses energy of its own, with no
   dissipation at all: measured (:func:`drake_restitution` with ``d = 0``),
-  the restitution is 0.52 at ``N = 2``, 0.58 at ``N = 8``, 0.64 at
-  ``N = 10``, 0.94 at ``N = 30``. A scene's ``e`` above the ``N = 8``
-  value (0.584) cannot be met by any dissipation: the engine then bounces
-  with 0.584 (``d = 0``).
+  the restitution is 0.33 at ``N = 2``, 0.58 at ``N = 8``, 0.64 at
+  ``N = 10``, 0.85 at ``N = 30``, 0.95 at ``N = 100``. A scene's ``e``
+  above the ``N = 8`` value (0.584) cannot be met by any dissipation: the
+  engine then bounces with 0.584 (``d = 0``). ``N = 8`` keeps the resting
+  depth inside the kit's allowance; meeting e = 0.8 would take ``N`` of
+  about 22 and a resting depth of 4.8e-4 m, e = 1 no ``N`` at all.
 - Dissipation ``d`` from the scene's ``e``, *by measurement*: for a linear
   spring the restitution of one impact depends on ``d v0`` and ``N`` alone
   (scale ``x`` by ``v0 sqrt(m / k)``), so :func:`drake_dv` bisects ``d

@@ -21,7 +21,7 @@ from refsim.report.section import Agreement, Cell, Divergence, Section, Table, T
 #: Column headings of the shipped engines (the engines' own names otherwise).
 ENGINE_TITLES = {"refsim-seed": "refsim seed", "refsim-corrected": "refsim corrected",
                  "fcl": "FCL", "trimesh": "trimesh", "pybullet": "pybullet",
-                 "mujoco": "MuJoCo"}
+                 "mujoco": "MuJoCo", "drake": "Drake"}
 
 #: Each status in the engine summaries of the page's agreement table ("12
 #: pass; 5 fail as declared").
