@@ -40,8 +40,9 @@ Conventions converted here and nowhere else
   spinning at 5 rad/s without gravity, keeps its centre of mass on its
   straight line to 3.9e-4 m over 0.2 s, Drake integrating the origin's
   velocity with a first-order step as MuJoCo does, 3.9e-4 m too; read as
-  the centre's velocity it would swing by more than 5 cm). refsim's velocity is the centre of mass's
-  (:mod:`refsim.dynamics.trajectory`): ``v_origin = v_com - w x (R c)``
+  the centre's velocity it would swing by more than 5 cm). refsim's
+  velocity is the centre of mass's (:mod:`refsim.dynamics.trajectory`):
+  ``v_origin = v_com - w x (R c)``
   when setting the initial state, ``v_com = v_origin + w x (R c)`` when
   reading (:func:`_origin_velocity`, :func:`_com_velocity`).
 - Meshes. ``Convex(points, label, scale)``: Drake computes the convex hull

@@ -109,6 +109,23 @@ def test_the_dissipation_meets_e_on_drakes_own_impact():
     assert drake_restitution(dv / 4, steps) > 0.5
 
 
+def test_linear_drag_is_applied_at_the_centre_of_mass_each_step():
+    """Drag ``F = -k v`` from the step's start velocity: after n steps
+    ``v = (1 - k h / m)^n v0`` (explicit in the drag, as the other oracles),
+    within ``k^2 h t / 2`` of ``exp(-k t / m)``; the body does not turn."""
+    k = 0.5
+    scene = scene_from_dict({
+        "world": {"half_size": 50.0, "gravity": 0.0, "drag": k},
+        "integration": {"step": H, "duration": 1.0},
+        "body": [{"model": "sphere-2k.ac", "velocity": [1.0, 0.0, 0.0]}]})
+    trajectory = engine().simulate(scene)
+    v = np.asarray(trajectory.velocity)[:, 0, 0]
+    n = np.rint(np.asarray(trajectory.t) / H)
+    np.testing.assert_allclose(v, (1.0 - k * H) ** n, rtol=1e-12)
+    assert abs(v[-1] - math.exp(-k)) < k ** 2 * H / 2
+    np.testing.assert_allclose(np.asarray(trajectory.angular_velocity), 0.0, atol=1e-15)
+
+
 def test_a_scene_with_particles_is_refused_naming_the_key_and_the_engine():
     scene = scene_from_dict({"particles": {"count": 4},
                              "body": [{"model": "cube.ac"}]})
