@@ -379,7 +379,7 @@ EXIT_CHECK_FAILED = 1
 
 def _conform(args) -> int:
     """``refsim conform``: one engine through the conformance kit, or the
-    shipped six side by side (``--all``). Exit 0 when every check passed
+    shipped engines side by side (``--all``). Exit 0 when every check passed
     (declared expected failures aside), 1 when one failed; user errors
     (a bad spec, a missing engine, a malformed expected-failures file) are
     RefsimErrors and exit 2 (``main``)."""

@@ -220,7 +220,7 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
                workers: int | None = None, scheduler: str | None = None,
                progress: bool = False, cancel=None) -> tuple[Matrix, dict]:
     """Run every engine of ``specs`` (name -> ``module:factory``; default the
-    shipped six) with shared case sets, and write the pages under ``out_dir``
+    shipped engines) with shared case sets, and write the pages under ``out_dir``
     when given (module docstring).
 
     ``expected`` maps a name to its expected-failures file (None for none);
