@@ -62,9 +62,17 @@ Every setting, and why (:class:`DrakeSettings` holds them)
   scene's ``solver`` is not used: Drake's discrete step is its own
   (implicit in the contact forces, symplectic Euler in the free motion),
   as Bullet's and MuJoCo's are.
-- ``DiscreteContactApproximation.kLagged`` (Drake's default in the
-  installed version, kept explicit): the convex SAP solver with
-  Hunt-Crossley dissipation, stable at any stiffness.
+- ``DiscreteContactApproximation.kLagged`` (``approximation="lagged"``,
+  Drake's default in the installed version, kept explicit): the convex SAP
+  solver with Hunt-Crossley dissipation, stable at any stiffness, with
+  Coulomb's bound taken from the previous step's normal impulse
+  (``|gamma_t| <= mu gamma_n0``). Drake's documentation prefers
+  ``kSimilar`` (``approximation="similar"``) where strong transients must be
+  resolved, as in impacts; measured on the kit's scenes the two bounce
+  alike, ``kLagged`` meets Coulomb's oblique impacts and holds the stacks
+  more closely, ``kSimilar`` decelerates the sliding cube more truly (the
+  lagged bound lets a chattering single contact brake 24 % too hard):
+  docs/decisions/drake.md has the numbers.
 - Point contact (``ContactModel.kPoint``) in :func:`engine`: one contact
   point per pair of geometries (the deepest), with the combined stiffness
   ``k1 k2 / (k1 + k2)`` and dissipation ``(k2 d1 + k1 d2) / (k1 + k2)``
@@ -167,12 +175,29 @@ class DrakeSettings:
     min_restitution: float = 0.01
 
 
-def drake_restitution(dv: float, contact_steps: float, h: float = 1e-3) -> float:
+def _approximation(name: str):
+    """Drake's ``DiscreteContactApproximation`` named ``name`` ("lagged",
+    "similar"; the ones with Hunt-Crossley dissipation and convex)."""
+    from pydrake.multibody.plant import DiscreteContactApproximation
+
+    from refsim.errors import OptionError
+
+    choices = {"lagged": DiscreteContactApproximation.kLagged,
+               "similar": DiscreteContactApproximation.kSimilar}
+    if name not in choices:
+        raise OptionError(f"engine drake: approximation must be one of "
+                          f"{', '.join(choices)}, got {name!r}")
+    return choices[name]
+
+
+def drake_restitution(dv: float, contact_steps: float, h: float = 1e-3,
+                      approximation: str = "lagged") -> float:
     """The coefficient of restitution of one of Drake's discrete point
     impacts, measured: a sphere of 1 kg meets a half-space at 1 m/s without
     gravity, stiffness ``k = pi^2 / (contact_steps h)^2`` and dissipation
-    ``dv`` (the same settings as :meth:`DrakeEngine.load`), stepped until it
-    is out of contact; its exit speed. Dimensionless: for a linear spring
+    ``dv`` (the same settings as :meth:`DrakeEngine.load`, the discrete
+    ``approximation`` among them), stepped until it is out of contact; its
+    exit speed. Dimensionless: for a linear spring
     the restitution depends on ``d v0`` and ``sqrt(k / m) h`` alone
     (``x`` scaled by ``v0 sqrt(m / k)``), so this one run stands for every
     mass and impact speed at the same ``contact_steps``."""
@@ -183,7 +208,6 @@ def drake_restitution(dv: float, contact_steps: float, h: float = 1e-3) -> float
         AddMultibodyPlantSceneGraph,
         ContactModel,
         CoulombFriction,
-        DiscreteContactApproximation,
     )
     from pydrake.multibody.tree import SpatialInertia, UnitInertia
     from pydrake.systems.analysis import Simulator
@@ -193,7 +217,7 @@ def drake_restitution(dv: float, contact_steps: float, h: float = 1e-3) -> float
     radius = 0.1
     builder = DiagramBuilder()
     plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=h)
-    plant.set_discrete_contact_approximation(DiscreteContactApproximation.kLagged)
+    plant.set_discrete_contact_approximation(_approximation(approximation))
     plant.set_contact_model(ContactModel.kPoint)
     plant.mutable_gravity_field().set_gravity_vector([0.0, 0.0, 0.0])
     ball = plant.AddRigidBody("probe", SpatialInertia(1.0, np.zeros(3),
@@ -219,7 +243,7 @@ def drake_restitution(dv: float, contact_steps: float, h: float = 1e-3) -> float
 
 
 @functools.lru_cache(maxsize=64)
-def drake_dv(e: float, contact_steps: float) -> float:
+def drake_dv(e: float, contact_steps: float, approximation: str = "lagged") -> float:
     """``d v0`` whose discrete Drake impact (:func:`drake_restitution`) has
     restitution ``e``, by bisection on ``log(d v0)`` (the restitution falls
     from its value at ``d = 0`` towards 0, at most ``1 / (d v0)``); 0 when
@@ -227,12 +251,13 @@ def drake_dv(e: float, contact_steps: float) -> float:
     loses more)."""
     if not 0.0 < e <= 1.0:
         raise ValueError(f"restitution must be in (0, 1], got {e}")
-    if drake_restitution(0.0, contact_steps) <= e:
+    if drake_restitution(0.0, contact_steps, approximation=approximation) <= e:
         return 0.0
     lo, hi = -6.0, math.log(2.0 / e)                # e(exp(lo)) > e > e(exp(hi))
     while hi - lo > DV_TOLERANCE:
         mid = 0.5 * (lo + hi)
-        if drake_restitution(math.exp(mid), contact_steps) > e:
+        if drake_restitution(math.exp(mid), contact_steps,
+                             approximation=approximation) > e:
             lo = mid
         else:
             hi = mid
@@ -280,7 +305,8 @@ def contact_parameters(scene, settings: DrakeSettings | None = None) -> ContactP
     k = m * math.pi ** 2 / (s.contact_steps * h) ** 2
     v0 = max(impact_speed(scene), s.min_impact_speed)
     e = min(max(scene.world.restitution, s.min_restitution), 1.0)
-    return ContactParameters(stiffness=k, dissipation=drake_dv(e, s.contact_steps) / v0,
+    return ContactParameters(stiffness=k,
+                             dissipation=drake_dv(e, s.contact_steps, s.approximation) / v0,
                              impact_speed=v0, restitution=e)
 
 
@@ -353,7 +379,6 @@ class DrakeEngine:
             AddMultibodyPlantSceneGraph,
             ContactModel,
             CoulombFriction,
-            DiscreteContactApproximation,
         )
         from pydrake.multibody.tree import RotationalInertia, SpatialInertia
         from pydrake.systems.analysis import Simulator
@@ -369,11 +394,7 @@ class DrakeEngine:
 
         builder = DiagramBuilder()
         plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=scene.integration.step)
-        plant.set_discrete_contact_approximation(
-            {"lagged": DiscreteContactApproximation.kLagged,
-             "similar": DiscreteContactApproximation.kSimilar,
-             "tamsi": DiscreteContactApproximation.kTamsi,
-             "sap": DiscreteContactApproximation.kSap}[s.approximation])
+        plant.set_discrete_contact_approximation(_approximation(s.approximation))
         plant.set_contact_model(ContactModel.kHydroelastic if hydro else ContactModel.kPoint)
         plant.mutable_gravity_field().set_gravity_vector([0.0, -scene.world.gravity, 0.0])
 

@@ -2,6 +2,7 @@
 pybullet in the same run (docs/decisions/drake.md).
 
     python docs/decisions/drake_table.py [MODULE:FACTORY ...]
+    python docs/decisions/drake_table.py --approximation similar [MODULE:FACTORY ...]
     python docs/decisions/drake_table.py --dissipation
 
 Without arguments: Drake's point contact, Drake's hydroelastic contact,
@@ -58,11 +59,13 @@ def slide_scene():
                            R.GRAVITY, 0.5, SLIDE_MU, 0.6)
 
 
-def main(specs) -> None:
+def main(specs, **drake_settings) -> None:
+    """The tables for each engine; ``drake_settings`` (e.g.
+    ``approximation="similar"``) go to the Drake factories."""
     cases = R.rigid_cases()
     for spec in specs:
         try:
-            engine = load_engine(spec)
+            engine = load_engine(spec, **(drake_settings if "drake_adapter" in spec else {}))
         except OracleUnavailable as exc:
             print(f"{spec}: not run: {exc}")
             continue
@@ -191,7 +194,10 @@ def dissipation() -> None:
 
 
 if __name__ == "__main__":
-    if sys.argv[1:] == ["--dissipation"]:
+    args = sys.argv[1:]
+    if args == ["--dissipation"]:
         dissipation()
+    elif args[:1] == ["--approximation"]:
+        main(args[2:] or ENGINES[:1], approximation=args[1])
     else:
-        main(sys.argv[1:] or ENGINES)
+        main(args or ENGINES)

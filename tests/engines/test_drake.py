@@ -131,6 +131,9 @@ def test_a_scene_with_particles_is_refused_naming_the_key_and_the_engine():
                              "body": [{"model": "cube.ac"}]})
     with pytest.raises(OptionError, match=r"^scene key particles: engine drake "):
         engine().simulate(scene)
+    with pytest.raises(OptionError, match=r"^engine drake: approximation must be one of "
+                                          r"lagged, similar, got 'sap'$"):
+        engine(approximation="sap").simulate(_sphere_scene(0.0, 0.01))
 
 
 def test_the_kit_finds_no_undeclared_failure():
