@@ -17,6 +17,19 @@ import sys
 #: What ``pip`` installs for the oracles (pyproject.toml's ``oracles`` extra).
 INSTALL_HINT = "pip install 'refsim[oracles]'"
 
+#: The shipped engines whose package is an extra of its own, not in
+#: ``oracles`` (Drake's wheel is some 200 MB): engine name -> extra.
+OWN_EXTRAS = {"drake": "drake"}
+
+
+def install_hint(engines) -> str:
+    """The ``pip`` command that installs the packages of the named shipped
+    engines: ``oracles`` for most, an engine's own extra for those in
+    :data:`OWN_EXTRAS` (``pip install 'refsim[oracles,drake]'``)."""
+    extras = {OWN_EXTRAS.get(name, "oracles") for name in engines} or {"oracles"}
+    ordered = sorted(extras, key=lambda extra: (extra != "oracles", extra))
+    return f"pip install 'refsim[{','.join(ordered)}]'"
+
 
 class OracleUnavailable(RuntimeError):
     """The engine behind an oracle is not installed or cannot run here."""

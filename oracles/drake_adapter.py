@@ -151,7 +151,7 @@ import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from refsim.oracles import import_engine, trajectory_of_frames
+from refsim.oracles import import_engine, install_hint, trajectory_of_frames
 
 #: Wall names in the order of refsim's events (x-, x+, y-, y+, z-, z+).
 WALL_NAMES = ("x-", "x+", "y-", "y+", "z-", "z+")
@@ -349,7 +349,7 @@ class DrakeEngine:
         self.name = "drake" if self.settings.contact_model == "point" else "drake-hydroelastic"
         self.contact_law = ("hunt-crossley" if self.settings.contact_model == "point"
                             else "hydroelastic")
-        self.pydrake = import_engine("pydrake", "drake", "pip install 'refsim[drake]'")
+        self.pydrake = import_engine("pydrake", "drake", install_hint(["drake"]))
         self.properties: list = []
         self.parameters: ContactParameters | None = None
         self._scene = None

@@ -424,10 +424,10 @@ def _conform(args) -> int:
         wrote = f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine"
         if matrix.unavailable:
             # a matrix with engines missing is not the check asked for
-            from refsim.oracles import INSTALL_HINT
+            from refsim.oracles import install_hint
 
             print(f"{wrote}; not run: {', '.join(sorted(matrix.unavailable))} (see the "
-                  f"warnings; {INSTALL_HINT})")
+                  f"warnings; {install_hint(matrix.unavailable)})")
             return EXIT_CHECK_FAILED
         print(wrote)
         return 0 if matrix.ok else EXIT_CHECK_FAILED

@@ -136,6 +136,20 @@ def test_a_scene_with_particles_is_refused_naming_the_key_and_the_engine():
         engine(approximation="sap").simulate(_sphere_scene(0.0, 0.01))
 
 
+def test_a_missing_drake_names_its_own_extra(monkeypatch):
+    """Drake is an extra of its own: a missing pydrake says ``refsim[drake]``,
+    and ``conform --all`` names both extras when both are wanted."""
+    import sys
+
+    from refsim.oracles import OracleUnavailable, install_hint
+
+    monkeypatch.setitem(sys.modules, "pydrake", None)          # import pydrake -> ImportError
+    with pytest.raises(OracleUnavailable, match=r"pip install 'refsim\[drake\]'"):
+        engine()
+    assert install_hint(["mujoco", "drake"]) == "pip install 'refsim[oracles,drake]'"
+    assert install_hint(["pybullet"]) == "pip install 'refsim[oracles]'"
+
+
 def test_the_kit_finds_no_undeclared_failure():
     """The rigid checks on Drake with its shipped declarations: every check
     passes or fails only as refsim/conformance/expected/drake.txt says."""
