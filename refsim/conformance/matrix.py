@@ -7,7 +7,7 @@ every engine), runs each engine through its checks with its declared
 expected failures, and writes each engine's pages (``DIR/<engine>/
 conformance.json`` and ``index.html``), the matrix (``DIR/matrix.json``) and
 its page (``DIR/index.html``). ``refsim conform --all -o DIR`` calls it for
-the seven shipped engines (:data:`refsim.conformance.shipped.SHIPPED_ENGINES`).
+the shipped engines (:data:`refsim.conformance.shipped.SHIPPED_ENGINES`).
 
 A :class:`Divergence` is one engine's failing or expected-failing check:
 its classes, its declared reason (or none, for a failure nobody declared)
@@ -220,7 +220,7 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
                workers: int | None = None, scheduler: str | None = None,
                progress: bool = False, cancel=None) -> tuple[Matrix, dict]:
     """Run every engine of ``specs`` (name -> ``module:factory``; default the
-    shipped seven) with shared case sets, and write the pages under ``out_dir``
+    shipped engines) with shared case sets, and write the pages under ``out_dir``
     when given (module docstring).
 
     ``expected`` maps a name to its expected-failures file (None for none);
