@@ -4,9 +4,10 @@ MuJoCo (E. Todorov, T. Erez, Y. Tassa, "MuJoCo: A physics engine for
 model-based control", IROS 2012; E. Todorov, "Convex and analytically-invertible
 dynamics with contacts and constraints", ICRA 2014) solves contacts as soft
 constraints in one convex optimisation per step. Here it runs a refsim
-:class:`~refsim.scenes.schema.Scene`: the world cube's six walls as planes,
+:class:`~refsim.scenes.schema.Scene`: the world cube's walls as planes,
 each body as the convex hull of its mesh with its true mass properties on a
-free joint, gravity along -y, the scene's step. The result is a
+free joint, the scene's gravity and step (and the keys beyond the seed's
+world: Scene keys, below). The result is a
 :class:`~refsim.dynamics.trajectory.Trajectory`, frame for frame comparable
 with ``refsim.simulate`` and the pybullet oracle.
 
@@ -36,7 +37,7 @@ Conventions converted here and nowhere else
   off): the uniform solid of the body's mass, from trimesh's integrals, as
   the pybullet oracle computes them
   (:func:`refsim.oracles.pybullet_adapter.mass_properties`).
-- Units and gravity: SI, ``gravity="0 -g 0"`` (y up, as refsim).
+- Units and gravity: SI, ``gravity="0 -g 0"`` by default (y up, as refsim).
 
 Every setting, and why (:class:`MujocoSettings` holds them)
 ------------------------------------------------------------
@@ -62,7 +63,8 @@ Every setting, and why (:class:`MujocoSettings` holds them)
   own one-step damper ``solreffriction="0 -1/h"`` (tangential speed brought
   to 0 in one step, within the friction cone) and ``cone="elliptic"``
   (``solreffriction`` applies to elliptic cones only). ``friction`` is
-  ``mu mu 0 0 0``: sliding friction ``mu = scene.world.friction`` in both
+  ``mu mu 0 0 0``: sliding friction ``mu`` (``world.coulomb_mu``, or the
+  pair's: Scene keys) in both
   tangent directions, no torsional or rolling friction, ``condim=3``. It is
   still MuJoCo's law, not Coulomb's impact law: an oblique bounce leaves
   with MuJoCo's own tangential speed (measured: 3.738 m/s where Coulomb
@@ -78,6 +80,33 @@ Every setting, and why (:class:`MujocoSettings` holds them)
   (``xfrc_applied``, world frame), ``F = -k v`` or ``-k |v| v`` with the
   centre of mass's velocity at the start of the step (first order, as in
   the pybullet oracle).
+
+Scene keys
+----------
+
+The keys beyond the seed's world (:data:`refsim.scenes.support.LOAD_KEYS`;
+:attr:`MujocoOracle.honoured_keys`). :meth:`MujocoOracle.load` calls
+:func:`refsim.scenes.support.refuse_unhonoured` before it compiles anything.
+
+- ``world.gravity_direction``: ``<option gravity>`` of ``gravity_vector``.
+- ``world.walls``: only the named walls' planes (a plane is infinite: a
+  body leaving through a missing wall keeps the floor under it).
+- ``world.mu``, ``body.restitution``, ``body.mu``, ``pair``: every contact
+  is an explicit ``<pair>`` with its own ``friction`` and ``solref``, so
+  each gets the ``e`` and ``mu`` :meth:`refsim.scenes.schema.Scene.coefficients`
+  resolves for its two bodies (or the body and the wall): any combination
+  the scene can pose.
+- ``body.fixed``: a body without a free joint (welded to the world; its
+  state is the scene's pose at rest). No pair is made between a fixed body
+  and a wall or another fixed body.
+- ``body.force``, ``body.torque``: ``xfrc_applied`` (world frame, at the
+  centre of mass), set once; MuJoCo keeps it between steps, and the drag,
+  when the scene has one, is added to the force each step.
+- Refused: ``world.restitution_threshold``. The one-step damper is a
+  constant of each pair's ``solref``: it reverses every approach speed by
+  ``e``, however slow, and nothing in MuJoCo's contact model switches it
+  off below a speed (changing ``pair_solref`` between steps from a
+  separate collision pass would be this adapter's law, not MuJoCo's).
 
 A missing MuJoCo raises :class:`refsim.oracles.OracleUnavailable`.
 

@@ -4,9 +4,10 @@ pybullet (E. Coumans and Y. Bai, https://pybullet.org; Bullet's
 ``btSequentialImpulseConstraintSolver``, a projected Gauss-Seidel solver of
 velocity-level contact constraints, E. Catto, "Iterative Dynamics with
 Temporal Coherence", GDC 2005) is an independent rigid-body engine. Here it
-runs a refsim :class:`~refsim.scenes.schema.Scene`: the world cube's six walls
-as static boxes, each body as the convex hull of its mesh with its true mass
-properties, gravity along -y, the scene's time step. The result is a
+runs a refsim :class:`~refsim.scenes.schema.Scene`: the world cube's walls as
+static boxes, each body as the convex hull of its mesh with its true mass
+properties, the scene's gravity and time step (and the keys beyond the
+seed's world: Scene keys, below). The result is a
 :class:`~refsim.dynamics.trajectory.Trajectory`, frame for frame comparable
 with ``refsim.simulate``.
 
@@ -70,7 +71,8 @@ Every setting, and why (:class:`PybulletSettings` holds them)
   bodies' (``btManifoldResult::calculateCombinedRestitution``). Every body
   and every wall gets ``sqrt(e)`` of the scene's ``e``, so that a body-wall
   contact and a body-body contact both see ``e`` (1 on the walls and ``e`` on
-  the bodies would give ``e^2`` between two bodies).
+  the bodies would give ``e^2`` between two bodies); coefficients per body
+  or pair: Scene keys, below.
 - Friction likewise multiplies (``calculateCombinedFriction``): every body
   and wall gets ``sqrt(mu)`` of the scene's ``friction`` read as the Coulomb
   coefficient ``mu``, so that every contact sees ``mu``. This is a
@@ -120,6 +122,47 @@ Every setting, and why (:class:`PybulletSettings` holds them)
   numbers are the same bytes each time).
 - Sleeping (deactivation) is disabled per body (``activationState``), so a
   body near rest is still stepped, as in refsim.
+
+Scene keys
+----------
+
+The keys beyond the seed's world (:data:`refsim.scenes.support.LOAD_KEYS`;
+:attr:`PybulletOracle.honoured_keys`). :meth:`PybulletOracle.load` calls
+:func:`refsim.scenes.support.refuse_unhonoured` before it builds anything.
+
+- ``world.gravity_direction``: ``setGravity`` of ``gravity_vector``.
+- ``world.walls``: only the named walls' boxes are built. The floor and the
+  other boxes reach ``3 half_size`` from the centre (``wall_thickness``), so
+  a body that leaves through a missing wall keeps a wall under it to there,
+  not beyond.
+- ``world.mu``: the Coulomb coefficient everywhere the adapter reads one
+  (``coulomb_mu``: ``friction`` when unset, as before).
+- ``body.fixed``: mass 0, a static Bullet body (no inertia is set, no
+  velocity: the loader makes it 0). Two static objects never touch.
+- ``body.force``, ``body.torque``: ``applyExternalForce`` at the centre of
+  mass and ``applyExternalTorque``, world frame, before every step: Bullet
+  clears both after each step (measured: a force applied once changes the
+  velocity of one step only).
+- ``world.restitution_threshold``: Bullet's ``restitutionVelocityThreshold``
+  (no restitution below that approach speed, as refsim's rule) takes the
+  scene's value when the scene sets the key; otherwise the adapter keeps its
+  1e-3 m/s (below), so the bounce studies' long bounce series keep the
+  restitution law where refsim's default (0.05 m/s) would stop them early.
+- ``body.restitution``, ``body.mu``, ``pair``: Bullet multiplies the two
+  objects' values at a contact (and clamps the friction product to
+  :data:`BULLET_MAX_FRICTION`); pybullet exposes no coefficient per pair
+  (``changeDynamics`` is per body; Bullet's combining callbacks are C++
+  only). So each body and the walls get a factor, and the coefficients
+  :meth:`refsim.scenes.schema.Scene.coefficients` resolves are honoured when
+  factors exist whose products give every contact the scene can have (a
+  body with each wall, two bodies not both fixed): :func:`contact_factors`
+  derives the condition and finds them. When every such contact sees the
+  world's value, every factor is its square root (the adapter's convention
+  before these keys, to the bit). One body with its own coefficient among
+  others at the world's, or a pair among two or three bodies, always has
+  factors; three bodies at the world's value and a pair of two of them at
+  another have none. Where none exist, or a friction exceeds Bullet's
+  clamp, the scene is refused with the key that sets the coefficient.
 
 Cost: building is O(vertices) per body for the hull; a step is Bullet's
 broadphase plus GJK/EPA per overlapping pair plus the solver's iterations.
