@@ -347,7 +347,8 @@ class MujocoOracle:
         parts = [self._body_state(i) for i in range(len(self._scene.bodies))]
         return tuple(np.array([p[k] for p in parts]) for k in range(4))
 
-    def _wall_contacts(self) -> set[tuple[int, int]]:
+    def _wall_contacts(self) -> set[tuple[int, str]]:
+        """(body index, wall name) of every body touching a wall."""
         d = self.data
         touching = set()
         for c in range(d.ncon):
@@ -375,7 +376,7 @@ class MujocoOracle:
         frames = [self.state()]
         times = [0.0]
         events = []
-        touching: set[tuple[int, int]] = set()
+        touching: set[tuple[int, str]] = set()
         stepping = 0.0
         start = time.perf_counter()
         for k in range(1, n + 1):
