@@ -177,48 +177,61 @@ def test_mujoco_refuses_a_restitution_threshold_by_name(oracle):
     assert info.value.key == "world.restitution_threshold"
 
 
-def _three_balls(**extra):
+def _three_balls(mu_a: float | None = None, pairs=()):
+    """Balls a, b, c apart in the cube (world e 0.8, mu 0.2); ``mu_a``: a's
+    own mu; ``pairs``: the [[pair]] entries."""
     return scene_from_dict({
-        "world": {"restitution": 0.8},
+        "world": {"restitution": 0.8, "mu": 0.2},
         "integration": {"solver": "euler", "step": H, "duration": 0.01},
         "dynamics": CORRECTED,
         "body": [{"name": n, "shape": "sphere", "radius": 0.25, "frequency": 2,
-                  "position": [x, 0.0, 0.0]} for n, x in (("a", -2.0), ("b", 0.0), ("c", 2.0))],
-        **extra})
+                  "position": [x, 0.0, 0.0], **({"mu": mu_a} if n == "a" and mu_a else {})}
+                 for n, x in (("a", -2.0), ("b", 0.0), ("c", 2.0))],
+        "pair": list(pairs)})
 
 
-def test_pybullet_refuses_pair_coefficients_no_products_can_give(oracle):
-    """Walls and a, b, c at 0.8 each fix every factor at sqrt(0.8), so a
-    pair a-b of 0.5 has none; a friction of 12 is above Bullet's clamp."""
-    scene = _three_balls(pair=[{"bodies": ["a", "b"], "restitution": 0.5}])
+def test_pybullet_refuses_coefficients_no_products_can_give(oracle):
+    """Walls and a, b, c at e = 0.8 fix every factor at sqrt(0.8), so a pair
+    a-b of 0.5 has none; a friction of 12 is above Bullet's clamp."""
     with pytest.raises(SceneError) as info:
-        _adapter("pybullet", oracle).simulate(scene)
+        _adapter("pybullet", oracle).simulate(
+            _three_balls(pairs=[{"bodies": ["a", "b"], "restitution": 0.5}]))
     assert info.value.key == "pair[0].restitution"
-    scene = _three_balls()
-    scene = scene_from_dict({
-        "world": {"restitution": 0.8}, "dynamics": CORRECTED,
-        "integration": {"solver": "euler", "step": H, "duration": 0.01},
-        "body": [{"shape": "box", "mu": BULLET_MAX_FRICTION + 2.0}]})
     with pytest.raises(SceneError) as info:
-        _adapter("pybullet", oracle).simulate(scene)
+        _adapter("pybullet", oracle).simulate(_three_balls(mu_a=BULLET_MAX_FRICTION + 2.0))
     assert info.value.key == "body[0].mu"
 
 
 def test_pybullet_gives_one_body_its_own_coefficient_through_the_factors(oracle):
-    """Body a at mu 0.5 among walls and bodies at 0.2: a's factor 0.5 /
-    sqrt(0.2), every other sqrt(0.2); each contact's product is the scene's."""
-    scene = _three_balls(world={"restitution": 0.8, "mu": 0.2})
-    scene = scene_from_dict({
-        "world": {"restitution": 0.8, "mu": 0.2}, "dynamics": CORRECTED,
-        "integration": {"solver": "euler", "step": H, "duration": 0.01},
-        "body": [{"name": n, "shape": "sphere", "radius": 0.25, "frequency": 2,
-                  "position": [x, 0.0, 0.0], **m}
-                 for n, x, m in (("a", -2.0, {"mu": 0.5}), ("b", 0.0, {}), ("c", 2.0, {}))]})
+    """Ball a at mu 0.5 among walls and balls at 0.2: a's factor 0.5 /
+    sqrt(0.2), every other sqrt(0.2), so each contact's product is the
+    scene's (a's 0.5 with the walls and with b and c: one of them gives it)."""
     pb = _adapter("pybullet", oracle)
-    pb.simulate(scene)
+    pb.simulate(_three_balls(mu_a=0.5))
     friction = [pb.dynamics_info(i)["lateral_friction"] for i in range(3)]
     assert friction == pytest.approx([0.5 / math.sqrt(0.2), math.sqrt(0.2), math.sqrt(0.2)],
                                      rel=1e-15)
+
+
+def test_mujoco_gives_each_contact_its_own_pair_coefficients(oracle):
+    """The scene pybullet refuses: MuJoCo's a-b pair carries e = 0.5 (its
+    damper ``-(1 + e) / h``) and a's mu 0.5, every other pair e = 0.8 and
+    the mu Scene.coefficients gives it."""
+    import xml.etree.ElementTree as ET
+
+    scene = _three_balls(mu_a=0.5, pairs=[{"bodies": ["a", "b"], "restitution": 0.5}])
+    root = ET.fromstring(_adapter("mujoco", oracle).mjcf(scene))
+    found = {(p.get("geom1"), p.get("geom2")): (float(p.get("solref").split()[1]),
+                                                float(p.get("friction").split()[0]))
+             for p in root.findall("./contact/pair")}
+    assert len(found) == 3 * 6 + 3
+    for (g1, g2), (damping, mu) in found.items():
+        a, b = (scene.bodies[int(g[1:])] if g[0] == "g" else None for g in (g1, g2))
+        e, expected_mu = scene.coefficients(a, b)
+        assert damping == pytest.approx(-(1.0 + e) / H, rel=1e-15)
+        assert mu == expected_mu
+    assert found[("g0", "g1")] == (pytest.approx(-1.5 / H), 0.5)
+    assert found[("g1", "g2")] == (pytest.approx(-1.8 / H), 0.2)
 
 
 @pytest.mark.parametrize("n, values, expected", [
