@@ -39,8 +39,9 @@ REST = -3.75
 
 #: The incline of 30 degrees, mu 0.3, distance in 1 s against Coulomb's
 #: ``g (sin a - mu cos a) / 2`` = 1.178 m. Measured: pybullet -0.34 % (h =
-#: 1e-3) and -0.43 % (5e-4): Bullet's block rises 1 mm off the floor at
-#: the start and rocks as it slides, an error that does not shrink with h;
+#: 1e-3) and -0.43 % (5e-4): Bullet's block rises 1 mm off the floor (to
+#: its resting distance, on a level floor too) and rocks as it slides, an
+#: error that does not shrink with h;
 #: MuJoCo +0.09 % and +0.04 %, first order. Twice each engine's measured
 #: miss at h = 1e-3.
 SLIDE_RTOL = {"pybullet": 7e-3, "mujoco": 2e-3}
