@@ -131,8 +131,16 @@ Every setting, and why (:class:`DrakeSettings` holds them)
   the centre of mass's velocity at the start of the step, first order, as
   in the other oracles.
 
-What the adapter refuses: a scene with particles (``[particles]``), one
-line naming the key and the engine (:class:`refsim.errors.OptionError`).
+Scene keys beyond the seed's world: ``world.gravity_direction`` (the
+gravity field's vector), ``world.walls`` (only the named half-spaces) and
+``world.mu`` (the Coulomb coefficient of every contact) are posed. Fixed
+bodies, applied forces and torques, coefficients per body or pair and the
+restitution threshold (Drake's law has no threshold) are refused before
+anything is built, with one line naming the key
+(:func:`refsim.scenes.support.refuse_unhonoured`).
+
+What the adapter refuses besides: a scene with particles (``[particles]``),
+one line naming the key and the engine (:class:`refsim.errors.OptionError`).
 A missing Drake raises :class:`refsim.oracles.OracleUnavailable` (``pip
 install 'refsim[drake]'``).
 
@@ -339,6 +347,10 @@ class DrakeEngine:
     """Drake's MultibodyPlant behind the engine contract's ``rigid``
     capability (lazy import)."""
 
+    #: The scene keys beyond the seed's world it poses (module docstring:
+    #: What the adapter refuses); any other it refuses by name.
+    honoured_keys = frozenset({"world.gravity_direction", "world.walls", "world.mu"})
+
     def __init__(self, settings: DrakeSettings | None = None):
         self.settings = settings or DrakeSettings()
         if self.settings.contact_model not in ("point", "hydroelastic"):
@@ -358,7 +370,9 @@ class DrakeEngine:
 
     def _refuse(self, scene) -> None:
         from refsim.errors import OptionError
+        from refsim.scenes.support import refuse_unhonoured
 
+        refuse_unhonoured(scene, self.name, self.honoured_keys)
         if scene.particles is not None:
             raise OptionError(f"scene key particles: engine {self.name} simulates rigid "
                               "bodies only")
@@ -388,7 +402,7 @@ class DrakeEngine:
         self._refuse(scene)
         s = self.settings
         self.parameters = p = contact_parameters(scene, s)
-        mu = scene.world.friction
+        mu = scene.world.coulomb_mu
         H = scene.world.half_size
         hydro = s.contact_model == "hydroelastic"
 
@@ -396,7 +410,7 @@ class DrakeEngine:
         plant, _ = AddMultibodyPlantSceneGraph(builder, time_step=scene.integration.step)
         plant.set_discrete_contact_approximation(_approximation(s.approximation))
         plant.set_contact_model(ContactModel.kHydroelastic if hydro else ContactModel.kPoint)
-        plant.mutable_gravity_field().set_gravity_vector([0.0, -scene.world.gravity, 0.0])
+        plant.mutable_gravity_field().set_gravity_vector(list(scene.world.gravity_vector))
 
         def material(modulus: float | None = None, wall: bool = False):
             props = ProximityProperties()
@@ -430,6 +444,8 @@ class DrakeEngine:
             self._hulls.append(np.asarray(mesh.vertices, dtype=np.float64) * body.scale)
             self.bodies.append(rigid)
         for k, wall in enumerate(WALL_NAMES):
+            if wall not in scene.world.walls:
+                continue                                  # a world without that wall
             axis, sign = k // 2, (-1.0 if wall.endswith("-") else 1.0)
             point = np.zeros(3)
             point[axis] = sign * H

@@ -34,6 +34,9 @@ class Cell:
     classes: dict
     #: What the check measured per case or scene (CheckResult.measured).
     measured: dict = field(default_factory=dict)
+    #: Why the check did not apply (``n/a``: e.g. a scene key the engine
+    #: cannot pose), or the declaration's reason (CheckResult.reason).
+    reason: str = ""
 
 
 @dataclass(frozen=True)
@@ -128,7 +131,7 @@ def conformance_matrix(results, pages: dict | None = None, unavailable: dict | N
     for result in results:
         for c in result.checks:
             cells[(c.key, result.engine)] = Cell(c.status, c.cases, c.passed, c.failed,
-                                                 dict(c.classes), dict(c.measured))
+                                                 dict(c.classes), dict(c.measured), c.reason)
             if c.status in ("failed", "xfailed"):
                 divergences.append(Divergence(
                     engine=result.engine, check=c.key, status=c.status, classes=dict(c.classes),

@@ -56,7 +56,7 @@ def cell_text(cell) -> str:
         return NO_CAPABILITY
     classes = f" ({_classes(cell.classes)})" if cell.classes else ""
     if cell.status == "n/a":
-        return "not run (no case)"
+        return f"not run ({cell.reason})" if cell.reason else "not run (no case)"
     if cell.status == "passed":
         return f"pass: {_plural(cell.cases, 'case')}"
     if cell.status == "xfailed":
