@@ -60,7 +60,7 @@ import numpy as np
 from refsim.bundled import models_dir
 from refsim.dynamics.simulation import BATCH_VERTICES, Simulation
 from refsim.errors import DivergenceError, StateError, check_count
-from refsim.scenes.loader import scene_from_dict
+from refsim.scenes.loader import SHAPE_KEYS, scene_from_dict
 from refsim.scenes.schema import Scene
 from refsim.solvers.integrate import whole_steps
 from refsim.solvers.methods import SOLVERS
@@ -120,17 +120,34 @@ def scene_data(scene: Scene) -> dict:
     bundled = models_dir().resolve()
     bodies = []
     for body in scene.bodies:
-        values = asdict(body)
-        model = Path(body.model).resolve()
-        values["model"] = model.name if model.parent == bundled else str(model)
-        values["position"] = list(body.position)
-        values["velocity"] = list(body.velocity)
-        values["angular_velocity"] = list(body.angular_velocity)
-        values["orientation"] = [list(row) for row in body.orientation]
+        values = _unset_left_out(asdict(body))
+        if body.shape:                       # a shape is rebuilt from its own keys
+            del values["model"]
+            for key in [k for k in ("size", "radius", "frequency")
+                        if SHAPE_KEYS[k] != body.shape]:
+                del values[key]
+        else:
+            model = Path(body.model).resolve()
+            values["model"] = model.name if model.parent == bundled else str(model)
+            for key in ("shape", "size", "radius", "frequency"):
+                del values[key]
         bodies.append(values)
-    return {"world": asdict(scene.world), "integration": asdict(scene.integration),
+    data = {"world": _unset_left_out(asdict(scene.world)),
+            "integration": asdict(scene.integration),
             "collision": asdict(scene.collision), "dynamics": asdict(scene.dynamics),
             "body": bodies}
+    if scene.pairs:
+        data["pair"] = [_unset_left_out(asdict(p)) for p in scene.pairs]
+    return data
+
+
+def _unset_left_out(values: dict) -> dict:
+    """A table's values without the keys left unset (None: the world's
+    ``mu``, a body's own coefficients), as a file that does not write them;
+    tuples as lists, as TOML reads them."""
+    return {k: (list(v) if isinstance(v, tuple) and k != "orientation"
+                else [list(r) for r in v] if k == "orientation" else v)
+            for k, v in values.items() if v is not None}
 
 
 class CountingSimulation(Simulation):
