@@ -60,7 +60,7 @@ import numpy as np
 from refsim.bundled import models_dir
 from refsim.dynamics.simulation import BATCH_VERTICES, Simulation
 from refsim.errors import DivergenceError, StateError, check_count
-from refsim.scenes.loader import scene_from_dict
+from refsim.scenes.loader import SHAPE_KEYS, scene_from_dict
 from refsim.scenes.schema import Scene
 from refsim.solvers.integrate import whole_steps
 from refsim.solvers.methods import SOLVERS
@@ -107,9 +107,10 @@ def with_fidelity(scene: Scene, fidelity: Fidelity, duration: float | None = Non
 
 def scene_data(scene: Scene) -> dict:
     """``scene`` as plain data that :func:`refsim.scenes.loader.scene_from_dict`
-    turns back into an equal scene: its tables as written by the schema, each
-    body's model by its bare name when it is a bundled model (a worker finds
-    it in its own installation) and by absolute path otherwise.
+    turns back into an equal scene: its tables and ``[[pair]]`` entries as a
+    TOML file gives them, each body's model by its bare name when it is a
+    bundled model (a worker finds it in its own installation) and by absolute
+    path otherwise, or its shape's keys.
 
     Raises :class:`StateError` for a scene with a ``[particles]`` table (the
     advisor simulates rigid bodies).
@@ -120,17 +121,34 @@ def scene_data(scene: Scene) -> dict:
     bundled = models_dir().resolve()
     bodies = []
     for body in scene.bodies:
-        values = asdict(body)
-        model = Path(body.model).resolve()
-        values["model"] = model.name if model.parent == bundled else str(model)
-        values["position"] = list(body.position)
-        values["velocity"] = list(body.velocity)
-        values["angular_velocity"] = list(body.angular_velocity)
-        values["orientation"] = [list(row) for row in body.orientation]
+        values = _toml_values(asdict(body))
+        if body.shape:
+            # a shape's mesh is built from its keys; its model is only its name
+            del values["model"]
+            for key, owner in SHAPE_KEYS.items():
+                if owner != body.shape:
+                    del values[key]
+        else:
+            model = Path(body.model).resolve()
+            values["model"] = model.name if model.parent == bundled else str(model)
+            for key in ("shape", *SHAPE_KEYS):
+                del values[key]
         bodies.append(values)
-    return {"world": asdict(scene.world), "integration": asdict(scene.integration),
+    data = {"world": _toml_values(asdict(scene.world)),
+            "integration": asdict(scene.integration),
             "collision": asdict(scene.collision), "dynamics": asdict(scene.dynamics),
             "body": bodies}
+    if scene.pairs:
+        data["pair"] = [_toml_values(asdict(pair)) for pair in scene.pairs]
+    return data
+
+
+def _toml_values(values: dict) -> dict:
+    """A configuration's fields as a TOML file gives them: tuples as lists,
+    and an unset key (None: ``world.mu``, a body's ``restitution``) left out."""
+    def plain(value):
+        return [plain(x) for x in value] if isinstance(value, tuple) else value
+    return {key: plain(value) for key, value in values.items() if value is not None}
 
 
 class CountingSimulation(Simulation):
