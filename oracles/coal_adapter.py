@@ -54,7 +54,7 @@ pair one GJK run of at most ``gjk_max_iterations`` (128) steps.
 from __future__ import annotations
 
 import numpy as np
-from refsim.oracles import import_engine
+from refsim.oracles import import_engine, install_hint
 
 from refsim.engines.cache import MeshCache
 
@@ -76,7 +76,7 @@ class CoalEngine:
     distance_tolerance = 1e-6
 
     def __init__(self):
-        self.coal = import_engine("coal", "coal", install="pip install 'refsim[coal]'")
+        self.coal = import_engine("coal", "coal", install_hint(["coal"]))
         self._models = MeshCache(self._bvh)
         # side (0: first body, 1: second) -> (model, its CollisionObject)
         self._posed: dict[int, tuple] = {}

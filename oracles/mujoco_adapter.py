@@ -4,9 +4,10 @@ MuJoCo (E. Todorov, T. Erez, Y. Tassa, "MuJoCo: A physics engine for
 model-based control", IROS 2012; E. Todorov, "Convex and analytically-invertible
 dynamics with contacts and constraints", ICRA 2014) solves contacts as soft
 constraints in one convex optimisation per step. Here it runs a refsim
-:class:`~refsim.scenes.schema.Scene`: the world cube's six walls as planes,
+:class:`~refsim.scenes.schema.Scene`: the world cube's walls as planes,
 each body as the convex hull of its mesh with its true mass properties on a
-free joint, gravity along -y, the scene's step. The result is a
+free joint, the scene's gravity and step (and the keys beyond the seed's
+world: Scene keys, below). The result is a
 :class:`~refsim.dynamics.trajectory.Trajectory`, frame for frame comparable
 with ``refsim.simulate`` and the pybullet oracle.
 
@@ -36,7 +37,7 @@ Conventions converted here and nowhere else
   off): the uniform solid of the body's mass, from trimesh's integrals, as
   the pybullet oracle computes them
   (:func:`refsim.oracles.pybullet_adapter.mass_properties`).
-- Units and gravity: SI, ``gravity="0 -g 0"`` (y up, as refsim).
+- Units and gravity: SI, ``gravity="0 -g 0"`` by default (y up, as refsim).
 
 Every setting, and why (:class:`MujocoSettings` holds them)
 ------------------------------------------------------------
@@ -62,7 +63,8 @@ Every setting, and why (:class:`MujocoSettings` holds them)
   own one-step damper ``solreffriction="0 -1/h"`` (tangential speed brought
   to 0 in one step, within the friction cone) and ``cone="elliptic"``
   (``solreffriction`` applies to elliptic cones only). ``friction`` is
-  ``mu mu 0 0 0``: sliding friction ``mu = scene.world.friction`` in both
+  ``mu mu 0 0 0``: sliding friction ``mu`` (``world.coulomb_mu``, or the
+  pair's: Scene keys) in both
   tangent directions, no torsional or rolling friction, ``condim=3``. It is
   still MuJoCo's law, not Coulomb's impact law: an oblique bounce leaves
   with MuJoCo's own tangential speed (measured: 3.738 m/s where Coulomb
@@ -78,6 +80,33 @@ Every setting, and why (:class:`MujocoSettings` holds them)
   (``xfrc_applied``, world frame), ``F = -k v`` or ``-k |v| v`` with the
   centre of mass's velocity at the start of the step (first order, as in
   the pybullet oracle).
+
+Scene keys
+----------
+
+The keys beyond the seed's world (:data:`refsim.scenes.support.LOAD_KEYS`;
+:attr:`MujocoOracle.honoured_keys`). :meth:`MujocoOracle.load` calls
+:func:`refsim.scenes.support.refuse_unhonoured` before it compiles anything.
+
+- ``world.gravity_direction``: ``<option gravity>`` of ``gravity_vector``.
+- ``world.walls``: only the named walls' planes (a plane is infinite: a
+  body leaving through a missing wall keeps the floor under it).
+- ``world.mu``, ``body.restitution``, ``body.mu``, ``pair``: every contact
+  is an explicit ``<pair>`` with its own ``friction`` and ``solref``, so
+  each gets the ``e`` and ``mu`` :meth:`refsim.scenes.schema.Scene.coefficients`
+  resolves for its two bodies (or the body and the wall): any combination
+  the scene can pose.
+- ``body.fixed``: a body without a free joint (welded to the world; its
+  state is the scene's pose at rest). No pair is made between a fixed body
+  and a wall or another fixed body.
+- ``body.force``, ``body.torque``: ``xfrc_applied`` (world frame, at the
+  centre of mass), set once; MuJoCo keeps it between steps, and the drag,
+  when the scene has one, is added to the force each step.
+- Refused: ``world.restitution_threshold``. The one-step damper is a
+  constant of each pair's ``solref``: it reverses every approach speed by
+  ``e``, however slow, and nothing in MuJoCo's contact model switches it
+  off below a speed (changing ``pair_solref`` between steps from a
+  separate collision pass would be this adapter's law, not MuJoCo's).
 
 A missing MuJoCo raises :class:`refsim.oracles.OracleUnavailable`.
 
@@ -95,8 +124,8 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from refsim.oracles import import_engine, trajectory_of_frames
 
-#: Wall names in the order of refsim's events (x-, x+, y-, y+, z-, z+).
-WALL_NAMES = ("x-", "x+", "y-", "y+", "z-", "z+")
+from refsim.scenes.support import LOAD_KEYS, refuse_unhonoured
+from refsim.scenes.world import WALL_NAMES
 
 
 @dataclass(frozen=True)
@@ -136,6 +165,9 @@ class MujocoOracle:
     """MuJoCo behind the engine contract's ``rigid`` capability (lazy import)."""
 
     name = "mujoco"
+    #: The scene keys beyond the seed's world this adapter honours (module
+    #: docstring, Scene keys): all but the restitution threshold.
+    honoured_keys = frozenset(LOAD_KEYS) - {"world.restitution_threshold"}
 
     def __init__(self, settings: MujocoSettings | None = None):
         self.mujoco = import_engine("mujoco", "mujoco")
@@ -143,6 +175,11 @@ class MujocoOracle:
         self.model = None
         self.data = None
         self.properties: list = []
+        self.wall_names: list[str] = []
+        self._address: list = []
+        self._wall_geom: dict[int, str] = {}
+        self._body_geom: dict[int, int] = {}
+        self._loads = np.zeros((0, 6))
         self._scene = None
 
     # -- building -----------------------------------------------------------------
@@ -153,13 +190,10 @@ class MujocoOracle:
 
         s = self.settings
         h = scene.integration.step
-        e = scene.world.restitution
-        mu = scene.world.friction
-        H = scene.world.half_size
-        solref = f"0 {-(1.0 + e) / h!r}"
+        world = scene.world
+        H = world.half_size
         solreffriction = f"0 {-1.0 / h!r}"
         solimp = _floats(s.solimp)
-        friction = _floats([mu, mu, 0.0, 0.0, 0.0])
         assets, bodies, pairs = [], [], []
         self.properties = []
         meshes = {}
@@ -173,15 +207,19 @@ class MujocoOracle:
             props = mass_properties(mesh.vertices, mesh.faces, body.mass, body.scale)
             self.properties.append(props)
             r = np.asarray(body.orientation, dtype=np.float64)
+            joint = "" if body.fixed else f'<freejoint name="j{i}"/>'   # fixed: welded to the world
             bodies.append(
                 f'<body name="b{i}" pos="{_floats(body.position)}" quat="{_floats(_quat_wxyz(r))}">'
-                f'<freejoint name="j{i}"/>'
+                f'{joint}'
                 f'<inertial pos="{_floats(props.center)}" quat="{_floats(_quat_wxyz(props.axes))}" '
                 f'mass="{float(body.mass)!r}" diaginertia="{_floats(props.inertia)}"/>'
                 f'<geom name="g{i}" type="mesh" mesh="{meshes[key]}" contype="0" '
                 f'conaffinity="0"/></body>')
         walls = []
+        self.wall_names = [w for w in WALL_NAMES if w in world.walls]
         for k, wall in enumerate(WALL_NAMES):
+            if wall not in world.walls:
+                continue
             axis, sign = k // 2, (-1.0 if wall.endswith("-") else 1.0)
             pos = [0.0, 0.0, 0.0]
             pos[axis] = sign * H
@@ -190,20 +228,30 @@ class MujocoOracle:
             walls.append(f'<geom name="w{k}" type="plane" size="{H!r} {H!r} 0.1" '
                          f'pos="{_floats(pos)}" zaxis="{_floats(zaxis)}" contype="0" '
                          f'conaffinity="0"/>')
-        common = (f'condim="3" friction="{friction}" solref="{solref}" '
-                  f'solreffriction="{solreffriction}" solimp="{solimp}" '
-                  f'margin="{s.margin!r}" gap="0"')
+
+        def pair(geom1: str, geom2: str, e: float, mu: float) -> str:
+            # the pair's own coefficients: restitution through the one-step
+            # damper, Coulomb's mu in both tangent directions
+            return (f'<pair geom1="{geom1}" geom2="{geom2}" condim="3" '
+                    f'friction="{_floats([mu, mu, 0.0, 0.0, 0.0])}" '
+                    f'solref="0 {-(1.0 + e) / h!r}" solreffriction="{solreffriction}" '
+                    f'solimp="{solimp}" margin="{s.margin!r}" gap="0"/>')
+
         n = len(scene.bodies)
-        for i in range(n):
-            for k in range(len(WALL_NAMES)):
-                pairs.append(f'<pair geom1="g{i}" geom2="w{k}" {common}/>')
+        for i, a in enumerate(scene.bodies):
+            if not a.fixed:                              # a fixed body never meets a wall
+                for k, wall in enumerate(WALL_NAMES):
+                    if wall in world.walls:
+                        pairs.append(pair(f"g{i}", f"w{k}", *scene.coefficients(a)))
             for j in range(i + 1, n):
-                pairs.append(f'<pair geom1="g{i}" geom2="g{j}" {common}/>')
-        g = scene.world.gravity
+                b = scene.bodies[j]
+                if not (a.fixed and b.fixed):
+                    pairs.append(pair(f"g{i}", f"g{j}", *scene.coefficients(a, b)))
         return (
             '<mujoco model="refsim">'
             '<compiler angle="radian" inertiafromgeom="false"/>'
-            f'<option timestep="{h!r}" gravity="0 {-g!r} 0" integrator={quoteattr(s.integrator)} '
+            f'<option timestep="{h!r}" gravity="{_floats(world.gravity_vector)}" '
+            f'integrator={quoteattr(s.integrator)} '
             f'cone={quoteattr(s.cone)} iterations="{s.iterations}" '
             f'tolerance="{s.tolerance!r}"/>'
             f'<asset>{"".join(assets)}</asset>'
@@ -212,31 +260,67 @@ class MujocoOracle:
             '</mujoco>')
 
     def load(self, scene) -> None:
-        """Compile ``scene`` and set its initial state."""
+        """Compile ``scene`` and set its initial state.
+
+        Raises
+        ------
+        SceneError
+            For a scene key this adapter does not honour
+            (:attr:`honoured_keys`, module docstring: Scene keys).
+        """
+        refuse_unhonoured(scene, self.name, self.honoured_keys)
         mj = self.mujoco
         self.model = mj.MjModel.from_xml_string(self.mjcf(scene))
         self.data = mj.MjData(self.model)
+        model = self.model
+        # each body's joint addresses (None: fixed, no joint)
+        self._address = []
+        for i in range(len(scene.bodies)):
+            b = i + 1                                    # body 0 is the world
+            if model.body_jntnum[b] == 0:
+                self._address.append(None)
+                continue
+            jnt = model.body_jntadr[b]
+            self._address.append((int(model.jnt_qposadr[jnt]), int(model.jnt_dofadr[jnt])))
+        geom = mj.mjtObj.mjOBJ_GEOM
+        self._wall_geom = {mj.mj_name2id(model, geom, f"w{WALL_NAMES.index(w)}"): w
+                           for w in self.wall_names}
+        self._body_geom = {mj.mj_name2id(model, geom, f"g{i}"): i
+                           for i in range(len(scene.bodies))}
+        # constant loads (world frame, at the centre of mass), added to drag
+        self._loads = np.zeros((len(scene.bodies), 6))
         for i, body in enumerate(scene.bodies):
+            if not body.fixed:
+                self._loads[i] = [*body.force, *body.torque]
+        for i, body in enumerate(scene.bodies):
+            if self._address[i] is None:
+                continue
+            _, dof = self._address[i]
             r = np.asarray(body.orientation, dtype=np.float64)
             w_world = np.asarray(body.angular_velocity, dtype=np.float64)
             v_com = np.asarray(body.velocity, dtype=np.float64)
-            self.data.qvel[6 * i:6 * i + 3] = v_com - np.cross(w_world,
-                                                               r @ self.properties[i].center)
-            self.data.qvel[6 * i + 3:6 * i + 6] = r.T @ w_world
+            self.data.qvel[dof:dof + 3] = v_com - np.cross(w_world,
+                                                           r @ self.properties[i].center)
+            self.data.qvel[dof + 3:dof + 6] = r.T @ w_world
+        self.data.xfrc_applied[1:] = self._loads
         mj.mj_forward(self.model, self.data)
         self._scene = scene
 
     # -- stepping and reading ------------------------------------------------------
 
     def _apply_drag(self) -> None:
+        """``xfrc_applied``: each body's constant force and torque, plus the
+        drag of its centre's velocity at the start of the step."""
         world = self._scene.world
         if world.drag == 0.0:
             return
         d = self.data
         for i in range(len(self.properties)):
+            if self._address[i] is None:
+                continue
             _, v_com, _, _ = self._body_state(i)
             k = world.drag * (np.linalg.norm(v_com) if world.drag_model == "quadratic" else 1.0)
-            d.xfrc_applied[i + 1, :3] = -k * v_com           # body 0 is the world
+            d.xfrc_applied[i + 1, :3] = self._loads[i, :3] - k * v_com   # body 0: the world
 
     def step(self) -> None:
         """One MuJoCo step of the loaded scene (drag applied first)."""
@@ -244,11 +328,16 @@ class MujocoOracle:
         self.mujoco.mj_step(self.model, self.data)
 
     def _body_state(self, i: int):
+        if self._address[i] is None:                    # fixed: the scene's pose, at rest
+            body = self._scene.bodies[i]
+            return (np.array(body.position, dtype=np.float64), np.zeros(3), np.zeros(3),
+                    np.array(body.orientation, dtype=np.float64))
         qpos, qvel = self.data.qpos, self.data.qvel
-        r = _matrix(qpos[7 * i + 3:7 * i + 7])
-        x = np.array(qpos[7 * i:7 * i + 3])
-        w = r @ np.array(qvel[6 * i + 3:6 * i + 6])
-        v_com = np.array(qvel[6 * i:6 * i + 3]) + np.cross(w, r @ self.properties[i].center)
+        q, dof = self._address[i]
+        r = _matrix(qpos[q + 3:q + 7])
+        x = np.array(qpos[q:q + 3])
+        w = r @ np.array(qvel[dof + 3:dof + 6])
+        v_com = np.array(qvel[dof:dof + 3]) + np.cross(w, r @ self.properties[i].center)
         return x, v_com, w, r
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -258,18 +347,18 @@ class MujocoOracle:
         parts = [self._body_state(i) for i in range(len(self._scene.bodies))]
         return tuple(np.array([p[k] for p in parts]) for k in range(4))
 
-    def _wall_contacts(self) -> set[tuple[int, int]]:
+    def _wall_contacts(self) -> set[tuple[int, str]]:
+        """(body index, wall name) of every body touching a wall."""
         d = self.data
         touching = set()
-        n = len(self._scene.bodies)
         for c in range(d.ncon):
             contact = d.contact[c]
             if contact.dist > 0.0:
                 continue
-            a, b = sorted((int(contact.geom1), int(contact.geom2)))
-            # geoms: the six walls first (ids 0..5), then one per body
-            if a < len(WALL_NAMES) <= b < len(WALL_NAMES) + n:
-                touching.add((b - len(WALL_NAMES), a))
+            for g1, g2 in ((int(contact.geom1), int(contact.geom2)),
+                           (int(contact.geom2), int(contact.geom1))):
+                if g1 in self._body_geom and g2 in self._wall_geom:
+                    touching.add((self._body_geom[g1], self._wall_geom[g2]))
         return touching
 
     def simulate(self, scene, *, every: int = 1):
@@ -287,7 +376,7 @@ class MujocoOracle:
         frames = [self.state()]
         times = [0.0]
         events = []
-        touching: set[tuple[int, int]] = set()
+        touching: set[tuple[int, str]] = set()
         stepping = 0.0
         start = time.perf_counter()
         for k in range(1, n + 1):
@@ -295,8 +384,9 @@ class MujocoOracle:
             self.step()
             stepping += time.perf_counter() - before
             now = self._wall_contacts()
-            for i, j in sorted(now - touching):
-                events.append(Event("wall", k, k * h, names[i], WALL_NAMES[j]))
+            for i, wall in sorted(now - touching,
+                                  key=lambda iw: (iw[0], WALL_NAMES.index(iw[1]))):
+                events.append(Event("wall", k, k * h, names[i], wall))
             touching = now
             if k % every == 0 or k == n:
                 frames.append(self.state())

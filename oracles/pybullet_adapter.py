@@ -4,9 +4,10 @@ pybullet (E. Coumans and Y. Bai, https://pybullet.org; Bullet's
 ``btSequentialImpulseConstraintSolver``, a projected Gauss-Seidel solver of
 velocity-level contact constraints, E. Catto, "Iterative Dynamics with
 Temporal Coherence", GDC 2005) is an independent rigid-body engine. Here it
-runs a refsim :class:`~refsim.scenes.schema.Scene`: the world cube's six walls
-as static boxes, each body as the convex hull of its mesh with its true mass
-properties, gravity along -y, the scene's time step. The result is a
+runs a refsim :class:`~refsim.scenes.schema.Scene`: the world cube's walls as
+static boxes, each body as the convex hull of its mesh with its true mass
+properties, the scene's gravity and time step (and the keys beyond the
+seed's world: Scene keys, below). The result is a
 :class:`~refsim.dynamics.trajectory.Trajectory`, frame for frame comparable
 with ``refsim.simulate``.
 
@@ -70,7 +71,8 @@ Every setting, and why (:class:`PybulletSettings` holds them)
   bodies' (``btManifoldResult::calculateCombinedRestitution``). Every body
   and every wall gets ``sqrt(e)`` of the scene's ``e``, so that a body-wall
   contact and a body-body contact both see ``e`` (1 on the walls and ``e`` on
-  the bodies would give ``e^2`` between two bodies).
+  the bodies would give ``e^2`` between two bodies); coefficients per body
+  or pair: Scene keys, below.
 - Friction likewise multiplies (``calculateCombinedFriction``): every body
   and wall gets ``sqrt(mu)`` of the scene's ``friction`` read as the Coulomb
   coefficient ``mu``, so that every contact sees ``mu``. This is a
@@ -121,6 +123,47 @@ Every setting, and why (:class:`PybulletSettings` holds them)
 - Sleeping (deactivation) is disabled per body (``activationState``), so a
   body near rest is still stepped, as in refsim.
 
+Scene keys
+----------
+
+The keys beyond the seed's world (:data:`refsim.scenes.support.LOAD_KEYS`;
+:attr:`PybulletOracle.honoured_keys`). :meth:`PybulletOracle.load` calls
+:func:`refsim.scenes.support.refuse_unhonoured` before it builds anything.
+
+- ``world.gravity_direction``: ``setGravity`` of ``gravity_vector``.
+- ``world.walls``: only the named walls' boxes are built. The floor and the
+  other boxes reach ``3 half_size`` from the centre (``wall_thickness``), so
+  a body that leaves through a missing wall keeps a wall under it to there,
+  not beyond.
+- ``world.mu``: the Coulomb coefficient everywhere the adapter reads one
+  (``coulomb_mu``: ``friction`` when unset, as before).
+- ``body.fixed``: mass 0, a static Bullet body (no inertia is set, no
+  velocity: the loader makes it 0). Two static objects never touch.
+- ``body.force``, ``body.torque``: ``applyExternalForce`` at the centre of
+  mass and ``applyExternalTorque``, world frame, before every step: Bullet
+  clears both after each step (measured: a force applied once changes the
+  velocity of one step only).
+- ``world.restitution_threshold``: Bullet's ``restitutionVelocityThreshold``
+  (no restitution below that approach speed, as refsim's rule) takes the
+  scene's value when the scene sets the key; otherwise the adapter keeps its
+  1e-3 m/s (below), so the bounce studies' long bounce series keep the
+  restitution law where refsim's default (0.05 m/s) would stop them early.
+- ``body.restitution``, ``body.mu``, ``pair``: Bullet multiplies the two
+  objects' values at a contact (and clamps the friction product to
+  :data:`BULLET_MAX_FRICTION`); pybullet exposes no coefficient per pair
+  (``changeDynamics`` is per body; Bullet's combining callbacks are C++
+  only). So each body and the walls get a factor, and the coefficients
+  :meth:`refsim.scenes.schema.Scene.coefficients` resolves are honoured when
+  factors exist whose products give every contact the scene can have (a
+  body with each wall, two bodies not both fixed): :func:`contact_factors`
+  derives the condition and finds them. When every such contact sees the
+  world's value, every factor is its square root (the adapter's convention
+  before these keys, to the bit). One body with its own coefficient among
+  others at the world's, or a pair among two or three bodies, always has
+  factors; three bodies at the world's value and a pair of two of them at
+  another have none. Where none exist, or a friction exceeds Bullet's
+  clamp, the scene is refused with the key that sets the coefficient.
+
 Cost: building is O(vertices) per body for the hull; a step is Bullet's
 broadphase plus GJK/EPA per overlapping pair plus the solver's iterations.
 """
@@ -133,6 +176,19 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 from refsim.oracles import c_banner_dropped, import_engine, trajectory_of_frames
+
+from refsim.errors import SceneError
+from refsim.scenes.support import LOAD_KEYS, keys_in_use, refuse_unhonoured
+from refsim.scenes.world import WALL_NAMES
+
+#: Bullet clamps a contact's combined friction (the product) to this
+#: (``MAX_FRICTION`` in ``btManifoldResult::calculateCombinedFriction``;
+#: measured: a plate pushed at 12 m g over a contact of 4 x 4 slides at 2 g).
+BULLET_MAX_FRICTION = 10.0
+#: The products of :func:`contact_factors` give the scene's coefficients to
+#: this relative error: a square root, a quotient and a product, each
+#: rounded to half an ulp (1.1e-16), with room for a chain of a few bodies.
+FACTOR_RTOL = 1e-12
 
 
 @dataclass(frozen=True)
@@ -193,6 +249,91 @@ def mass_properties(vertices, faces, mass: float, scale: float = 1.0) -> MassPro
                           inertia=inertia, axes=axes)
 
 
+def restitution_threshold(scene, settings: PybulletSettings) -> float:
+    """Bullet's ``restitutionVelocityThreshold`` for ``scene``: the scene's
+    ``world.restitution_threshold`` when it sets one, else the adapter's
+    setting (module docstring: why 1e-3 m/s)."""
+    if "world.restitution_threshold" in keys_in_use(scene):
+        return scene.world.restitution_threshold
+    return settings.restitution_velocity_threshold
+
+
+def contact_factors(n: int, values: dict[tuple[int, int], float], *,
+                    free: float = 1.0) -> np.ndarray | None:
+    """Factors ``x`` (n,) of n objects with ``x_u x_v = c`` for every
+    contact ``(u, v)`` of ``values`` (each ``c >= 0``), or None when no
+    factors give them all; an object in no contact gets ``free``.
+
+    Derivation. A zero ``c`` needs a zero factor, which makes every contact
+    of that object zero; so the objects whose contacts are all zero get 0
+    (harmless: nothing else depends on them), and a zero contact between two
+    other objects has no factors. What remains is positive: in each
+    connected set of contacts, the root's factor ``t`` fixes every other
+    along a spanning tree, ``x_v = c_v t^(s_v)`` with ``s_v = +-1`` by the
+    parity of its depth. A contact closing an even cycle (``s_u = -s_v``)
+    must satisfy ``c_u c_v = c`` (t cancels); one closing an odd cycle fixes
+    ``t^2 = (c / (c_u c_v))^(s_u)``. With no odd cycle, ``t`` is free and
+    is taken as the square root of the root's first contact (two objects
+    in one contact get ``sqrt(c)`` each). Every product is then checked
+    against ``c`` to :data:`FACTOR_RTOL`.
+
+    Cost: O(n + contacts).
+    """
+    neighbours: list[list[tuple[int, float]]] = [[] for _ in range(n)]
+    for (u, v), c in values.items():
+        neighbours[u].append((v, c))
+        neighbours[v].append((u, c))
+    zero = [bool(nb) and all(c == 0.0 for _, c in nb) for nb in neighbours]
+    x = np.full(n, free)
+    seen = [False] * n
+    for root in range(n):
+        if seen[root] or zero[root]:
+            continue
+        seen[root] = True
+        scale, parity = {root: 1.0}, {root: 1}         # x_v = scale_v t^parity_v
+        order, t2 = [root], None
+        for u in order:
+            for v, c in neighbours[u]:
+                if zero[v]:
+                    continue
+                if c == 0.0:
+                    return None                          # zero between two non-zero factors
+                if not seen[v]:
+                    seen[v] = True
+                    scale[v], parity[v] = c / scale[u], -parity[u]
+                    order.append(v)
+                elif parity[v] == parity[u] and t2 is None:
+                    t2 = (c / (scale[u] * scale[v])) ** parity[u]
+        if len(order) == 1:
+            continue                                     # in no contact: free
+        if t2 is None:
+            t2 = next(c for v, c in neighbours[root] if not zero[v])
+        t = math.sqrt(t2)
+        for v in order:
+            x[v] = scale[v] * t ** parity[v]
+    for i, z in enumerate(zero):
+        if z:
+            x[i] = 0.0
+    for (u, v), c in values.items():
+        if abs(x[u] * x[v] - c) > FACTOR_RTOL * c:
+            return None
+    return x
+
+
+def _coefficient_key(scene, name: str) -> str:
+    """The first key that sets coefficient ``name`` ("restitution" or
+    "mu"): a pair's, a body's, else the world's."""
+    for i, pair in enumerate(scene.pairs):
+        if getattr(pair, name) is not None:
+            return f"pair[{i}].{name}"
+    for i, body in enumerate(scene.bodies):
+        if getattr(body, name) is not None:
+            return f"body[{i}].{name}"
+    if name == "mu":
+        return "world.mu" if scene.world.mu is not None else "world.friction"
+    return "world.restitution"
+
+
 def _quat(rotation) -> list[float]:
     from scipy.spatial.transform import Rotation
 
@@ -213,6 +354,10 @@ class PybulletOracle:
     """
 
     name = "pybullet"
+    #: The scene keys beyond the seed's world this adapter honours (module
+    #: docstring, Scene keys): all of them; coefficients per body and pair
+    #: only where Bullet's products can give them (refused by name otherwise).
+    honoured_keys = frozenset(LOAD_KEYS)
 
     def __init__(self, settings: PybulletSettings | None = None):
         with c_banner_dropped("pybullet build time:"):      # printed as it loads
@@ -221,6 +366,8 @@ class PybulletOracle:
         self.client = self.p.connect(self.p.DIRECT)
         self.bodies: list[int] = []
         self.walls: list[int] = []
+        self.wall_names: list[str] = []
+        self._loads: list = []
         self.properties: list[MassProperties] = []
         self._scene = None
 
@@ -248,44 +395,52 @@ class PybulletOracle:
     def _configure(self, scene) -> None:
         p, s, c = self.p, self.settings, self.client
         p.resetSimulation(physicsClientId=c)
-        p.setGravity(0.0, -scene.world.gravity, 0.0, physicsClientId=c)
+        p.setGravity(*scene.world.gravity_vector, physicsClientId=c)
         p.setPhysicsEngineParameter(
             fixedTimeStep=scene.integration.step, numSubSteps=0,
             numSolverIterations=s.num_solver_iterations,
             useSplitImpulse=s.use_split_impulse,
             splitImpulsePenetrationThreshold=s.split_impulse_penetration_threshold,
-            restitutionVelocityThreshold=s.restitution_velocity_threshold,
+            restitutionVelocityThreshold=restitution_threshold(scene, s),
             enableConeFriction=s.enable_cone_friction,
             contactBreakingThreshold=s.contact_breaking_threshold,
             deterministicOverlappingPairs=1,
             physicsClientId=c)
 
-    def _add_walls(self, world) -> None:
+    def _add_walls(self, world, factors: tuple[float, float]) -> None:
+        """The scene's walls as static boxes, each with the wall factors
+        ``(restitution, friction)`` (:meth:`_contact_factors`)."""
         p, s, c = self.p, self.settings, self.client
         half_size = world.half_size
         t = s.wall_thickness * half_size                 # half thickness of a wall box
         span = half_size + 2.0 * t                       # walls overlap at the edges
         self.walls = []
-        for axis in range(3):
-            for sign in (-1.0, 1.0):
-                extents = [span, span, span]
-                extents[axis] = t
-                center = [0.0, 0.0, 0.0]
-                center[axis] = sign * (half_size + t)
-                shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=extents,
-                                               physicsClientId=c)
-                wall = p.createMultiBody(0.0, shape, basePosition=center,
-                                         useMaximalCoordinates=s.use_maximal_coordinates,
-                                         physicsClientId=c)
-                p.changeDynamics(wall, -1, restitution=math.sqrt(world.restitution),
-                                 lateralFriction=math.sqrt(world.friction),
-                                 rollingFriction=0.0,
-                                 spinningFriction=0.0,
-                                 contactProcessingThreshold=s.contact_processing_threshold,
-                                 physicsClientId=c)
-                self.walls.append(wall)
+        self.wall_names = []
+        for k, name in enumerate(WALL_NAMES):
+            if name not in world.walls:
+                continue
+            axis, sign = k // 2, (-1.0 if name.endswith("-") else 1.0)
+            extents = [span, span, span]
+            extents[axis] = t
+            center = [0.0, 0.0, 0.0]
+            center[axis] = sign * (half_size + t)
+            shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=extents,
+                                           physicsClientId=c)
+            wall = p.createMultiBody(0.0, shape, basePosition=center,
+                                     useMaximalCoordinates=s.use_maximal_coordinates,
+                                     physicsClientId=c)
+            p.changeDynamics(wall, -1, restitution=factors[0],
+                             lateralFriction=factors[1],
+                             rollingFriction=0.0,
+                             spinningFriction=0.0,
+                             contactProcessingThreshold=s.contact_processing_threshold,
+                             physicsClientId=c)
+            self.walls.append(wall)
+            self.wall_names.append(name)
 
-    def _add_body(self, scene, body) -> int:
+    def _add_body(self, scene, body, factors: tuple[float, float]) -> int:
+        """``body`` as a hull with its mass properties (static, mass 0, when
+        it is fixed), with the factors ``(restitution, friction)``."""
         p, s, c = self.p, self.settings, self.client
         mesh = scene.mesh(body)
         props = mass_properties(mesh.vertices, mesh.faces, body.mass, body.scale)
@@ -293,35 +448,97 @@ class PybulletOracle:
                                        meshScale=[body.scale] * 3, physicsClientId=c)
         r = np.asarray(body.orientation, dtype=np.float64)
         x = np.asarray(body.position, dtype=np.float64)
+        mass = 0.0 if body.fixed else body.mass             # Bullet: mass 0 is static
         uid = p.createMultiBody(
-            baseMass=body.mass, baseCollisionShapeIndex=shape, basePosition=x.tolist(),
+            baseMass=mass, baseCollisionShapeIndex=shape, basePosition=x.tolist(),
             baseOrientation=_quat(r),
             baseInertialFramePosition=props.center.tolist(),
             baseInertialFrameOrientation=_quat(props.axes),
             useMaximalCoordinates=s.use_maximal_coordinates, physicsClientId=c)
-        p.changeDynamics(uid, -1, mass=body.mass, localInertiaDiagonal=props.inertia.tolist(),
-                         restitution=math.sqrt(scene.world.restitution),
-                         lateralFriction=math.sqrt(scene.world.friction), rollingFriction=0.0,
+        inertia = {} if body.fixed else {"mass": body.mass,
+                                         "localInertiaDiagonal": props.inertia.tolist()}
+        p.changeDynamics(uid, -1, **inertia,
+                         restitution=factors[0],
+                         lateralFriction=factors[1], rollingFriction=0.0,
                          spinningFriction=0.0, linearDamping=s.linear_damping,
                          angularDamping=s.angular_damping,
                          contactProcessingThreshold=s.contact_processing_threshold,
                          collisionMargin=s.hull_collision_margin,
                          activationState=p.ACTIVATION_STATE_DISABLE_SLEEPING,
                          physicsClientId=c)
-        # The scene's velocity is the centre of mass's, as pybullet's is.
+        # The scene's velocity is the centre of mass's, as pybullet's is (a
+        # fixed body's is zero: the loader requires it).
         p.resetBaseVelocity(uid, [float(a) for a in body.velocity],
                             [float(a) for a in body.angular_velocity], physicsClientId=c)
         self.properties.append(props)
         return uid
 
+    def _contact_factors(self, scene) -> tuple[np.ndarray, np.ndarray]:
+        """Each body's and the walls' restitution and friction factors,
+        (B + 1,) each (the walls last), whose products at every contact the
+        scene can have are the coefficients :meth:`Scene.coefficients`
+        resolves (module docstring, Scene keys).
+
+        Raises
+        ------
+        SceneError
+            Naming the key that sets the coefficients no factors can give,
+            or a friction above :data:`BULLET_MAX_FRICTION`.
+        """
+        world, bodies = scene.world, scene.bodies
+        B = len(bodies)
+        walls = len(world.walls) > 0
+        # the contacts the scene can have: two static objects never touch
+        edges: dict[tuple[int, int], tuple[float, float]] = {}
+        for i, a in enumerate(bodies):
+            if walls and not a.fixed:
+                edges[(i, B)] = scene.coefficients(a)
+            for j in range(i + 1, B):
+                if not (a.fixed and bodies[j].fixed):
+                    edges[(i, j)] = scene.coefficients(a, bodies[j])
+        result = []
+        for k, (name, uniform) in enumerate((("restitution", world.restitution),
+                                             ("mu", world.coulomb_mu))):
+            values = {edge: c[k] for edge, c in edges.items()}
+            if name == "mu" and any(v > BULLET_MAX_FRICTION for v in values.values()):
+                raise SceneError(f"pybullet clamps a contact's friction to "
+                                 f"{BULLET_MAX_FRICTION:g} (the product of two bodies')",
+                                 scene.path, _coefficient_key(scene, name))
+            if all(v == uniform for v in values.values()):
+                # every contact sees the world's value: sqrt of it everywhere
+                result.append(np.full(B + 1, math.sqrt(uniform)))
+                continue
+            x = contact_factors(B + 1, values, free=math.sqrt(uniform))
+            if x is None:
+                raise SceneError(f"pybullet multiplies two objects' {name} at a contact, and "
+                                 f"no factor per body and wall gives every contact the "
+                                 f"{name} the scene resolves", scene.path,
+                                 _coefficient_key(scene, name))
+            result.append(x)
+        return result[0], result[1]
+
     def load(self, scene) -> None:
-        """Build ``scene`` in this client (replacing whatever was there)."""
+        """Build ``scene`` in this client (replacing whatever was there).
+
+        Raises
+        ------
+        SceneError
+            For a scene key this adapter does not honour
+            (:attr:`honoured_keys`, module docstring: Scene keys).
+        """
+        refuse_unhonoured(scene, self.name, self.honoured_keys)
+        e, mu = self._contact_factors(scene)
         self._configure(scene)
-        self._add_walls(scene.world)
+        self._add_walls(scene.world, (float(e[-1]), float(mu[-1])))
         self.bodies = []
         self.properties = []
-        for body in scene.bodies:
-            self.bodies.append(self._add_body(scene, body))
+        for i, body in enumerate(scene.bodies):
+            self.bodies.append(self._add_body(scene, body, (float(e[i]), float(mu[i]))))
+        # constant loads, world frame, applied every step (Bullet clears its
+        # external forces after each step)
+        self._loads = [(uid, tuple(map(float, b.force)), tuple(map(float, b.torque)))
+                       for uid, b in zip(self.bodies, scene.bodies, strict=True)
+                       if not b.fixed and (any(b.force) or any(b.torque))]
         self._scene = scene
 
     # -- stepping and reading ------------------------------------------------------
@@ -338,9 +555,21 @@ class PybulletOracle:
             p.applyExternalForce(uid, -1, (-k * v).tolist(), com, p.WORLD_FRAME,
                                  physicsClientId=c)
 
+    def _apply_loads(self) -> None:
+        """The bodies' constant forces (at the centre of mass) and torques,
+        world frame: Bullet clears external forces after every step."""
+        p, c = self.p, self.client
+        for uid, force, torque in self._loads:
+            if any(force):
+                com = p.getBasePositionAndOrientation(uid, physicsClientId=c)[0]
+                p.applyExternalForce(uid, -1, force, com, p.WORLD_FRAME, physicsClientId=c)
+            if any(torque):
+                p.applyExternalTorque(uid, -1, torque, p.WORLD_FRAME, physicsClientId=c)
+
     def step(self) -> None:
-        """One Bullet step of the loaded scene (drag applied first)."""
+        """One Bullet step of the loaded scene (drag and loads applied first)."""
         self._apply_drag()
+        self._apply_loads()
         self.p.stepSimulation(physicsClientId=self.client)
 
     def state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -380,7 +609,6 @@ class PybulletOracle:
         h = scene.integration.step
         n = scene.integration.n_steps
         names = tuple(b.name for b in scene.bodies)
-        wall_names = ("x-", "x+", "y-", "y+", "z-", "z+")
         frames = [self.state()]
         times = [0.0]
         events = []
@@ -398,14 +626,16 @@ class PybulletOracle:
                     if any(point[8] <= 0.0 for point in points):    # distance <= 0: touching
                         now.add((i, j))
             for i, j in sorted(now - touching):
-                events.append(Event("wall", k, k * h, names[i], wall_names[j]))
+                events.append(Event("wall", k, k * h, names[i], self.wall_names[j]))
             touching = now
             if k % every == 0 or k == n:
                 frames.append(self.state())
                 times.append(k * h)
         elapsed = time.perf_counter() - start
+        settings = asdict(self.settings)
+        settings["restitution_velocity_threshold"] = restitution_threshold(scene, self.settings)
         return trajectory_of_frames(frames, times, names, events, stepping, elapsed,
-                                    {"engine": "pybullet", **asdict(self.settings)})
+                                    {"engine": "pybullet", **settings})
 
     def step_time(self, scene, steps: int, warmup: int = 0) -> float:
         """Seconds per step of ``scene`` (mean over ``steps`` steps after

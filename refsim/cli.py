@@ -379,7 +379,7 @@ EXIT_CHECK_FAILED = 1
 
 def _conform(args) -> int:
     """``refsim conform``: one engine through the conformance kit, or the
-    shipped seven side by side (``--all``). Exit 0 when every check passed
+    shipped engines side by side (``--all``). Exit 0 when every check passed
     (declared expected failures aside), 1 when one failed; user errors
     (a bad spec, a missing engine, a malformed expected-failures file) are
     RefsimErrors and exit 2 (``main``)."""
@@ -424,10 +424,10 @@ def _conform(args) -> int:
         wrote = f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine"
         if matrix.unavailable:
             # a matrix with engines missing is not the check asked for
-            from refsim.oracles import SHIPPED_INSTALL_HINT
+            from refsim.oracles import install_hint
 
             print(f"{wrote}; not run: {', '.join(sorted(matrix.unavailable))} (see the "
-                  f"warnings; {SHIPPED_INSTALL_HINT})")
+                  f"warnings; {install_hint(matrix.unavailable)})")
             return EXIT_CHECK_FAILED
         print(wrote)
         return 0 if matrix.ok else EXIT_CHECK_FAILED
@@ -463,14 +463,14 @@ def _add_conform_command(commands) -> None:
                     "refsim.engines) through every check its capabilities call for, "
                     "against answers that depend on no float engine. Writes "
                     "DIR/conformance.json and a self-contained DIR/index.html, prints a "
-                    "table. --all runs the seven shipped engines and writes their matrix. "
+                    "table. --all runs the shipped engines and writes their matrix. "
                     "Exit status 0: every check passed (declared expected failures "
                     "aside); 1: a check failed, or --all left out an engine whose package "
                     "is missing; 2: a usage error.")
     conform.add_argument("engine", nargs="?", metavar="MODULE:FACTORY",
                          help="the engine, e.g. refsim.engines.refsim_engines:corrected")
     conform.add_argument("--all", action="store_true",
-                         help="the seven shipped engines side by side (each with its own "
+                         help="the shipped engines side by side (each with its own "
                               "expected failures)")
     conform.add_argument("-o", "--output", default="conformance", metavar="DIR",
                          help="output directory (default: conformance)")
@@ -670,7 +670,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="refsim",
         description="Reference implementation of a 1997 rigid-body N-body simulation, "
-                    "checked against FCL, coal, trimesh, scipy, pybullet and MuJoCo.")
+                    "checked against FCL, coal, trimesh, scipy, pybullet, MuJoCo and Drake.")
     parser.add_argument("--debug", action="store_true",
                         help="show the full traceback on errors")
     parser.add_argument("--version", action="version", version=f"refsim {version()}",

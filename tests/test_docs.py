@@ -43,3 +43,31 @@ def test_every_cited_section_of_the_design_page_exists():
     assert missing == []
     assert {"Architecture", "Errors", "Conventions", "Public API", "Scene files",
             "Speed"} <= headings
+
+
+def test_the_design_pages_key_table_is_each_engines_honoured_keys():
+    """docs/design.md, "Which engines pose which keys": every cell is the
+    engine's ``honoured_keys`` ("yes" when it holds the key)."""
+    import importlib
+
+    from refsim.engines.refsim_engines import corrected, seed
+    from refsim.scenes.support import LOAD_KEYS
+
+    oracles = {}
+    for title, module, cls in (("pybullet", "refsim.oracles.pybullet_adapter", "PybulletOracle"),
+                               ("MuJoCo", "refsim.oracles.mujoco_adapter", "MujocoOracle"),
+                               ("Drake", "refsim.oracles.drake_adapter", "DrakeEngine")):
+        oracles[title] = getattr(importlib.import_module(module), cls).honoured_keys
+    engines = {"refsim corrected": corrected().honoured_keys,
+               "refsim seed": seed().honoured_keys, **oracles}
+    text = DESIGN.read_text()
+    table = text[text.index("<!-- honoured-keys -->"):text.index("<!-- /honoured-keys -->")]
+    rows = [[c.strip() for c in line.strip("|").split("|")]
+            for line in table.splitlines() if line.startswith("|")]
+    header, body = rows[0], rows[2:]
+    assert header[1:] == list(engines)
+    assert [r[0].strip("`") for r in body] == list(LOAD_KEYS)
+    for row in body:
+        key = row[0].strip("`")
+        for title, cell in zip(header[1:], row[1:], strict=True):
+            assert cell.split()[0] == ("yes" if key in engines[title] else "no"), (key, title)

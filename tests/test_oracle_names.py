@@ -18,7 +18,7 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 
 #: How each shipped external engine is named in prose.
 NAMES = {"fcl": r"FCL|python-fcl", "coal": r"coal", "trimesh": r"trimesh", "pybullet": r"pybullet",
-         "mujoco": r"MuJoCo"}
+         "mujoco": r"MuJoCo", "drake": r"Drake"}
 
 
 def _texts() -> dict[str, str]:

@@ -77,7 +77,7 @@ from refsim.collision.predicates import (
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "cc012aab043fe5a6"
+SOURCES_DIGEST = "deb19c759b880566"
 
 #: Dekker's splitter for float64: 2**ceil(53 / 2) + 1 (Shewchuk, section 2.5).
 SPLITTER = 134217729.0

@@ -34,7 +34,7 @@ from refsim.collision.predicates import (
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "5f8856ac24de2bcd"
+SOURCES_DIGEST = "1488c50bc7187b63"
 
 # -- the certified triangle-pair filter (triangle_numba's steps 1-4) -------------------
 #

@@ -17,17 +17,20 @@ flat polytope: S. Gottschalk, M. C. Lin, D. Manocha, "OBBTree", SIGGRAPH
 On each axis the projections are compared strictly, so touching sets (a
 shared point) are never separated: closed semantics, like refsim's test.
 
-Every float coordinate is an exact rational (``fractions.Fraction``), so
-every projection and comparison is exact: no tolerance anywhere. It is a
-different algorithm from refsim's edge-triangle test, so agreement between
-the two is evidence for both.
+Every float coordinate is an exact rational whose denominator is a power
+of two (``float.as_integer_ratio``); the six points are scaled by their
+common denominator into Python integers (a positive scale: every
+comparison of projections keeps its sign), so every projection and
+comparison is exact integer arithmetic: no tolerance anywhere, and no
+fraction reduced on the way. It is a different algorithm from refsim's
+edge-triangle test, so agreement between the two is evidence for both.
 
-Cost: 17 axes x 6 dot products in rationals, about a millisecond per pair.
+Cost: 17 axes x 6 dot products of integers of a few hundred bits, about 50
+microseconds per pair (``fractions.Fraction`` took 6 ms: a gcd per
+operation).
 """
 
 from __future__ import annotations
-
-from fractions import Fraction
 
 
 def _sub(p, q):
@@ -42,14 +45,23 @@ def _dot(u, v):
     return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
 
 
+def _integer_points(a, b) -> tuple[list, list]:
+    """The vertices of ``a`` and ``b`` as integer triples, all scaled by one
+    power of two ``D`` (the largest denominator of their coordinates as
+    exact rationals): ``x = n / d`` becomes ``n (D / d)``, exactly."""
+    ratios = [[[float(x).as_integer_ratio() for x in p] for p in t] for t in (a, b)]
+    D = max(d for t in ratios for p in t for _, d in p)
+    A, B = ([tuple(n * (D // d) for n, d in p) for p in t] for t in ratios)
+    return A, B
+
+
 def triangles_intersect_sat(a, b) -> bool | None:
     """Whether closed triangles ``a`` and ``b`` (3, 3) intersect, exactly.
 
     Returns None when either triangle is degenerate (zero area: its normal
     vanishes and the axis set above is no longer complete).
     """
-    A = [tuple(Fraction(float(x)) for x in p) for p in a]
-    B = [tuple(Fraction(float(x)) for x in p) for p in b]
+    A, B = _integer_points(a, b)
     edges_a = [_sub(A[(i + 1) % 3], A[i]) for i in range(3)]
     edges_b = [_sub(B[(i + 1) % 3], B[i]) for i in range(3)]
     n_a, n_b = _cross(edges_a[0], edges_a[1]), _cross(edges_b[0], edges_b[1])

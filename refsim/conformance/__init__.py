@@ -8,7 +8,7 @@ Three ways to run it, one engine at a time or side by side:
   ``DIR/conformance.json`` and a self-contained ``DIR/index.html``, prints a
   table and exits 0 (every check passed, declared expected failures aside),
   1 (a check failed) or 2 (a user error). ``refsim conform --all -o DIR``
-  runs the seven engines refsim ships and writes their matrix
+  runs the engines refsim ships and writes their matrix
   (:mod:`refsim.conformance.matrix`).
 - ``pytest --refsim-engine module:factory``: one test per check
   (:mod:`refsim.conformance.pytest_plugin`, loaded through its ``pytest11``

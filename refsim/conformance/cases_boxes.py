@@ -40,8 +40,8 @@ near-identity   the identity rotation and a translation of 10^-12 .. 10^-8
 tiny            points of size 10^-12 .. 10^-9 moved by a unit translation
 ==============  ============================================================
 
-Cost: O(n) rational operations per case (the truth, in exact arithmetic,
-dominates).
+Cost: O(n) float operations per case, and exact integer arithmetic on the
+few vertices that can be extreme (:func:`exact_box`).
 """
 
 from __future__ import annotations
@@ -74,21 +74,56 @@ UNDERFLOW = 4 * 2.0 ** -1074
 
 
 def exact_box(vertices, pose) -> tuple[tuple[Fraction, ...], tuple[Fraction, ...]]:
-    """The box of ``R p + t`` over the rows ``p`` of ``vertices``, exactly."""
+    """The box of ``R p + t`` over the rows ``p`` of ``vertices``, exactly.
+
+    Each coordinate's extremes are found among its candidates: the vertices
+    whose float value (:func:`_float_coordinates`) lies within four times
+    :func:`rounding_bound` of the float extreme. The float value of every
+    vertex is within one bound of its exact value, so the exact extreme is
+    always among them (the margin is four bounds where two would do). The
+    candidates are then evaluated exactly, in integers: every float is a
+    rational with a power-of-two denominator, so scaled by the largest
+    such denominator ``D`` of ``R``, ``t`` and the points, ``R p`` is an
+    integer over ``D^2`` and ``t`` one over ``D``. The float values only
+    choose which vertices to evaluate; the answer is exact.
+    """
     rotation, translation = pose
-    R = [[Fraction(float(x)) for x in row] for row in np.asarray(rotation)]
-    t = [Fraction(float(x)) for x in np.asarray(translation)]
+    V = np.asarray(vertices, dtype=np.float64)
+    R = np.asarray(rotation, dtype=np.float64)
+    t = np.asarray(translation, dtype=np.float64)
+    approx = _float_coordinates(V, R, t)
+    margin = 4.0 * rounding_bound(V, (R, t))
+    ratios = {}
+
+    def ratio(x: float) -> tuple[int, int]:
+        if x not in ratios:
+            ratios[x] = float(x).as_integer_ratio()
+        return ratios[x]
+
     lo: list = [None, None, None]
     hi: list = [None, None, None]
-    for p in np.asarray(vertices, dtype=np.float64).tolist():
-        q = [Fraction(x) for x in p]
-        for i in range(3):
-            c = R[i][0] * q[0] + R[i][1] * q[1] + R[i][2] * q[2] + t[i]
-            if lo[i] is None or c < lo[i]:
-                lo[i] = c
-            if hi[i] is None or c > hi[i]:
-                hi[i] = c
+    for i in range(3):
+        column = approx[:, i]
+        low = np.flatnonzero(column <= column.min() + margin[i])
+        high = np.flatnonzero(column >= column.max() - margin[i])
+        rows = sorted(set(low.tolist()) | set(high.tolist()))
+        terms = [ratio(x) for x in R[i].tolist()] + [ratio(float(t[i]))]
+        points = [[ratio(x) for x in V[r].tolist()] for r in rows]
+        D = max(d for _, d in terms + [c for p in points for c in p])
+        r_int = [n * (D // d) for n, d in terms[:3]]
+        t_int = terms[3][0] * (D // terms[3][1]) * D            # over D^2
+        values = {r: sum(r_int[j] * (p[j][0] * (D // p[j][1])) for j in range(3)) + t_int
+                  for r, p in zip(rows, points, strict=True)}
+        lo[i] = Fraction(min(values[r] for r in low.tolist()), D * D)
+        hi[i] = Fraction(max(values[r] for r in high.tolist()), D * D)
     return tuple(lo), tuple(hi)
+
+
+def _float_coordinates(V: np.ndarray, R: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """(n, 3) ``R p + t`` of the rows of ``V`` in float64, element by element
+    (no matrix product, so no BLAS kernel chooses the order)."""
+    return np.stack([((R[i, 0] * V[:, 0] + R[i, 1] * V[:, 1]) + R[i, 2] * V[:, 2]) + t[i]
+                     for i in range(3)], axis=1)
 
 
 def rounding_bound(vertices, pose) -> np.ndarray:

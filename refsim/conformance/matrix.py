@@ -7,7 +7,7 @@ every engine), runs each engine through its checks with its declared
 expected failures, and writes each engine's pages (``DIR/<engine>/
 conformance.json`` and ``index.html``), the matrix (``DIR/matrix.json``) and
 its page (``DIR/index.html``). ``refsim conform --all -o DIR`` calls it for
-the seven shipped engines (:data:`refsim.conformance.shipped.SHIPPED_ENGINES`).
+the shipped engines (:data:`refsim.conformance.shipped.SHIPPED_ENGINES`).
 
 A :class:`Divergence` is one engine's failing or expected-failing check:
 its classes, its declared reason (or none, for a failure nobody declared)
@@ -34,6 +34,9 @@ class Cell:
     classes: dict
     #: What the check measured per case or scene (CheckResult.measured).
     measured: dict = field(default_factory=dict)
+    #: Why the check did not apply (``n/a``: e.g. a scene key the engine
+    #: cannot pose), or the declaration's reason (CheckResult.reason).
+    reason: str = ""
 
 
 @dataclass(frozen=True)
@@ -128,7 +131,7 @@ def conformance_matrix(results, pages: dict | None = None, unavailable: dict | N
     for result in results:
         for c in result.checks:
             cells[(c.key, result.engine)] = Cell(c.status, c.cases, c.passed, c.failed,
-                                                 dict(c.classes), dict(c.measured))
+                                                 dict(c.classes), dict(c.measured), c.reason)
             if c.status in ("failed", "xfailed"):
                 divergences.append(Divergence(
                     engine=result.engine, check=c.key, status=c.status, classes=dict(c.classes),
@@ -220,7 +223,7 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
                workers: int | None = None, scheduler: str | None = None,
                progress: bool = False, cancel=None) -> tuple[Matrix, dict]:
     """Run every engine of ``specs`` (name -> ``module:factory``; default the
-    shipped seven) with shared case sets, and write the pages under ``out_dir``
+    shipped engines) with shared case sets, and write the pages under ``out_dir``
     when given (module docstring).
 
     ``expected`` maps a name to its expected-failures file (None for none);

@@ -13,6 +13,7 @@ coal               refsim.oracles.coal_adapter:engine              triangles, pa
 trimesh            refsim.conformance.shipped:trimesh              collide, aabb
 pybullet           refsim.oracles.pybullet_adapter:engine          rigid
 mujoco             refsim.oracles.mujoco_adapter:engine            rigid
+drake              refsim.oracles.drake_adapter:engine             rigid
 =================  ==============================================  ==================
 
 trimesh has two adapters, one per question it answers (its boxes,
@@ -36,6 +37,7 @@ SHIPPED_ENGINES: dict[str, str] = {
     "trimesh": "refsim.conformance.shipped:trimesh",
     "pybullet": "refsim.oracles.pybullet_adapter:engine",
     "mujoco": "refsim.oracles.mujoco_adapter:engine",
+    "drake": "refsim.oracles.drake_adapter:engine",
 }
 
 

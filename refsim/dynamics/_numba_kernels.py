@@ -94,14 +94,14 @@ import numba
 import numpy as np
 
 from refsim.bounds._numba_kernels import incremental_update_numba
-from refsim.dynamics.impulse import solve_contacts_python
+from refsim.dynamics.impulse import contact_sum_python, solve_contacts_python
 from refsim.dynamics.rotation_impulse import WALL_DEEPEST_FRACTION, free_rotation_step
 from refsim.dynamics.rotation_seed import axes_step_seed
 
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "a6bba92146857a76"
+SOURCES_DIGEST = "73da5a0bb07feb0c"
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -124,6 +124,7 @@ ROTATION_EXACT = 2      # "impulse": the exact rotation with angular momentum
 #: readable source (:func:`refsim.dynamics.impulse.solve_contacts_python`,
 #: as :func:`~refsim.dynamics.impulse.solve_contacts_compiled` compiles it).
 _solve_contacts = numba.njit(cache=True, nogil=True)(solve_contacts_python)
+_contact_sum = numba.njit(cache=True, nogil=True)(contact_sum_python)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -133,7 +134,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
             Q, moments, I_body_inv, energy_limit, leaf_order, leaf_start, leaf_spheres,
             first_leaf, body_mode,
             x, v, w, R, lo, hi, walls, bodies, events, tracked, tracker_rows, trackers_f,
-            trackers_i):
+            trackers_i, impulse_now, event_data):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation.step`, up to
     ``n_steps`` times, in place; returns ``(steps, events, stop)`` (module
     docstring: the readable function of each stage, and the hand-back).
@@ -166,6 +167,9 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
     x, v, w : (B, 3); R : (B, 3, 3); lo, hi : (B, 3) the state and boxes
     walls : (B, 6) bool; bodies : (B, B) bool (the contacts, read and written)
     events : (capacity, 4) int64
+    impulse_now : (B, 6, 7) each body's wall contacts' impulse records of
+        the step (:func:`refsim.dynamics.impulse.contact_sum_python`);
+        event_data : (capacity, 7), the record of each event's contact
     tracked : (B,) int64, the row of ``tracker_rows`` of a body whose box
         comes from its incremental tracker (the walk of
         :func:`refsim.bounds._numba_kernels.incremental_update_numba`: the
@@ -299,6 +303,8 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
         for b in range(B):
             for k in range(6):
                 now_walls[b, k] = False
+                for j in range(7):
+                    impulse_now[b, k, j] = 0.0
             beyond = False
             for k in range(3):
                 if lo[b, k] < -half_size or hi[b, k] > half_size:
@@ -318,7 +324,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
                 _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres,
                               first_leaf, x, center, v, w, R, half_size, gravity,
                               restitution, friction, threshold, iterations, inv_mass[b], E,
-                              past, r_a, P, n)
+                              past, r_a, P, n, impulse_now)
             else:
                 if rotation_mode == ROTATION_SEED:
                     _wall_spin_seed(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1],
@@ -364,6 +370,8 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
                     events[n_events, 1] = 0
                     events[n_events, 2] = b
                     events[n_events, 3] = k
+                    for j in range(7):
+                        event_data[n_events, j] = impulse_now[b, k, j]
                     n_events += 1
                 walls[b, k] = now_walls[b, k]
         # 8. the seed's exchange (S8) for each pair, in order
@@ -385,6 +393,8 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
                             events[n_events, 1] = 1
                             events[n_events, 2] = i
                             events[n_events, 3] = j
+                            for c in range(7):          # the seed's exchange: no impulse
+                                event_data[n_events, c] = 0.0
                             n_events += 1
                     bodies[i, j] = now
     return n_steps, n_events, DONE
@@ -648,7 +658,7 @@ def _deepest(b, k, low, wall, o_k, R, vertices_t, past, count):
 @numba.njit(cache=True, nogil=True)
 def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, first_leaf, x,
                   center, v, w, R, half_size, gravity, restitution, friction, threshold,
-                  iterations, inv_mass, I_inv, past, r_a, P, n):
+                  iterations, inv_mass, I_inv, past, r_a, P, n, impulse_now):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation._wall_impulse` for
     body b, in place: for each crossed wall, the vertices past it
     (:func:`refsim.dynamics.rotation_impulse.wall_contacts`, found by
@@ -656,7 +666,9 @@ def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, fir
     :func:`refsim.types.transform_points` computes them), the push-back, the
     speed at the wall (D6) and the contact solve
     (:func:`refsim.dynamics.impulse.wall_impulses`, the wall static: B's
-    arrays None). ``I_inv`` is the body's world inverse inertia."""
+    arrays None), and its impulses into ``impulse_now[b, wall]``
+    (:func:`refsim.dynamics.impulse.contact_sum_python`). ``I_inv`` is the
+    body's world inverse inertia."""
     for k in range(3):
         if corr[k] == 0.0:
             continue
@@ -682,3 +694,4 @@ def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, fir
         n[k] = 1.0 if low else -1.0
         _solve_contacts(r_a[:count], None, n, inv_mass, I_inv, v[b], w[b], 0.0, None, None,
                         None, restitution, friction, threshold, iterations, P[:count])
+        _contact_sum(P[:count], n, r_a[:count], x[b], impulse_now[b, 2 * k + (0 if low else 1)])

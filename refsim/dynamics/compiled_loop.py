@@ -161,6 +161,8 @@ class CompiledLoop:
         self.walls = np.zeros((B, 6), np.bool_)
         self.bodies = np.zeros((B, B), np.bool_)
         self.events = np.zeros((max(EVENT_ROWS, 4 * (6 * B + B * (B - 1) // 2)), 4), np.int64)
+        self.event_data = np.zeros((len(self.events), impulse.IMPULSE_RECORD))
+        self.impulse_now = np.zeros((B, 6, impulse.IMPULSE_RECORD))
         self._index = {name: i for i, name in enumerate(sim.names)}
         self._flags_stale = False        # the set changed since the flags were built
         self._set_stale = False          # the flags changed since the set was built
@@ -297,7 +299,7 @@ class CompiledLoop:
             self.leaf_order, self.leaf_start, self.leaf_spheres, self.first_leaf,
             self.body_mode, sim.x, sim.v, sim.w, sim.R, sim.lo, sim.hi, self.walls,
             self.bodies, self.events, self.tracked, self.tracker_rows, self.trackers_f,
-            self.trackers_i)
+            self.trackers_i, self.impulse_now, self.event_data)
         sim.loop_seconds += time.perf_counter() - start
         if done:
             self._note_events(n_events)
@@ -317,12 +319,14 @@ class CompiledLoop:
         rows = self.events[:n_events].tolist()
         base = sim.steps
         found = []
-        for step, kind, i, j in rows:
+        for row, (step, kind, i, j) in enumerate(rows):
             if kind == 0:
-                found.append((step, names[i], WALLS[j], "wall"))
+                found.append((step, names[i], WALLS[j], "wall", row))
             else:
-                found.append((step, names[i], names[j], "body"))
+                found.append((step, names[i], names[j], "body", row))
         found.sort(key=lambda r: (r[0], r[1], r[2]))
-        for step, body, other, kind in found:
+        for step, body, other, kind, row in found:
             n = base + step + 1
-            sim.events.append(Event(kind=kind, step=n, time=n * sim.h, body=body, other=other))
+            J, point = impulse.impulse_and_point(self.event_data[row])
+            sim.events.append(Event(kind=kind, step=n, time=n * sim.h, body=body, other=other,
+                                    impulse=J, point=point))

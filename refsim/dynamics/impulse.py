@@ -230,9 +230,9 @@ def solve_contacts_python(r_a, r_b, n, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
     ``is None`` branches away.)
     e, mu, threshold : restitution, Coulomb coefficient, restitution threshold.
     iterations : int, sweeps of phase 1.
-    P : (c, 4) float64 output: accumulated normal impulse (with restitution's,
-        when phase 3 ran) and friction impulse vector of each contact, for
-        the caller's bookkeeping.
+    P : (c, 4) float64 output: accumulated normal impulse (restitution's
+        included) and friction impulse vector of each contact, for the
+        caller's bookkeeping (the contact events' impulses).
 
     Returns
     -------
@@ -347,19 +347,20 @@ def _restitution(r_a, r_b, n0, n1, n2, m_inv_a, I_inv_a, v_a, w_a, m_inv_b, I_in
                 j = -(1.0 - lam) * e * P[i, 0]
                 _apply(i, j * n0, j * n1, j * n2, r_a, r_b, m_inv_a, I_inv_a, m_inv_b,
                        I_inv_b, v_a, w_a, v_b, w_b)
+    # The normal impulse of each contact now includes the restitution
+    # impulse lam e P_n (what the caller reads in P, and phase 3's cone).
+    for i in range(c):
+        if vn0[i] < -threshold and P[i, 0] > 0.0:
+            P[i, 0] = P[i, 0] + lam * e * P[i, 0]
     if not restituted or mu == 0.0:
         return
-    # Phase 3, friction through restitution: the normal impulse now includes
-    # the restitution impulse lam e P_n, and Coulomb's cone is that of the
+    # Phase 3, friction through restitution: Coulomb's cone is that of the
     # whole impact, |P_t| <= mu (1 + lam e) P_n; the friction sweeps of
     # phase 1 run again in it. A contact that slid throughout takes
     # mu (1 + e) P_n of friction in all, Coulomb's law over the impact
     # (Stronge 2000, ch. 3-5); one that stuck in compression stays stuck.
     # Each friction impulse removes energy, so the energy bound of phase 2
     # still holds.
-    for i in range(c):
-        if vn0[i] < -threshold and P[i, 0] > 0.0:
-            P[i, 0] = P[i, 0] + lam * e * P[i, 0]
     for _ in range(iterations):
         moved = False
         for i in range(c):
@@ -468,6 +469,41 @@ def solve_contacts(*args, kernel: str | None = None):
     if choose_kernel(kernel) == "compiled":
         return solve_contacts_compiled(*args)
     return solve_contacts_python(*args)
+
+
+#: Entries of a contact's impulse record (:func:`contact_sum_python`): the
+#: impulse vector (3), the normal impulses' sum, and the sum of each contact
+#: point (3) weighted by its normal impulse.
+IMPULSE_RECORD = 7
+
+
+def contact_sum_python(P, n, r_a, x_a, out):
+    """Add what one contact set did to body A to ``out`` (:data:`IMPULSE_RECORD`,),
+    in place: the impulses ``sum_i (P_n,i n + P_t,i)`` (``P`` (c, 4) of
+    :func:`solve_contacts_python`, ``n`` the normal into A), the normal
+    impulses' sum, and ``sum_i P_n,i (x_a + r_a,i)``, the points weighted by
+    their normal impulses (``x_a`` A's centre of mass, ``r_a`` (c, 3) the
+    contacts from it). Plain loops, summed in contact order, so the compiled
+    loop gets the same bits (it compiles this function as it stands)."""
+    for i in range(P.shape[0]):
+        for j in range(3):
+            out[j] += P[i, 0] * n[j] + P[i, 1 + j]
+        out[3] += P[i, 0]
+        for j in range(3):
+            out[4 + j] += P[i, 0] * (x_a[j] + r_a[i, j])
+
+
+def impulse_and_point(record) -> tuple[tuple | None, tuple | None]:
+    """``(impulse, point)`` of a record of :func:`contact_sum_python`, as an
+    :class:`refsim.dynamics.trajectory.Event` holds them: None where no
+    impulse acted, and no point without a normal impulse."""
+    if record is None or not any(record[:4]):
+        return None, None
+    impulse = (float(record[0]), float(record[1]), float(record[2]))
+    if not record[3] > 0.0:
+        return impulse, None
+    return impulse, (float(record[4] / record[3]), float(record[5] / record[3]),
+                     float(record[6] / record[3]))
 
 
 def wall_impulses(r_a, n, inv_mass: float, I_inv, v, w, restitution: float,

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from refsim.dynamics.impulse import RESTITUTION_THRESHOLD
 from refsim.errors import UnposableKey
 
 #: The world keys beyond the seed's, and what the default of each is.
@@ -83,7 +84,8 @@ def scene_loads(scene, *, rotation: str, body_response: str, wall_response: str)
     UnposableKey
         Naming the scene file and the key, for a key the chosen model cannot
         honour: a torque without the corrected rotation, a fixed body with
-        the seed's body response, a tilted gravity under the seed's wall law,
+        the seed's body response, a tilted gravity or a force under the
+        seed's wall law, a restitution threshold with no corrected response,
         coefficients per body or pair or ``world.mu`` with no corrected
         response to read them.
     """
@@ -94,12 +96,19 @@ def scene_loads(scene, *, rotation: str, body_response: str, wall_response: str)
         raise UnposableKey("is the Coulomb coefficient of the corrected responses; the seed's "
                          "laws read world.friction (set dynamics.wall_response or "
                          "body_response = 'impulse')", path, "world.mu")
+    if world.restitution_threshold != RESTITUTION_THRESHOLD and not corrected:
+        raise UnposableKey("is read by the corrected responses only; the seed's laws have "
+                           "no threshold (set dynamics.wall_response or body_response = "
+                           "'impulse')", path, "world.restitution_threshold")
     if world.gravity_direction != (0.0, -1.0, 0.0) and wall_response == "seed":
         raise UnposableKey("the seed's wall law assumes gravity along -y; a tilted gravity "
-                         "needs dynamics.wall_response = 'impulse'", path,
-                         "world.gravity_direction")
+                           "needs dynamics.wall_response = 'impulse'", path,
+                           "world.gravity_direction")
     for i, b in enumerate(bodies):
         where = f"body[{i}]"
+        if any(b.force) and wall_response == "seed":
+            raise UnposableKey("the seed's wall law assumes gravity alone; a force needs "
+                               "dynamics.wall_response = 'impulse'", path, f"{where}.force")
         if any(b.torque) and rotation != "impulse":
             raise UnposableKey("a torque needs the corrected rotation (dynamics.rotation = "
                              "'impulse')", path, f"{where}.torque")

@@ -359,6 +359,9 @@ class Simulation:
         self.hi = np.empty((B, 3))
         self.events: list[Event] = []
         self._touching: set[Contact] = set()
+        # what each contact's impulses did in this step, (body index, other
+        # name) -> impulse.contact_sum_python's record
+        self._impulses: dict[tuple[int, str], np.ndarray] = {}
         # the wall stage's contacts of the step, (body, axis, low wall) -> r
         self._wall_contacts: dict[tuple[int, int, bool], np.ndarray] = {}
         self.stages = tuple(s for s in STAGES if self._needs(s))
@@ -480,6 +483,7 @@ class Simulation:
         timer.lap("bounds")
         touching: set[Contact] = set()
         self._wall_contacts = {}
+        self._impulses = {}
         # AMBIGUITY (A9): walls before bodies, the order of the seed's text
         self._walls(touching)
         timer.lap("walls")
@@ -671,9 +675,11 @@ class Simulation:
                 continue
             n = np.zeros(3)
             n[k] = 1.0 if low else -1.0
-            impulse.wall_impulses(r_a, n, self.inv_mass[i], I_inv, self.v[i], self.w[i],
-                                  self.loads.wall_e[i], self.loads.wall_mu[i],
-                                  self.loads.threshold, kernel=self.kernel)
+            P = impulse.wall_impulses(r_a, n, self.inv_mass[i], I_inv, self.v[i], self.w[i],
+                                      self.loads.wall_e[i], self.loads.wall_mu[i],
+                                      self.loads.threshold, kernel=self.kernel)
+            impulse.contact_sum_python(P, n, r_a, self.x[i],
+                                       self._impulse_record(i, wall_name(k, correction[k])))
 
     # 6. broad phase (S4 test 1)
     def _broad_phase(self) -> np.ndarray:
@@ -783,6 +789,17 @@ class Simulation:
             impulse.ITERATIONS, P, kernel=self.kernel)
         self.v[...] = v[:B]
         self.w[...] = w[:B]
+        for s, (a, b, r_a, _, n, _, _) in enumerate(sets):
+            other = self.names[b] if b < B else wall_name(int(np.flatnonzero(n)[0]), n.sum())
+            impulse.contact_sum_python(P[starts[s]:starts[s + 1]], n, r_a, self.x[a],
+                                       self._impulse_record(a, other))
+
+    def _impulse_record(self, i: int, other: str) -> np.ndarray:
+        """The step's impulse record of body ``i``'s contact with ``other``."""
+        key = (i, other)
+        if key not in self._impulses:
+            self._impulses[key] = np.zeros(impulse.IMPULSE_RECORD)
+        return self._impulses[key]
 
     # 3. divergence
     def _check(self) -> None:
@@ -810,9 +827,13 @@ class Simulation:
     def _note_events(self, touching: set[Contact]) -> None:
         """An event for each contact that began in this step (in the order of
         the bodies' and the others' names, so that runs compare)."""
+        index = {name: i for i, name in enumerate(self.names)}
         for contact in sorted(touching - self._touching, key=lambda c: (c.body, c.other)):
+            J, point = impulse.impulse_and_point(
+                self._impulses.get((index[contact.body], contact.other)))
             self.events.append(Event(kind=contact.kind, step=self.steps, time=self.t,
-                                     body=contact.body, other=contact.other))
+                                     body=contact.body, other=contact.other, impulse=J,
+                                     point=point))
         self._touching = touching
         if self._loop is not None:
             self._loop.touching_changed()

@@ -19,7 +19,9 @@ Shapes, for F frames and B bodies:
 - ``angular_velocity`` (F, B, 3): radians per second, world frame;
 - ``orientation`` (F, B, 3, 3): columns are the body's axes in world space.
 
-``events`` lists wall hits and body contacts. ``stages`` names the stages of
+``events`` lists wall hits and body contacts as they begin (:class:`Event`;
+under the corrected responses each with the impulse it gave and where).
+``stages`` names the stages of
 the loop that ran; ``stage_seconds`` the wall time spent in each.
 
 The frame arrays are numpy arrays, except in a trajectory whose frames were
@@ -54,13 +56,24 @@ ENTRIES = (*FRAME_ENTRIES, "names", "events", "stages", "stage_seconds", "settin
 @dataclass(frozen=True)
 class Event:
     """A wall hit (``kind="wall"``, ``other`` is the wall, e.g. "y-") or a
-    body contact (``kind="body"``, ``other`` is the other body's name)."""
+    body contact (``kind="body"``, ``other`` is the other body's name): the
+    step in which the contact began.
+
+    With the corrected responses (impulses) the event also holds what the
+    contact did in that step: ``impulse``, the contact impulses on ``body``
+    summed (N s, world frame: normal and friction; ``other`` received its
+    opposite), and ``point``, where they acted (m, world frame: the contact
+    points weighted by their normal impulses). Both are None where no
+    impulse acts: the seed's laws, which set velocities, and a contact
+    whose impulses were all zero (a body already leaving)."""
 
     kind: str
     step: int
     time: float
     body: str
     other: str
+    impulse: tuple[float, float, float] | None = None
+    point: tuple[float, float, float] | None = None
 
 
 @dataclass
@@ -97,7 +110,7 @@ class Trajectory:
         OSError
             As the file system reports it (e.g. a full disk); no file left.
         """
-        events = json.dumps([e.__dict__ for e in self.events])
+        events = json.dumps([_event_json(e) for e in self.events])
         return write_npz_atomic(path, dict(
             t=self.t, position=self.position, velocity=self.velocity,
             angular_velocity=self.angular_velocity, orientation=self.orientation,
@@ -140,8 +153,9 @@ class Trajectory:
                                f"{stages.shape}", path, "stages")
         events = _json(data, "events", list, path)
         try:
-            events = [Event(**e) for e in events]
-        except TypeError as exc:
+            events = [Event(**{k: tuple(v) if isinstance(v, list) else v
+                               for k, v in e.items()}) for e in events]
+        except (TypeError, AttributeError) as exc:
             raise NpzFileError(f"not a list of events ({exc})", path, "events") from None
         return cls(
             t=t, position=data["position"], velocity=data["velocity"],
@@ -150,6 +164,18 @@ class Trajectory:
             stages=tuple(str(s) for s in stages),
             stage_seconds=_json(data, "stage_seconds", dict, path),
             settings=_json(data, "settings", dict, path))
+
+
+def _event_json(event: Event) -> dict:
+    """An event as JSON data; an event without impulse leaves both keys out
+    (as files written before they existed)."""
+    data = dict(event.__dict__)
+    for key in ("impulse", "point"):
+        if data[key] is None:
+            del data[key]
+        else:
+            data[key] = list(data[key])
+    return data
 
 
 def _json(data: dict, name: str, kind: type, path):

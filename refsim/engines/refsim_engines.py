@@ -110,6 +110,17 @@ class RefsimEngine:
 
     # -- rigid bodies ----------------------------------------------------------------------
 
+    @property
+    def honoured_keys(self) -> frozenset:
+        """The scene keys beyond the seed's world this model poses
+        (:data:`refsim.scenes.support.LOAD_KEYS`): every one for the
+        corrected model; for the seed's, only the walls (its laws read no
+        other; :func:`refsim.dynamics.loads.scene_loads` refuses the rest by
+        name)."""
+        from refsim.scenes.support import LOAD_KEYS
+
+        return frozenset(LOAD_KEYS) if self.model == "corrected" else frozenset({"world.walls"})
+
     def simulate(self, scene, **kwargs):
         """``refsim.simulate`` of ``scene`` under this engine's model."""
         rotation = response = "seed" if self.model == "seed" else "impulse"

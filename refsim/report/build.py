@@ -55,8 +55,8 @@ AREAS: tuple[tuple[str, str, str], ...] = (
      "Wall bounces against pybullet and the analytic answer, the seed's rotation model "
      "against the corrected one (C12), body-body interpenetration (C11)."),
     ("conformance", "Engines side by side: the conformance kit",
-     "The seven shipped engines (refsim's seed and corrected models, python-fcl, coal, "
-     "trimesh, pybullet, MuJoCo) through the same checks against exact answers."),
+     "The shipped engines (refsim's seed and corrected models, python-fcl, coal, "
+     "trimesh, pybullet, MuJoCo, Drake) through the same checks against exact answers."),
     ("textbook", "Textbook mechanics",
      "Problems with closed-form answers (drops, oblique impacts with friction, a spin "
      "stopped by friction, torque-free rotation, an off-centre strike, resting stacks) "

@@ -153,7 +153,7 @@ def test_all_with_an_engine_missing_says_so_last_and_exits_1(tmp_path, capsys, m
     printed = capsys.readouterr()
     assert printed.out.splitlines()[-1] == (
         f"wrote {out / 'index.html'}, {out / 'matrix.json'} and a page per engine; not run: "
-        "mujoco, pybullet (see the warnings; pip install 'refsim[oracles,coal]')")
+        "mujoco, pybullet (see the warnings; pip install 'refsim[oracles]')")
     warned = [line for line in printed.err.splitlines() if " not run: " in line]
     assert [line.split()[2] for line in warned] == ["pybullet", "mujoco"]
     assert all("pip install 'refsim[oracles]'" in line for line in warned)

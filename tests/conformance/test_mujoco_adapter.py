@@ -79,7 +79,8 @@ def test_model_carries_the_one_step_damper_and_inward_walls():
             assert pair.get("friction").split()[:2] == ["0.3", "0.3"]
             assert float(pair.get("margin")) == 0.0
         option = root.find("option")
-        assert option.get("gravity") == "0 -9.81 0" and option.get("cone") == "elliptic"
+        gravity = [float(g) for g in option.get("gravity").split()]
+        assert gravity == [0.0, -9.81, 0.0] and option.get("cone") == "elliptic"
         assert option.get("integrator") == "Euler"
         walls = [g for g in root.iter("geom") if g.get("type") == "plane"]
         for wall in walls:

@@ -21,7 +21,7 @@ from refsim.report.section import Agreement, Cell, Divergence, Section, Table, T
 #: Column headings of the shipped engines (the engines' own names otherwise).
 ENGINE_TITLES = {"refsim-seed": "refsim seed", "refsim-corrected": "refsim corrected",
                  "fcl": "FCL", "coal": "coal", "trimesh": "trimesh", "pybullet": "pybullet",
-                 "mujoco": "MuJoCo"}
+                 "mujoco": "MuJoCo", "drake": "Drake"}
 
 #: Each status in the engine summaries of the page's agreement table ("12
 #: pass; 5 fail as declared").
@@ -56,7 +56,7 @@ def cell_text(cell) -> str:
         return NO_CAPABILITY
     classes = f" ({_classes(cell.classes)})" if cell.classes else ""
     if cell.status == "n/a":
-        return "not run (no case)"
+        return f"not run ({cell.reason})" if cell.reason else "not run (no case)"
     if cell.status == "passed":
         return f"pass: {_plural(cell.cases, 'case')}"
     if cell.status == "xfailed":
@@ -121,7 +121,7 @@ def build(ctx) -> Section:
     intro = ("The conformance kit (refsim conform) checks any engine against answers that "
              "depend on no float engine: exact rational triangle tests, refsim's exact "
              "mesh pairs, boxes in exact arithmetic, ODE problems with exact solutions and "
-             "rigid-body scenes with analytic answers. Here the seven shipped engines run "
+             "rigid-body scenes with analytic answers. Here the shipped engines run "
              "through the same cases side by side; every disagreement is classified "
              "(touching, coplanar, tolerance, known divergence, bug) by the check that "
              "found it.")

@@ -44,6 +44,8 @@ def build(ctx) -> Section:
             cell = matrix.cell(problem.check, engine)
             if cell is None:
                 cells.append(Cell("not run", "none"))
+            elif cell.status == "n/a":              # a scene key it cannot pose
+                cells.append(Cell("cannot pose", CELL_COLOURS[cell.status]))
             elif not cell.measured:      # every scene crashed or none was read
                 cells.append(Cell("no value", CELL_COLOURS[cell.status]))
             else:
