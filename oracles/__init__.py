@@ -17,19 +17,12 @@ import sys
 
 #: What ``pip`` installs for the oracles (pyproject.toml's ``oracles`` extra).
 INSTALL_HINT = "pip install 'refsim[oracles]'"
-#: The shipped engines whose package is an extra of its own, not in
-#: ``oracles`` (coal's wheels bring some 300 MB, Drake's some 200 MB):
-#: engine name -> extra.
-OWN_EXTRAS = {"coal": "coal", "drake": "drake"}
-
-
 def install_hint(engines) -> str:
     """The ``pip`` command that installs the packages of the named shipped
-    engines: ``oracles`` for most, an engine's own extra for those in
-    :data:`OWN_EXTRAS` (``pip install 'refsim[oracles,drake]'``)."""
-    extras = {OWN_EXTRAS.get(name, "oracles") for name in engines} or {"oracles"}
-    ordered = sorted(extras, key=lambda extra: (extra != "oracles", extra))
-    return f"pip install 'refsim[{','.join(ordered)}]'"
+    engines (:func:`refsim.engines.registry.install_hint`)."""
+    from refsim.engines.registry import install_hint as hint
+
+    return hint(engines)
 
 
 class OracleUnavailable(RuntimeError):

@@ -21,7 +21,9 @@ trimesh has two adapters, one per question it answers (its boxes,
 :mod:`refsim.oracles.trimesh_collision`); :func:`trimesh` puts them behind
 one engine so that the matrix has one trimesh column.
 
-Each shipped engine's declared divergences are in
+The table is :data:`refsim.engines.registry.SHIPPED` (titles and extras
+too); ``SHIPPED_ENGINES`` is its name -> spec view. Each shipped engine's
+declared divergences are in
 ``refsim/conformance/expected/<name>.txt`` (:mod:`refsim.conformance.expected`).
 
 Cost: building an engine is its adapter's (imports, a client); O(1) here.
@@ -29,16 +31,9 @@ Cost: building an engine is its adapter's (imports, a client); O(1) here.
 
 from __future__ import annotations
 
-SHIPPED_ENGINES: dict[str, str] = {
-    "refsim-seed": "refsim.engines.refsim_engines:seed",
-    "refsim-corrected": "refsim.engines.refsim_engines:corrected",
-    "fcl": "refsim.oracles.fcl_adapter:engine",
-    "coal": "refsim.oracles.coal_adapter:engine",
-    "trimesh": "refsim.conformance.shipped:trimesh",
-    "pybullet": "refsim.oracles.pybullet_adapter:engine",
-    "mujoco": "refsim.oracles.mujoco_adapter:engine",
-    "drake": "refsim.oracles.drake_adapter:engine",
-}
+from refsim.engines.registry import SHIPPED
+
+SHIPPED_ENGINES: dict[str, str] = {e.name: e.spec for e in SHIPPED}
 
 
 class TrimeshEngine:

@@ -425,7 +425,7 @@ def _convert(value, kind: str, path, key):
         return value
     if kind in ("walls", "names2"):
         count = "2 " if kind == "names2" else ""
-        if (not isinstance(value, list) or not all(isinstance(x, str) for x in value)
+        if (not isinstance(value, list | tuple) or not all(isinstance(x, str) for x in value)
                 or (kind == "names2" and len(value) != 2)):
             raise SceneError(f"must be a list of {count}strings, got {value!r}", path, key)
         return tuple(value)
@@ -435,11 +435,12 @@ def _convert(value, kind: str, path, key):
                              path, key)
         return value
     if kind == "vec3":
-        if not isinstance(value, list) or len(value) != 3:
+        # a tuple too: a scene written back from its dataclasses (asdict)
+        if not isinstance(value, list | tuple) or len(value) != 3:
             raise SceneError(f"must be a list of 3 numbers, got {value!r}", path, key)
         return tuple(_number(x, path, f"{key}[{i}]") for i, x in enumerate(value))
     if kind == "mat3":
-        if not isinstance(value, list) or len(value) != 3:
+        if not isinstance(value, list | tuple) or len(value) != 3:
             raise SceneError("must be a 3x3 matrix (a list of 3 rows)", path, key)
         return tuple(_convert(row, "vec3", path, f"{key}[{i}]") for i, row in enumerate(value))
     raise AssertionError(f"unknown field kind {kind!r}")

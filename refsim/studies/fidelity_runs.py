@@ -107,10 +107,9 @@ def with_fidelity(scene: Scene, fidelity: Fidelity, duration: float | None = Non
 
 def scene_data(scene: Scene) -> dict:
     """``scene`` as plain data that :func:`refsim.scenes.loader.scene_from_dict`
-    turns back into an equal scene: its tables and ``[[pair]]`` entries as a
-    TOML file gives them, each body's model by its bare name when it is a
-    bundled model (a worker finds it in its own installation) and by absolute
-    path otherwise, or its shape's keys.
+    turns back into an equal scene: its tables as written by the schema, each
+    body's model by its bare name when it is a bundled model (a worker finds
+    it in its own installation) and by absolute path otherwise.
 
     Raises :class:`StateError` for a scene with a ``[particles]`` table (the
     advisor simulates rigid bodies).
@@ -121,34 +120,34 @@ def scene_data(scene: Scene) -> dict:
     bundled = models_dir().resolve()
     bodies = []
     for body in scene.bodies:
-        values = _toml_values(asdict(body))
-        if body.shape:
-            # a shape's mesh is built from its keys; its model is only its name
+        values = _unset_left_out(asdict(body))
+        if body.shape:                       # a shape is rebuilt from its own keys
             del values["model"]
-            for key, owner in SHAPE_KEYS.items():
-                if owner != body.shape:
-                    del values[key]
+            for key in [k for k in ("size", "radius", "frequency")
+                        if SHAPE_KEYS[k] != body.shape]:
+                del values[key]
         else:
             model = Path(body.model).resolve()
             values["model"] = model.name if model.parent == bundled else str(model)
-            for key in ("shape", *SHAPE_KEYS):
+            for key in ("shape", "size", "radius", "frequency"):
                 del values[key]
         bodies.append(values)
-    data = {"world": _toml_values(asdict(scene.world)),
+    data = {"world": _unset_left_out(asdict(scene.world)),
             "integration": asdict(scene.integration),
             "collision": asdict(scene.collision), "dynamics": asdict(scene.dynamics),
             "body": bodies}
     if scene.pairs:
-        data["pair"] = [_toml_values(asdict(pair)) for pair in scene.pairs]
+        data["pair"] = [_unset_left_out(asdict(p)) for p in scene.pairs]
     return data
 
 
-def _toml_values(values: dict) -> dict:
-    """A configuration's fields as a TOML file gives them: tuples as lists,
-    and an unset key (None: ``world.mu``, a body's ``restitution``) left out."""
-    def plain(value):
-        return [plain(x) for x in value] if isinstance(value, tuple) else value
-    return {key: plain(value) for key, value in values.items() if value is not None}
+def _unset_left_out(values: dict) -> dict:
+    """A table's values without the keys left unset (None: the world's
+    ``mu``, a body's own coefficients), as a file that does not write them;
+    tuples as lists, as TOML reads them."""
+    return {k: (list(v) if isinstance(v, tuple) and k != "orientation"
+                else [list(r) for r in v] if k == "orientation" else v)
+            for k, v in values.items() if v is not None}
 
 
 class CountingSimulation(Simulation):

@@ -398,3 +398,43 @@ mu = 0.2
     assert scene.coefficients(ball) == (0.8, 1.5)             # with a wall: the world's
     assert scene.coefficients(table) == (0.3, 1.5)
 
+
+
+def test_a_scene_with_every_key_survives_its_plain_data(tmp_path):
+    """The advisor ships a scene to its workers as plain data
+    (refsim.studies.fidelity_runs.scene_data): shapes, fixed bodies, forces,
+    coefficients and pairs come back equal, and unset keys stay unset."""
+    from refsim.scenes.loader import scene_from_dict
+    from refsim.studies.fidelity_runs import scene_data
+
+    scene = load_scene(write(tmp_path, """
+[world]
+gravity_direction = [1, -2, 0]
+walls = ["y-"]
+mu = 1.5
+[[body]]
+name = "table"
+shape = "box"
+size = [4, 0.5, 3]
+position = [0, -4.75, 0]
+fixed = true
+[[body]]
+name = "ball"
+shape = "sphere"
+radius = 0.25
+position = [0, -3, 0]
+force = [1, 0, 0]
+restitution = 0.5
+[[body]]
+name = "cube"
+model = "cube.ac"
+position = [3, -4.5, 0]
+[[pair]]
+bodies = ["ball", "table"]
+mu = 0.2
+"""))
+    data = scene_data(scene)
+    assert "mu" not in data["body"][0] and "model" not in data["body"][0]
+    assert data["body"][2]["model"] == "cube.ac" and "shape" not in data["body"][2]
+    back = scene_from_dict(data)
+    assert (back.world, back.bodies, back.pairs) == (scene.world, scene.bodies, scene.pairs)

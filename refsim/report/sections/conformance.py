@@ -15,13 +15,13 @@ arranges it.
 
 from __future__ import annotations
 
+from refsim.engines.registry import TITLES
 from refsim.report.plan import command
 from refsim.report.section import Agreement, Cell, Divergence, Section, Table, Timing
 
-#: Column headings of the shipped engines (the engines' own names otherwise).
-ENGINE_TITLES = {"refsim-seed": "refsim seed", "refsim-corrected": "refsim corrected",
-                 "fcl": "FCL", "coal": "coal", "trimesh": "trimesh", "pybullet": "pybullet",
-                 "mujoco": "MuJoCo", "drake": "Drake"}
+#: Column headings of the shipped engines (the registry's titles:
+#: refsim.engines.registry; the engines' own names otherwise).
+ENGINE_TITLES = TITLES
 
 #: Each status in the engine summaries of the page's agreement table ("12
 #: pass; 5 fail as declared").
