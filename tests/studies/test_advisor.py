@@ -470,57 +470,6 @@ def test_a_proposal_past_the_affordable_becomes_the_last_chance():
     assert advisor._propose("midpoint", tried, m_max=159) is None
 
 
-#: A scene that sets the keys beyond the seed's world: a tilted gravity, some
-#: walls, Coulomb's mu, shapes, a fixed body, a force, a torque and a pair.
-KEYS = """\
-[world]
-gravity_direction = [0.5, -0.8660254037844386, 0.0]
-walls = ["y-", "x-"]
-mu = 0.4
-
-[dynamics]
-rotation = "impulse"
-body_response = "impulse"
-
-[[body]]
-name = "table"
-shape = "box"
-size = [2.0, 0.5, 2.0]
-position = [0.0, -4.75, 0.0]
-fixed = true
-
-[[body]]
-name = "ball"
-shape = "sphere"
-radius = 0.25
-frequency = 3
-position = [0.0, -4.0, 0.0]
-torque = [0.0, 0.0, 0.1]
-restitution = 0.5
-
-[[body]]
-name = "cube"
-model = "cube.ac"
-position = [2.0, 0.0, 0.0]
-force = [1.0, 0.0, 0.0]
-
-[[pair]]
-bodies = ["table", "ball"]
-mu = 0.2
-"""
-
-
-@pytest.mark.parametrize("text", [DROP, HEAD_ON, KEYS], ids=["drop", "head-on", "keys"])
-def test_scene_data_is_the_scene_as_data(tmp_path, text):
-    """What the advisor sends its workers loads back as the same scene,
-    every key beyond the seed's world included."""
-    path = tmp_path / "scene.toml"
-    path.write_text(text)
-    scene = load_scene(path)
-    again = scene_from_dict(scene_data(scene))
-    assert replace(again, path=scene.path) == scene
-
-
 def test_the_counting_simulation_is_the_loop_bit_for_bit(tmp_path):
     path = tmp_path / "head-on.toml"
     path.write_text(HEAD_ON)
