@@ -6,7 +6,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: test typecheck report bench lint models fuzz clean
+.PHONY: test typecheck docs report bench lint models fuzz clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -20,6 +20,14 @@ test: $(STAMP)
 # mypy over the whole package (configuration: pyproject.toml's [tool.mypy]).
 typecheck: $(STAMP)
 	$(BIN)/mypy refsim
+
+# The documentation site (docs/site/) into docs/_build/html, a warning
+# being an error: first the tutorials' code runs (the doctest builder), then
+# the pages are written, reusing the doctrees the first pass read.
+SPHINX := $(BIN)/sphinx-build -W --keep-going -q -d docs/_build/doctrees docs/site
+docs: $(STAMP)
+	$(SPHINX) -b doctest docs/_build/doctest
+	$(SPHINX) -b html docs/_build/html
 
 report: $(STAMP)
 	$(BIN)/refsim report
@@ -44,4 +52,4 @@ fuzz: $(STAMP)
 		--workers $(WORKERS) --out fuzz-out
 
 clean:
-	rm -rf $(VENV) reports/out fuzz-out .pytest_cache .hypothesis .benchmarks
+	rm -rf $(VENV) reports/out docs/_build fuzz-out .pytest_cache .hypothesis .benchmarks

@@ -206,6 +206,12 @@ class Body:
 class Simulation:
     """The bodies of a scene and their state; :meth:`step` advances all of them.
 
+    The scene's choices are made once, here: which rotation step (none, the
+    seed's, the exact one), which wall response (the seed's per-axis one,
+    with S9's spin change when the rotation model is the seed's, or the
+    corrected impulses; ``dynamics.wall_response``), which body response,
+    which stages run at all.
+
     Parameters
     ----------
     scene : refsim.Scene
@@ -230,12 +236,6 @@ class Simulation:
         Where :meth:`record` puts frames: a :class:`refsim.frames.MemorySink`
         by default (growing by doubling), or e.g. a
         :class:`refsim.frames.SpillSink` that writes them to disk as they come.
-
-    The scene's choices are made once, here: which rotation step (none, the
-    seed's, the exact one), which wall response (the seed's per-axis one,
-    with S9's spin change when the rotation model is the seed's, or the
-    corrected impulses; ``dynamics.wall_response``), which body response,
-    which stages run at all.
 
     Attributes
     ----------

@@ -41,6 +41,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -153,8 +154,10 @@ class Trajectory:
                                f"{stages.shape}", path, "stages")
         events = _json(data, "events", list, path)
         try:
-            events = [Event(**{k: tuple(v) if isinstance(v, list) else v
-                               for k, v in e.items()}) for e in events]
+            records: list[dict[str, Any]] = [
+                {k: tuple(v) if isinstance(v, list) else v for k, v in e.items()}
+                for e in events]
+            events = [Event(**r) for r in records]
         except (TypeError, AttributeError) as exc:
             raise NpzFileError(f"not a list of events ({exc})", path, "events") from None
         return cls(

@@ -704,6 +704,8 @@ def write_ac3d(mesh: Mesh, path) -> None:
     OutputError
         The file cannot be written.
 
+    Notes
+    -----
     The text is formatted first (a mesh AC3D cannot hold raises before any
     file is touched), then written by :func:`refsim.io.write_text_atomic`: a
     reader sees the old file or the new one, never half of one.
