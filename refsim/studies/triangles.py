@@ -525,13 +525,16 @@ class Throughput:
 
 
 def measure_throughput(n: int = 20_000, seed: int = 0,
-                       oracle: TriangleTest | None = None) -> Throughput:
+                       oracle: TriangleTest | None = None, *,
+                       cold_compile: bool = True) -> Throughput:
     """Readable vs batch kernel (vs the numba kernel and the oracle, when
     available) on n uniform random pairs.
 
     The readable kernel and the oracle run on the first min(n, 5000) pairs
     only, to bound the time; the rates are per pair either way. The numba
-    rate excludes compilation, which is reported separately.
+    rate excludes compilation, which is reported separately: compiled from
+    nothing in a fresh interpreter (tens of seconds), unless
+    ``cold_compile`` is False (``numba_compile_seconds`` is then None).
     """
     rng = np.random.default_rng(seed)
     A, B = rng.uniform(-1.0, 1.0, (2, n, 3, 3))
@@ -554,7 +557,8 @@ def measure_throughput(n: int = 20_000, seed: int = 0,
     from refsim.collision import triangle_numba
     if triangle_numba.available():
         # Compilation from nothing, measured in a fresh interpreter.
-        compile_seconds = triangle_numba.measure_numba_compile_seconds()
+        if cold_compile:
+            compile_seconds = triangle_numba.measure_numba_compile_seconds()
         triangle_numba.triangles_intersect_numba(A[:1], B[:1])   # compile here first
         start = time.perf_counter()
         fast = triangle_numba.triangles_intersect_numba(A, B)

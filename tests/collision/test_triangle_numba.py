@@ -55,10 +55,13 @@ def test_bad_input_raises():
 def test_throughput_figures_are_consistent():
     # No timing assert: only that every kernel ran and agreed (the function
     # raises if the kernels disagree) and the figures are positive numbers.
-    result = measure_throughput(n=2000, seed=0)
+    # The cold compile (a fresh interpreter, about 30 s) is the report's to
+    # measure: its build runs measure_throughput with it (report/plan.py).
+    result = measure_throughput(n=2000, seed=0, cold_compile=False)
     print(f"\npairs/s readable={result.readable:.3g} batch={result.batch:.3g} "
-          f"numba={result.numba:.3g} (compile from nothing {result.numba_compile_seconds:.2f} s)")
+          f"numba={result.numba:.3g}")
     assert result.readable > 0 and result.batch > 0 and result.numba > 0
+    assert result.numba_compile_seconds is None
     assert result.batch_fallback_fraction == 0.0
     np.testing.assert_array_equal(
         triangles_intersect_numba(np.array([T]), np.array([CASES["piercing"][0]], float)),
