@@ -99,6 +99,59 @@ def _flush_c_stdio() -> None:
         pass
 
 
+#: The six walls by name, in the order the rigid adapters report contacts.
+WALL_ORDER = ("x-", "x+", "y-", "y+", "z-", "z+")
+
+
+def run_recorded(adapter, scene, every: int, wall_contacts, settings: dict):
+    """The loop of a rigid-body adapter whose ``load(scene)`` has run:
+    ``adapter.step()`` for the scene's steps, ``adapter.state()`` recorded
+    at the start, every ``every`` steps and at the last, and an event for
+    each (body index, wall name) of ``wall_contacts()`` (the contacts after
+    a step) that was not there after the step before. Returns
+    :func:`trajectory_of_frames` with ``settings``; "step" is the time in
+    ``adapter.step`` (the engine and the drag forces)."""
+    import time
+
+    from refsim.dynamics.trajectory import Event
+
+    h = scene.integration.step
+    n = scene.integration.n_steps
+    names = tuple(b.name for b in scene.bodies)
+    frames = [adapter.state()]
+    times = [0.0]
+    events = []
+    touching: set = set()
+    stepping = 0.0
+    start = time.perf_counter()
+    for k in range(1, n + 1):
+        before = time.perf_counter()
+        adapter.step()
+        stepping += time.perf_counter() - before
+        now = wall_contacts()
+        for i, wall in sorted(now - touching, key=lambda iw: (iw[0], WALL_ORDER.index(iw[1]))):
+            events.append(Event("wall", k, k * h, names[i], wall))
+        touching = now
+        if k % every == 0 or k == n:
+            frames.append(adapter.state())
+            times.append(k * h)
+    return trajectory_of_frames(frames, times, names, events, stepping,
+                                time.perf_counter() - start, settings)
+
+
+def seconds_per_step(adapter, steps: int, warmup: int = 0) -> float:
+    """Mean seconds of ``adapter.step()`` over ``steps`` steps after
+    ``warmup`` untimed ones, reading no state (a loaded rigid adapter)."""
+    import time
+
+    for _ in range(warmup):
+        adapter.step()
+    start = time.perf_counter()
+    for _ in range(steps):
+        adapter.step()
+    return (time.perf_counter() - start) / steps
+
+
 def trajectory_of_frames(frames, times, names, events, step_seconds: float,
                          total_seconds: float, settings: dict):
     """A :class:`refsim.dynamics.trajectory.Trajectory` from an engine's

@@ -155,11 +155,10 @@ from __future__ import annotations
 import contextlib
 import functools
 import math
-import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from refsim.oracles import import_engine, install_hint, trajectory_of_frames
+from refsim.oracles import import_engine, install_hint, run_recorded, seconds_per_step
 
 #: Wall names in the order of refsim's events (x-, x+, y-, y+, z-, z+).
 WALL_NAMES = ("x-", "x+", "y-", "y+", "z-", "z+")
@@ -545,45 +544,21 @@ class DrakeEngine:
         wall contacts that began in a step; ``stage_seconds`` splits the
         wall time into "step" (the discrete update and the drag forces) and
         "record"."""
-        from refsim.dynamics.trajectory import Event
-
         self.load(scene)
-        h = scene.integration.step
-        n = scene.integration.n_steps
-        names = tuple(b.name for b in scene.bodies)
-        frames = [self.state()]
-        times = [0.0]
-        events = []
-        touching: set[tuple[int, int]] = set()
-        stepping = 0.0
-        start = time.perf_counter()
-        for k in range(1, n + 1):
-            before = time.perf_counter()
-            self.step()
-            stepping += time.perf_counter() - before
-            frame = self.state()
-            now = self._wall_contacts(frame[0], frame[3])
-            for i, j in sorted(now - touching):
-                events.append(Event("wall", k, k * h, names[i], WALL_NAMES[j]))
-            touching = now
-            if k % every == 0 or k == n:
-                frames.append(frame)
-                times.append(k * h)
-        elapsed = time.perf_counter() - start
-        return trajectory_of_frames(frames, times, names, events, stepping, elapsed,
-                                    {"engine": self.name, "version": _version(),
-                                     **asdict(self.settings), **asdict(self.parameters)})
+
+        def wall_contacts() -> set[tuple[int, str]]:
+            x, _, _, r = self.state()
+            return {(i, WALL_NAMES[j]) for i, j in self._wall_contacts(x, r)}
+
+        return run_recorded(self, scene, every, wall_contacts,
+                            {"engine": self.name, "version": _version(),
+                             **asdict(self.settings), **asdict(self.parameters)})
 
     def step_time(self, scene, steps: int, warmup: int = 0) -> float:
         """Seconds per step of ``scene`` (mean over ``steps`` steps after
         loading and ``warmup`` untimed steps; reading no state)."""
         self.load(scene)
-        for _ in range(warmup):
-            self.step()
-        start = time.perf_counter()
-        for _ in range(steps):
-            self.step()
-        return (time.perf_counter() - start) / steps
+        return seconds_per_step(self, steps, warmup)
 
 
 #: What Drake logs (a warning) as it builds a diagram whose SceneGraph holds

@@ -117,12 +117,11 @@ constraint solver (Newton, a few iterations over the active contacts).
 
 from __future__ import annotations
 
-import time
 from dataclasses import asdict, dataclass
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
-from refsim.oracles import import_engine, trajectory_of_frames
+from refsim.oracles import import_engine, run_recorded, seconds_per_step
 
 from refsim.scenes.support import LOAD_KEYS, refuse_unhonoured
 from refsim.scenes.world import WALL_NAMES
@@ -367,45 +366,16 @@ class MujocoOracle:
         :class:`~refsim.dynamics.trajectory.Trajectory` whose events are the
         wall contacts that began in a step; ``stage_seconds`` splits the
         wall time into "step" (``mj_step`` and the drag forces) and "record"."""
-        from refsim.dynamics.trajectory import Event
-
         self.load(scene)
-        h = scene.integration.step
-        n = scene.integration.n_steps
-        names = tuple(b.name for b in scene.bodies)
-        frames = [self.state()]
-        times = [0.0]
-        events = []
-        touching: set[tuple[int, str]] = set()
-        stepping = 0.0
-        start = time.perf_counter()
-        for k in range(1, n + 1):
-            before = time.perf_counter()
-            self.step()
-            stepping += time.perf_counter() - before
-            now = self._wall_contacts()
-            for i, wall in sorted(now - touching,
-                                  key=lambda iw: (iw[0], WALL_NAMES.index(iw[1]))):
-                events.append(Event("wall", k, k * h, names[i], wall))
-            touching = now
-            if k % every == 0 or k == n:
-                frames.append(self.state())
-                times.append(k * h)
-        elapsed = time.perf_counter() - start
-        return trajectory_of_frames(frames, times, names, events, stepping, elapsed,
-                                    {"engine": "mujoco", "version": self.mujoco.__version__,
-                                     **asdict(self.settings)})
+        return run_recorded(self, scene, every, self._wall_contacts,
+                            {"engine": "mujoco", "version": self.mujoco.__version__,
+                             **asdict(self.settings)})
 
     def step_time(self, scene, steps: int, warmup: int = 0) -> float:
         """Seconds per step of ``scene`` (mean over ``steps`` steps after
         loading and ``warmup`` untimed steps; reading no state)."""
         self.load(scene)
-        for _ in range(warmup):
-            self.step()
-        start = time.perf_counter()
-        for _ in range(steps):
-            self.step()
-        return (time.perf_counter() - start) / steps
+        return seconds_per_step(self, steps, warmup)
 
 
 def engine(**settings) -> MujocoOracle:

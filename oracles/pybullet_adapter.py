@@ -171,11 +171,10 @@ broadphase plus GJK/EPA per overlapping pair plus the solver's iterations.
 from __future__ import annotations
 
 import math
-import time
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from refsim.oracles import c_banner_dropped, import_engine, trajectory_of_frames
+from refsim.oracles import c_banner_dropped, import_engine, run_recorded, seconds_per_step
 
 from refsim.errors import SceneError
 from refsim.scenes.support import LOAD_KEYS, keys_in_use, refuse_unhonoured
@@ -599,43 +598,25 @@ class PybulletOracle:
         whose events are the wall contacts that began in a step;
         ``stage_seconds`` splits the wall time into "step" (``stepSimulation``
         and the drag forces) and "record" (reading state and contacts)."""
-        from refsim.dynamics.trajectory import Event
-
         self.load(scene)
         p, c = self.p, self.client
         p.setPhysicsEngineParameter(
             contactBreakingThreshold=self.settings.contact_breaking_threshold,
             physicsClientId=c)
-        h = scene.integration.step
-        n = scene.integration.n_steps
-        names = tuple(b.name for b in scene.bodies)
-        frames = [self.state()]
-        times = [0.0]
-        events = []
-        touching: set[tuple[int, int]] = set()
-        stepping = 0.0
-        start = time.perf_counter()
-        for k in range(1, n + 1):
-            before = time.perf_counter()
-            self.step()
-            stepping += time.perf_counter() - before
+
+        def wall_contacts() -> set[tuple[int, str]]:
             now = set()
             for i, uid in enumerate(self.bodies):
                 for j, wall in enumerate(self.walls):
                     points = p.getContactPoints(uid, wall, physicsClientId=c)
                     if any(point[8] <= 0.0 for point in points):    # distance <= 0: touching
-                        now.add((i, j))
-            for i, j in sorted(now - touching):
-                events.append(Event("wall", k, k * h, names[i], self.wall_names[j]))
-            touching = now
-            if k % every == 0 or k == n:
-                frames.append(self.state())
-                times.append(k * h)
-        elapsed = time.perf_counter() - start
+                        now.add((i, self.wall_names[j]))
+            return now
+
         settings = asdict(self.settings)
         settings["restitution_velocity_threshold"] = restitution_threshold(scene, self.settings)
-        return trajectory_of_frames(frames, times, names, events, stepping, elapsed,
-                                    {"engine": "pybullet", **settings})
+        return run_recorded(self, scene, every, wall_contacts,
+                            {"engine": "pybullet", **settings})
 
     def step_time(self, scene, steps: int, warmup: int = 0) -> float:
         """Seconds per step of ``scene`` (mean over ``steps`` steps after
@@ -644,12 +625,7 @@ class PybulletOracle:
         self.p.setPhysicsEngineParameter(
             contactBreakingThreshold=self.settings.contact_breaking_threshold,
             physicsClientId=self.client)
-        for _ in range(warmup):
-            self.step()
-        start = time.perf_counter()
-        for _ in range(steps):
-            self.step()
-        return (time.perf_counter() - start) / steps
+        return seconds_per_step(self, steps, warmup)
 
     def dynamics_info(self, index: int) -> dict:
         """pybullet's own view of body ``index``: mass and inertia diagonal."""

@@ -354,11 +354,8 @@ def test_a_scene_beyond_the_default_step_limit_needs_max_steps(tmp_path):
         load_scene(path, max_steps=MAX_STEPS + 1)
 
 
-def test_the_textbook_keys_load_into_the_scene(tmp_path):
-    """Every key of refsim.dynamics.loads, read and resolved: shapes become
-    meshes of the given size, coefficients resolve pair first, then body,
-    then world."""
-    scene = load_scene(write(tmp_path, """
+#: A scene with every key beyond the seed's world (refsim.dynamics.loads).
+EVERY_KEY = """
 [world]
 gravity_direction = [1, -2, 0]
 walls = ["y-", "x+"]
@@ -382,8 +379,19 @@ torque = [0, 0, 0.5]
 [[pair]]
 bodies = ["ball", "table"]
 mu = 0.2
-"""))
-    table, ball = scene.bodies
+[[body]]
+name = "cube"
+model = "cube.ac"
+position = [3, -4.5, 0]
+"""
+
+
+def test_the_textbook_keys_load_into_the_scene(tmp_path):
+    """Every key of refsim.dynamics.loads, read and resolved: shapes become
+    meshes of the given size, coefficients resolve pair first, then body,
+    then world."""
+    scene = load_scene(write(tmp_path, EVERY_KEY))
+    table, ball, _ = scene.bodies
     assert scene.world.walls == ("y-", "x+") and scene.world.coulomb_mu == 1.5
     assert scene.world.restitution_threshold == 0.1
     g = scene.world.gravity_vector
@@ -407,32 +415,7 @@ def test_a_scene_with_every_key_survives_its_plain_data(tmp_path):
     from refsim.scenes.loader import scene_from_dict
     from refsim.studies.fidelity_runs import scene_data
 
-    scene = load_scene(write(tmp_path, """
-[world]
-gravity_direction = [1, -2, 0]
-walls = ["y-"]
-mu = 1.5
-[[body]]
-name = "table"
-shape = "box"
-size = [4, 0.5, 3]
-position = [0, -4.75, 0]
-fixed = true
-[[body]]
-name = "ball"
-shape = "sphere"
-radius = 0.25
-position = [0, -3, 0]
-force = [1, 0, 0]
-restitution = 0.5
-[[body]]
-name = "cube"
-model = "cube.ac"
-position = [3, -4.5, 0]
-[[pair]]
-bodies = ["ball", "table"]
-mu = 0.2
-"""))
+    scene = load_scene(write(tmp_path, EVERY_KEY))
     data = scene_data(scene)
     assert "mu" not in data["body"][0] and "model" not in data["body"][0]
     assert data["body"][2]["model"] == "cube.ac" and "shape" not in data["body"][2]
