@@ -1,8 +1,8 @@
 """What acts on each body beyond the seed's world, and where it is honoured:
 gravity along any direction, constant applied forces and torques, fixed
 bodies, restitution and friction per body and per pair, a world with only
-some of its six walls, and the restitution threshold (scene keys: the
-README's scene reference table).
+some of its six walls, and the restitution threshold (the scene keys:
+docs/design.md, Scene files).
 
 These keys exist to pose textbook problems (an incline, a ball on a fixed
 table, a torque spinning a body up) on the corrected model: the readable
@@ -94,8 +94,8 @@ def scene_loads(scene, *, rotation: str, body_response: str, wall_response: str)
     corrected = "impulse" in (body_response, wall_response)
     if world.mu is not None and not corrected:
         raise UnposableKey("is the Coulomb coefficient of the corrected responses; the seed's "
-                         "laws read world.friction (set dynamics.wall_response or "
-                         "body_response = 'impulse')", path, "world.mu")
+                           "laws read world.friction (set dynamics.wall_response or "
+                           "body_response = 'impulse')", path, "world.mu")
     if world.restitution_threshold != RESTITUTION_THRESHOLD and not corrected:
         raise UnposableKey("is read by the corrected responses only; the seed's laws have "
                            "no threshold (set dynamics.wall_response or body_response = "
@@ -111,19 +111,19 @@ def scene_loads(scene, *, rotation: str, body_response: str, wall_response: str)
                                "dynamics.wall_response = 'impulse'", path, f"{where}.force")
         if any(b.torque) and rotation != "impulse":
             raise UnposableKey("a torque needs the corrected rotation (dynamics.rotation = "
-                             "'impulse')", path, f"{where}.torque")
+                               "'impulse')", path, f"{where}.torque")
         if b.fixed and body_response == "seed":
             raise UnposableKey("a fixed body needs dynamics.body_response = 'impulse' (the "
-                             "seed's exchange of velocities has no infinite mass)", path,
-                             f"{where}.fixed")
+                               "seed's exchange of velocities has no infinite mass)", path,
+                               f"{where}.fixed")
         for key in ("restitution", "mu"):
             if getattr(b, key) is not None and not corrected:
                 raise UnposableKey("is read by the corrected responses only (dynamics."
-                                 "wall_response or body_response = 'impulse')", path,
-                                 f"{where}.{key}")
+                                   "wall_response or body_response = 'impulse')", path,
+                                   f"{where}.{key}")
     if scene.pairs and body_response != "impulse":
         raise UnposableKey("coefficients per pair are read by the corrected body response "
-                         "only (dynamics.body_response = 'impulse')", path, "pair[0]")
+                           "only (dynamics.body_response = 'impulse')", path, "pair[0]")
 
     B = len(bodies)
     g = np.array(world.gravity_vector, dtype=np.float64)

@@ -18,7 +18,7 @@ from collections.abc import Collection
 from refsim.errors import UnposableKey
 
 #: The generic names of the keys beyond the seed's world, in the order of the
-#: scene reference table (README, Scene keys).
+#: key tables of docs/design.md (Scene files).
 LOAD_KEYS = ("world.gravity_direction", "world.walls", "world.mu",
              "world.restitution_threshold", "body.fixed", "body.force", "body.torque",
              "body.restitution", "body.mu", "pair")
@@ -52,12 +52,12 @@ def keys_in_use(scene) -> dict[str, str]:
 
 
 def refuse_unhonoured(scene, engine: str, honoured: Collection[str]) -> None:
-    """Raise a :class:`refsim.errors.UnposableKey` naming the scene file, the first key
-    ``scene`` sets that ``engine`` does not honour (not in ``honoured``, a
-    subset of :data:`LOAD_KEYS`), and the engine; nothing when it honours
-    every key the scene sets."""
+    """Raise a :class:`refsim.errors.UnposableKey` naming the scene file,
+    the first key ``scene`` sets that ``engine`` does not honour (not in
+    ``honoured``, a subset of :data:`LOAD_KEYS`), and the engine; nothing
+    when it honours every key the scene sets."""
+    poses = ", ".join(sorted(honoured)) or "none of the keys beyond the seed world"
     for name, where in keys_in_use(scene).items():
         if name not in honoured:
-            raise UnposableKey(f"engine {engine!r} cannot pose this key (it honours "
-                             f"{', '.join(sorted(honoured)) or 'none of the keys beyond the '}"
-                             f"{'' if honoured else 'seed world'})", scene.path, where)
+            raise UnposableKey(f"engine {engine!r} cannot pose this key (it honours {poses})",
+                               scene.path, where)
