@@ -8,8 +8,11 @@ time now and are left out), times the tasks left. Being wall time per task,
 not a task's own time, it already accounts for W workers running at once.
 
 The line goes to stderr only, never to stdout (which may carry a result a
-script pipes on), and is drawn only when stderr is a terminal: in a log file
-or CI a line redrawn a thousand times is noise.
+script pipes on). On a terminal it is redrawn; elsewhere (a log file, CI, a
+pipe) a line redrawn a thousand times is noise, so a sweep that has run for
+``LOG_SECONDS`` writes the line as a line of its own, then again at most
+every ``LOG_SECONDS``, and once more at the end: a long run off a terminal
+is never silent, and a short one writes nothing.
 
 Cost: O(1) per update; a redraw at most every ``MIN_REDRAW_SECONDS``.
 """
@@ -27,6 +30,10 @@ MIN_REDRAW_SECONDS = 0.1
 #: shown keeps moving (and the run loop wakes this often to draw it).
 REFRESH_SECONDS = 0.5
 
+#: Off a terminal, the line is written (as a line of its own) at most this
+#: often, and not before the sweep has run this long.
+LOG_SECONDS = 10.0
+
 
 class Progress:
     """One sweep's progress line (state: counts, start time, last redraw).
@@ -38,8 +45,8 @@ class Progress:
     resumed : int
         Tasks already done when the sweep started (their results were stored).
     enabled : bool
-        Draw at all; the line is drawn only when this is true *and* ``stream``
-        is a terminal.
+        Draw at all; on a terminal the line is redrawn in place, elsewhere
+        written as whole lines every ``LOG_SECONDS`` (module docstring).
     stream : file, optional
         Where to draw; default ``sys.stderr``.
     clock : callable, optional
@@ -49,7 +56,8 @@ class Progress:
     def __init__(self, total: int, resumed: int = 0, *, enabled: bool = True, stream=None,
                  clock=time.monotonic):
         self.stream = sys.stderr if stream is None else stream
-        self.enabled = bool(enabled) and _is_terminal(self.stream)
+        self.enabled = bool(enabled)
+        self.terminal = _is_terminal(self.stream)
         self.total = total
         self.resumed = resumed
         self.done = resumed
@@ -58,6 +66,7 @@ class Progress:
         self._start = clock()
         self._drawn_at = None
         self._width = 0
+        self._logged = False
 
     def update(self, done: int, failed: int, *, force: bool = False) -> None:
         """Record ``done`` finished tasks (resumed ones included; failures
@@ -65,6 +74,12 @@ class Progress:
         self.done, self.failed = done, failed
         now = self._clock()
         if not self.enabled:
+            return
+        if not self.terminal:
+            last = self._start if self._drawn_at is None else self._drawn_at
+            if now - last >= LOG_SECONDS:
+                self._log(self.line(now))
+                self._drawn_at = now
             return
         if not force and self._drawn_at is not None and now - self._drawn_at < MIN_REDRAW_SECONDS:
             return
@@ -91,11 +106,22 @@ class Progress:
         return (now - self._start) / finished_now * (self.total - self.done)
 
     def close(self) -> None:
-        """Draw the final line and end it with a newline."""
-        if self.enabled:
-            self._draw(self.line())
-            self.stream.write("\n")
-            self.stream.flush()
+        """Draw the final line and end it with a newline (off a terminal:
+        write it, if the sweep wrote any line before)."""
+        if not self.enabled:
+            return
+        if not self.terminal:
+            if self._logged:
+                self._log(self.line())
+            return
+        self._draw(self.line())
+        self.stream.write("\n")
+        self.stream.flush()
+
+    def _log(self, text: str) -> None:
+        self.stream.write(text + "\n")
+        self.stream.flush()
+        self._logged = True
 
     def _draw(self, text: str) -> None:
         pad = " " * max(0, self._width - len(text))     # wipe a longer previous line

@@ -1,10 +1,11 @@
-"""The progress line: counts and time left, on a terminal only."""
+"""The progress line: counts and time left, redrawn on a terminal, written
+as lines every LOG_SECONDS elsewhere."""
 
 from __future__ import annotations
 
 import io
 
-from refsim.sweep.progress import Progress
+from refsim.sweep.progress import LOG_SECONDS, Progress
 
 
 class Terminal(io.StringIO):
@@ -49,9 +50,34 @@ def test_redraws_are_limited_and_a_shorter_line_wipes_a_longer_one():
     assert len(last) == len("sweep: 1/3 done, 1 failed, about 0:00:00 left")
 
 
-def test_nothing_is_drawn_off_a_terminal_or_when_disabled():
-    for stream, enabled in ((io.StringIO(), True), (Terminal(), False)):
-        shown = Progress(2, stream=stream, enabled=enabled)
+def test_nothing_is_drawn_when_disabled_or_off_a_terminal_for_a_short_sweep():
+    for stream, enabled in ((io.StringIO(), True), (Terminal(), False), (io.StringIO(), False)):
+        clock = Clock()
+        shown = Progress(2, stream=stream, enabled=enabled, clock=clock)
         shown.update(1, 0, force=True)
+        clock.now += LOG_SECONDS - 0.5           # a sweep shorter than LOG_SECONDS
+        shown.update(2, 0, force=True)
         shown.close()
         assert stream.getvalue() == ""
+
+
+def test_off_a_terminal_a_long_sweep_writes_a_line_every_log_seconds_and_at_the_end():
+    """A log file or a pipe gets whole lines (no carriage returns): the
+    first once the sweep has run LOG_SECONDS, then at most every
+    LOG_SECONDS however many results arrive, and the final counts."""
+    clock, stream = Clock(), io.StringIO()
+    shown = Progress(4, stream=stream, clock=clock)
+    clock.now += LOG_SECONDS
+    shown.update(1, 0)
+    for _ in range(3):
+        clock.now += 1.0
+        shown.update(2, 0)                       # within LOG_SECONDS of the last line
+    clock.now += LOG_SECONDS
+    shown.update(3, 1)
+    shown.close()
+    assert "\r" not in stream.getvalue()
+    assert stream.getvalue().splitlines() == [
+        "sweep: 1/4 done, about 0:00:30 left",
+        "sweep: 3/4 done, 1 failed, about 0:00:08 left",
+        "sweep: 3/4 done, 1 failed, about 0:00:08 left",
+    ]
