@@ -35,7 +35,9 @@ CELL_COLOURS = {"passed": "pass", "xfailed": "declared", "failed": "fail",
 LEGEND = (("pass", "passes every case"),
           ("declared", "fails as the engine declares (a known divergence)"),
           ("fail", "fails, not declared"),
-          ("none", "not run: the engine lacks the capability, or the check has no case"))
+          ("none", "not run: the engine lacks the capability, cannot pose the check's "
+                   "scenes (a scene key it refuses, named in the cell), or the check has "
+                   "no case"))
 
 #: A cell of an engine without the check's capability.
 NO_CAPABILITY = "not run"
