@@ -26,8 +26,8 @@ scene to the readable step: :func:`refsim.dynamics.compiled_loop.loop_support`).
 - Coefficients: :meth:`refsim.Scene.coefficients`, per body and wall, per
   body pair.
 
-Cost: O(B^2) once per simulation (the pair coefficients); per step O(B)
-for the field and the torques.
+Cost: O(B) once per simulation, O(B^2 P) when bodies or P pairs give
+their own coefficients; per step O(B) for the field and the torques.
 """
 
 from __future__ import annotations
@@ -135,12 +135,14 @@ def scene_loads(scene, *, rotation: str, body_response: str, wall_response: str)
     uniform = (world.gravity_direction == (0.0, -1.0, 0.0) and not force.any()
                and not fixed.any())
     wall = [scene.coefficients(b) for b in bodies]
-    pair_e = np.zeros((B, B))
-    pair_mu = np.zeros((B, B))
-    for i in range(B):
-        for j in range(B):
-            if i != j:
-                pair_e[i, j], pair_mu[i, j] = scene.coefficients(bodies[i], bodies[j])
+    pair_e = np.full((B, B), world.restitution)
+    pair_mu = np.full((B, B), world.coulomb_mu)
+    own = [i for i, b in enumerate(bodies) if b.restitution is not None or b.mu is not None]
+    if scene.pairs or own:             # else every pair takes the world's values
+        for i in range(B):
+            for j in range(B):
+                if i != j:
+                    pair_e[i, j], pair_mu[i, j] = scene.coefficients(bodies[i], bodies[j])
     return Loads(accel=accel,
                  torque=np.array([b.torque for b in bodies], dtype=np.float64).reshape(B, 3),
                  fixed=fixed,
