@@ -204,8 +204,7 @@ def _runs(engine, cases, kinds, outcomes: list, examples: list,
     the refusal's line."""
     for scene in cases.of_kind(*kinds):
         trajectory = attempt(cases.run, engine, scene)
-        if not_posed is not None and isinstance(trajectory, Crash) and \
-                trajectory.error.startswith(("UnposableKey:", "refsim.errors.UnposableKey:")):
+        if not_posed is not None and isinstance(trajectory, Crash) and trajectory.unposable:
             not_posed[scene.name] = trajectory.error.split(":", 1)[1].strip()
             continue
         if isinstance(trajectory, Crash):

@@ -86,10 +86,13 @@ def classify_miss(miss: float, tolerance: float) -> str | None:
 class Crash:
     """An exception raised while a case was run: the traceback's last line
     (``"ValueError: ..."``, the exception's type and message) and the
-    traceback itself (its innermost frames)."""
+    traceback itself (its innermost frames). ``unposable``: the exception
+    was :class:`refsim.errors.UnposableKey`, a scene key the engine refused
+    to pose (a check reports such a scene as not posed, not as a crash)."""
 
     error: str
     traceback: str
+    unposable: bool = False
 
     def example(self, **case) -> dict:
         """A failing-case example of class "crash" with the case's input."""
@@ -107,10 +110,13 @@ def attempt(function, *args):
     try:
         return function(*args)
     except Exception as exc:  # noqa: BLE001 - recorded as the case's crash
+        from refsim.errors import UnposableKey
+
         last = traceback.format_exception_only(type(exc), exc)[-1].strip()
         return Crash(error=last, traceback="".join(
             traceback.format_exception(type(exc), exc, exc.__traceback__,
-                                       limit=-CRASH_FRAMES)))
+                                       limit=-CRASH_FRAMES)),
+            unposable=isinstance(exc, UnposableKey))
 
 
 def worst_class(classes) -> str:

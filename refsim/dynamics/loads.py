@@ -137,8 +137,8 @@ def scene_loads(scene, *, rotation: str, body_response: str, wall_response: str)
     wall = [scene.coefficients(b) for b in bodies]
     pair_e = np.full((B, B), world.restitution)
     pair_mu = np.full((B, B), world.coulomb_mu)
-    own = [i for i, b in enumerate(bodies) if b.restitution is not None or b.mu is not None]
-    if scene.pairs or own:             # else every pair takes the world's values
+    # every pair takes the world's values unless a body or a pair gives its own
+    if scene.pairs or any(b.restitution is not None or b.mu is not None for b in bodies):
         for i in range(B):
             for j in range(B):
                 if i != j:

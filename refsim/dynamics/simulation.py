@@ -303,6 +303,7 @@ class Simulation:
                                center=np.array(center), inertia=props.inertia))
         self.bodies = tuple(bodies)
         self.names = tuple(b.name for b in bodies)
+        self._index = {name: i for i, name in enumerate(self.names)}
         self.mass = np.array([b.mass for b in bodies])
         self.inv_mass = np.where(self.loads.fixed, 0.0, 1.0 / self.mass)   # fixed: no push
         self.center = np.array([b.center for b in bodies])                  # (B, 3)
@@ -827,10 +828,9 @@ class Simulation:
     def _note_events(self, touching: set[Contact]) -> None:
         """An event for each contact that began in this step (in the order of
         the bodies' and the others' names, so that runs compare)."""
-        index = {name: i for i, name in enumerate(self.names)}
         for contact in sorted(touching - self._touching, key=lambda c: (c.body, c.other)):
             J, point = impulse.impulse_and_point(
-                self._impulses.get((index[contact.body], contact.other)))
+                self._impulses.get((self._index[contact.body], contact.other)))
             self.events.append(Event(kind=contact.kind, step=self.steps, time=self.t,
                                      body=contact.body, other=contact.other, impulse=J,
                                      point=point))

@@ -145,9 +145,10 @@ def _unset_left_out(values: dict) -> dict:
     """A table's values without the keys left unset (None: the world's
     ``mu``, a body's own coefficients), as a file that does not write them;
     tuples as lists, as TOML reads them."""
-    return {k: (list(v) if isinstance(v, tuple) and k != "orientation"
-                else [list(r) for r in v] if k == "orientation" else v)
-            for k, v in values.items() if v is not None}
+    def plain(v):
+        return [plain(x) for x in v] if isinstance(v, tuple) else v
+
+    return {k: plain(v) for k, v in values.items() if v is not None}
 
 
 class CountingSimulation(Simulation):
