@@ -11,6 +11,11 @@ SIGHUP, SIGINT and SIGQUIT ignored, and so would every process it starts,
 which then cannot be stopped by the signals the tests send. Each test
 process puts them back as an interactive shell would have them
 (:func:`pytest_configure`).
+
+The conformance kit's case sets are not kept on disk during the tests
+(``REFSIM_CACHE_DIR`` empty, inherited by the commands the tests start): a
+test's result never depends on a file an earlier run left in the user's
+cache. The cache's own tests give it a directory of their own.
 """
 
 from __future__ import annotations
@@ -19,6 +24,8 @@ import os
 import signal
 
 import pytest
+
+os.environ["REFSIM_CACHE_DIR"] = ""
 
 
 def pytest_configure(config) -> None:

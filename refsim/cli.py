@@ -402,16 +402,13 @@ def _conform(args) -> int:
     if args.only is not None and args.only not in CAPABILITIES:
         raise OptionError(f"--only {args.only!r}: not a capability (capabilities: "
                           f"{', '.join(CAPABILITIES)})")
-    if (args.workers is not None or args.scheduler is not None) and not args.all:
-        raise OptionError("--workers and --scheduler run the engines of --all side by side; "
-                          "one engine runs in this process")
     if args.workers is not None and args.scheduler is not None:
         raise OptionError("give --workers (local processes) or --scheduler (a Dask "
                           "cluster), not both")
+    backend = ("dask" if args.scheduler is not None
+               else "processes" if args.workers is not None else None)
+    workers = None if args.workers is None else check_count("--workers", args.workers, 1)
     if args.all:
-        backend = ("dask" if args.scheduler is not None
-                   else "processes" if args.workers is not None else None)
-        workers = None if args.workers is None else check_count("--workers", args.workers, 1)
         make_directory(out)
         matrix, results = run_matrix(cases=cases, seed=seed, out_dir=out, only=args.only,
                                      backend=backend, workers=workers,
@@ -444,8 +441,21 @@ def _conform(args) -> int:
     if args.expected_failures:
         read_expected(args.expected_failures)
     make_directory(out)
-    result = check_engine(engine, cases=cases, seed=seed, only=args.only,
-                          expected_failures=args.expected_failures, spec=args.engine)
+
+    def say(text: str) -> None:
+        print(f"refsim conform: {text}", file=sys.stderr, flush=True)
+
+    if backend is None:
+        result = check_engine(engine, cases=cases, seed=seed, only=args.only,
+                              expected_failures=args.expected_failures, spec=args.engine,
+                              progress=say)
+    else:
+        from refsim.conformance.shards import check_engine_sharded
+
+        result = check_engine_sharded(args.engine, cases=cases, seed=seed, only=args.only,
+                                      expected_failures=args.expected_failures,
+                                      backend=backend, workers=workers,
+                                      scheduler=args.scheduler, progress=say)
     print(summary_table(result))
     json_path, page = write_engine_pages(result, out)
     expected = sum(c.status == "xfailed" for c in result.checks)
@@ -483,11 +493,13 @@ def _add_conform_command(commands) -> None:
                          help="check one capability: triangles, pairs, collide, aabb, ode "
                               "or rigid")
     conform.add_argument("--workers", type=int, metavar="N",
-                         help="with --all: run the engines on N local processes (each builds "
-                              "the same seeded cases; the cells are the same)")
+                         help="run on N local processes: one engine's cases in shards of "
+                              "12000, or with --all the engines side by side (the results "
+                              "are the same as in one process)")
     conform.add_argument("--scheduler", metavar="ADDRESS",
-                         help="with --all: run the engines on a Dask cluster, e.g. "
-                              "tcp://host:8786 (pip install 'refsim[sweep]')")
+                         help="run on a Dask cluster, e.g. tcp://host:8786, as --workers "
+                              "does (pip install 'refsim[sweep]'; the engine's module must be "
+                              "importable on the workers)")
     conform.add_argument("--expected-failures", metavar="FILE",
                          help="declared divergences, one a line: "
                               "'capability.check[class,...]  reason'")

@@ -46,3 +46,18 @@ def bundled_models() -> list[Path]:
 def bundled_scenes() -> list[Path]:
     """Every bundled ``.toml`` scene, sorted by name."""
     return sorted(scenes_dir().glob("*.toml"))
+
+
+def model_path(name: str) -> Path:
+    """The bundled model ``name`` (e.g. ``"tetrahedron.ac"``, as the
+    conformance kit's cases and scenes name them) as a file path.
+
+    Raises :class:`refsim.errors.ModelError` naming the bundled models when
+    there is none of that name."""
+    from refsim.errors import ModelError
+
+    path = models_dir() / name
+    if Path(name).name != name or not path.is_file():
+        available = ", ".join(sorted(p.name for p in models_dir().glob("*.ac")))
+        raise ModelError(f"{name}: not a bundled model (bundled: {available})")
+    return path

@@ -53,7 +53,7 @@ import numpy as np
 
 from refsim.conformance.cases_meshes import bundled_mesh
 from refsim.conformance.draw import (
-    NumpyDraw,
+    seeded_range,
     signed_permutations,
     strategy,
     unit_quaternion_rotation,
@@ -213,8 +213,9 @@ class BoxCases:
         return box_strategy()
 
 
-def box_cases(n: int, seed: int = 0) -> BoxCases:
-    """The seeded set of ``n`` box cases, family ``i % 6``."""
-    draw = NumpyDraw(np.random.default_rng([seed, 0xB0C5]))
-    return BoxCases(cases=tuple(_box_case(draw, FAMILIES[i % len(FAMILIES)]) for i in range(n)),
-                    seed=seed)
+def box_cases(n: int, seed: int = 0, start: int = 0, stop: int | None = None) -> BoxCases:
+    """The seeded set of ``n`` box cases, family ``i % 6``, or its cases
+    ``start`` to ``stop - 1`` (a shard)."""
+    cases = seeded_range(lambda draw, i: _box_case(draw, FAMILIES[i % len(FAMILIES)]),
+                         seed, 0xB0C5, start, n if stop is None else stop)
+    return BoxCases(cases=cases, seed=seed)

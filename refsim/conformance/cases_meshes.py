@@ -42,9 +42,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.conformance.draw import (
-    NumpyDraw,
     dot3,
     matmul3,
+    seeded_range,
     signed_permutations,
     strategy,
     unit_quaternion_rotation,
@@ -181,9 +181,12 @@ class PoseCases:
         return pose_strategy()
 
 
-def pose_cases(n: int, seed: int = 0) -> PoseCases:
-    """The seeded set of ``n`` mesh-pair cases (module docstring)."""
-    draw = NumpyDraw(np.random.default_rng([seed, 0x9053]))
-    cases = tuple(_pose_case(draw, FAMILIES[i % len(FAMILIES)], draw.choice(MODELS),
-                             draw.choice(MODELS)) for i in range(n))
+def pose_cases(n: int, seed: int = 0, start: int = 0, stop: int | None = None) -> PoseCases:
+    """The seeded set of ``n`` mesh-pair cases (module docstring), or its
+    cases ``start`` to ``stop - 1`` (a shard)."""
+    def build(draw, i):
+        return _pose_case(draw, FAMILIES[i % len(FAMILIES)], draw.choice(MODELS),
+                          draw.choice(MODELS))
+
+    cases = seeded_range(build, seed, 0x9053, start, n if stop is None else stop)
     return PoseCases(cases=cases, seed=seed)

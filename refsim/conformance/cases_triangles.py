@@ -48,7 +48,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.sat_exact import triangles_intersect_sat
-from refsim.conformance.draw import Draw, NumpyDraw, dot3, signed_permutations, strategy
+from refsim.conformance.draw import Draw, dot3, seeded_range, signed_permutations, strategy
 
 FAMILIES = ("random", "vertex-on-face", "edge-on-edge", "near-parallel", "touching-exact",
             "coplanar-exact")
@@ -201,9 +201,11 @@ class TriangleCases:
         return pair_strategy()
 
 
-def triangle_cases(n: int, seed: int = 0) -> TriangleCases:
-    """The seeded set of ``n`` pairs (module docstring). Cost: O(n), the
-    exact answers in rational arithmetic."""
-    draw = NumpyDraw(np.random.default_rng([seed, 0x7219]))
-    pairs = tuple(build_pair(draw, FAMILIES[i % len(FAMILIES)]) for i in range(n))
+def triangle_cases(n: int, seed: int = 0, start: int = 0, stop: int | None = None
+                   ) -> TriangleCases:
+    """The seeded set of ``n`` pairs (module docstring), or its pairs
+    ``start`` to ``stop - 1`` (a shard: :func:`refsim.conformance.draw.seeded_range`).
+    Cost: O(n), the exact answers in rational arithmetic."""
+    pairs = seeded_range(lambda draw, i: build_pair(draw, FAMILIES[i % len(FAMILIES)]),
+                         seed, 0x7219, start, n if stop is None else stop)
     return TriangleCases(pairs=pairs, seed=seed)

@@ -39,6 +39,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 from fractions import Fraction
 
 import numpy as np
@@ -56,26 +58,99 @@ EXAMPLES_PER_CLASS = 2
 GAP_PAIRS = 500
 
 
-def _keep(found: list, example: dict) -> None:
-    """Keep ``example`` if its class has fewer than EXAMPLES_PER_CLASS so far
-    (every class that occurs gets its examples, however rare)."""
-    if sum(e["class"] == example["class"] for e in found) < EXAMPLES_PER_CLASS:
-        found.append(example)
+@dataclass(frozen=True)
+class CaseCheck:
+    """A check that judges every case of a generated set on its own, so that
+    a set may be split into shards run anywhere (:mod:`refsim.conformance.shards`)
+    and the result put together from their failures is the one a single run
+    gives.
+
+    ``prepare(engine)`` is what ``judge`` needs of the engine, read once per
+    run (the method to call, the declared tolerances); ``judge(prepared,
+    case)`` is None when the engine's answer is right, else the failure's
+    fields: its class, the gap or excess, the engine's answer (the case's
+    input and truth are added from ``case.to_dict()``). ``measure(failures)``
+    gives the check's ``measured`` numbers from the failure records alone
+    (so that shards' records give the same numbers), and ``miss`` names the
+    field holding a failure's length in metres. ``retry(prepared, case)``
+    judges a case Hypothesis made (the same as ``judge``, the crash
+    excepted: it is not the failure being shrunk).
+    """
+
+    capability: str
+    name: str
+    prepare: Callable
+    judge: Callable
+    measure: Callable
+    miss: str
+
+    @property
+    def key(self) -> str:
+        return f"{self.capability}.{self.name}"
+
+    def failures(self, engine, items, first: int = 0) -> list[dict]:
+        """The failure record of every failing case of ``items`` (cases
+        ``first``, ``first + 1``, ...), in case order; a crash is recorded
+        with the traceback's last line."""
+        prepared = self.prepare(engine)
+        found: list[dict] = []
+        for index, case in enumerate(items, start=first):
+            verdict = attempt(self.judge, prepared, case)
+            if isinstance(verdict, Crash):
+                found.append(verdict.example(case=index, **case.to_dict()))
+            elif verdict is not None:
+                found.append({"case": index, **verdict, **case.to_dict()})
+        return found
+
+    def result(self, engine, cases, failures: list[dict], count: int,
+               seconds: float) -> CheckResult:
+        """The check's result from every failure of its ``count`` cases (from
+        one run or from shards, in case order), with the minimal failing case
+        Hypothesis finds when there is a failure."""
+        outcomes: list[str | None] = [None] * count
+        misses: list[float | None] = [None] * count
+        for failure in failures:
+            outcomes[failure["case"]] = failure["class"]
+            misses[failure["case"]] = failure.get(self.miss)
+        shrunk = None
+        if failures:
+            start = time.perf_counter()
+            prepared = self.prepare(engine)
+            value = minimal_failure(cases.strategy(), lambda c: self.judge(prepared, c) is not None,
+                                    cases.seed)
+            verdict = None if value is None else attempt(self.judge, prepared, value)
+            if isinstance(verdict, dict):         # the engine failed it again, the same way
+                shrunk = {"shrunk": True, **verdict, **value.to_dict()}
+            seconds += time.perf_counter() - start
+        return tally(self.capability, self.name, outcomes, examples=_examples(failures, shrunk),
+                     measured=self.measure(failures), misses=misses, failures=failures,
+                     seconds=seconds)
+
+    def run(self, engine, cases) -> CheckResult:
+        """The check on every case of ``cases`` in this process."""
+        start = time.perf_counter()
+        items = _items(cases)
+        failures = self.failures(engine, items)
+        return self.result(engine, cases, failures, len(items), time.perf_counter() - start)
 
 
-def _examples(found, shrunk) -> list[dict]:
-    """The shrunk case first, then the kept seeded ones, by class order."""
+def _items(cases) -> tuple:
+    """The cases of a generated set (triangle pairs, or poses and boxes)."""
+    return cases.pairs if hasattr(cases, "pairs") else cases.cases
+
+
+def _examples(failures: list[dict], shrunk) -> list[dict]:
+    """The shrunk case first, then the first EXAMPLES_PER_CLASS failures of
+    each class in case order (every class that occurs gets its examples,
+    however rare), by class order."""
     from refsim.conformance.results import CLASSES
 
+    kept: list[dict] = []
+    for failure in failures:
+        if sum(e["class"] == failure["class"] for e in kept) < EXAMPLES_PER_CLASS:
+            kept.append(failure)
     return ([shrunk] if shrunk is not None else []) + sorted(
-        found, key=lambda e: CLASSES.index(e["class"]))
-
-
-def _shrunk(cases, fails, classify, describe):
-    value = minimal_failure(cases.strategy(), fails, cases.seed)
-    if value is None:
-        return None
-    return {"shrunk": True, **classify(value), **describe(value)}
+        kept, key=lambda e: CLASSES.index(e["class"]))
 
 
 def _distance_tolerance(engine) -> float:
@@ -118,47 +193,39 @@ def classify_triangles(a, b, distance_tolerance: float = 0.0) -> dict:
     return _verdict(kind, gap, bound, distance_tolerance)
 
 
-def _triangle_check(name: str, answer, cases, tolerance: float) -> CheckResult:
-    start = time.perf_counter()
-    outcomes: list[str | None] = []  # per case: None (passed) or its class
-    misses: list[float | None] = []
-    found: list[dict] = []
-    for index, pair in enumerate(cases.pairs):
-        got = attempt(lambda p: bool(answer(p.a, p.b)), pair)
-        if isinstance(got, Crash):
-            outcomes.append("crash")
-            misses.append(None)
-            _keep(found, got.example(case=index, **pair.to_dict()))
-            continue
-        if got == pair.truth:
-            outcomes.append(None)
-            misses.append(None)
-            continue
-        verdict = classify_triangles(pair.a, pair.b, tolerance)
-        outcomes.append(verdict["class"])
-        misses.append(verdict["gap_metres"])
-        _keep(found, {"case": index, **verdict, "answer": got, **pair.to_dict()})
-    shrunk = None
-    if any(outcomes):
-        def fails(p):
-            return bool(answer(p.a, p.b)) != p.truth
+def _judge_triangles(prepared, pair) -> dict | None:
+    answer, tolerance = prepared
+    got = bool(answer(pair.a, pair.b))
+    if got == pair.truth:
+        return None
+    return {**classify_triangles(pair.a, pair.b, tolerance), "answer": got}
 
-        shrunk = _shrunk(cases, fails, lambda p: classify_triangles(p.a, p.b, tolerance),
-                         lambda p: {"answer": not p.truth, **p.to_dict()})
-    by_family: dict[str, int] = {}
-    for pair, outcome in zip(cases.pairs, outcomes, strict=True):
-        if outcome is not None:
-            by_family[pair.family] = by_family.get(pair.family, 0) + 1
-    return tally("triangles", name, outcomes, examples=_examples(found, shrunk),
-                 measured={"failed_by_family": by_family}, misses=misses,
-                 seconds=time.perf_counter() - start)
+
+def _by_family(failures: list[dict]) -> dict:
+    counts: dict[str, int] = {}
+    for failure in failures:
+        counts[failure["family"]] = counts.get(failure["family"], 0) + 1
+    return {"failed_by_family": counts}
+
+
+def _refsim_triangles(engine):
+    from refsim.collision.triangle import triangles_intersect
+
+    return triangles_intersect, 0.0
+
+
+TRIANGLES_AGREEMENT = CaseCheck(
+    "triangles", "agreement", lambda engine: (engine.triangles_intersect,
+                                              _distance_tolerance(engine)),
+    _judge_triangles, _by_family, "gap_metres")
+TRIANGLES_REFERENCE = CaseCheck("triangles", "reference", _refsim_triangles, _judge_triangles,
+                                _by_family, "gap_metres")
 
 
 def check_triangles_agreement(engine, cases) -> CheckResult:
     """``triangles.agreement``: the engine's ``triangles_intersect(a, b)`` is
     the exact answer (closed triangles, touching counts) on every pair."""
-    return _triangle_check("agreement", engine.triangles_intersect, cases,
-                           _distance_tolerance(engine))
+    return TRIANGLES_AGREEMENT.run(engine, cases)
 
 
 def check_triangles_reference(engine, cases) -> CheckResult:
@@ -168,9 +235,7 @@ def check_triangles_reference(engine, cases) -> CheckResult:
     truth every other check of this engine leans on (the mesh-pair answers
     come from refsim's test) with a second, independent exact algorithm, in
     every report."""
-    from refsim.collision.triangle import triangles_intersect
-
-    return _triangle_check("reference", triangles_intersect, cases, 0.0)
+    return TRIANGLES_REFERENCE.run(engine, cases)
 
 
 # -- mesh pairs and bodies ------------------------------------------------------------------
@@ -271,48 +336,30 @@ def classify_collide(case, got: bool, tolerance: float = 0.0) -> dict:
     return _surface_gap(case, tolerance)
 
 
-def _mesh_check(name: str, engine, cases, agrees, classify, describe) -> CheckResult:
-    """The loop of ``pairs.agreement`` and ``collide.agreement``: per case the
-    engine's answer (``agrees(case, got)``), a crash, or a classified
-    disagreement (``classify(case, got, tolerance)``, ``describe(case, got)``
-    the answer's fields)."""
-    start = time.perf_counter()
-    method = "intersecting_pairs" if name == "pairs" else "bodies_collide"
-    tolerance = _distance_tolerance(engine)
-    outcomes: list[str | None] = []  # per case: None (passed) or its class
-    misses: list[float | None] = []
-    found: list[dict] = []
-    counts: dict[str, int] = {}        # the answers' *_count fields, summed
-    for index, case in enumerate(cases.cases):
-        got = attempt(_call, engine, method, case)
-        if isinstance(got, Crash):
-            outcomes.append("crash")
-            misses.append(None)
-            _keep(found, got.example(case=index, **case.to_dict()))
-            continue
-        if agrees(case, got):
-            outcomes.append(None)
-            misses.append(None)
-            continue
-        verdict, answer = classify(case, got, tolerance), describe(case, got)
-        outcomes.append(verdict["class"])
-        misses.append(verdict.get("gap_metres"))
-        for key, value in answer.items():
+def _answer_counts(failures: list[dict]) -> dict:
+    """The failures' ``*_count`` fields (pairs added and missed), summed."""
+    counts: dict[str, int] = {}
+    for failure in failures:
+        for key, value in failure.items():
             if key.endswith("_count"):
                 counts[key] = counts.get(key, 0) + value
-        _keep(found, {"case": index, **verdict, **answer, **case.to_dict()})
-    shrunk = None
-    if any(outcomes):
-        def fails(c):
-            return not agrees(c, _call(engine, method, c))
+    return counts
 
-        def classified(c):
-            got = _call(engine, method, c)
-            return {**classify(c, got, tolerance), **describe(c, got)}
 
-        shrunk = _shrunk(cases, fails, classified, lambda c: c.to_dict())
-    return tally(name, "agreement", outcomes, examples=_examples(found, shrunk), misses=misses,
-                 measured=counts, seconds=time.perf_counter() - start)
+def _judge_pairs(prepared, case) -> dict | None:
+    engine, tolerance = prepared
+    got = _call(engine, "intersecting_pairs", case)
+    if _pair_set(got) == _pair_set(case.truth):
+        return None
+    return {**classify_pairs(case, got, tolerance), **_pairs_answer(case, got)}
+
+
+def _judge_collide(prepared, case) -> dict | None:
+    engine, tolerance = prepared
+    got = bool(_call(engine, "bodies_collide", case))
+    if got == (len(case.truth) > 0):
+        return None
+    return {**classify_collide(case, got, tolerance), "answer": got}
 
 
 def _pairs_answer(case, got) -> dict:
@@ -324,22 +371,27 @@ def _pairs_answer(case, got) -> dict:
             "extra_pair_count": len(answer - truth), "missing_pair_count": len(truth - answer)}
 
 
+def _with_tolerance(engine):
+    return engine, _distance_tolerance(engine)
+
+
+PAIRS_AGREEMENT = CaseCheck("pairs", "agreement", _with_tolerance, _judge_pairs, _answer_counts,
+                            "gap_metres")
+COLLIDE_AGREEMENT = CaseCheck("collide", "agreement", _with_tolerance, _judge_collide,
+                              lambda failures: {}, "gap_metres")
+
+
 def check_pairs_agreement(engine, cases) -> CheckResult:
     """``pairs.agreement``: the engine's ``intersecting_pairs`` is the exact
     set of intersecting face pairs on every pose (as a set: order and
     duplicates do not matter)."""
-    return _mesh_check("pairs", engine, cases,
-                       lambda c, got: _pair_set(got) == _pair_set(c.truth),
-                       classify_pairs, _pairs_answer)
+    return PAIRS_AGREEMENT.run(engine, cases)
 
 
 def check_collide_agreement(engine, cases) -> CheckResult:
     """``collide.agreement``: the engine's ``bodies_collide`` is true exactly
     when some triangle of one surface meets a triangle of the other."""
-    return _mesh_check("collide", engine, cases,
-                       lambda c, got: bool(got) == (len(c.truth) > 0),
-                       lambda c, got, tol: classify_collide(c, bool(got), tol),
-                       lambda c, got: {"answer": bool(got)})
+    return COLLIDE_AGREEMENT.run(engine, cases)
 
 
 # -- boxes ---------------------------------------------------------------------------------
@@ -394,57 +446,39 @@ def classify_box(case, lo, hi, side: int, declared) -> dict | None:
             "box_slack_metres": declared.box_slack}
 
 
-def _box_check(name: str, engine, cases, side: int) -> CheckResult:
+def _box_judge(side: int):
+    def judge(prepared, case) -> dict | None:
+        engine, declared = prepared
+        lo, hi = _box(engine, case)
+        verdict = classify_box(case, lo, hi, side, declared)
+        return None if verdict is None else {**verdict, "lo": lo.tolist(), "hi": hi.tolist()}
+    return judge
+
+
+def _largest_excess(failures: list[dict]) -> dict:
+    return {"largest_excess_metres": max((f.get("excess_metres", 0.0) for f in failures),
+                                         default=0.0),
+            "largest_excess_rounding_bounds": max(
+                (f.get("excess_rounding_bounds", 0.0) for f in failures), default=0.0)}
+
+
+def _with_declarations(engine):
     from refsim.engines import declarations
 
-    start = time.perf_counter()
-    declared = declarations(engine)
-    outcomes: list[str | None] = []  # per case: None (passed) or its class
-    misses: list[float | None] = []
-    found: list[dict] = []
-    worst, worst_ratio = 0.0, 0.0
-    for index, case in enumerate(cases.cases):
-        box = attempt(_box, engine, case)
-        if isinstance(box, Crash):
-            outcomes.append("crash")
-            misses.append(None)
-            _keep(found, box.example(case=index, **case.to_dict()))
-            continue
-        lo, hi = box
-        verdict = classify_box(case, lo, hi, side, declared)
-        if verdict is None:
-            outcomes.append(None)
-            misses.append(None)
-            continue
-        worst = max(worst, verdict["excess_metres"])
-        worst_ratio = max(worst_ratio, verdict["excess_rounding_bounds"])
-        outcomes.append(verdict["class"])
-        misses.append(verdict["excess_metres"])
-        _keep(found, {"case": index, **verdict, "lo": lo.tolist(), "hi": hi.tolist(),
-                      **case.to_dict()})
-    shrunk = None
-    if any(outcomes):
-        def classified(c):
-            lo, hi = _box(engine, c)
-            return {**(classify_box(c, lo, hi, side, declared) or {}),
-                    "lo": lo.tolist(), "hi": hi.tolist()}
+    return engine, declarations(engine)
 
-        def fails(c):
-            lo, hi = _box(engine, c)
-            return classify_box(c, lo, hi, side, declared) is not None
 
-        shrunk = _shrunk(cases, fails, classified, lambda c: c.to_dict())
-    return tally("aabb", name, outcomes, examples=_examples(found, shrunk), misses=misses,
-                 measured={"largest_excess_metres": worst,
-                           "largest_excess_rounding_bounds": worst_ratio},
-                 seconds=time.perf_counter() - start)
+AABB_ENCLOSES = CaseCheck("aabb", "encloses", _with_declarations, _box_judge(0),
+                          _largest_excess, "excess_metres")
+AABB_TIGHT = CaseCheck("aabb", "tight", _with_declarations, _box_judge(1), _largest_excess,
+                       "excess_metres")
 
 
 def check_aabb_encloses(engine, cases) -> CheckResult:
     """``aabb.encloses``: the engine's box contains every exactly transformed
     vertex, up to the rounding bound of a float64 evaluation of ``R p + t``
     (each side at most ``bound_i`` inside the exact box)."""
-    return _box_check("encloses", engine, cases, 0)
+    return AABB_ENCLOSES.run(engine, cases)
 
 
 def check_aabb_tight(engine, cases) -> CheckResult:
@@ -452,9 +486,13 @@ def check_aabb_tight(engine, cases) -> CheckResult:
     more than the same bound (each side at most ``bound_i`` outside it): the
     box of the vertices, not of a padded or coarser shape (a padded box the
     engine declares, ``box_slack``, is "loose")."""
-    return _box_check("tight", engine, cases, 1)
+    return AABB_TIGHT.run(engine, cases)
 
+
+#: The checks that judge each case alone, by key: the ones a run may shard.
+CASE_CHECKS = {c.key: c for c in (TRIANGLES_REFERENCE, TRIANGLES_AGREEMENT, PAIRS_AGREEMENT,
+                                  COLLIDE_AGREEMENT, AABB_ENCLOSES, AABB_TIGHT)}
 
 __all__ = ["check_triangles_agreement", "check_triangles_reference", "check_pairs_agreement",
            "check_collide_agreement", "check_aabb_encloses", "check_aabb_tight",
-           "CheckResult"]
+           "CASE_CHECKS", "CaseCheck", "CheckResult"]

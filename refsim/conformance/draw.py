@@ -20,6 +20,7 @@ Cost: O(1) per number drawn.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from typing import Any, NoReturn, Protocol
@@ -151,9 +152,11 @@ def unit_quaternion_rotation(draw) -> np.ndarray:
     return quaternion_to_rotation(q / norm)
 
 
+@functools.cache
 def signed_permutations() -> tuple[np.ndarray, ...]:
     """The 24 proper rotations with entries in {-1, 0, 1}: a point's
-    rotated coordinates are exact (each is +-1 times one coordinate)."""
+    rotated coordinates are exact (each is +-1 times one coordinate).
+    Built once (read-only arrays)."""
     from itertools import permutations, product
 
     out = []
@@ -166,5 +169,36 @@ def signed_permutations() -> tuple[np.ndarray, ...]:
             m = np.zeros((3, 3))
             for row, col in enumerate(perm):
                 m[row, col] = signs[row]
+            m.flags.writeable = False
             out.append(m)
+    return tuple(out)
+
+
+#: Cases of a seeded set drawn from one random stream. Case ``i`` comes from
+#: stream ``i // BLOCK`` (:func:`seeded_range`), so any run of whole blocks
+#: is built alone, by a shard on another process, and a set is the same
+#: however it is split. A multiple of every family count (4 and 6), so that
+#: the families cycle the same way in every block.
+BLOCK = 12_000
+
+
+def block_draw(seed: int, tag: int, block: int) -> NumpyDraw:
+    """The draw of block ``block`` of the set tagged ``tag``. Block 0 keeps
+    the stream every set was drawn from before sets came in blocks, so that
+    a set of up to :data:`BLOCK` cases is the one it always was."""
+    key = [seed, tag] if block == 0 else [seed, tag, block]
+    return NumpyDraw(np.random.default_rng(key))
+
+
+def seeded_range(build, seed: int, tag: int, start: int, stop: int) -> tuple:
+    """Cases ``start`` to ``stop - 1`` of a seeded set, ``build(draw, i)``
+    making case ``i``. A range that starts inside a block draws (and drops)
+    the block's earlier cases: give whole blocks to avoid that cost."""
+    out = []
+    for block in range(start // BLOCK, -(-stop // BLOCK)):
+        draw = block_draw(seed, tag, block)
+        for i in range(block * BLOCK, min(stop, (block + 1) * BLOCK)):
+            case = build(draw, i)
+            if i >= start:
+                out.append(case)
     return tuple(out)

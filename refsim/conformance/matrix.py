@@ -147,13 +147,17 @@ def conformance_matrix(results, pages: dict | None = None, unavailable: dict | N
 
 
 def write_engine_pages(result, out_dir) -> tuple[Path, Path]:
-    """``out_dir/conformance.json`` and ``out_dir/index.html`` of one engine's
-    result, each written whole or not at all (:mod:`refsim.io`); ``out_dir``
-    is created if missing."""
+    """``out_dir/conformance.json``, ``out_dir/failures.jsonl`` (every
+    failing case, one a line: :meth:`ConformanceResult.failure_lines`) and
+    ``out_dir/index.html`` of one engine's result, each written whole or not
+    at all (:mod:`refsim.io`); ``out_dir`` is created if missing. Returns
+    the JSON record's path and the page's."""
     from refsim.conformance.page import engine_page
-    from refsim.io import write_text_atomic
+    from refsim.io import write_atomic, write_text_atomic
 
     out_dir = make_directory(out_dir)
+    write_atomic(out_dir / "failures.jsonl",
+                 lambda handle: handle.writelines(result.failure_lines()))
     return (write_text_atomic(out_dir / "conformance.json", result.to_json()),
             write_text_atomic(out_dir / "index.html", engine_page(result)))
 
@@ -215,7 +219,7 @@ def engine_task(*, seed: int, name: str, spec: str, cases: int, case_seed: int,
     file = shipped_expected_failures(engine.name) if expected == SHIPPED_EXPECTED else expected
     result = check_engine(engine, cases=cases, seed=case_seed, only=only,
                           expected_failures=file, spec=spec)
-    return {"result": result.to_dict()}
+    return {"result": result.to_dict(failures=True)}
 
 
 def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=None,

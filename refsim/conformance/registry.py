@@ -124,7 +124,10 @@ def checks_for(capabilities) -> tuple[Check, ...]:
 
 def build_cases(needed, n: int, seed: int) -> dict:
     """The case sets named in ``needed`` (a subset of :data:`CASE_SETS`),
-    ``n`` cases in each generated set, from ``seed``."""
+    ``n`` cases in each generated set, from ``seed``; the generated sets
+    are read from the disk cache when they were built before
+    (:mod:`refsim.conformance.case_cache`)."""
+    from refsim.conformance.case_cache import cached
     from refsim.conformance.cases_boxes import box_cases
     from refsim.conformance.cases_meshes import pose_cases
     from refsim.conformance.cases_ode import ode_cases
@@ -136,4 +139,5 @@ def build_cases(needed, n: int, seed: int) -> dict:
                 "boxes": lambda: box_cases(n, seed),
                 "ode": lambda: ode_cases(seed),
                 "rigid": lambda: rigid_cases(seed)}
-    return {name: builders[name]() for name in CASE_SETS if name in set(needed)}
+    return {name: cached(name, n, seed, builders[name])
+            for name in CASE_SETS if name in set(needed)}

@@ -23,7 +23,7 @@ from __future__ import annotations
 import json
 import math
 import traceback
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 #: What each class of failing case means, from the most to the least serious
 #: (a case with several disagreements, e.g. a mesh pose, takes the first that
@@ -158,6 +158,11 @@ class CheckResult:
         what a bounded declaration (``class <= bound``) is compared with.
     seconds : float
         Wall time of the check (a timing: differs per machine and run).
+    failures : list of dict
+        Every failing case's record (input, the engine's answer, class, gap),
+        in case order, where ``examples`` keeps a few: written to
+        ``failures.jsonl`` beside ``conformance.json``, not into it
+        (:meth:`to_dict` leaves it out unless asked).
     """
 
     capability: str
@@ -172,6 +177,7 @@ class CheckResult:
     measured: dict = field(default_factory=dict)
     largest_miss_metres: dict = field(default_factory=dict)
     seconds: float = 0.0
+    failures: list = field(default_factory=list, repr=False)
 
     @property
     def key(self) -> str:
@@ -181,8 +187,11 @@ class CheckResult:
     def with_status(self, status: str, reason: str = "") -> CheckResult:
         return replace(self, status=status, reason=reason)
 
-    def to_dict(self) -> dict:
-        return asdict(self)
+    def to_dict(self, failures: bool = False) -> dict:
+        """The record of ``conformance.json``; with ``failures`` every
+        failure too (to send a result between processes whole)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)
+                if failures or f.name != "failures"}
 
     @classmethod
     def from_dict(cls, data: dict) -> CheckResult:
@@ -191,10 +200,12 @@ class CheckResult:
 
 
 def tally(capability: str, check: str, outcomes, *, examples=(), measured=None,
-          misses=None, seconds: float = 0.0) -> CheckResult:
+          misses=None, failures=None, seconds: float = 0.0) -> CheckResult:
     """A :class:`CheckResult` from per-case outcomes: ``None`` for a passing
     case, a class name (:data:`CLASSES`) for a failing one. ``misses``, when
-    given, holds each case's gap or excess in metres (None where it has none)."""
+    given, holds each case's gap or excess in metres (None where it has none).
+    ``failures``: every failing case's record; by default the ``examples``
+    (a check with few cases keeps every failure there)."""
     outcomes = list(outcomes)
     classes: dict[str, int] = {}
     largest: dict[str, float] = {}
@@ -213,6 +224,7 @@ def tally(capability: str, check: str, outcomes, *, examples=(), measured=None,
                        examples=list(examples), status="failed" if failed else "passed",
                        measured=dict(measured or {}),
                        largest_miss_metres={c: largest[c] for c in CLASSES if c in largest},
+                       failures=list(examples if failures is None else failures),
                        seconds=seconds)
 
 
@@ -262,11 +274,22 @@ class ConformanceResult:
         """``capability.check`` of every check that failed, in order."""
         return [c.key for c in self.checks if c.status == "failed"]
 
-    def to_dict(self) -> dict:
-        data = asdict(self)
+    def to_dict(self, failures: bool = False) -> dict:
+        """The record of ``conformance.json`` (with every check's failures
+        when ``failures``: :meth:`CheckResult.to_dict`)."""
+        data = {f.name: getattr(self, f.name) for f in fields(self)}
         data["capabilities"] = list(self.capabilities)
-        data["checks"] = [c.to_dict() for c in self.checks]
+        data["checks"] = [c.to_dict(failures) for c in self.checks]
+        data["case_seconds"] = dict(self.case_seconds)
         return data
+
+    def failure_lines(self):
+        """``failures.jsonl``: one strict-JSON line per failing case of every
+        check, ``{"check": "capability.check", ...its record}``, in check
+        and case order."""
+        for check in self.checks:
+            for failure in check.failures:
+                yield strict_json({"check": check.key, **failure}, indent=None)
 
     def to_json(self) -> str:
         """Strict JSON (:func:`strict_json`), valid against the schema

@@ -60,9 +60,10 @@ def needed_case_sets(capabilities) -> tuple[str, ...]:
 
 
 def _crashed(check, crash: Crash, seconds: float) -> CheckResult:
+    example = crash.example(case="none: the check itself")
     return CheckResult(capability=check.capability, check=check.name, cases=1, passed=0,
                        failed=1, classes={"crash": 1}, status="failed", seconds=seconds,
-                       examples=[crash.example(case="none: the check itself")])
+                       examples=[example], failures=[example])
 
 
 def run_check(check, engine, case_set) -> CheckResult:
@@ -75,9 +76,19 @@ def run_check(check, engine, case_set) -> CheckResult:
     return result
 
 
+def read_declarations(expected_failures) -> tuple[dict, str]:
+    """The declarations of ``expected_failures`` (a file, a dict already
+    parsed, or None) and where they came from, for the record."""
+    if isinstance(expected_failures, dict):
+        return expected_failures, "<declarations>"
+    if expected_failures is not None:
+        return read_expected(expected_failures), str(expected_failures)
+    return {}, ""
+
+
 def check_engine(engine, *, cases: int = DEFAULT_CASES, seed: int = 0, only=None,
                  expected_failures=None, case_sets: dict | None = None,
-                 spec: str = "") -> ConformanceResult:
+                 spec: str = "", progress=None) -> ConformanceResult:
     """Every applicable check of ``engine`` (module docstring).
 
     Parameters
@@ -98,6 +109,9 @@ def check_engine(engine, *, cases: int = DEFAULT_CASES, seed: int = 0, only=None
         built with the same ``cases`` and ``seed``), to share between engines.
     spec : str
         The ``module:factory`` the engine came from, for the record.
+    progress : callable, optional
+        Called with a line of text as each case set and each check starts
+        and ends (the command line prints them on stderr).
 
     Returns
     -------
@@ -110,23 +124,25 @@ def check_engine(engine, *, cases: int = DEFAULT_CASES, seed: int = 0, only=None
     cases = check_count("cases", cases, minimum=1)
     seed = check_count("seed", seed, minimum=0)
     chosen = select_capabilities(engine, only)
-    declarations, source = {}, ""
-    if isinstance(expected_failures, dict):
-        declarations, source = expected_failures, "<declarations>"
-    elif expected_failures is not None:
-        declarations, source = read_expected(expected_failures), str(expected_failures)
+    declarations, source = read_declarations(expected_failures)
     start = time.perf_counter()
     sets = dict(case_sets or {})
     case_seconds = {}
+    say = progress or (lambda text: None)
     for set_name in needed_case_sets(chosen):
         if set_name not in sets:
+            say(f"case set {set_name}: building (or reading from the cache)")
             before = time.perf_counter()
             sets.update(build_cases([set_name], cases, seed))
             case_seconds[set_name] = time.perf_counter() - before
+            say(f"case set {set_name}: {len(sets[set_name])} cases, "
+                f"{case_seconds[set_name]:.1f} s")
     results = []
     for check in checks_for(chosen):
-        result = run_check(check, engine, sets[check.cases])
-        results.append(apply_expected(result, declarations))
+        say(f"{check.key}: running")
+        result = apply_expected(run_check(check, engine, sets[check.cases]), declarations)
+        say(f"{check.key}: {result.status}, {result.seconds:.1f} s")
+        results.append(result)
     return ConformanceResult(engine=name, refsim=__version__, seed=seed, cases=cases,
                              capabilities=chosen, checks=tuple(results), spec=spec,
                              expected_failures=source,

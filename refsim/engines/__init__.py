@@ -82,6 +82,14 @@ Pose = tuple[np.ndarray, np.ndarray]
 
 @runtime_checkable
 class TriangleTest(Protocol):
+    """``triangles``: ``triangles_intersect(a, b) -> bool``.
+
+    ``a``, ``b``: (3, 3) float64, one vertex a row, in any one frame and
+    length unit. True when the closed triangles share at least one point
+    (a touching pair intersects). Checked by ``triangles.agreement`` against
+    the separating-axis test in rational arithmetic; a miss is measured by
+    the pair's gap in the same unit."""
+
     name: str
 
     def triangles_intersect(self, a: np.ndarray, b: np.ndarray) -> bool: ...
@@ -89,6 +97,16 @@ class TriangleTest(Protocol):
 
 @runtime_checkable
 class MeshPairs(Protocol):
+    """``pairs``: ``intersecting_pairs(vertices_a, faces_a, pose_a,
+    vertices_b, faces_b, pose_b) -> (k, 2) int array``.
+
+    ``vertices`` (n, 3) float64 in the body frame (metres), ``faces`` (m, 3)
+    int vertex indices, a pose ``(R (3, 3), t (3,))`` placing the body at
+    ``R p + t`` in the world. Every face pair ``(i, j)`` (``i`` of a, ``j``
+    of b) whose closed triangles meet in the world, each once, in any order.
+    The meshes are refsim's bundled models (``refsim.bundled.model_path``
+    locates the files the examples name)."""
+
     name: str
 
     def intersecting_pairs(self, vertices_a: np.ndarray, faces_a: np.ndarray, pose_a: Pose,
@@ -98,6 +116,11 @@ class MeshPairs(Protocol):
 
 @runtime_checkable
 class BodyCollision(Protocol):
+    """``collide``: ``bodies_collide(...) -> bool`` with the arguments of
+    :class:`MeshPairs`: whether the two *surfaces* meet. One body wholly
+    inside the other does not meet it (a solid engine answering True there
+    is classed "known-divergence")."""
+
     name: str
 
     def bodies_collide(self, vertices_a: np.ndarray, faces_a: np.ndarray, pose_a: Pose,
@@ -106,6 +129,11 @@ class BodyCollision(Protocol):
 
 @runtime_checkable
 class BoundingBox(Protocol):
+    """``aabb``: ``aabb(vertices, pose) -> (lo, hi)``, each (3,) float64: the
+    smallest axis-aligned box of ``R p + t`` over the (n, 3) ``vertices``
+    (metres, world frame). Held to the float64 rounding bound of ``R p + t``
+    on each side; a fattened box declares its ``box_slack``."""
+
     name: str
 
     def aabb(self, vertices: np.ndarray, pose: Pose) -> tuple[np.ndarray, np.ndarray]: ...
@@ -113,6 +141,14 @@ class BoundingBox(Protocol):
 
 @runtime_checkable
 class OdeStepper(Protocol):
+    """``ode``: ``ode_step(f, t, y, h) -> y_next``, one step of size ``h`` of
+    ``y' = f(t, y)`` from ``(t, y)``; ``y`` a float64 array (d,), ``f``
+    returning one. ``ode_order``: the order the engine claims (observed
+    order checked on problems with exact solutions). Optional:
+    ``ode_stability(z) -> complex``, the method's R(z) (checked against one
+    step of ``y' = z y``), and ``ode_evaluations``, the calls of ``f`` per
+    step it claims (else at least the order's minimum is required)."""
+
     name: str
     ode_order: int
 
@@ -121,6 +157,39 @@ class OdeStepper(Protocol):
 
 @runtime_checkable
 class RigidBodyWorld(Protocol):
+    """``rigid``: ``simulate(scene) -> trajectory``.
+
+    ``scene`` is a :class:`refsim.Scene` (:mod:`refsim.scenes.schema`);
+    ``docs/design.md`` lists every key with its unit and default. SI units
+    throughout. What the kit's scenes use:
+
+    - ``scene.world``: ``gravity`` (m/s^2) along ``gravity_direction`` (a
+      unit vector, default -y), the ``walls`` present (``"y-"`` is the floor;
+      the world cube has half-size ``half_size``), ``restitution`` e and
+      Coulomb's ``coulomb_mu`` at every contact; ``scene.integration.step``
+      h (s) and ``duration`` (s).
+    - each ``scene.bodies[i]``: ``model`` (a bundled model's file name:
+      ``refsim.bundled.model_path(name)``; ``scene.mesh(body)`` is its
+      loaded mesh) at ``scale``; ``mass`` (kg, a uniform solid);
+      ``position``: the mesh origin in the world frame; ``orientation``:
+      R, whose columns are the body's axes in the world; ``velocity``: the
+      centre of mass's (not the origin's); ``angular_velocity``: rad/s,
+      world frame; ``restitution``, ``mu``, ``fixed``, ``force``,
+      ``torque`` where set (see :meth:`refsim.Scene.coefficients`).
+
+    The trajectory has ``t`` (F,), the frames' times in seconds from the
+    initial state (``t[0] = 0``, F >= 2, every frame at a whole step; the
+    checks read apexes, contacts and rest from the frames, so keep at least
+    one frame every few steps: refsim keeps one every ``ceil(steps /
+    1000)``), and per frame and body, in the scene's
+    body order: ``position`` (F, B, 3) the mesh origin, ``velocity`` (F, B,
+    3) the centre of mass's, ``angular_velocity`` (F, B, 3) world frame,
+    ``orientation`` (F, B, 3, 3) with the body's axes as columns (as
+    :class:`refsim.Trajectory` holds them). An engine that cannot pose a
+    key the scene uses raises :class:`refsim.errors.UnposableKey` naming it
+    (:func:`refsim.scenes.support.refuse_unhonoured` does it from
+    ``honoured_keys``): that check is ``n/a``, not failed."""
+
     name: str
 
     def simulate(self, scene) -> Any: ...

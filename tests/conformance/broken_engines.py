@@ -114,6 +114,36 @@ class RigidStub:
         return self.answer(scene)
 
 
+class SeveralFlaws:
+    """Float triangles, a collide that reaches 1 mm, a box padded by 1e-9 m
+    and the seed's RK4: failures in every check that judges cases one by one
+    and in one of the fixed ODE checks (the sharding tests)."""
+
+    name = "several-flaws"
+    ode_order = 4
+
+    def __init__(self):
+        self._collide = GjkLikeCollide(1e-3, 0.0)
+        self._box = PaddedBox(1e-9, 0.0)
+        self._ode = SeedLiteralRK4()
+
+    def triangles_intersect(self, a, b) -> bool:
+        return triangles_intersect_float(a, b)
+
+    def bodies_collide(self, *args) -> bool:
+        return self._collide.bodies_collide(*args)
+
+    def aabb(self, vertices, pose):
+        return self._box.aabb(vertices, pose)
+
+    def ode_step(self, f, t, y, h):
+        return self._ode.ode_step(f, t, y, h)
+
+
+def several_flaws() -> SeveralFlaws:
+    return SeveralFlaws()
+
+
 def crashing_triangles() -> CrashingTriangles:
     return CrashingTriangles()
 

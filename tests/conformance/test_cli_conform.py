@@ -28,7 +28,28 @@ def test_passing_engine_exits_0_and_writes_json_and_page(tmp_path, capsys):
     assert [c["check"] for c in record["checks"]] == ["order", "stability", "evaluations"]
     assert all(c["status"] == "passed" for c in record["checks"])
     assert (out / "index.html").read_text().startswith("<!DOCTYPE html>")
-    assert sorted(p.name for p in out.iterdir()) == ["conformance.json", "index.html"]
+    assert sorted(p.name for p in out.iterdir()) == ["conformance.json", "failures.jsonl",
+                                                      "index.html"]
+    assert (out / "failures.jsonl").read_text() == ""      # nothing failed
+
+
+def test_every_failure_is_a_line_of_failures_jsonl(tmp_path):
+    """Not only the few examples of conformance.json: every failing case,
+    with its input, the engine's answer, the truth and the gap."""
+    out = tmp_path / "out"
+    assert main(["conform", BOX, "--cases", "24", "-o", str(out)]) == 1
+    record = json.loads((out / "conformance.json").read_text())
+    lines = [json.loads(line) for line in (out / "failures.jsonl").read_text().splitlines()]
+    failed = {f"{c['capability']}.{c['check']}": c["failed"] for c in record["checks"]}
+    assert failed["aabb.encloses"] > 2               # more than the examples keep
+    for key, count in failed.items():
+        mine = [line for line in lines if line["check"] == key]
+        assert len(mine) == count
+        assert [line["case"] for line in mine] == sorted({line["case"] for line in mine})
+    first = next(line for line in lines if line["check"] == "aabb.encloses")
+    assert {"vertices", "R", "t", "lo", "hi", "exact_lo", "exact_hi", "excess_metres",
+            "class"} <= set(first)
+    assert first["excess_metres"] > 0
 
 
 def test_failing_engine_exits_1_unless_declared(tmp_path, capsys):
@@ -106,11 +127,13 @@ def test_all_on_two_local_processes_gives_the_same_cells(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("args, phrase", [
-    (["refsim.engines.refsim_engines:corrected", "--workers", "2"], "run the engines of --all"),
     (["--all", "--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], "not both"),
+    (["refsim.engines.refsim_engines:corrected", "--workers", "2", "--scheduler",
+      "tcp://127.0.0.1:1"], "not both"),
     (["--all", "--workers", "0"], "--workers"),
+    (["refsim.engines.refsim_engines:corrected", "--workers", "0"], "--workers"),
 ])
-def test_workers_and_scheduler_are_for_all_and_exclusive(tmp_path, capsys, args, phrase):
+def test_workers_and_scheduler_are_exclusive(tmp_path, capsys, args, phrase):
     assert main(["conform", *args, "-o", str(tmp_path / "x")]) == EXIT_USER_ERROR
     err = capsys.readouterr().err
     assert err.startswith("refsim: error: ") and phrase in err and err.count("\n") == 1
