@@ -59,5 +59,5 @@ def model_path(name: str) -> Path:
     path = models_dir() / name
     if Path(name).name != name or not path.is_file():
         available = ", ".join(sorted(p.name for p in models_dir().glob("*.ac")))
-        raise ModelError(f"{name}: not a bundled model (bundled: {available})")
+        raise ModelError(f"not a bundled model (bundled: {available})", path=name)
     return path
