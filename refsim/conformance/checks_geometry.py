@@ -27,8 +27,9 @@ declares (:func:`refsim.engines.declarations`):
 
 An exception on a case is that case's "crash" (its input and the
 traceback's last line). Where a check fails, Hypothesis searches the same
-families for a failing case and shrinks it (:mod:`refsim.conformance.shrink`);
-it goes first in ``examples``.
+families for a case failing in the most serious class the seeded cases met
+and shrinks it (:mod:`refsim.conformance.shrink`); it goes first in
+``examples``.
 
 Cost: one engine call per case, plus, per failing case, a classification
 (O(1) exact predicates and a gap per disagreeing triangle pair), plus one
@@ -72,9 +73,7 @@ class CaseCheck:
     input and truth are added from ``case.to_dict()``). ``measure(failures)``
     gives the check's ``measured`` numbers from the failure records alone
     (so that shards' records give the same numbers), and ``miss`` names the
-    field holding a failure's length in metres. ``retry(prepared, case)``
-    judges a case Hypothesis made (the same as ``judge``, the crash
-    excepted: it is not the failure being shrunk).
+    field holding a failure's length in metres.
     """
 
     capability: str
@@ -115,16 +114,34 @@ class CaseCheck:
         shrunk = None
         if failures:
             start = time.perf_counter()
-            prepared = self.prepare(engine)
-            value = minimal_failure(cases.strategy(), lambda c: self.judge(prepared, c) is not None,
-                                    cases.seed)
-            verdict = None if value is None else attempt(self.judge, prepared, value)
-            if isinstance(verdict, dict):         # the engine failed it again, the same way
-                shrunk = {"shrunk": True, **verdict, **value.to_dict()}
+            shrunk = self._shrunk(engine, cases, worst_class(f["class"] for f in failures))
             seconds += time.perf_counter() - start
         return tally(self.capability, self.name, outcomes, examples=_examples(failures, shrunk),
                      measured=self.measure(failures), misses=misses, failures=failures,
                      seconds=seconds)
+
+    def _shrunk(self, engine, cases, target: str) -> dict | None:
+        """The minimal case Hypothesis finds in the set's families that fails
+        in class ``target`` (the most serious class among the seeded
+        failures, so that the shrunk example is one of the classes counted),
+        as an example record marked ``"shrunk": true``; None if none is found."""
+        prepared = self.prepare(engine)
+
+        def verdict(case):
+            answer = attempt(self.judge, prepared, case)
+            if isinstance(answer, Crash):
+                return answer.example()
+            return answer
+
+        def fails(case) -> bool:
+            answer = verdict(case)
+            return answer is not None and answer["class"] == target
+
+        value = minimal_failure(cases.strategy(), fails, cases.seed)
+        answer = None if value is None else verdict(value)
+        if answer is None or answer["class"] != target:
+            return None
+        return {"shrunk": True, **answer, **value.to_dict()}
 
     def run(self, engine, cases) -> CheckResult:
         """The check on every case of ``cases`` in this process."""
@@ -320,19 +337,21 @@ def _surface_gap(case, tolerance: float) -> dict:
     return {**_verdict(kind, gap, bound, tolerance), "gap_is_lower_bound": lower_bound}
 
 
-def classify_collide(case, got: bool, tolerance: float = 0.0) -> dict:
+def classify_collide(case, got: bool, tolerance: float = 0.0, solid: bool = False) -> dict:
     """The class of an engine's boolean answer that differs from the truth
     (module docstring): a false "apart" takes the most serious class of the
-    exact pairs it missed (the deepest gap); a false "collide" is
-    "known-divergence" when one body's centroid is inside the other, else
-    classed by the surfaces' distance."""
+    exact pairs it missed (the deepest gap); a false "collide" with one
+    body's centroid inside the other is "known-divergence" for an engine
+    that declares itself ``solid`` and "bug" for any other (its surfaces do
+    not meet); else it is classed by the surfaces' distance."""
     if len(case.truth) > 0:
         return _classify_face_pairs(case, [tuple(p) for p in np.asarray(case.truth)], tolerance)
     centroid_a = np.asarray(case.pose_a[0]) @ case.mesh_a.vertices.mean(axis=0) + case.pose_a[1]
     centroid_b = np.asarray(case.pose_b[0]) @ case.mesh_b.vertices.mean(axis=0) + case.pose_b[1]
     if (_inside(centroid_b, case.mesh_a, case.pose_a)
             or _inside(centroid_a, case.mesh_b, case.pose_b)):
-        return {"class": "known-divergence", "contained": True}
+        return {"class": "known-divergence" if solid else "bug", "contained": True,
+                "solid_declared": solid}
     return _surface_gap(case, tolerance)
 
 
@@ -355,11 +374,12 @@ def _judge_pairs(prepared, case) -> dict | None:
 
 
 def _judge_collide(prepared, case) -> dict | None:
-    engine, tolerance = prepared
+    engine, declared = prepared
     got = bool(_call(engine, "bodies_collide", case))
     if got == (len(case.truth) > 0):
         return None
-    return {**classify_collide(case, got, tolerance), "answer": got}
+    return {**classify_collide(case, got, declared.distance_tolerance, declared.solid),
+            "answer": got}
 
 
 def _pairs_answer(case, got) -> dict:
@@ -375,9 +395,15 @@ def _with_tolerance(engine):
     return engine, _distance_tolerance(engine)
 
 
+def _with_declarations(engine):
+    from refsim.engines import declarations
+
+    return engine, declarations(engine)
+
+
 PAIRS_AGREEMENT = CaseCheck("pairs", "agreement", _with_tolerance, _judge_pairs, _answer_counts,
                             "gap_metres")
-COLLIDE_AGREEMENT = CaseCheck("collide", "agreement", _with_tolerance, _judge_collide,
+COLLIDE_AGREEMENT = CaseCheck("collide", "agreement", _with_declarations, _judge_collide,
                               lambda failures: {}, "gap_metres")
 
 
@@ -460,12 +486,6 @@ def _largest_excess(failures: list[dict]) -> dict:
                                          default=0.0),
             "largest_excess_rounding_bounds": max(
                 (f.get("excess_rounding_bounds", 0.0) for f in failures), default=0.0)}
-
-
-def _with_declarations(engine):
-    from refsim.engines import declarations
-
-    return engine, declarations(engine)
 
 
 AABB_ENCLOSES = CaseCheck("aabb", "encloses", _with_declarations, _box_judge(0),

@@ -45,7 +45,8 @@ CLASS_DEFINITIONS: dict[str, str] = {
            "the law.",
     "known-divergence": "the check recognises, in the answer itself, a documented other law "
                         "(the seed's lateral friction (1 - friction) v_t instead of "
-                        "Coulomb's; a solid engine finding one body inside another).",
+                        "Coulomb's; an engine that declares solid = True finding one "
+                        "body inside another).",
     "loose": "a box that encloses every point but stands outside the exact box by more "
              "than the rounding bound and the distance tolerance, and no more than the "
              "engine's declared box_slack (metres).",

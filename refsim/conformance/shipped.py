@@ -53,6 +53,10 @@ class TrimeshEngine:
     #: at most 1e-8 (|x| + |y| + |z| + 1), within the same tolerance.
     distance_tolerance = 1e-6
 
+    #: The CollisionManager tests a convex mesh as the solid it bounds (GJK on
+    #: its hull), so a body wholly inside another collides.
+    solid = True
+
     def __init__(self):
         from refsim.oracles.trimesh_adapter import TrimeshOracle
         from refsim.oracles.trimesh_collision import TrimeshCollisionOracle

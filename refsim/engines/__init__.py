@@ -57,6 +57,12 @@ attribute                meaning
                          fattened box: Bullet's collision margin, Box2D's
                          AABB margin). A box that encloses and is wider by
                          no more is class "loose".
+``solid``                ``False`` (the default): ``bodies_collide`` tests
+                         surfaces, as the contract asks. ``True`` declares
+                         that the engine tests closed meshes as solids
+                         (GJK on convex shapes does): a body wholly inside
+                         the other collides, class "known-divergence";
+                         undeclared, that answer is a "bug".
 ``contact_law``          ``"restitution"`` (the default): a coefficient of
                          restitution ``e`` sets the bounce, the law the
                          apex-ratio and oblique-bounce checks assume. Any
@@ -119,7 +125,8 @@ class BodyCollision(Protocol):
     """``collide``: ``bodies_collide(...) -> bool`` with the arguments of
     :class:`MeshPairs`: whether the two *surfaces* meet. One body wholly
     inside the other does not meet it (a solid engine answering True there
-    is classed "known-divergence")."""
+    is classed "known-divergence" when the engine declares ``solid = True``,
+    else "bug")."""
 
     name: str
 
@@ -178,10 +185,11 @@ class RigidBodyWorld(Protocol):
       ``torque`` where set (see :meth:`refsim.Scene.coefficients`).
 
     The trajectory has ``t`` (F,), the frames' times in seconds from the
-    initial state (``t[0] = 0``, F >= 2, every frame at a whole step; the
-    checks read apexes, contacts and rest from the frames, so keep at least
-    one frame every few steps: refsim keeps one every ``ceil(steps /
-    1000)``), and per frame and body, in the scene's
+    initial state (``t[0] = 0``, F >= 2, each frame at a whole step). The
+    checks read times from ``t``, never frame counts, and apexes, impacts
+    and rest from the frames: keep one frame a step (refsim keeps one every
+    ``ceil(steps / 1000)``: every step in all but the long drops and the free
+    brick), and per frame and body, in the scene's
     body order: ``position`` (F, B, 3) the mesh origin, ``velocity`` (F, B,
     3) the centre of mass's, ``angular_velocity`` (F, B, 3) world frame,
     ``orientation`` (F, B, 3, 3) with the body's axes as columns (as
@@ -244,6 +252,7 @@ class Declarations:
     distance_tolerance: float = 0.0
     box_slack: float = 0.0
     contact_law: str = RESTITUTION
+    solid: bool = False
 
 
 def declarations(engine) -> Declarations:
@@ -266,7 +275,11 @@ def declarations(engine) -> Declarations:
         raise OptionError(f"engine {getattr(engine, 'name', '?')!r}: contact_law must be a "
                           f"non-empty name, e.g. 'restitution' or 'hunt-crossley', "
                           f"got {law!r}")
-    return Declarations(contact_law=law.strip(), **found)
+    solid = getattr(engine, "solid", False)
+    if not isinstance(solid, bool):
+        raise OptionError(f"engine {getattr(engine, 'name', '?')!r}: solid must be True or "
+                          f"False, got {solid!r}")
+    return Declarations(contact_law=law.strip(), solid=solid, **found)
 
 
 def engine_name(engine) -> str:

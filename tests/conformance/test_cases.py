@@ -151,7 +151,7 @@ def test_fitted_order_recovers_a_power_law():
     steps = [0.1, 0.05, 0.025, 0.0125]
     assert fitted_order(steps, [3 * h ** 2 for h in steps]) == pytest.approx(2.0, abs=1e-12)
     # points at the rounding floor are left out; fewer than two: no order
-    assert fitted_order(steps, [1e-3, 1e-12, 1e-13, 1e-14]) is None
+    assert fitted_order(steps, [1e-3, 1e-13, 1e-14, 1e-15]) is None
     assert fitted_order(steps, [h ** 4 for h in steps]) == pytest.approx(4.0, abs=1e-12)
     assert 1e-4 ** 4 < ERROR_FLOOR
     assert math.isnan(fitted_order(steps, [1.0, math.inf, 1.0, 1.0]))

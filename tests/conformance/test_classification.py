@@ -84,12 +84,27 @@ def test_gaps_against_closed_forms():
     assert penetration_depth(TRIANGLE, spike) == pytest.approx(0.1, rel=1e-12)
 
 
-def test_a_body_inside_a_convex_one_is_a_known_divergence():
+def test_a_body_inside_another_is_a_known_divergence_only_for_a_declared_solid():
     # the tetrahedron inside the sphere-2k: no surfaces meet (truth: apart),
     # a solid engine (trimesh's GJK on convex meshes) says they collide
     case = _case("sphere-2k.ac", IDENTITY, "tetrahedron.ac", (np.eye(3), np.array([0.1, 0.05, 0])))
     assert len(case.truth) == 0
-    assert classify_collide(case, True)["class"] == "known-divergence"
+    assert classify_collide(case, True, solid=True)["class"] == "known-divergence"
+    # an engine that tests surfaces, as the contract asks, has no excuse
+    verdict = classify_collide(case, True)
+    assert verdict["class"] == "bug" and verdict["contained"] and not verdict["solid_declared"]
+
+
+def test_solid_must_be_a_bool():
+    from refsim.engines import declarations
+    from refsim.errors import OptionError
+
+    class Engine:
+        name = "e"
+        solid = "yes"
+
+    with pytest.raises(OptionError, match="solid must be True or False"):
+        declarations(Engine())
 
 
 def test_a_grazing_gap_is_tolerance_only_within_the_declared_distance():

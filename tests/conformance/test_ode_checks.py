@@ -64,3 +64,36 @@ def test_end_error_needs_an_exact_solution():
     problem = replace(problems.kepler_orbit(), exact=None)
     with pytest.raises(ValueError, match="'kepler' has no exact solution"):
         end_error(SOLVERS["rk4"].step, problem, 10)
+
+
+def test_an_order_that_does_not_show_is_unmeasurable_not_passed():
+    """An engine exact to rounding at every step size shows no order: each
+    problem is "unmeasurable", with the reason, not a pass."""
+    from refsim.conformance.cases_ode import ode_cases
+    from refsim.conformance.checks_ode import check_ode_order
+
+    cases = ode_cases()
+    exact = {id(p.f): p.exact for p in cases.problems}
+
+    class Oracle:
+        name = "exact-oracle"
+        ode_order = 4
+
+        def ode_step(self, f, t, y, h):
+            return exact[id(f)](t + h)
+
+    result = check_ode_order(Oracle(), cases)
+    assert result.classes == {"unmeasurable": len(cases.problems)}
+    assert all(v is None for v in result.measured["observed_orders"].values())
+    assert "the order does not show" in result.examples[0]["reason"]
+
+
+def test_the_order_is_read_where_the_errors_are_asymptotic():
+    from refsim.conformance.cases_ode import asymptotic_order
+
+    steps = [1 / 32, 1 / 64, 1 / 128, 1 / 256]
+    assert asymptotic_order(steps, [3.0 * h ** 4 for h in steps]) == pytest.approx(4.0)
+    # two errors above rounding: no order
+    assert asymptotic_order(steps, [1e-12, 3e-14, 1e-15, 1e-16]) is None
+    # local slopes 3, 4, 5: the regime is not reached
+    assert asymptotic_order(steps, [1.0, 2.0 ** -3, 2.0 ** -7, 2.0 ** -12]) is None
