@@ -62,7 +62,7 @@ def _document(title: str, body: str) -> str:
 
 def engine_page(result) -> str:
     """The page of one :class:`~refsim.conformance.results.ConformanceResult`."""
-    from refsim.conformance.registry import CHECKS
+    from refsim.conformance.registry import CHECKS, TRUTH_CHECKS
     from refsim.conformance.results import CLASS_DEFINITIONS
 
     docs = {c.key: c.doc for c in CHECKS}
@@ -79,8 +79,10 @@ def engine_page(result) -> str:
              "<th>classes</th><th>status</th><th>reason</th></tr>"]
     for c in result.checks:
         classes = ", ".join(f"{k} {v}" for k, v in c.classes.items()) or "-"
+        truth = " (the kit's ground truth: the engine is not called)" \
+            if c.key in TRUTH_CHECKS else ""
         parts.append(f"<tr class=\"{_status_class(c.status)}\"><td><a href=\"#{_e(c.key)}\">"
-                     f"{_e(c.key)}</a></td><td class=\"n\">{c.cases}</td>"
+                     f"{_e(c.key)}</a>{_e(truth)}</td><td class=\"n\">{c.cases}</td>"
                      f"<td class=\"n\">{c.passed}</td><td class=\"n\">{c.failed}</td>"
                      f"<td>{_e(classes)}</td><td>{_e(c.status)}</td><td>{_e(c.reason)}</td></tr>")
     parts.append("</table>")

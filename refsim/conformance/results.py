@@ -149,7 +149,8 @@ class CheckResult:
         One of :data:`STATUSES` (see the module docstring).
     reason : str
         The expected-failure declaration's reason (``xfailed``/``xpassed``),
-        or why the check does not apply (``n/a``).
+        why the check does not apply (``n/a``), or for a failed check how
+        many cases failed in which classes, with each class's largest miss.
     measured : dict
         Numbers the check measured that a reader wants besides pass/fail
         (observed orders, evaluations per step, largest errors).
@@ -219,10 +220,16 @@ def tally(capability: str, check: str, outcomes, *, examples=(), measured=None,
             if miss is not None:
                 largest[outcome] = max(largest.get(outcome, 0.0), abs(float(miss)))
     failed = sum(classes.values())
+    reason = ""
+    if failed:
+        reason = f"{failed} of {len(outcomes)} cases failed: " + ", ".join(
+            f"{c} {classes[c]}" + (f" (largest miss {largest[c]:.3g} m)" if c in largest else "")
+            for c in CLASSES if c in classes)
     return CheckResult(capability=capability, check=check, cases=len(outcomes),
                        passed=len(outcomes) - failed, failed=failed,
                        classes={c: classes[c] for c in CLASSES if c in classes},
                        examples=list(examples), status="failed" if failed else "passed",
+                       reason=reason,
                        measured=dict(measured or {}),
                        largest_miss_metres={c: largest[c] for c in CLASSES if c in largest},
                        failures=list(examples if failures is None else failures),
@@ -350,10 +357,13 @@ def strict_json(data, indent: int | None = 1) -> str:
 def summary_table(result: ConformanceResult) -> str:
     """The plain-text table the command line prints: check, cases, passed,
     failed, classes, status."""
+    from refsim.conformance.registry import TRUTH_CHECKS
+
     rows = [("check", "cases", "passed", "failed", "classes", "status")]
     for c in result.checks:
         classes = ", ".join(f"{k} {v}" for k, v in c.classes.items()) or "-"
-        rows.append((c.key, str(c.cases), str(c.passed), str(c.failed), classes, c.status))
+        key = c.key + (" *" if c.key in TRUTH_CHECKS else "")
+        rows.append((key, str(c.cases), str(c.passed), str(c.failed), classes, c.status))
     widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
     lines = []
     for n, row in enumerate(rows):
@@ -362,4 +372,6 @@ def summary_table(result: ConformanceResult) -> str:
         lines.append("  ".join(cells).rstrip())
         if n == 0:
             lines.append("  ".join("-" * w for w in widths))
+    if any(c.key in TRUTH_CHECKS for c in result.checks):
+        lines.append("* checks the kit's own ground truth; it does not call the engine")
     return "\n".join(lines)
