@@ -349,6 +349,11 @@ class DrakeEngine:
     #: The scene keys beyond the seed's world it poses (module docstring:
     #: What the adapter refuses); any other it refuses by name.
     honoured_keys = frozenset({"world.gravity_direction", "world.walls", "world.mu"})
+    #: The order of its time step (:func:`refsim.engines.declarations`): a
+    #: discrete MultibodyPlant advances velocities, then positions with the
+    #: new velocities (Castro et al., "An unconstrained convex formulation
+    #: of compliant contact", IEEE T-RO 2022: first order in h).
+    integrator_order = 1
 
     def __init__(self, settings: DrakeSettings | None = None):
         self.settings = settings or DrakeSettings()

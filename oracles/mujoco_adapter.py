@@ -167,6 +167,9 @@ class MujocoOracle:
     #: The scene keys beyond the seed's world this adapter honours (module
     #: docstring, Scene keys): all but the restitution threshold.
     honoured_keys = frozenset(LOAD_KEYS) - {"world.restitution_threshold"}
+    #: The order of its time step (:func:`refsim.engines.declarations`):
+    #: ``integrator="Euler"`` is MuJoCo's semi-implicit Euler, first order.
+    integrator_order = 1
 
     def __init__(self, settings: MujocoSettings | None = None):
         self.mujoco = import_engine("mujoco", "mujoco")

@@ -357,6 +357,11 @@ class PybulletOracle:
     #: docstring, Scene keys): all of them; coefficients per body and pair
     #: only where Bullet's products can give them (refused by name otherwise).
     honoured_keys = frozenset(LOAD_KEYS)
+    #: The order of its time step (:func:`refsim.engines.declarations`):
+    #: Bullet's btSequentialImpulseConstraintSolver world steps velocities,
+    #: then positions with the new velocities (semi-implicit Euler), first
+    #: order.
+    integrator_order = 1
 
     def __init__(self, settings: PybulletSettings | None = None):
         with c_banner_dropped("pybullet build time:"):      # printed as it loads

@@ -45,6 +45,9 @@ Declarations:
   0.10000000149 (``MeshShape.getBoundingBox``). Half a float32 ulp of each of three
   coordinates up to 2 m (every mesh the kit poses lies within 1.46 m of its origin).
 - ``contact_law``: the default, ``"restitution"`` (ContactConstraint.cpp, above).
+- ``integrator_order`` = 1: ``World::step`` integrates velocities, solves the
+  contacts, then integrates positions with the new velocities (semi-implicit
+  Euler, first order).
 - No ``box_slack``: no ``aabb`` capability.
 """
 
@@ -99,6 +102,8 @@ def _isometry(R, t):
 class DartEngine:
     #: metres: assimp stores a mesh's vertices as float32 (module docstring).
     distance_tolerance = FLOAT32_ROUNDING
+    #: semi-implicit Euler (module docstring).
+    integrator_order = 1
     honoured_keys = ("world.gravity_direction", "world.walls", "world.mu",
                      "body.fixed", "body.force", "body.torque")
 

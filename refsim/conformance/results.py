@@ -52,7 +52,9 @@ CLASS_DEFINITIONS: dict[str, str] = {
              "engine's declared box_slack (metres).",
     "tolerance": "the gap or excess (metres) is within the rounding bound of a float64 "
                  "evaluation or within the engine's declared distance_tolerance; or a "
-                 "measured quantity misses its tolerance by at most a factor of two.",
+                 "measured quantity misses its tolerance by at most a factor of two; or "
+                 "a free body's drift falls at the engine's declared integrator_order "
+                 "when the step is halved (its truncation error).",
     "touching": "the exact answer turns on an exact contact: the two sets share a point but "
                 "nothing crosses transversally (gap exactly 0). A float engine may answer "
                 "either way.",

@@ -63,6 +63,15 @@ attribute                meaning
                          (GJK on convex shapes does): a body wholly inside
                          the other collides, class "known-divergence";
                          undeclared, that answer is a "bug".
+``integrator_order``     ``None`` (the default): the order of the rigid
+                         engine's time step (1 for semi-implicit Euler, as
+                         Bullet, MuJoCo's "Euler" and Drake's discrete
+                         solvers take). Declared, a free body's energy and
+                         momentum drift beyond ``rigid.free_rotation``'s
+                         tolerance is run again at half the step: falling
+                         at the declared order (within 0.3), it is the
+                         integrator's truncation error, class "tolerance";
+                         otherwise, or undeclared, "bug".
 ``contact_law``          ``"restitution"`` (the default): a coefficient of
                          restitution ``e`` sets the bounce, the law the
                          apex-ratio and oblique-bounce checks assume. Any
@@ -253,6 +262,7 @@ class Declarations:
     box_slack: float = 0.0
     contact_law: str = RESTITUTION
     solid: bool = False
+    integrator_order: int | None = None
 
 
 def declarations(engine) -> Declarations:
@@ -279,7 +289,13 @@ def declarations(engine) -> Declarations:
     if not isinstance(solid, bool):
         raise OptionError(f"engine {getattr(engine, 'name', '?')!r}: solid must be True or "
                           f"False, got {solid!r}")
-    return Declarations(contact_law=law.strip(), solid=solid, **found)
+    order = getattr(engine, "integrator_order", None)
+    if order is not None and (isinstance(order, bool) or not isinstance(order, int)
+                              or order < 1):
+        raise OptionError(f"engine {getattr(engine, 'name', '?')!r}: integrator_order must "
+                          f"be a whole number >= 1 or None, got {order!r}")
+    return Declarations(contact_law=law.strip(), solid=solid, integrator_order=order,
+                        **found)
 
 
 def engine_name(engine) -> str:
