@@ -8,12 +8,10 @@ section shows the same table). Lengths are in the scene's unit (metres),
 and every reported number names its unit in its field name (``gap_metres``,
 ``excess_metres``, ``excess_rounding_bounds``).
 
-A check's **status** is ``passed`` (no failing case), ``failed``,
-``xfailed`` (failing cases, all of them in classes an expected-failures
-declaration accepts, see :mod:`refsim.conformance.expected`), ``xpassed``
-(declared, yet nothing failed: not an error, the declaration may be stale)
-or ``n/a`` (the check needs something the engine does not give, e.g.
-``ode_stability``; no case was run).
+A check's **status** is one of :data:`STATUS_DEFINITIONS`: ``passed``,
+``failed``, ``xfailed`` and ``xpassed`` (as an expected-failures
+declaration, :mod:`refsim.conformance.expected`, accepts the failures or
+finds none), or ``n/a``.
 
 Cost: plain records; building them is O(checks).
 """
@@ -67,7 +65,20 @@ CLASSES = tuple(CLASS_DEFINITIONS)
 #: all but "crash" (see :mod:`refsim.conformance.expected`).
 DECLARABLE_WITHOUT_NAMING = tuple(c for c in CLASSES if c != "crash")
 
-STATUSES = ("passed", "failed", "xfailed", "xpassed", "n/a")
+#: What each status of a check means (the module docstring's list).
+STATUS_DEFINITIONS = {
+    "passed": "no case failed.",
+    "failed": "a case failed, outside what any expected-failures declaration accepts; the "
+              "reason says how many in which classes, or which declaration it broke.",
+    "xfailed": "cases failed, every one in the classes (and within the bounds) an "
+               "expected-failures declaration accepts; the reason is the declaration's.",
+    "xpassed": "declared as an expected failure, yet nothing failed: not an error, the "
+               "declaration may be stale.",
+    "n/a": "the check needs something the engine does not give (e.g. ode_stability) or "
+           "cannot pose (a scene key it refuses); no case was run, the reason says which.",
+}
+
+STATUSES = tuple(STATUS_DEFINITIONS)
 
 #: A measured quantity that misses its tolerance by no more than this factor
 #: is classed "tolerance" (the engine does the right thing, less accurately

@@ -100,7 +100,46 @@ class ClassesTable(SphinxDirective):
         return container.children
 
 
+class _Table(SphinxDirective):
+    """A two-column table of names and meanings from the package."""
+
+    has_content = False
+    header: tuple = ()
+
+    def rows(self) -> list[tuple[str, str]]:
+        raise NotImplementedError
+
+    def run(self) -> list[nodes.Node]:
+        container = nodes.container()
+        self.state.nested_parse(StringList(list_table(self.header, self.rows()),
+                                           "refsim.conformance"),
+                                self.content_offset, container)
+        return container.children
+
+
+class StatusesTable(_Table):
+    header = ("status", "meaning")
+
+    def rows(self):
+        from refsim.conformance.results import STATUS_DEFINITIONS
+
+        return [(f"``{name}``", meaning) for name, meaning in STATUS_DEFINITIONS.items()]
+
+
+class ChecksTable(_Table):
+    header = ("check", "what it asks of the engine")
+
+    def rows(self):
+        from refsim.conformance.registry import CHECKS, TRUTH_CHECKS
+
+        return [(f"``{c.key}``", c.doc + (" (The kit's own ground truth: the engine is not "
+                                          "called.)" if c.key in TRUTH_CHECKS else ""))
+                for c in CHECKS]
+
+
 def setup(app: Sphinx) -> dict:
     app.add_directive("refsim-public-api", PublicApi)
     app.add_directive("refsim-classes", ClassesTable)
+    app.add_directive("refsim-statuses", StatusesTable)
+    app.add_directive("refsim-checks", ChecksTable)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
