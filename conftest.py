@@ -15,7 +15,10 @@ process puts them back as an interactive shell would have them
 The conformance kit's case sets are not kept on disk during the tests
 (``REFSIM_CACHE_DIR`` empty, inherited by the commands the tests start): a
 test's result never depends on a file an earlier run left in the user's
-cache. The cache's own tests give it a directory of their own.
+cache. The cache's own tests give it a directory of their own. For the
+same reason the command line's notice of numba compiling
+(``REFSIM_COMPILE_NOTICE``) is off: whether a command compiles depends on
+numba's cache, not on the command.
 """
 
 from __future__ import annotations
@@ -26,6 +29,7 @@ import signal
 import pytest
 
 os.environ["REFSIM_CACHE_DIR"] = ""
+os.environ["REFSIM_COMPILE_NOTICE"] = "0"
 
 
 def pytest_configure(config) -> None:

@@ -28,6 +28,7 @@ status 1. ``refsim --version`` prints the installed version.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import sys
@@ -36,6 +37,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 from refsim.errors import DivergenceError, OutputError, RefsimError, SceneError
+from refsim.kernels import compile_notices
 from refsim.signals import Interrupted, signals_raise
 
 EXIT_USER_ERROR = 2
@@ -792,7 +794,9 @@ def _main(argv: list[str] | None) -> int:
         warnings.showwarning = _one_line_warning
     try:
         # SIGTERM and SIGHUP unwind like Ctrl-C, so temporary files are removed
-        with signals_raise():
+        # `info` computes nothing numba compiles: it does not pay numba's import
+        with signals_raise(), (contextlib.nullcontext() if args.run is _info
+                               else compile_notices(sys.stderr)):
             return args.run(args)
     except DivergenceError as exc:
         if args.debug:

@@ -39,10 +39,12 @@ the kernel module itself, which renews its cache.
 from __future__ import annotations
 
 import ast
+import contextlib
 import functools
 import hashlib
 import importlib
 import os
+import time
 import warnings
 from pathlib import Path
 
@@ -122,6 +124,52 @@ def _warn_readable() -> None:
     warnings.warn(f"numba does not work here ({numba_error()}); refsim runs its readable "
                   "kernels, tens of times slower (pip install numba)", KernelWarning,
                   stacklevel=3)
+
+
+#: Set to "0" to silence :func:`compile_notices` (the test suite does, so
+#: that a command's output does not depend on what numba's cache holds).
+COMPILE_NOTICE_ENV = "REFSIM_COMPILE_NOTICE"
+
+
+@contextlib.contextmanager
+def compile_notices(stream):
+    """Within the body, the first time numba compiles a kernel (its disk
+    cache empty or stale: a fresh install, an edited kernel) one line on
+    ``stream`` says so before the wait; at the end, if anything compiled,
+    one line says how many kernels took how long. Loads from numba's cache
+    say nothing (numba emits its "numba:compile" event only for a compile).
+    Nothing when numba is missing or ``REFSIM_COMPILE_NOTICE=0``."""
+    if os.environ.get(COMPILE_NOTICE_ENV, "1") == "0" or not numba_usable():
+        yield
+        return
+    from numba.core import event
+
+    class Notice(event.Listener):
+        """Counts top-level compiles (a kernel's callees compile inside it)."""
+
+        def __init__(self):
+            self.depth, self.count, self.seconds, self.began = 0, 0, 0.0, 0.0
+
+        def on_start(self, ev):
+            if self.depth == 0:
+                if self.count == 0:
+                    print("refsim: compiling kernels for this machine (once: numba keeps "
+                          "them for later runs)...", file=stream, flush=True)
+                self.count += 1
+                self.began = time.perf_counter()
+            self.depth += 1
+
+        def on_end(self, ev):
+            self.depth -= 1
+            if self.depth == 0:
+                self.seconds += time.perf_counter() - self.began
+
+    notice = Notice()
+    with event.install_listener("numba:compile", notice):
+        yield
+    if notice.count:
+        print(f"refsim: compiled {notice.count} kernel{'s' * (notice.count > 1)} in "
+              f"{notice.seconds:.1f} s", file=stream, flush=True)
 
 
 @functools.cache
