@@ -176,6 +176,17 @@ def _distance_tolerance(engine) -> float:
     return declarations(engine).distance_tolerance
 
 
+def _roundoff(engine_or_declarations) -> float:
+    """The engine's declared unit roundoff over float64's: the factor on
+    every rounding bound (1 for a float64 engine, 2^29 for float32)."""
+    from refsim.conformance.gaps import UNIT_ROUNDOFF
+    from refsim.engines import Declarations, declarations
+
+    declared = engine_or_declarations if isinstance(engine_or_declarations, Declarations) \
+        else declarations(engine_or_declarations)
+    return declared.unit_roundoff / UNIT_ROUNDOFF
+
+
 def _verdict(kind: str, gap: float, bound: float, tolerance: float) -> dict:
     """A classified disagreement as example fields, units in the names."""
     return {"class": kind, "gap_metres": gap, "rounding_bound_metres": bound,
@@ -185,10 +196,11 @@ def _verdict(kind: str, gap: float, bound: float, tolerance: float) -> dict:
 # -- triangles ---------------------------------------------------------------------------
 
 
-def classify_triangles(a, b, distance_tolerance: float = 0.0) -> dict:
+def classify_triangles(a, b, distance_tolerance: float = 0.0, roundoff: float = 1.0) -> dict:
     """The class of a disagreement on the triangle pair ``(a, b)`` with its
     gap, the rounding bound and the tolerance (module docstring), as
-    example fields."""
+    example fields. ``roundoff``: the engine's declared unit roundoff over
+    float64's (:func:`_roundoff`), which scales the rounding bound."""
     from refsim.collision.sat_exact import triangles_intersect_sat
     from refsim.collision.triangle import triangles_intersect
     from refsim.studies.triangles import _points_coplanar, _strict_crossing
@@ -197,7 +209,7 @@ def classify_triangles(a, b, distance_tolerance: float = 0.0) -> dict:
     t2 = tuple(map(tuple, np.asarray(b, np.float64).tolist()))
     refsim = triangles_intersect(t1, t2)
     truth = triangles_intersect_sat(t1, t2)
-    bound = rounding_bound(a, b)
+    bound = rounding_bound(a, b) * roundoff
     gap = signed_gap(a, b, refsim if truth is None else truth)
     if truth is not None and truth != refsim:
         kind = "bug"                       # the ground truth itself is wrong
@@ -211,11 +223,11 @@ def classify_triangles(a, b, distance_tolerance: float = 0.0) -> dict:
 
 
 def _judge_triangles(prepared, pair) -> dict | None:
-    answer, tolerance = prepared
+    answer, tolerance, roundoff = prepared
     got = bool(answer(pair.a, pair.b))
     if got == pair.truth:
         return None
-    return {**classify_triangles(pair.a, pair.b, tolerance), "answer": got}
+    return {**classify_triangles(pair.a, pair.b, tolerance, roundoff), "answer": got}
 
 
 def _by_family(failures: list[dict]) -> dict:
@@ -228,12 +240,12 @@ def _by_family(failures: list[dict]) -> dict:
 def _refsim_triangles(engine):
     from refsim.collision.triangle import triangles_intersect
 
-    return triangles_intersect, 0.0
+    return triangles_intersect, 0.0, 1.0
 
 
 TRIANGLES_AGREEMENT = CaseCheck(
     "triangles", "agreement", lambda engine: (engine.triangles_intersect,
-                                              _distance_tolerance(engine)),
+                                              _distance_tolerance(engine), _roundoff(engine)),
     _judge_triangles, _by_family, "gap_metres")
 TRIANGLES_REFERENCE = CaseCheck("triangles", "reference", _refsim_triangles, _judge_triangles,
                                 _by_family, "gap_metres")
@@ -275,23 +287,23 @@ def _world(case):
             transform_points(case.mesh_b.vertices, case.pose_b))
 
 
-def _classify_face_pairs(case, differing, tolerance: float) -> dict:
+def _classify_face_pairs(case, differing, tolerance: float, roundoff: float = 1.0) -> dict:
     """The most serious class of the face pairs ``differing``, with the gap
     of the pair farthest from touching."""
     world_a, world_b = _world(case)
     fa, fb = case.mesh_a.faces, case.mesh_b.faces
-    verdicts = [classify_triangles(world_a[fa[i]], world_b[fb[j]], tolerance)
+    verdicts = [classify_triangles(world_a[fa[i]], world_b[fb[j]], tolerance, roundoff)
                 for i, j in differing]
     kind = worst_class(v["class"] for v in verdicts)
     widest = max(verdicts, key=lambda v: abs(v["gap_metres"]))
     return {**widest, "class": kind}
 
 
-def classify_pairs(case, got, tolerance: float = 0.0) -> dict:
+def classify_pairs(case, got, tolerance: float = 0.0, roundoff: float = 1.0) -> dict:
     """The class of an engine's face pairs ``got`` that differ from the
     truth, with the largest gap among them (module docstring)."""
     truth, answer = _pair_set(case.truth), _pair_set(got)
-    return _classify_face_pairs(case, sorted(truth ^ answer), tolerance)
+    return _classify_face_pairs(case, sorted(truth ^ answer), tolerance, roundoff)
 
 
 def _inside(point, mesh, pose) -> bool:
@@ -317,7 +329,7 @@ def _inside(point, mesh, pose) -> bool:
     return bool(hits.sum() % 2)
 
 
-def _surface_gap(case, tolerance: float) -> dict:
+def _surface_gap(case, tolerance: float, roundoff: float = 1.0) -> dict:
     """The class of a false "collide" between surfaces that do not meet, by
     their smallest distance: the triangle distances of the face pairs whose
     boxes are within reach (at most :data:`GAP_PAIRS`, nearest first)."""
@@ -332,12 +344,13 @@ def _surface_gap(case, tolerance: float) -> dict:
     lower_bound = len(order) < boxes.size and float(boxes.flat[order[-1]]) < gap
     if lower_bound:
         gap = float(boxes.flat[order[-1]])
-    bound = max(rounding_bound(world_a), rounding_bound(world_b))
+    bound = max(rounding_bound(world_a), rounding_bound(world_b)) * roundoff
     kind = "tolerance" if gap <= max(bound, tolerance) and not lower_bound else "bug"
     return {**_verdict(kind, gap, bound, tolerance), "gap_is_lower_bound": lower_bound}
 
 
-def classify_collide(case, got: bool, tolerance: float = 0.0, solid: bool = False) -> dict:
+def classify_collide(case, got: bool, tolerance: float = 0.0, solid: bool = False,
+                     roundoff: float = 1.0) -> dict:
     """The class of an engine's boolean answer that differs from the truth
     (module docstring): a false "apart" takes the most serious class of the
     exact pairs it missed (the deepest gap); a false "collide" with one
@@ -345,14 +358,15 @@ def classify_collide(case, got: bool, tolerance: float = 0.0, solid: bool = Fals
     that declares itself ``solid`` and "bug" for any other (its surfaces do
     not meet); else it is classed by the surfaces' distance."""
     if len(case.truth) > 0:
-        return _classify_face_pairs(case, [tuple(p) for p in np.asarray(case.truth)], tolerance)
+        return _classify_face_pairs(case, [tuple(p) for p in np.asarray(case.truth)], tolerance,
+                                    roundoff)
     centroid_a = np.asarray(case.pose_a[0]) @ case.mesh_a.vertices.mean(axis=0) + case.pose_a[1]
     centroid_b = np.asarray(case.pose_b[0]) @ case.mesh_b.vertices.mean(axis=0) + case.pose_b[1]
     if (_inside(centroid_b, case.mesh_a, case.pose_a)
             or _inside(centroid_a, case.mesh_b, case.pose_b)):
         return {"class": "known-divergence" if solid else "bug", "contained": True,
                 "solid_declared": solid}
-    return _surface_gap(case, tolerance)
+    return _surface_gap(case, tolerance, roundoff)
 
 
 def _answer_counts(failures: list[dict]) -> dict:
@@ -366,11 +380,12 @@ def _answer_counts(failures: list[dict]) -> dict:
 
 
 def _judge_pairs(prepared, case) -> dict | None:
-    engine, tolerance = prepared
+    engine, declared = prepared
     got = _call(engine, "intersecting_pairs", case)
     if _pair_set(got) == _pair_set(case.truth):
         return None
-    return {**classify_pairs(case, got, tolerance), **_pairs_answer(case, got)}
+    return {**classify_pairs(case, got, declared.distance_tolerance, _roundoff(declared)),
+            **_pairs_answer(case, got)}
 
 
 def _judge_collide(prepared, case) -> dict | None:
@@ -378,7 +393,8 @@ def _judge_collide(prepared, case) -> dict | None:
     got = bool(_call(engine, "bodies_collide", case))
     if got == (len(case.truth) > 0):
         return None
-    return {**classify_collide(case, got, declared.distance_tolerance, declared.solid),
+    return {**classify_collide(case, got, declared.distance_tolerance, declared.solid,
+                               _roundoff(declared)),
             "answer": got}
 
 
@@ -391,17 +407,13 @@ def _pairs_answer(case, got) -> dict:
             "extra_pair_count": len(answer - truth), "missing_pair_count": len(truth - answer)}
 
 
-def _with_tolerance(engine):
-    return engine, _distance_tolerance(engine)
-
-
 def _with_declarations(engine):
     from refsim.engines import declarations
 
     return engine, declarations(engine)
 
 
-PAIRS_AGREEMENT = CaseCheck("pairs", "agreement", _with_tolerance, _judge_pairs, _answer_counts,
+PAIRS_AGREEMENT = CaseCheck("pairs", "agreement", _with_declarations, _judge_pairs, _answer_counts,
                             "gap_metres")
 COLLIDE_AGREEMENT = CaseCheck("collide", "agreement", _with_declarations, _judge_collide,
                               lambda failures: {}, "gap_metres")
@@ -459,8 +471,9 @@ def classify_box(case, lo, hi, side: int, declared) -> dict | None:
         return None
     axis = int(np.argmax(ratio))
     metres = float(excess[side][axis])
-    encloses = not (excess[0] > np.maximum(case.bound, declared.distance_tolerance)).any()
-    if metres <= declared.distance_tolerance:
+    engine_bound = case.bound * _roundoff(declared)           # the engine's own rounding
+    encloses = not (excess[0] > np.maximum(engine_bound, declared.distance_tolerance)).any()
+    if metres <= max(declared.distance_tolerance, float(engine_bound[axis])):
         kind = "tolerance"
     elif side == 1 and encloses and metres <= declared.box_slack:
         kind = "loose"
@@ -468,6 +481,7 @@ def classify_box(case, lo, hi, side: int, declared) -> dict | None:
         kind = "bug"
     return {"class": kind, "excess_metres": metres,
             "excess_rounding_bounds": float(ratio[axis]), "axis": axis,
+            "engine_rounding_bound_metres": float(engine_bound[axis]),
             "distance_tolerance_metres": declared.distance_tolerance,
             "box_slack_metres": declared.box_slack}
 

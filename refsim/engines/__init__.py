@@ -8,8 +8,11 @@ conformance kit receive engines as arguments; only a composition root (the
 command line, the report build, a test fixture) chooses them (docs/design.md,
 Architecture).
 
-The contract uses plain arrays, so that an engine needs nothing of refsim
-but, for ``simulate``, the :class:`refsim.Scene` it is given:
+The contract uses plain float64 and int64 arrays, so that an engine needs
+nothing of refsim but, for ``simulate``, the :class:`refsim.Scene` it is
+given. The arrays the kit hands over may be read-only (a mesh case's
+vertices and faces are shared by every case): an engine that writes to its
+input, or a library that needs writable buffers, copies them first.
 
 =================  =========================================================
 capability         method
@@ -57,6 +60,13 @@ attribute                meaning
                          fattened box: Bullet's collision margin, Box2D's
                          AABB margin). A box that encloses and is wider by
                          no more is class "loose".
+``unit_roundoff``         ``2**-53`` (the default, float64): the unit
+                         roundoff of the arithmetic the engine computes in
+                         (``2**-24`` for float32 coordinates, as MeshLib
+                         stores them). Every rounding bound the kit compares
+                         a geometric miss with is float64's scaled by
+                         ``unit_roundoff / 2**-53``: a miss within the
+                         engine's own rounding is "tolerance", not "bug".
 ``solid``                ``False`` (the default): ``bodies_collide`` tests
                          surfaces, as the contract asks. ``True`` declares
                          that the engine tests closed meshes as solids
@@ -263,6 +273,7 @@ class Declarations:
     contact_law: str = RESTITUTION
     solid: bool = False
     integrator_order: int | None = None
+    unit_roundoff: float = 2.0 ** -53
 
 
 def declarations(engine) -> Declarations:
@@ -285,6 +296,15 @@ def declarations(engine) -> Declarations:
         raise OptionError(f"engine {getattr(engine, 'name', '?')!r}: contact_law must be a "
                           f"non-empty name, e.g. 'restitution' or 'hunt-crossley', "
                           f"got {law!r}")
+    roundoff = getattr(engine, "unit_roundoff", 2.0 ** -53)
+    try:
+        roundoff_value = float(roundoff)
+    except (TypeError, ValueError):
+        roundoff_value = math.nan
+    if isinstance(roundoff, bool) or not (2.0 ** -53 <= roundoff_value < 1.0):
+        raise OptionError(f"engine {getattr(engine, 'name', '?')!r}: unit_roundoff must be a "
+                          f"number in [2**-53, 1), e.g. 2**-24 for float32, got {roundoff!r}")
+    found["unit_roundoff"] = roundoff_value
     solid = getattr(engine, "solid", False)
     if not isinstance(solid, bool):
         raise OptionError(f"engine {getattr(engine, 'name', '?')!r}: solid must be True or "
