@@ -60,7 +60,7 @@ attribute                meaning
                          fattened box: Bullet's collision margin, Box2D's
                          AABB margin). A box that encloses and is wider by
                          no more is class "loose".
-``unit_roundoff``         ``2**-53`` (the default, float64): the unit
+``unit_roundoff``        ``2**-53`` (the default, float64): the unit
                          roundoff of the arithmetic the engine computes in
                          (``2**-24`` for float32 coordinates, as MeshLib
                          stores them). Every rounding bound the kit compares
