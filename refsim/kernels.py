@@ -138,8 +138,10 @@ def compile_notices(stream):
     ``stream`` says so before the wait; at the end, if anything compiled,
     one line says how many kernels took how long. Loads from numba's cache
     say nothing (numba emits its "numba:compile" event only for a compile).
-    Nothing when numba is missing or ``REFSIM_COMPILE_NOTICE=0``."""
-    if os.environ.get(COMPILE_NOTICE_ENV, "1") == "0" or not numba_usable():
+    Nothing when numba is missing, ``REFSIM_COMPILE_NOTICE=0`` or
+    ``REFSIM_KERNELS=readable`` (numba is then not even imported)."""
+    if (os.environ.get(COMPILE_NOTICE_ENV, "1") == "0"
+            or os.environ.get(KERNELS_ENV) == "readable" or not numba_usable()):
         yield
         return
     from numba.core import event

@@ -5,14 +5,16 @@ answers: about 9 s for 1e5 triangle pairs and 1 ms a pose on this
 project's two-core machine (docs/decisions/conformance.md). A run asked
 for the same set again reads it back instead, in well under a second.
 
-A file is named by everything its content depends on: the set, ``n``, the
-seed, and a digest of the source of the module that builds the set and of
-every refsim module it imports (:func:`refsim.kernels.sources_digest`),
-with the numpy version (its random generators draw the cases). An edit to
-any of those, or another numpy, names another file: a stale set is never
-read. A file that cannot be read (truncated, from another Python) is built
-again and replaced; a directory that cannot be written only costs the
-saving.
+A file is named by everything its content can depend on: the set, ``n``,
+the seed, refsim's version, numpy's (its random generators draw the
+cases), a digest of the source of every module of the refsim package (the
+builders import the collision code that computes the truths, some of it
+inside functions, so no import graph is trusted to find them all), and the
+directory of models with the bytes of every model in it (the mesh cases'
+truths depend on them; ``$REFSIM_MODELS`` may point elsewhere). Any edit,
+another numpy or other models name another file: a stale set is never read.
+A file that cannot be read (truncated, from another Python) is built again
+and replaced; a directory that cannot be written only costs the saving.
 
 Where: ``$REFSIM_CACHE_DIR`` if set (an empty value turns the cache off),
 else ``$XDG_CACHE_HOME/refsim/cases``, else ``~/.cache/refsim/cases``. The
@@ -23,17 +25,12 @@ few megabytes at 1e5 cases.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import pickle
 from collections.abc import Callable
 from pathlib import Path
-
-#: The sets worth keeping (the others are fixed and built in milliseconds),
-#: with the module that builds each.
-CACHED_SETS = {"triangles": "refsim.conformance.cases_triangles",
-               "poses": "refsim.conformance.cases_meshes",
-               "boxes": "refsim.conformance.cases_boxes"}
 
 
 def cache_directory() -> Path | None:
@@ -45,27 +42,49 @@ def cache_directory() -> Path | None:
     return Path(base) / "refsim" / "cases"
 
 
-def _builder_digest(module: str) -> str:
+def _digest(models: Path) -> str:
+    """The digest of everything a cached set depends on but its name
+    (module docstring)."""
+    return _digest_of(str(models), _source_stamp(), _models_stamp(models))
+
+
+@functools.cache
+def _digest_of(models: str, sources: tuple, model_files: tuple) -> str:
     import numpy
 
     from refsim import __version__
-    from refsim.kernels import _source_file, sources_digest
 
     digest = hashlib.sha256()
-    own = _source_file(module)
-    for part in (__version__, numpy.__version__, sources_digest(module),
-                 own.read_text(encoding="utf-8") if own else ""):
+    for part in (__version__, numpy.__version__, models):
         digest.update(part.encode() + b"\0")
+    for path, _size, _time in (*sources, *model_files):
+        digest.update(Path(path).name.encode() + b"\0" + Path(path).read_bytes() + b"\0")
     return digest.hexdigest()[:16]
+
+
+def _source_stamp() -> tuple:
+    """Every source file of the refsim package, with its size and time (the
+    content is read once per process for a stamp: :func:`_digest_of`)."""
+    package = Path(__file__).resolve().parent.parent
+    return tuple((str(p), p.stat().st_size, p.stat().st_mtime_ns)
+                 for p in sorted(package.rglob("*.py")))
+
+
+def _models_stamp(models: Path) -> tuple:
+    return tuple((str(p), p.stat().st_size, p.stat().st_mtime_ns)
+                 for p in sorted(models.glob("*")) if p.is_file())
 
 
 def cache_path(name: str, n: int, seed: int) -> Path | None:
     """The file that holds set ``name`` of ``n`` cases from ``seed``; None
     when the cache is off or the set is not one that is kept."""
+    from refsim.bundled import models_dir
+    from refsim.conformance.registry import GENERATED_SETS
+
     directory = cache_directory()
-    if directory is None or name not in CACHED_SETS:
+    if directory is None or name not in GENERATED_SETS:   # the fixed sets take milliseconds
         return None
-    return directory / f"{name}-n{n}-seed{seed}-{_builder_digest(CACHED_SETS[name])}.pickle"
+    return directory / f"{name}-n{n}-seed{seed}-{_digest(models_dir())}.pickle"
 
 
 def cached(name: str, n: int, seed: int, build: Callable[[], object]):

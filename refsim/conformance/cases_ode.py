@@ -52,7 +52,7 @@ STEP_COUNTS = (32, 64, 128, 256)
 #: than three errors above ERROR_FLOOR: Tsit5 and Dopri5 on most of the five
 #: problems), the same factor-8 range of h is tried at twice the step, then
 #: four times, ...: the order is measured at the finest steps where the
-#: truncation error shows (:func:`asymptotic_order`). Never coarser once
+#: truncation error shows (:func:`fitted_order` there). Never coarser once
 #: three errors show: coarser steps are further from the asymptotic regime,
 #: and a slope that looks steady there can be the next term's (Tsit5 on
 #: y' = cos(t) y shows 5.97 at 2 to 16 steps, 5.57 at 16 to 64).
@@ -65,10 +65,6 @@ COARSER_STEP_COUNTS = ((16, 32, 64, 128), (8, 16, 32, 64), (4, 8, 16, 32), (2, 4
 #: or fewer. Left out of the fit.
 ERROR_FLOOR = 1e-13
 
-#: The local slopes (between consecutive step sizes) of a fit may spread by
-#: this much and the errors still count as asymptotic, ``C h^p`` and not yet
-#: the higher terms: the order check's tolerance (its ORDER_TOL).
-ASYMPTOTIC_SPREAD = 0.3
 
 #: The stability sample points z = -k / 8, k = 0 .. 40.
 STABILITY_POINTS = tuple(-k / 8.0 for k in range(41))
@@ -136,33 +132,14 @@ def end_error(step, problem: problems.Problem, n: int) -> float:
     return float(np.abs(error).max() / problem.scale)
 
 
-def asymptotic_order(steps, errors, floor: float = ERROR_FLOOR,
-                     spread: float = ASYMPTOTIC_SPREAD) -> float | None:
-    """:func:`fitted_order` when at least three errors stand above ``floor``
-    and their local slopes (consecutive pairs) agree within ``spread``: the
-    errors are in their asymptotic regime, where the slope is the method's
-    order. None otherwise (too few points above rounding, or slopes still
-    changing: the higher-order terms dominate at these steps); NaN for an
-    error that is not finite."""
-    pts = [(h, e) for h, e in zip(steps, errors, strict=True) if e > floor]
-    if any(not math.isfinite(e) for _, e in pts):
-        return math.nan
-    if len(pts) < 3:
-        return None
-    local = [math.log(e0 / e1) / math.log(h0 / h1)
-             for (h0, e0), (h1, e1) in zip(pts, pts[1:], strict=False)]
-    if max(local) - min(local) > spread:
-        return None
-    return fitted_order(steps, errors, floor)
-
-
 def fitted_order(steps, errors, floor: float = ERROR_FLOOR) -> float | None:
     """Least-squares slope of log(error) on log(h) over the points with an
     error above ``floor``; None when fewer than two are (the engine is exact
-    to rounding on the problem) or an error is not finite."""
-    pts = [(h, e) for h, e in zip(steps, errors, strict=True) if e > floor]
-    if any(not math.isfinite(e) for _, e in pts):
+    to rounding on the problem); NaN when any error is not finite (NaN
+    included: it is never "below the floor")."""
+    if not all(math.isfinite(e) for e in errors):
         return math.nan
+    pts = [(h, e) for h, e in zip(steps, errors, strict=True) if e > floor]
     if len(pts) < 2:
         return None
     x = np.log([h for h, _ in pts])

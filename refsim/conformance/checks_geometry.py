@@ -11,14 +11,16 @@ declares (:func:`refsim.engines.declarations`):
   never the engine's fault); then "coplanar" and "touching" by exact
   predicates; otherwise the pair's gap (:mod:`refsim.conformance.gaps`:
   distance apart, minus the depth of a crossing) within the rounding bound
-  or the engine's ``distance_tolerance`` is "tolerance", beyond both "bug";
+  (float64's, scaled by the engine's declared ``unit_roundoff``) or the
+  engine's ``distance_tolerance`` is "tolerance", beyond both "bug";
 - mesh pairs: each face pair the engine adds or misses is a triangle pair of
   the world triangles (refsim's transform arithmetic, as the truth used),
   classified as above; a case takes its most serious class
   (:func:`refsim.conformance.results.worst_class`) and reports its largest
-  gap. A false "collide" is "known-divergence" when one body's centroid is
-  inside the other (a solid engine; refsim's surfaces do not meet), else
-  classed by the smallest gap between the surfaces;
+  gap. A false "collide" with one body's centroid inside the other is
+  "known-divergence" for an engine that declares ``solid = True`` and "bug"
+  for any other (refsim's surfaces do not meet); else it is classed by the
+  smallest gap between the surfaces;
 - boxes: per side, how far the box stands inside the exact one (``aabb.encloses``)
   or outside it (``aabb.tight``), in metres; within the rounding bound of
   :mod:`refsim.conformance.cases_boxes` it passes, within the declared
@@ -46,7 +48,12 @@ from fractions import Fraction
 
 import numpy as np
 
-from refsim.conformance.gaps import face_box_distances, rounding_bound, signed_gap
+from refsim.conformance.gaps import (
+    UNIT_ROUNDOFF,
+    face_box_distances,
+    rounding_bound,
+    signed_gap,
+)
 from refsim.conformance.results import CheckResult, Crash, attempt, tally, worst_class
 from refsim.conformance.shrink import minimal_failure
 
@@ -66,11 +73,14 @@ class CaseCheck:
     and the result put together from their failures is the one a single run
     gives.
 
-    ``prepare(engine)`` is what ``judge`` needs of the engine, read once per
-    run (the method to call, the declared tolerances); ``judge(prepared,
-    case)`` is None when the engine's answer is right, else the failure's
-    fields: its class, the gap or excess, the engine's answer (the case's
-    input and truth are added from ``case.to_dict()``). ``measure(failures)``
+    ``prepare(engine)`` is what the others need of the engine, read once per
+    run (the method to call, the declared tolerances); ``ask(prepared,
+    case)`` is the engine's answer, read into plain values (an exception
+    there is the engine's: class "crash"); ``judge(prepared, case, answer)``
+    is None when the answer is right, else the failure's fields: its class,
+    the gap or excess, the answer (the case's input and truth are added from
+    ``case.to_dict()``). An exception in ``judge`` is the kit's own and stops
+    the check (it is not blamed on the engine). ``measure(failures)``
     gives the check's ``measured`` numbers from the failure records alone
     (so that shards' records give the same numbers), and ``miss`` names the
     field holding a failure's length in metres.
@@ -79,6 +89,7 @@ class CaseCheck:
     capability: str
     name: str
     prepare: Callable
+    ask: Callable
     judge: Callable
     measure: Callable
     miss: str
@@ -94,10 +105,12 @@ class CaseCheck:
         prepared = self.prepare(engine)
         found: list[dict] = []
         for index, case in enumerate(items, start=first):
-            verdict = attempt(self.judge, prepared, case)
-            if isinstance(verdict, Crash):
-                found.append(verdict.example(case=index, **case.to_dict()))
-            elif verdict is not None:
+            answer = attempt(self.ask, prepared, case)
+            if isinstance(answer, Crash):
+                found.append(answer.example(case=index, **case.to_dict()))
+                continue
+            verdict = self.judge(prepared, case, answer)
+            if verdict is not None:
                 found.append({"case": index, **verdict, **case.to_dict()})
         return found
 
@@ -128,10 +141,10 @@ class CaseCheck:
         prepared = self.prepare(engine)
 
         def verdict(case):
-            answer = attempt(self.judge, prepared, case)
+            answer = attempt(self.ask, prepared, case)
             if isinstance(answer, Crash):
                 return answer.example()
-            return answer
+            return self.judge(prepared, case, answer)
 
         def fails(case) -> bool:
             answer = verdict(case)
@@ -179,7 +192,6 @@ def _distance_tolerance(engine) -> float:
 def _roundoff(engine_or_declarations) -> float:
     """The engine's declared unit roundoff over float64's: the factor on
     every rounding bound (1 for a float64 engine, 2^29 for float32)."""
-    from refsim.conformance.gaps import UNIT_ROUNDOFF
     from refsim.engines import Declarations, declarations
 
     declared = engine_or_declarations if isinstance(engine_or_declarations, Declarations) \
@@ -187,10 +199,15 @@ def _roundoff(engine_or_declarations) -> float:
     return declared.unit_roundoff / UNIT_ROUNDOFF
 
 
-def _verdict(kind: str, gap: float, bound: float, tolerance: float) -> dict:
-    """A classified disagreement as example fields, units in the names."""
-    return {"class": kind, "gap_metres": gap, "rounding_bound_metres": bound,
-            "distance_tolerance_metres": tolerance}
+def _verdict(kind: str, gap: float, bound: float, tolerance: float,
+             roundoff: float = 1.0) -> dict:
+    """A classified disagreement as example fields, units in the names (the
+    engine's unit roundoff too, where it declared one other than float64's)."""
+    fields = {"class": kind, "gap_metres": gap, "rounding_bound_metres": bound,
+              "distance_tolerance_metres": tolerance}
+    if roundoff != 1.0:
+        fields["unit_roundoff"] = roundoff * UNIT_ROUNDOFF
+    return fields
 
 
 # -- triangles ---------------------------------------------------------------------------
@@ -219,12 +236,15 @@ def classify_triangles(a, b, distance_tolerance: float = 0.0, roundoff: float = 
         kind, gap = "touching", 0.0
     else:
         kind = "tolerance" if abs(gap) <= max(bound, distance_tolerance) else "bug"
-    return _verdict(kind, gap, bound, distance_tolerance)
+    return _verdict(kind, gap, bound, distance_tolerance, roundoff)
 
 
-def _judge_triangles(prepared, pair) -> dict | None:
-    answer, tolerance, roundoff = prepared
-    got = bool(answer(pair.a, pair.b))
+def _ask_triangles(prepared, pair) -> bool:
+    return bool(prepared[0](pair.a, pair.b))
+
+
+def _judge_triangles(prepared, pair, got: bool) -> dict | None:
+    _, tolerance, roundoff = prepared
     if got == pair.truth:
         return None
     return {**classify_triangles(pair.a, pair.b, tolerance, roundoff), "answer": got}
@@ -246,9 +266,9 @@ def _refsim_triangles(engine):
 TRIANGLES_AGREEMENT = CaseCheck(
     "triangles", "agreement", lambda engine: (engine.triangles_intersect,
                                               _distance_tolerance(engine), _roundoff(engine)),
-    _judge_triangles, _by_family, "gap_metres")
-TRIANGLES_REFERENCE = CaseCheck("triangles", "reference", _refsim_triangles, _judge_triangles,
-                                _by_family, "gap_metres")
+    _ask_triangles, _judge_triangles, _by_family, "gap_metres")
+TRIANGLES_REFERENCE = CaseCheck("triangles", "reference", _refsim_triangles, _ask_triangles,
+                                _judge_triangles, _by_family, "gap_metres")
 
 
 def check_triangles_agreement(engine, cases) -> CheckResult:
@@ -277,6 +297,9 @@ def _call(engine, method: str, case):
 
 
 def _pair_set(pairs) -> set[tuple[int, int]]:
+    """Face pairs as a set of ``(i, j)`` (an array, a list, or a set already)."""
+    if isinstance(pairs, set):
+        return pairs
     return {(int(i), int(j)) for i, j in np.asarray(pairs, dtype=np.int64).reshape(-1, 2)}
 
 
@@ -346,7 +369,7 @@ def _surface_gap(case, tolerance: float, roundoff: float = 1.0) -> dict:
         gap = float(boxes.flat[order[-1]])
     bound = max(rounding_bound(world_a), rounding_bound(world_b)) * roundoff
     kind = "tolerance" if gap <= max(bound, tolerance) and not lower_bound else "bug"
-    return {**_verdict(kind, gap, bound, tolerance), "gap_is_lower_bound": lower_bound}
+    return {**_verdict(kind, gap, bound, tolerance, roundoff), "gap_is_lower_bound": lower_bound}
 
 
 def classify_collide(case, got: bool, tolerance: float = 0.0, solid: bool = False,
@@ -379,18 +402,24 @@ def _answer_counts(failures: list[dict]) -> dict:
     return counts
 
 
-def _judge_pairs(prepared, case) -> dict | None:
-    engine, declared = prepared
-    got = _call(engine, "intersecting_pairs", case)
-    if _pair_set(got) == _pair_set(case.truth):
+def _ask_pairs(prepared, case) -> set:
+    return _pair_set(_call(prepared[0], "intersecting_pairs", case))
+
+
+def _judge_pairs(prepared, case, got: set) -> dict | None:
+    _, declared = prepared
+    if got == _pair_set(case.truth):
         return None
     return {**classify_pairs(case, got, declared.distance_tolerance, _roundoff(declared)),
             **_pairs_answer(case, got)}
 
 
-def _judge_collide(prepared, case) -> dict | None:
-    engine, declared = prepared
-    got = bool(_call(engine, "bodies_collide", case))
+def _ask_collide(prepared, case) -> bool:
+    return bool(_call(prepared[0], "bodies_collide", case))
+
+
+def _judge_collide(prepared, case, got: bool) -> dict | None:
+    _, declared = prepared
     if got == (len(case.truth) > 0):
         return None
     return {**classify_collide(case, got, declared.distance_tolerance, declared.solid,
@@ -413,10 +442,10 @@ def _with_declarations(engine):
     return engine, declarations(engine)
 
 
-PAIRS_AGREEMENT = CaseCheck("pairs", "agreement", _with_declarations, _judge_pairs, _answer_counts,
-                            "gap_metres")
-COLLIDE_AGREEMENT = CaseCheck("collide", "agreement", _with_declarations, _judge_collide,
-                              lambda failures: {}, "gap_metres")
+PAIRS_AGREEMENT = CaseCheck("pairs", "agreement", _with_declarations, _ask_pairs, _judge_pairs,
+                            _answer_counts, "gap_metres")
+COLLIDE_AGREEMENT = CaseCheck("collide", "agreement", _with_declarations, _ask_collide,
+                              _judge_collide, lambda failures: {}, "gap_metres")
 
 
 def check_pairs_agreement(engine, cases) -> CheckResult:
@@ -486,10 +515,14 @@ def classify_box(case, lo, hi, side: int, declared) -> dict | None:
             "box_slack_metres": declared.box_slack}
 
 
+def _ask_box(prepared, case):
+    return _box(prepared[0], case)
+
+
 def _box_judge(side: int):
-    def judge(prepared, case) -> dict | None:
-        engine, declared = prepared
-        lo, hi = _box(engine, case)
+    def judge(prepared, case, box) -> dict | None:
+        _, declared = prepared
+        lo, hi = box
         verdict = classify_box(case, lo, hi, side, declared)
         return None if verdict is None else {**verdict, "lo": lo.tolist(), "hi": hi.tolist()}
     return judge
@@ -502,10 +535,10 @@ def _largest_excess(failures: list[dict]) -> dict:
                 (f.get("excess_rounding_bounds", 0.0) for f in failures), default=0.0)}
 
 
-AABB_ENCLOSES = CaseCheck("aabb", "encloses", _with_declarations, _box_judge(0),
+AABB_ENCLOSES = CaseCheck("aabb", "encloses", _with_declarations, _ask_box, _box_judge(0),
                           _largest_excess, "excess_metres")
-AABB_TIGHT = CaseCheck("aabb", "tight", _with_declarations, _box_judge(1), _largest_excess,
-                       "excess_metres")
+AABB_TIGHT = CaseCheck("aabb", "tight", _with_declarations, _ask_box, _box_judge(1),
+                       _largest_excess, "excess_metres")
 
 
 def check_aabb_encloses(engine, cases) -> CheckResult:

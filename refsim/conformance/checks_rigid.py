@@ -69,9 +69,10 @@ meet them within these bounds.
   momentum (no contact, no force: any change is the integrator's). For an
   engine that declares its ``integrator_order`` p, a drift beyond that is
   measured again at h / 2: one that falls by 2^p (within
-  :data:`DRIFT_ORDER_TOL` in the exponent) is the integrator's truncation
-  error, "tolerance" (over a fixed time a method of order p errs by
-  O(h^p): Hairer, Norsett, Wanner, *Solving ODEs I*, II.3).
+  :data:`DRIFT_ORDER_TOL` in the exponent) and stays within
+  :data:`DRIFT_EXCUSE_LIMIT` is the integrator's truncation error,
+  "tolerance" (over a fixed time a method of order p errs by O(h^p):
+  Hairer, Norsett, Wanner, *Solving ODEs I*, II.3).
 
 - ``rigid.off_centre`` (the ball striking the free rod 1.5 m off its centre,
   frictionless, e = 1 and 0.5): after the impact the rod's velocity and
@@ -500,9 +501,16 @@ def check_rigid_determinism(engine, cases) -> CheckResult:
 #: truncation error (the ODE order check's tolerance).
 DRIFT_ORDER_TOL = 0.3
 
+#: The largest drift a declared order excuses: twice what the shipped
+#: first-order engines show at the kit's step (5.5 % over the brick's 12 s
+#: at h = 1e-3), rounded up. Beyond it a run no longer approximates the
+#: motion, whatever the order at which its error falls: "bug".
+DRIFT_EXCUSE_LIMIT = 0.1
 
-def _free_drift(scene, trajectory) -> float:
-    """The free brick's largest relative energy or angular-momentum drift."""
+
+def _free_drifts(scene, trajectory) -> tuple[float, float]:
+    """The free brick's largest relative energy drift and angular-momentum
+    drift (world frame) over the run."""
     closed = R.free_body(scene)
     W = R.body_angular_velocity(trajectory)
     moments = np.array(closed.moments)
@@ -510,7 +518,7 @@ def _free_drift(scene, trajectory) -> float:
     L = np.einsum("fij,fj->fi", np.asarray(trajectory.orientation)[:, 0], W * moments)
     momentum = float(np.sqrt(((L - L[0]) ** 2).sum(axis=1)).max()
                      / math.sqrt(closed.momentum_squared))
-    return max(float(np.abs(energy / closed.energy - 1.0).max()), momentum)
+    return float(np.abs(energy / closed.energy - 1.0).max()), momentum
 
 
 def _truncation_order(engine, cases, scene, drift: float) -> dict:
@@ -529,11 +537,12 @@ def _truncation_order(engine, cases, scene, drift: float) -> dict:
     trajectory = attempt(cases.rerun, engine, half)      # not kept: the name is the same
     if isinstance(trajectory, Crash):
         return {"integrator_order": order, "half_step_run": trajectory.error}
-    drift_half = _free_drift(half, trajectory)
+    drift_half = max(_free_drifts(half, trajectory))
     observed = math.log2(drift / drift_half) if drift_half > 0.0 else math.inf
     return {"integrator_order": order, "drift_at_half_step": drift_half,
             "observed_drift_order": observed,
-            "falls_at_declared_order": bool(abs(observed - order) <= DRIFT_ORDER_TOL)}
+            "falls_at_declared_order": bool(abs(observed - order) <= DRIFT_ORDER_TOL),
+            "excusable_drift_limit": DRIFT_EXCUSE_LIMIT}
 
 
 def check_rigid_free_rotation(engine, cases) -> CheckResult:
@@ -551,24 +560,18 @@ def check_rigid_free_rotation(engine, cases) -> CheckResult:
         expected = closed.flips(float(t[-1]))
         interval = float(np.diff(flips).mean()) if len(flips) > 1 else math.nan
         interval_error = abs(interval / closed.flip_interval - 1.0)
-        moments = np.array(closed.moments)
-        energy = 0.5 * (W * W * moments).sum(axis=1)
-        L = np.einsum("fij,fj->fi", np.asarray(trajectory.orientation)[:, 0], W * moments)
-        momentum = float(np.sqrt(((L - L[0]) ** 2).sum(axis=1)).max()
-                         / math.sqrt(closed.momentum_squared))
-        drift = max(float(np.abs(energy / closed.energy - 1.0).max()), momentum)
+        energy_drift, momentum_drift = _free_drifts(scene, trajectory)
+        drift = max(energy_drift, momentum_drift)
         measured[scene.name] = {"flips": len(flips), "closed_form_flips": expected,
                                 "flip_interval": interval,
                                 "closed_form_interval": closed.flip_interval,
                                 "interval_error": interval_error,
-                                "energy_drift": float(np.abs(energy / closed.energy
-                                                             - 1.0).max()),
-                                "momentum_drift": momentum}
+                                "energy_drift": energy_drift, "momentum_drift": momentum_drift}
         drift_class = classify_miss(drift, FREE_ENERGY_TOL) if math.isfinite(drift) else "bug"
         truncation = {}
         if drift_class == "bug":
             truncation = _truncation_order(engine, cases, scene, drift)
-            if truncation.get("falls_at_declared_order"):
+            if truncation.get("falls_at_declared_order") and drift <= DRIFT_EXCUSE_LIMIT:
                 drift_class = "tolerance"
             measured[scene.name].update(truncation)
         misses = [drift_class,

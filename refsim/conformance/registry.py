@@ -127,22 +127,35 @@ def checks_for(capabilities) -> tuple[Check, ...]:
     return tuple(c for c in CHECKS if c.capability in wanted)
 
 
+#: The generated sets (``--cases`` sizes them); the others are fixed.
+GENERATED_SETS = ("triangles", "poses", "boxes")
+
+
+def generated_range(set_name: str, n: int, seed: int, start: int = 0,
+                    stop: int | None = None):
+    """Cases ``start`` to ``stop - 1`` (default: all ``n``) of generated set
+    ``set_name`` of ``n`` cases from ``seed``; an empty range gives an empty
+    set, which still knows its Hypothesis strategy and seed."""
+    from refsim.conformance.cases_boxes import box_cases
+    from refsim.conformance.cases_meshes import pose_cases
+    from refsim.conformance.cases_triangles import triangle_cases
+
+    build = {"triangles": triangle_cases, "poses": pose_cases, "boxes": box_cases}[set_name]
+    return build(n, seed, start, stop)
+
+
 def build_cases(needed, n: int, seed: int) -> dict:
     """The case sets named in ``needed`` (a subset of :data:`CASE_SETS`),
     ``n`` cases in each generated set, from ``seed``; the generated sets
     are read from the disk cache when they were built before
     (:mod:`refsim.conformance.case_cache`)."""
     from refsim.conformance.case_cache import cached
-    from refsim.conformance.cases_boxes import box_cases
-    from refsim.conformance.cases_meshes import pose_cases
     from refsim.conformance.cases_ode import ode_cases
     from refsim.conformance.cases_rigid import rigid_cases
-    from refsim.conformance.cases_triangles import triangle_cases
 
-    builders = {"triangles": lambda: triangle_cases(n, seed),
-                "poses": lambda: pose_cases(n, seed),
-                "boxes": lambda: box_cases(n, seed),
-                "ode": lambda: ode_cases(seed),
-                "rigid": lambda: rigid_cases(seed)}
-    return {name: cached(name, n, seed, builders[name])
-            for name in CASE_SETS if name in set(needed)}
+    def build(name: str):
+        if name in GENERATED_SETS:
+            return cached(name, n, seed, lambda: generated_range(name, n, seed))
+        return ode_cases(seed) if name == "ode" else rigid_cases(seed)
+
+    return {name: build(name) for name in CASE_SETS if name in set(needed)}

@@ -49,10 +49,11 @@ CLASS_DEFINITIONS: dict[str, str] = {
              "than the rounding bound and the distance tolerance, and no more than the "
              "engine's declared box_slack (metres).",
     "tolerance": "the gap or excess (metres) is within the rounding bound of a float64 "
-                 "evaluation or within the engine's declared distance_tolerance; or a "
+                 "evaluation (scaled to the engine's declared unit_roundoff) or within the "
+                 "engine's declared distance_tolerance; or a "
                  "measured quantity misses its tolerance by at most a factor of two; or "
-                 "a free body's drift falls at the engine's declared integrator_order "
-                 "when the step is halved (its truncation error).",
+                 "a free body's drift, within 10 %, falls at the engine's declared "
+                 "integrator_order when the step is halved (its truncation error).",
     "touching": "the exact answer turns on an exact contact: the two sets share a point but "
                 "nothing crosses transversally (gap exactly 0). A float engine may answer "
                 "either way.",

@@ -36,28 +36,17 @@ def shard_ranges(n: int) -> list[tuple[int, int]]:
     return [(start, min(n, start + draw.BLOCK)) for start in range(0, n, draw.BLOCK)]
 
 
-def build_range(set_name: str, n: int, seed: int, start: int, stop: int):
-    """Cases ``start`` to ``stop - 1`` of generated set ``set_name`` of ``n``
-    cases from ``seed`` (an empty range gives an empty set, which still
-    knows its Hypothesis strategy and seed)."""
-    from refsim.conformance.cases_boxes import box_cases
-    from refsim.conformance.cases_meshes import pose_cases
-    from refsim.conformance.cases_triangles import triangle_cases
-
-    build = {"triangles": triangle_cases, "poses": pose_cases, "boxes": box_cases}[set_name]
-    return build(n, seed, start, stop)
-
-
 def shard_task(*, seed: int, spec: str, set_name: str, cases: int, case_seed: int,
                start: int, stop: int, checks: list) -> dict:
     """A sweep task: the failure records of ``checks`` (keys) on cases
     ``start`` to ``stop - 1`` of set ``set_name`` (the sweep's ``seed`` is
     not used: ``case_seed`` draws the cases)."""
     from refsim.conformance.checks_geometry import _items
+    from refsim.conformance.registry import generated_range
     from refsim.engines import load_engine
 
     engine = load_engine(spec)
-    items = _items(build_range(set_name, cases, case_seed, start, stop))
+    items = _items(generated_range(set_name, cases, case_seed, start, stop))
     out = {}
     for key in checks:
         began = time.perf_counter()
@@ -69,12 +58,15 @@ def shard_task(*, seed: int, spec: str, set_name: str, cases: int, case_seed: in
 def fixed_task(*, seed: int, spec: str, case_seed: int, checks: list) -> dict:
     """A sweep task: the results of ``checks`` (keys), whose case sets are
     fixed (the ODE problems, the rigid scenes), as plain records."""
-    from refsim.conformance.registry import build_cases, check_by_key
+    from refsim.conformance.registry import GENERATED_SETS, build_cases, check_by_key
     from refsim.conformance.runner import run_check
     from refsim.engines import load_engine
 
-    engine = load_engine(spec)
     chosen = [check_by_key(key) for key in checks]
+    generated = [c.key for c in chosen if c.cases in GENERATED_SETS]
+    if generated:      # their cases would be built at n = 1 below
+        raise ValueError(f"fixed_task runs checks of the fixed sets only, not {generated}")
+    engine = load_engine(spec)
     sets = build_cases({c.cases for c in chosen}, 1, case_seed)   # n sizes generated sets only
     return {"results": [run_check(c, engine, sets[c.cases]).to_dict(failures=True)
                         for c in chosen]}
@@ -94,7 +86,7 @@ def check_engine_sharded(spec: str, *, cases: int, seed: int = 0, only=None,
     (module docstring)."""
     from refsim import __version__
     from refsim.conformance.expected import apply_expected
-    from refsim.conformance.registry import checks_for
+    from refsim.conformance.registry import checks_for, generated_range
     from refsim.conformance.results import CheckResult, ConformanceResult
     from refsim.conformance.runner import read_declarations, select_capabilities
     from refsim.engines import engine_name, load_engine
@@ -147,7 +139,7 @@ def check_engine_sharded(spec: str, *, cases: int, seed: int = 0, only=None,
         else:
             say(f"{check.key}: {len(entry['failures'])} failures gathered"
                 + (", shrinking one" if entry["failures"] else ""))
-            empty = build_range(check.cases, cases, seed, 0, 0)
+            empty = generated_range(check.cases, cases, seed, 0, 0)
             result = CASE_CHECKS[check.key].result(engine, empty, entry["failures"],
                                                    entry["count"], entry["seconds"])
         results.append(apply_expected(result, declarations))

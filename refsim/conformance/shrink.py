@@ -45,7 +45,9 @@ SHRINK_STEPS = 2000
 def minimal_failure(strategy, fails, seed: int):
     """The minimal value of ``strategy`` for which ``fails(value)`` is true,
     or None when none is found. Exceptions inside ``fails`` count as "does
-    not fail" (an engine error is not the failure being minimized)."""
+    not fail" (a caller that minimizes a crash catches the engine's
+    exception in ``fails`` itself, as
+    :class:`refsim.conformance.checks_geometry.CaseCheck` does)."""
     from hypothesis import HealthCheck, Phase, find, settings
     from hypothesis.errors import NoSuchExample, Unsatisfiable
 

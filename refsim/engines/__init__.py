@@ -79,9 +79,9 @@ attribute                meaning
                          solvers take). Declared, a free body's energy and
                          momentum drift beyond ``rigid.free_rotation``'s
                          tolerance is run again at half the step: falling
-                         at the declared order (within 0.3), it is the
-                         integrator's truncation error, class "tolerance";
-                         otherwise, or undeclared, "bug".
+                         at the declared order (within 0.3) and within 10 %,
+                         it is the integrator's truncation error, class
+                         "tolerance"; otherwise, or undeclared, "bug".
 ``contact_law``          ``"restitution"`` (the default): a coefficient of
                          restitution ``e`` sets the bounce, the law the
                          apex-ratio and oblique-bounce checks assume. Any

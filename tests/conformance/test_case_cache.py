@@ -63,3 +63,30 @@ def test_a_directory_that_cannot_be_written_only_costs_the_saving(tmp_path, monk
     blocker.write_text("in the way")
     monkeypatch.setenv("REFSIM_CACHE_DIR", str(blocker / "cache"))
     assert len(build_cases(["boxes"], 6, 0)["boxes"]) == 6
+
+
+def test_other_models_or_other_sources_name_another_file(cache, tmp_path, monkeypatch):
+    """The mesh cases' truths depend on the models and on code the builders
+    import inside functions: another models directory, a model whose bytes
+    changed, or another set of source files gives another file."""
+    import shutil
+
+    from refsim.bundled import models_dir
+
+    default = case_cache.cache_path("poses", 10, 0)
+    copy = tmp_path / "models"
+    shutil.copytree(models_dir(), copy)
+    monkeypatch.setenv("REFSIM_MODELS", str(copy))
+    copied = case_cache.cache_path("poses", 10, 0)
+    assert copied != default
+    cube = copy / "cube.ac"
+    cube.write_text(cube.read_text() + "\n")
+    edited = case_cache.cache_path("poses", 10, 0)
+    assert edited != copied
+    extra = tmp_path / "extra.py"
+    extra.write_text("x = 1\n")
+    stamp = case_cache._source_stamp()
+    monkeypatch.setattr(case_cache, "_source_stamp",
+                        lambda: (*stamp, (str(extra), extra.stat().st_size,
+                                          extra.stat().st_mtime_ns)))
+    assert case_cache.cache_path("poses", 10, 0) != edited

@@ -24,9 +24,9 @@ class DriftingEngine:
 
     name = "drifting"
 
-    def __init__(self, order: int, declared):
+    def __init__(self, order: int, declared, scale: float = 1.0):
         self.order = order
-        self.rate = 2.0 * 1e-3 / 1e-3 ** order
+        self.rate = scale * 2.0 * 1e-3 / 1e-3 ** order
         self.inner = corrected()
         if declared is not None:
             self.integrator_order = declared
@@ -68,3 +68,12 @@ def test_integrator_order_must_be_a_whole_number(value):
 
     with pytest.raises(OptionError, match="integrator_order must be a whole number"):
         declarations(Engine())
+
+
+def test_a_drift_beyond_the_excusable_limit_is_a_bug_at_any_order(free_brick):
+    """Ten times the rate: about 50 % of the energy gained, falling at order
+    1 all the same: no declared order excuses it."""
+    result = check_rigid_free_rotation(DriftingEngine(1, 1, scale=10.0), RigidCases(free_brick))
+    measured = next(iter(result.measured.values()))
+    assert measured["falls_at_declared_order"] and measured["energy_drift"] > 0.3
+    assert result.classes == {"bug": 1}
