@@ -1,9 +1,8 @@
 """Generated case sets kept on disk between runs.
 
 The generated sets (triangle pairs, mesh poses, boxes) cost their exact
-answers: about 9 s for 1e5 triangle pairs and 1 ms a pose on this
-project's two-core machine (docs/decisions/conformance.md). A run asked
-for the same set again reads it back instead, in well under a second.
+answers, O(n) and large (measured in docs/decisions/conformance.md). A run
+asked for the same set again reads it back instead.
 
 A file is named by everything its content can depend on: the set, ``n``,
 the seed, refsim's version, numpy's (its random generators draw the
