@@ -183,19 +183,10 @@ def _examples(failures: list[dict], shrunk) -> list[dict]:
         kept, key=lambda e: CLASSES.index(e["class"]))
 
 
-def _distance_tolerance(engine) -> float:
-    from refsim.engines import declarations
-
-    return declarations(engine).distance_tolerance
-
-
-def _roundoff(engine_or_declarations) -> float:
-    """The engine's declared unit roundoff over float64's: the factor on
-    every rounding bound (1 for a float64 engine, 2^29 for float32)."""
-    from refsim.engines import Declarations, declarations
-
-    declared = engine_or_declarations if isinstance(engine_or_declarations, Declarations) \
-        else declarations(engine_or_declarations)
+def _roundoff(declared) -> float:
+    """The engine's declared unit roundoff (:class:`refsim.engines.Declarations`)
+    over float64's: the factor on every rounding bound (1 for a float64
+    engine, 2^29 for float32)."""
     return declared.unit_roundoff / UNIT_ROUNDOFF
 
 
@@ -257,16 +248,21 @@ def _by_family(failures: list[dict]) -> dict:
     return {"failed_by_family": counts}
 
 
+def _engine_triangles(engine):
+    from refsim.engines import declarations
+
+    declared = declarations(engine)
+    return engine.triangles_intersect, declared.distance_tolerance, _roundoff(declared)
+
+
 def _refsim_triangles(engine):
     from refsim.collision.triangle import triangles_intersect
 
     return triangles_intersect, 0.0, 1.0
 
 
-TRIANGLES_AGREEMENT = CaseCheck(
-    "triangles", "agreement", lambda engine: (engine.triangles_intersect,
-                                              _distance_tolerance(engine), _roundoff(engine)),
-    _ask_triangles, _judge_triangles, _by_family, "gap_metres")
+TRIANGLES_AGREEMENT = CaseCheck("triangles", "agreement", _engine_triangles, _ask_triangles,
+                                _judge_triangles, _by_family, "gap_metres")
 TRIANGLES_REFERENCE = CaseCheck("triangles", "reference", _refsim_triangles, _ask_triangles,
                                 _judge_triangles, _by_family, "gap_metres")
 

@@ -66,7 +66,7 @@ CLASSES = tuple(CLASS_DEFINITIONS)
 #: all but "crash" (see :mod:`refsim.conformance.expected`).
 DECLARABLE_WITHOUT_NAMING = tuple(c for c in CLASSES if c != "crash")
 
-#: What each status of a check means (the module docstring's list).
+#: What each status of a check means.
 STATUS_DEFINITIONS = {
     "passed": "no case failed.",
     "failed": "a case failed, outside what any expected-failures declaration accepts; the "
