@@ -88,9 +88,17 @@ def _entry(name: str, value) -> tuple[tuple, np.dtype, Iterator]:
 def write_npz(handle, entries: Mapping[str, object], *, compressed: bool) -> None:
     """Write ``entries`` (name -> array) as an .npz to the open binary,
     seekable ``handle``, in the mapping's order, entry ``name`` as
-    ``name.npy``. ``compressed`` chooses deflate or stored entries."""
+    ``name.npy``. ``compressed`` chooses deflate or stored entries.
+
+    An exception on the way (a full disk, or Ctrl-C or SIGTERM raised by
+    their handlers) abandons the archive unclosed and propagates: the caller
+    discards the half-written file (:func:`refsim.io.write_atomic`). Closing
+    it would be wrong twice: a signal raised inside ``archive.open`` leaves
+    zipfile unable to close, and its own error ("an open writing handle")
+    would replace the interruption."""
     method = zipfile.ZIP_DEFLATED if compressed else zipfile.ZIP_STORED
-    with zipfile.ZipFile(handle, mode="w", compression=method, allowZip64=True) as archive:
+    archive = zipfile.ZipFile(handle, mode="w", compression=method, allowZip64=True)
+    try:
         for name, value in entries.items():
             shape, dtype, chunks = _entry(name, value)
             info = zipfile.ZipInfo(f"{name}.npy", date_time=ZIP_DATE)
@@ -100,6 +108,10 @@ def write_npz(handle, entries: Mapping[str, object], *, compressed: bool) -> Non
                 member.write(npy_header(shape, dtype))
                 for chunk in chunks:
                     member.write(chunk)
+    except BaseException:
+        archive.fp = None          # abandoned: neither close() nor __del__ writes to it
+        raise
+    archive.close()
 
 
 def npz_size_bound(entry_bytes, *, compressed: bool) -> int:

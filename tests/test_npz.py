@@ -151,3 +151,29 @@ def test_a_corrupt_entry_names_it(tmp_path):
     with pytest.raises(NpzFileError, match="corrupt or truncated") as info:
         read_npz(path, ["t", "step"])
     assert info.value.entry == "step"
+
+
+def test_an_interruption_inside_archive_open_propagates_as_itself(monkeypatch):
+    """Ctrl-C (or SIGTERM's Interrupted) raised inside zipfile's ``open``,
+    after it marked an entry open and before the entry is returned: the
+    interruption propagates, not zipfile's "open writing handle" error, and
+    the abandoned archive writes nothing when it is collected."""
+    import gc
+    import sys
+
+    real_open = zipfile.ZipFile.open
+
+    opened = []                                    # kept, as the traceback's frames keep it
+
+    def interrupted_open(self, *args, **kwargs):
+        opened.append(real_open(self, *args, **kwargs))     # the entry is open now
+        raise KeyboardInterrupt
+
+    unraisable = []
+    monkeypatch.setattr(zipfile.ZipFile, "open", interrupted_open)
+    monkeypatch.setattr(sys, "unraisablehook", unraisable.append)
+    with pytest.raises(KeyboardInterrupt):
+        write_npz(io.BytesIO(), {"a": np.arange(3.0)}, compressed=False)
+    opened.clear()
+    gc.collect()
+    assert unraisable == []
