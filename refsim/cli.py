@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import gc
 import json
 import os
 import sys
@@ -774,6 +775,7 @@ def main(argv: list[str] | None = None) -> int:
     ``head``) ends quietly with :data:`EXIT_BROKEN_PIPE`, as Python's
     documentation of SIGPIPE advises: standard output is pointed at
     ``os.devnull`` so that the interpreter's final flush cannot fail again."""
+    unraisable_hook = sys.unraisablehook
     try:
         status = _main(argv)
         sys.stdout.flush()          # a broken pipe shows here, not at exit
@@ -785,6 +787,10 @@ def main(argv: list[str] | None = None) -> int:
         except (OSError, ValueError):   # a stream with no descriptor (a test's capture)
             pass
         return EXIT_BROKEN_PIPE
+    finally:
+        if sys.unraisablehook is not unraisable_hook:     # _quiet_finalizers ran
+            gc.collect()            # what the signal cut short is freed while quiet
+            sys.unraisablehook = unraisable_hook
 
 
 def _main(argv: list[str] | None) -> int:
@@ -809,11 +815,30 @@ def _main(argv: list[str] | None) -> int:
         print(f"refsim: error: {one_line(exc)}", file=sys.stderr)
         return EXIT_USER_ERROR
     except Interrupted as exc:
+        _quiet_finalizers()
         print(f"refsim: interrupted ({exc.name})", file=sys.stderr)
         return exc.exit_status
     except KeyboardInterrupt:
+        _quiet_finalizers()
         print("refsim: interrupted", file=sys.stderr)
         return 130
+
+
+def _drop(unraisable) -> None:
+    """An unraisable exception not reported (see :func:`_quiet_finalizers`)."""
+
+
+def _quiet_finalizers() -> None:
+    """After an interruption, errors raised in finalizers are not reported.
+
+    A signal can arrive inside a constructor, as numba compiles for example:
+    llvmlite's ``OutputString.__init__`` cut short before it sets
+    ``_owned`` fails in ``__del__`` when the unwound stack frees it, and
+    Python prints that as "Exception ignored in ..." with a traceback after
+    the one line an interruption gets. The process is ending; nothing is
+    left for such a report to explain. :func:`main` restores the hook.
+    """
+    sys.unraisablehook = _drop
 
 
 if __name__ == "__main__":

@@ -66,6 +66,39 @@ refsim.npz.npy_header = header_then_wait
 sys.exit(main(sys.argv[2:]))
 """
 
+#: A child whose run is signalled inside a constructor, as numba's compiler
+#: can be (llvmlite's OutputString): the object, cut short before its
+#: ``_owned`` is set, fails in ``__del__`` when the unwound stack frees it.
+CHILD_IN_CONSTRUCTOR = """
+import signal, sys
+from pathlib import Path
+
+import refsim.npz
+from refsim.cli import main
+
+marker = Path(sys.argv[1])
+
+
+class HalfBuilt:
+    def __init__(self):
+        marker.touch()
+        while True:
+            signal.pause()
+        self._owned = True
+
+    def __del__(self):
+        if self._owned:
+            pass
+
+
+def header_in_a_constructor(shape, dtype):
+    HalfBuilt()
+
+
+refsim.npz.npy_header = header_in_a_constructor
+sys.exit(main(sys.argv[2:]))
+"""
+
 EXPECTED = {
     signal.SIGTERM: (128 + 15, "refsim: interrupted (SIGTERM)\n"),
     signal.SIGHUP: (128 + 1, "refsim: interrupted (SIGHUP)\n"),
@@ -210,3 +243,18 @@ def test_held_signals_leave_a_signal_the_system_handles_alone():
             hold.check()
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_signal_inside_a_constructor_gets_one_line(tmp_path, signum):
+    # CI once printed llvmlite's "Exception ignored in: OutputString.__del__"
+    # traceback after the one line: the signal had come as numba compiled
+    work, scene, out = _setup(tmp_path, duration=1.0)
+    child_script = tmp_path / "child.py"
+    child_script.write_text(CHILD_IN_CONSTRUCTOR)
+    marker = tmp_path / "constructing"
+    child = subprocess.Popen(
+        [sys.executable, str(child_script), str(marker), "run", str(scene), "-o", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    _wait_for(child, marker.exists)
+    _signal_and_check(child, signum, work, out)
