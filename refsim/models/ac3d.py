@@ -597,7 +597,13 @@ def read_ac3d(path, *, weld_tolerance: float = 0.0) -> Mesh:
         Naming the file and, for a malformed file, the line; a directory,
         FIFO or device is refused without being opened.
     """
-    raw = read_regular_file(path, ModelError)
+    return parse_ac3d_bytes(read_regular_file(path, ModelError), path,
+                            weld_tolerance=weld_tolerance)
+
+
+def parse_ac3d_bytes(raw: bytes, path, *, weld_tolerance: float = 0.0) -> Mesh:
+    """:func:`read_ac3d` of the bytes ``raw`` already read from ``path``
+    (which names the file in messages)."""
     try:
         return _parse(raw.decode("utf-8"), path, weld_tolerance, "utf-8")
     except UnicodeDecodeError:

@@ -13,15 +13,25 @@ information". :func:`load_model` picks the reader by the file's suffix:
 Every failure (missing file, unknown suffix, a file the reader rejects) is a
 one-line :class:`~refsim.errors.ModelError` naming the path.
 
-Cost: that of the reader, O(file size), plus the O(n log n) weld.
+A file loaded again, the same bytes at the same path, gives the same
+:class:`Mesh` object back (:data:`CACHED_MESHES` of them are kept, the most
+recently loaded): a Mesh is immutable, and the structures it derives (its
+triangle hierarchies, built on its first query) are kept with it, so a scene,
+a study or a conformance check that loads a model again pays neither the
+parse nor the tree build twice.
+
+Cost: reading and hashing the file, O(file size); on a new file, that of the
+reader, O(file size), plus the O(n log n) weld.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import io
 import logging
 import warnings
+from collections import OrderedDict
 from pathlib import Path
 
 import numpy as np
@@ -29,12 +39,18 @@ import numpy as np
 from refsim.bundled import models_dir
 from refsim.errors import ModelError
 from refsim.files import as_path, bundled_if_bare, read_regular_file, refuse_missing_bundled
-from refsim.models.ac3d import read_ac3d
+from refsim.models.ac3d import parse_ac3d_bytes
 from refsim.models.mesh import Mesh
 
 #: Suffixes read by trimesh (the formats trimesh reads).
 TRIMESH_SUFFIXES = (".obj", ".stl", ".ply", ".off")
 SUFFIXES = (".ac",) + TRIMESH_SUFFIXES
+
+#: How many loaded meshes :func:`load_model` keeps for a second load of the
+#: same file (least recently loaded dropped first).
+CACHED_MESHES = 32
+
+_loaded: OrderedDict[tuple, Mesh] = OrderedDict()
 
 
 def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
@@ -48,6 +64,12 @@ def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
         bundled model (``refsim.bundled.models_dir()``), e.g. ``"cube.ac"``.
     weld_tolerance : float
         Passed to :class:`Mesh`: 0 welds exactly equal vertices only.
+
+    Returns
+    -------
+    Mesh
+        The same object as an earlier call's for the same path, bytes and
+        tolerance, while it is among the last :data:`CACHED_MESHES` loaded.
 
     Raises
     ------
@@ -64,9 +86,24 @@ def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
                          f"supported: {', '.join(SUFFIXES)}", path=path)
     path = bundled_if_bare(path, models_dir())
     refuse_missing_bundled(path, models_dir(), "model", ModelError)
+    data = read_regular_file(path, ModelError)
+    if type(weld_tolerance) not in (int, float):    # Mesh says what is wrong with it
+        return _parse(path, suffix, data, weld_tolerance)
+    key = (str(path), float(weld_tolerance), hashlib.blake2b(data, digest_size=20).digest())
+    mesh = _loaded.get(key)
+    if mesh is None:
+        mesh = _loaded[key] = _parse(path, suffix, data, weld_tolerance)
+        while len(_loaded) > CACHED_MESHES:
+            _loaded.popitem(last=False)
+    else:
+        _loaded.move_to_end(key)
+    return mesh
+
+
+def _parse(path: Path, suffix: str, data: bytes, weld_tolerance) -> Mesh:
     if suffix == ".ac":
-        return read_ac3d(path, weld_tolerance=weld_tolerance)
-    return _load_with_trimesh(path, read_regular_file(path, ModelError), weld_tolerance)
+        return parse_ac3d_bytes(data, path, weld_tolerance=weld_tolerance)
+    return _load_with_trimesh(path, data, weld_tolerance)
 
 
 #: The formats trimesh reads as text (the others, binary STL and PLY, as bytes).

@@ -15,9 +15,11 @@ import trimesh
 from scipy.spatial import cKDTree
 
 import refsim
+from refsim.bundled import models_dir
 from refsim.errors import ModelError
 from refsim.limits import MAX_MODEL_BYTES
 from refsim.models.ac3d import write_ac3d
+from refsim.models.loading import load_model
 from refsim.models.mesh import Mesh
 
 #: How far each format may move a coordinate of the unit-scale test shape
@@ -212,3 +214,48 @@ def test_trimesh_reads_quietly_and_a_non_finite_vertex_is_one_error(tmp_path, ca
         with pytest.raises(ModelError, match="non-finite"):
             refsim.load_model(nan_stl)
     assert [str(w.message) for w in caught] == []
+
+
+# -- a file loaded again -------------------------------------------------------------------
+
+
+def test_the_same_file_loaded_again_is_the_same_mesh_with_its_trees(tmp_path):
+    from refsim.collision import bvh
+
+    path = tmp_path / "cube.ac"
+    path.write_bytes((models_dir() / "cube.ac").read_bytes())
+    first = load_model(path)
+    tree = bvh.tree_of(first, "readable")
+    again = load_model(path)
+    assert again is first and bvh.tree_of(again, "readable") is tree
+    assert load_model(path, weld_tolerance=1e-9) is not first
+
+
+def test_new_bytes_at_the_same_path_are_read_again(tmp_path):
+    path = tmp_path / "m.ac"
+    path.write_bytes((models_dir() / "cube.ac").read_bytes())
+    cube = load_model(path)
+    path.write_bytes((models_dir() / "tetrahedron.ac").read_bytes())
+    tetra = load_model(path)
+    assert tetra is not cube and (cube.n_faces, tetra.n_faces) == (12, 4)
+
+
+def test_the_same_bytes_at_another_path_name_their_own_file(tmp_path):
+    a, b = tmp_path / "a.ac", tmp_path / "b.ac"
+    for p in (a, b):
+        p.write_bytes((models_dir() / "cube.ac").read_bytes())
+    assert (load_model(a).source, load_model(b).source) == (str(a), str(b))
+
+
+def test_only_the_last_meshes_loaded_are_kept(tmp_path):
+    from refsim.models import loading
+
+    cube = (models_dir() / "cube.ac").read_bytes()
+    paths = []
+    for i in range(loading.CACHED_MESHES + 1):
+        paths.append(tmp_path / f"m{i}.ac")
+        paths[-1].write_bytes(cube)
+    meshes = [load_model(p) for p in paths]
+    assert load_model(paths[-1]) is meshes[-1]         # kept
+    assert load_model(paths[0]) is not meshes[0]       # the oldest was dropped
+    assert len(loading._loaded) <= loading.CACHED_MESHES
