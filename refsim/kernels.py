@@ -131,6 +131,14 @@ def _warn_readable() -> None:
 COMPILE_NOTICE_ENV = "REFSIM_COMPILE_NOTICE"
 
 
+def notices_on() -> bool:
+    """Whether the command line says what numba compiles (and what it does
+    not wait for): not with ``REFSIM_COMPILE_NOTICE=0``,
+    ``REFSIM_KERNELS=readable`` or without numba."""
+    return (os.environ.get(COMPILE_NOTICE_ENV, "1") != "0"
+            and os.environ.get(KERNELS_ENV) != "readable" and numba_usable())
+
+
 @contextlib.contextmanager
 def compile_notices(stream):
     """Within the body, the first time numba compiles a kernel (its disk
@@ -140,8 +148,7 @@ def compile_notices(stream):
     say nothing (numba emits its "numba:compile" event only for a compile).
     Nothing when numba is missing, ``REFSIM_COMPILE_NOTICE=0`` or
     ``REFSIM_KERNELS=readable`` (numba is then not even imported)."""
-    if (os.environ.get(COMPILE_NOTICE_ENV, "1") == "0"
-            or os.environ.get(KERNELS_ENV) == "readable" or not numba_usable()):
+    if not notices_on():
         yield
         return
     from numba.core import event
@@ -172,6 +179,21 @@ def compile_notices(stream):
     if notice.count:
         print(f"refsim: compiled {notice.count} kernel{'s' * (notice.count > 1)} in "
               f"{notice.seconds:.1f} s", file=stream, flush=True)
+
+
+def compiled_here(dispatcher) -> bool:
+    """Whether numba holds machine code of ``dispatcher`` (a numba function)
+    for this processor: compiled in this process, or in its disk cache and
+    fresh for the source. Reads numba's cache index, whose layout is
+    numba's own: when it cannot be read, False (a compile may follow)."""
+    if dispatcher.signatures:
+        return True
+    try:
+        index = dispatcher._cache._cache_file._load_index()
+        machine = dispatcher.targetctx.codegen().magic_tuple()
+    except Exception:    # no disk cache, or another numba's layout
+        return False
+    return any(key[1] == machine for key in index)
 
 
 @functools.cache

@@ -904,7 +904,7 @@ def default_every(n_steps: int) -> int:
 
 def simulate(scene, *, every: int | None = None, duration: float | None = None,
              wall_speed: str | None = None, boxes: str = "auto",
-             sink: FrameSink | None = None) -> Trajectory:
+             sink: FrameSink | None = None, kernel: str | None = None) -> Trajectory:
     """Run ``scene`` and return its trajectory.
 
     Parameters
@@ -925,6 +925,9 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
         :class:`refsim.frames.SpillSink`, so that memory does not grow with
         the steps; the trajectory's frames are then views of its files, to be
         saved before the sink closes. Both give the same frames, bit for bit.
+    kernel : {"readable", "compiled"}, optional
+        See :class:`Simulation` (``refsim run`` passes
+        :func:`refsim.dynamics.start.start_kernel`'s choice).
 
     Raises
     ------
@@ -946,7 +949,7 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
     if sink is None:
         # the initial state, every every-th step, and the last step
         sink = MemorySink(capacity=frame_count(n_steps, every))
-    sim = Simulation(scene, wall_speed=wall_speed, boxes=boxes, sink=sink)
+    sim = Simulation(scene, wall_speed=wall_speed, boxes=boxes, sink=sink, kernel=kernel)
     sim.record()
     sim.run(n_steps, every=every)
     if sim.steps % every:

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.dynamics.simulation import Simulation, default_every
+from refsim.dynamics.start import start_kernel
 from refsim.dynamics.trajectory import Trajectory
 
 #: Steps between two progress reports (and cancellation checks): about a
@@ -56,7 +57,8 @@ def run_bodies(scene, *, every: int | None = None,
     """
     n_steps = scene.integration.n_steps
     every = default_every(n_steps) if every is None else every
-    sim = Simulation(scene)
+    # a short run does not wait for numba's first compile (the same frames)
+    sim = Simulation(scene, kernel=start_kernel(scene, n_steps))
     sim.record()
     while sim.steps < n_steps:
         if cancelled():

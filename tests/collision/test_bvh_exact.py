@@ -17,6 +17,7 @@ from refsim.collision.seed_levels import exact_pairs, triangle_box_pairs
 from refsim.errors import StateError
 from refsim.models import shapes
 from refsim.models.loading import load_model
+from refsim.models.mesh import Mesh
 from refsim.types import ORTHONORMAL_TOL, random_rotation
 
 SPHERE = load_model(models_dir() / "sphere-2k.ac")
@@ -135,13 +136,21 @@ def test_margin_is_enough_near_touching_with_rotations_at_the_tolerance():
     assert checked == 36 and hits >= 6
 
 
+def _fresh(name: str) -> Mesh:
+    """A new Mesh of a bundled model, with its own derived structures
+    (load_model gives every caller the same Mesh): the tests below plant
+    trees built along perturbed axes in it."""
+    loaded = load_model(models_dir() / name)
+    return Mesh(loaded.vertices, loaded.faces, name=loaded.name)
+
+
 def test_margin_is_needed_for_node_axes_off_orthonormal():
     """Every node's axes (1 - e) I (deviation 2e - e^2, within the tolerance):
     the node test then takes each box of b for (1 - e)^2 of its size, and two
     cubes overlapping by e/4 along x look apart by nearly 3e/4. The margin's
     deviation term finds the pairs again."""
     e = 2.0 ** -22
-    cube = load_model(models_dir() / "cube.ac")               # a fresh mesh: its own cache
+    cube = _fresh("cube.ac")
     frame = cube.derived("frame_tree", lambda m: bvh_exact.build_frame_tree(
         m, lambda points: (1.0 - e) * np.eye(3)))
     assert frame.axes_deviation == 2 * e - e * e
@@ -169,8 +178,7 @@ def test_margin_is_enough_with_node_axes_off_orthonormal():
         return (bvh_exact.principal_axes(points)
                 + rng.uniform(-0.15, 0.15, (3, 3)) * ORTHONORMAL_TOL)
 
-    cube = load_model(models_dir() / "cube.ac")               # fresh meshes: own caches
-    torus = load_model(models_dir() / "torus.ac")
+    cube, torus = _fresh("cube.ac"), _fresh("torus.ac")
     for mesh in (cube, torus):
         frame = mesh.derived("frame_tree", lambda m: bvh_exact.build_frame_tree(m, perturbed))
         assert bvh_exact.frame_tree_of(mesh) is frame and frame.axes_deviation > 1e-8

@@ -1,0 +1,70 @@
+"""The kernel a command-line run starts on: a short run does not wait for a
+compile.
+
+numba compiles the simulation loop (:mod:`refsim.dynamics._numba_kernels`)
+on its first call on a machine and keeps the machine code on disk; that
+first compile takes about 16 s on a two-core machine
+(docs/decisions/cold-start.md), while the bundled scenes' readable steps
+take 0.5-5 s in all. The readable and compiled kernels give the same
+results bit for bit (tests/dynamics/test_compiled_loop.py), so which one a
+run takes changes its time only. :func:`start_kernel` picks:
+
+- the default (the compiled loop) when numba already holds the loop's
+  machine code for this processor, in memory or in its disk cache, or when
+  ``REFSIM_KERNELS`` chooses, or the loop cannot run the scene;
+- else "readable" when the run's readable steps, timed on a few of them,
+  would take less than :data:`LOOP_COMPILE_SECONDS`; else the default.
+
+``refsim run`` and the viewer's runs (:mod:`refsim.viewer.runs`) ask it;
+:func:`refsim.simulate` itself keeps its default (a library caller chooses
+with ``kernel=``). A run started readable compiles nothing, so numba's cache
+stays empty until a run long enough to pay for the compile comes.
+"""
+
+from __future__ import annotations
+
+import time
+
+from refsim.errors import RefsimError
+
+#: The loop's first compile on a two-core machine, rounded down: a run whose
+#: readable steps take less starts readable (docs/decisions/cold-start.md).
+LOOP_COMPILE_SECONDS = 12.0
+
+#: The readable steps timed to estimate a run's readable time: at most this
+#: many, and no more once this much time has passed.
+PROBE_STEPS = 200
+PROBE_SECONDS = 0.25
+#: Steps between two looks at the clock while timing.
+PROBE_CHUNK = 10
+
+
+def start_kernel(scene, n_steps: int, *, wall_speed: str | None = None,
+                 boxes: str = "auto") -> str | None:
+    """"readable" when a run of ``n_steps`` of ``scene`` would end sooner on
+    the readable kernels than numba would compile the loop; else None (the
+    default kernel). Costs a file read when the loop is compiled, else up to
+    :data:`PROBE_SECONDS` of readable steps on a copy of the run."""
+    from refsim.dynamics.compiled_loop import loop_support
+    from refsim.dynamics.simulation import Simulation
+    from refsim.kernels import _environment_kernel, compiled_here, numba_usable
+
+    if _environment_kernel() is not None or not numba_usable():
+        return None
+    from refsim.dynamics import _numba_kernels
+
+    if compiled_here(_numba_kernels.advance):
+        return None
+    probe = Simulation(scene, wall_speed=wall_speed, boxes=boxes, kernel="readable")
+    if loop_support(probe) is not None:     # stage kernels then, not the loop
+        return None
+    began = time.perf_counter()
+    try:
+        while probe.steps < min(PROBE_STEPS, n_steps):
+            probe.advance(min(PROBE_CHUNK, n_steps - probe.steps))
+            if time.perf_counter() - began > PROBE_SECONDS:
+                break
+    except RefsimError:                      # the run itself will say it
+        return None
+    per_step = (time.perf_counter() - began) / max(probe.steps, 1)
+    return "readable" if per_step * n_steps < LOOP_COMPILE_SECONDS else None

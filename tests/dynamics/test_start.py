@@ -1,0 +1,74 @@
+"""The kernel ``refsim run`` starts on (refsim.dynamics.start): the readable
+one for a short run while numba has not compiled the loop, with the same
+frames bit for bit; the default otherwise."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from refsim import load_scene
+from refsim.bundled import scenes_dir
+from refsim.dynamics import start
+from refsim.dynamics.compiled_loop import loop_support
+from refsim.dynamics.simulation import Simulation, simulate
+
+SPIN = scenes_dir() / "spinning-cube.toml"
+
+
+@pytest.fixture
+def cold(monkeypatch):
+    """As if numba's cache held no loop for this machine."""
+    monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: False)
+    monkeypatch.delenv("REFSIM_KERNELS", raising=False)
+
+
+def test_a_short_run_starts_readable_when_the_loop_is_not_compiled(cold):
+    scene = load_scene(SPIN)
+    assert start.start_kernel(scene, scene.integration.n_steps) == "readable"
+
+
+def test_a_long_run_waits_for_the_compile(cold, monkeypatch):
+    # 10^8 steps of about 0.1 ms: hours readable, against a compile of seconds
+    scene = load_scene(SPIN)
+    assert start.start_kernel(scene, 10**8) is None
+
+
+def test_the_environment_and_the_compiled_loop_decide_first(monkeypatch):
+    scene = load_scene(SPIN)
+    monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: True)
+    assert start.start_kernel(scene, scene.integration.n_steps) is None
+    monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: False)
+    monkeypatch.setenv("REFSIM_KERNELS", "compiled")
+    assert start.start_kernel(scene, scene.integration.n_steps) is None
+
+
+def test_a_scene_the_loop_cannot_run_keeps_the_default(cold, tmp_path):
+    text = (SPIN.read_text().replace('rotation = "seed"', 'rotation = "impulse"')
+            .replace('name = "cube"', 'name = "cube"\ntorque = [0.0, 0.1, 0.0]'))
+    path = tmp_path / "torque.toml"
+    path.write_text(text)
+    scene = load_scene(path)
+    assert loop_support(Simulation(scene, kernel="readable")) == "a torque"
+    assert start.start_kernel(scene, scene.integration.n_steps) is None
+
+
+def test_refsim_run_on_an_empty_cache_writes_the_compiled_loops_frames(tmp_path):
+    # a fresh numba cache: the run says it starts readable and compiles nothing
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), REFSIM_COMPILE_NOTICE="1")
+    env.pop("REFSIM_KERNELS", None)
+    out = tmp_path / "spin.npz"
+    done = subprocess.run([sys.executable, "-m", "refsim.cli", "run", str(SPIN), "-o", str(out)],
+                          env=env, capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.startswith("refsim: numba has not compiled the simulation loop")
+    assert "compiling" not in done.stderr and len(done.stderr.splitlines()) == 1
+    compiled = simulate(load_scene(SPIN), kernel="compiled")
+    with np.load(out) as written:
+        assert '"kernel": "readable"' in str(written["settings"])
+        for name in ("t", "position", "velocity", "angular_velocity", "orientation"):
+            assert written[name].tobytes() == getattr(compiled, name).tobytes(), name
