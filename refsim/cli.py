@@ -735,7 +735,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     report = commands.add_parser("report", help="write the HTML accuracy report")
     report.add_argument("--quick", action="store_true",
-                        help="fewer sizes and repeats (under a minute)")
+                        help="fewer sizes and repeats (about a minute on two idle cores "
+                             "once numba has compiled)")
     report.add_argument("-o", "--output", default="reports/out", metavar="DIR",
                         help="output directory (default: reports/out)")
     report.add_argument("--workers", type=int, metavar="N",
