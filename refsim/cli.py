@@ -796,8 +796,10 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BROKEN_PIPE
     finally:
         if sys.unraisablehook is not unraisable_hook:     # _quiet_finalizers ran
-            gc.collect()            # what the signal cut short is freed while quiet
-            sys.unraisablehook = unraisable_hook
+            try:
+                gc.collect()        # what the signal cut short is freed while quiet
+            finally:
+                sys.unraisablehook = unraisable_hook
 
 
 def _main(argv: list[str] | None) -> int:

@@ -185,8 +185,14 @@ def compiled_here(dispatcher) -> bool:
     """Whether numba holds machine code of ``dispatcher`` (a numba function)
     for this processor: compiled in this process, or in its disk cache and
     fresh for the source. Reads numba's cache index, whose layout is
-    numba's own: when it cannot be read, False (a compile may follow)."""
-    if dispatcher.signatures:
+    numba's own: when it cannot be read, False (a compile may follow).
+
+    By processor, not by signature: a scene whose arguments numba types
+    otherwise than the cached ones' would still compile (the simulation
+    loop is called with one signature for every scene). A plain function
+    (``NUMBA_DISABLE_JIT=1``) has nothing to compile: True."""
+    signatures = getattr(dispatcher, "signatures", None)
+    if signatures is None or signatures:
         return True
     try:
         index = dispatcher._cache._cache_file._load_index()

@@ -6,6 +6,9 @@ default and the switch behave as documented."""
 from __future__ import annotations
 
 import inspect
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -18,6 +21,7 @@ from refsim.dynamics import impulse
 from refsim.dynamics.boxes import boxes_kernel
 from refsim.dynamics.rotation_seed import orientation_step_seed_kernel
 from refsim.errors import OptionError
+from refsim.kernels import compiled_here
 from refsim.models import polygons
 from refsim.models.triangulate import ear_clip_indexed
 from refsim.types import random_rotation
@@ -336,3 +340,43 @@ def test_the_digest_covers_what_the_loop_compiles_in_and_changes_with_it(monkeyp
     monkeypatch.setattr(kernels, "_source_file",
                         lambda m: edited if m == "refsim.dynamics.impulse" else real(m))
     assert kernels.sources_digest(loop) != before
+
+
+COMPILED_HERE_CHILD = """
+import sys
+sys.path.insert(0, sys.argv[1])
+import numba
+from refsim.kernels import compiled_here
+import tiny
+if sys.argv[2] == "call":
+    tiny.twice(1.5)
+print(compiled_here(tiny.twice))
+"""
+
+
+def test_compiled_here_reads_numbas_disk_cache(tmp_path):
+    """``compiled_here``: False on an empty cache, True in the process that
+    compiled and in a later one reading the same cache, False on another."""
+    (tmp_path / "tiny.py").write_text("import numba\n\n\n@numba.njit(cache=True)\n"
+                                      "def twice(x):\n    return 2.0 * x\n")
+
+    def child(cache: str, action: str) -> str:
+        env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / cache))
+        env.pop("NUMBA_DISABLE_JIT", None)
+        done = subprocess.run([sys.executable, "-c", COMPILED_HERE_CHILD, str(tmp_path), action],
+                              env=env, capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+        return done.stdout.strip()
+
+    assert child("a", "look") == "False"
+    assert child("a", "call") == "True"
+    assert child("a", "look") == "True"
+    assert child("b", "look") == "False"
+
+
+def test_compiled_here_without_the_jit_is_true():
+    # NUMBA_DISABLE_JIT=1: njit gives the plain function, which compiles nothing
+    def plain(x):
+        return x
+
+    assert compiled_here(plain)

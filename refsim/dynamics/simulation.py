@@ -370,7 +370,9 @@ class Simulation:
         self._frames: FrameSink = MemorySink() if sink is None else sink
         # the largest principal moment of each body: 1/2 lambda_max |w|^2 bounds
         # the rotational energy without a rotation of the inertia tensor
-        self._lambda_max = np.linalg.eigvalsh(self.I_body)[:, -1]
+        # (contiguous: the compiled loop then has one signature for any number
+        # of bodies, not a second compile for a strided column)
+        self._lambda_max = np.ascontiguousarray(np.linalg.eigvalsh(self.I_body)[:, -1])
         self._energy_limit = DIVERGENCE_FACTOR * (self._energy_bound().sum()
                                                   + self._energy_scale())
         # The compiled loop (many steps per call), when the kernel is compiled

@@ -15,6 +15,12 @@ run takes changes its time only. :func:`start_kernel` picks:
 - else "readable" when the run's readable steps, timed on a few of them,
   would take less than :data:`LOOP_COMPILE_SECONDS`; else the default.
 
+The estimate is the first steps' rate: a scene whose bodies meet only
+later (each readable body contact costs far more than a step in flight)
+can run readable for longer than the compile would have taken. The probe
+looks at the clock every :data:`PROBE_CHUNK` steps, so it can pass
+:data:`PROBE_SECONDS` by up to that many steps.
+
 ``refsim run`` and the viewer's runs (:mod:`refsim.viewer.runs`) ask it;
 :func:`refsim.simulate` itself keeps its default (a library caller chooses
 with ``kernel=``). A run started readable compiles nothing, so numba's cache

@@ -537,7 +537,7 @@ class _Parser:
         if self.skipped_lines:
             warnings.warn(ModelWarning(
                 f"{self.path or '<ac3d>'}: skipped {self.skipped_lines} line surface(s) "
-                "(SURF types 1 and 2 have no area)"), stacklevel=4)
+                "(SURF types 1 and 2 have no area)"), stacklevel=5)   # read_ac3d's caller
         name = Path(self.path).stem if self.path is not None else None
         return Mesh(np.concatenate(self.vertex_blocks), np.concatenate(self.faces),
                     weld_tolerance=weld_tolerance,

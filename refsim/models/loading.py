@@ -50,7 +50,8 @@ SUFFIXES = (".ac",) + TRIMESH_SUFFIXES
 #: same file (least recently loaded dropped first).
 CACHED_MESHES = 32
 
-_loaded: OrderedDict[tuple, Mesh] = OrderedDict()
+#: key -> (the Mesh, the warnings its reading gave)
+_loaded: OrderedDict[tuple, tuple[Mesh, tuple[Warning, ...]]] = OrderedDict()
 
 
 def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
@@ -90,14 +91,20 @@ def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
     if type(weld_tolerance) not in (int, float):    # Mesh says what is wrong with it
         return _parse(path, suffix, data, weld_tolerance)
     key = (str(path), float(weld_tolerance), hashlib.blake2b(data, digest_size=20).digest())
-    mesh = _loaded.get(key)
-    if mesh is None:
-        mesh = _loaded[key] = _parse(path, suffix, data, weld_tolerance)
-        while len(_loaded) > CACHED_MESHES:
-            _loaded.popitem(last=False)
-    else:
-        _loaded.move_to_end(key)
-    return mesh
+    # popped and put back (the most recent last): two steps another thread
+    # cannot break, at worst both parse
+    entry = _loaded.pop(key, None)
+    if entry is None:
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            mesh = _parse(path, suffix, data, weld_tolerance)
+        entry = (mesh, tuple(w.message for w in said))
+    _loaded[key] = entry
+    while len(_loaded) > CACHED_MESHES:
+        _loaded.popitem(last=False)
+    for message in entry[1]:           # what the file's reader said, at every load
+        warnings.warn(message, stacklevel=2)
+    return entry[0]
 
 
 def _parse(path: Path, suffix: str, data: bytes, weld_tolerance) -> Mesh:

@@ -259,3 +259,18 @@ def test_only_the_last_meshes_loaded_are_kept(tmp_path):
     assert load_model(paths[-1]) is meshes[-1]         # kept
     assert load_model(paths[0]) is not meshes[0]       # the oldest was dropped
     assert len(loading._loaded) <= loading.CACHED_MESHES
+
+
+def test_a_file_loaded_again_warns_again_at_the_callers_line(tmp_path):
+    # a line surface (SURF type 1) in a cube: skipped, with a ModelWarning
+    text = (models_dir() / "cube.ac").read_text()
+    head, _, tail = text.partition("kids 0")
+    numsurf = int(head.split("numsurf ")[1].split()[0])
+    text = (head.replace(f"numsurf {numsurf}", f"numsurf {numsurf + 1}")
+            + "SURF 0x1\nmat 0\nrefs 2\n0 0 0\n1 0 0\nkids 0" + tail)
+    path = tmp_path / "cube-and-line.ac"
+    path.write_text(text)
+    for _ in range(2):
+        with pytest.warns(refsim.ModelWarning, match="skipped 1 line surface") as said:
+            load_model(path)
+        assert [w.filename for w in said] == [__file__]
