@@ -31,8 +31,8 @@ XFAILED = {
     "fcl": {"triangles.agreement", "pairs.agreement", "collide.agreement"},
     "coal": {"triangles.agreement", "pairs.agreement", "collide.agreement"},
     "trimesh": {"collide.agreement", "aabb.encloses", "aabb.tight"},
-    "pybullet": {"rigid.apex_ratio", "rigid.no_spin", "rigid.spin_to_rest",
-                 "rigid.free_rotation", "rigid.oblique_bounce"},
+    "pybullet": {"rigid.apex_ratio", "rigid.no_spin", "rigid.free_rotation",
+                 "rigid.oblique_bounce"},
     "mujoco": {"rigid.oblique_bounce", "rigid.free_rotation", "rigid.off_centre"},
     "drake": {"rigid.apex_ratio", "rigid.no_spin", "rigid.oblique_bounce",
               "rigid.resting_contact", "rigid.free_rotation", "rigid.off_centre", "rigid.stack",
@@ -123,8 +123,10 @@ def test_rigid_oracles_measured_against_the_analytic_answers(shipped_run):
     spin = pybullet.check("rigid.no_spin").measured["drop-icosahedron-e0.8"]["largest_spin"]
     assert spin > 5.0                                   # Bullet spins a symmetric landing
     assert mujoco.check("rigid.no_spin").measured["drop-icosahedron-e0.8"]["largest_spin"] < 1e-6
-    kept = pybullet.check("rigid.spin_to_rest").measured["spin-cube"]["largest_spin_after_limit"]
-    assert abs(kept - 5.0) < 1e-6                       # Bullet never slows the spin
+    # the spinning cube stops by Coulomb's 0.444 s in Bullet (the adapter's
+    # spinning friction) and well before the limit in MuJoCo
+    bullet = pybullet.check("rigid.spin_to_rest").measured["spin-cube"]
+    assert 0.43 <= bullet["first_time_below"] <= 0.45 and bullet["largest_spin_after_limit"] < 1e-9
     stopped = mujoco.check("rigid.spin_to_rest").measured["spin-cube"]["first_time_below"]
     assert stopped < 0.89
     lateral = mujoco.check("rigid.oblique_bounce").measured["oblique-sphere"]
