@@ -3,11 +3,11 @@ compile.
 
 numba compiles the simulation loop (:mod:`refsim.dynamics._numba_kernels`)
 on its first call on a machine and keeps the machine code on disk; that
-first compile takes about 16 s on a two-core machine
-(docs/decisions/cold-start.md), while the bundled scenes' readable steps
-take 0.5-5 s in all. The readable and compiled kernels give the same
-results bit for bit (tests/dynamics/test_compiled_loop.py), so which one a
-run takes changes its time only. :func:`start_kernel` picks:
+first compile takes longer than the bundled scenes' whole runs on the
+readable kernels (docs/decisions/cold-start.md has the figures). The
+readable and compiled kernels give the same results bit for bit
+(tests/dynamics/test_compiled_loop.py), so which one a run takes changes
+its time only. :func:`start_kernel` picks:
 
 - the default (the compiled loop) when numba already holds the loop's
   machine code for this processor, in memory or in its disk cache, or when
@@ -33,8 +33,9 @@ import time
 
 from refsim.errors import RefsimError
 
-#: The loop's first compile on a two-core machine, rounded down: a run whose
-#: readable steps take less starts readable (docs/decisions/cold-start.md).
+#: About the loop's first compile on a two-core machine, rounded down
+#: (docs/decisions/cold-start.md): a run whose readable steps take less
+#: starts readable.
 LOOP_COMPILE_SECONDS = 12.0
 
 #: The readable steps timed to estimate a run's readable time: at most this
