@@ -13,7 +13,9 @@ its time only. :func:`start_kernel` picks:
   machine code for this processor, in memory or in its disk cache, or when
   ``REFSIM_KERNELS`` chooses, or the loop cannot run the scene;
 - else "readable" when the run's readable steps, timed on a few of them,
-  would take less than :data:`LOOP_COMPILE_SECONDS`; else the default.
+  would take less than :data:`LOOP_COMPILE_SECONDS`; else the default
+  (also, untimed, for bodies of more than :data:`PROBE_FACES` triangles
+  that can meet at a triangle level).
 
 The estimate is the first steps' rate: a scene whose bodies meet only
 later (each readable body contact costs far more than a step in flight)
@@ -44,6 +46,12 @@ PROBE_STEPS = 200
 PROBE_SECONDS = 0.25
 #: Steps between two looks at the clock while timing.
 PROBE_CHUNK = 10
+#: A scene whose bodies can meet at a triangle level ("triangle-aabb",
+#: "exact") is not timed when a body has more triangles than this: the
+#: readable build of its triangle hierarchy, on the first contact, can take
+#: longer than the compile (seconds for 20 000 triangles), and a probe that
+#: met it would pay it before deciding.
+PROBE_FACES = 5000
 
 
 def start_kernel(scene, n_steps: int, *, wall_speed: str | None = None,
@@ -52,6 +60,7 @@ def start_kernel(scene, n_steps: int, *, wall_speed: str | None = None,
     the readable kernels than numba would compile the loop; else None (the
     default kernel). Costs a file read when the loop is compiled, else up to
     :data:`PROBE_SECONDS` of readable steps on a copy of the run."""
+    from refsim.collision.bodies import PAIR_LEVELS
     from refsim.dynamics.compiled_loop import loop_support
     from refsim.dynamics.simulation import Simulation
     from refsim.kernels import _environment_kernel, compiled_here, numba_usable
@@ -64,6 +73,9 @@ def start_kernel(scene, n_steps: int, *, wall_speed: str | None = None,
         return None
     probe = Simulation(scene, wall_speed=wall_speed, boxes=boxes, kernel="readable")
     if loop_support(probe) is not None:     # stage kernels then, not the loop
+        return None
+    if (probe.body_body and probe.level in PAIR_LEVELS
+            and max(b.mesh.n_faces for b in probe.bodies) > PROBE_FACES):
         return None
     began = time.perf_counter()
     try:

@@ -72,3 +72,46 @@ def test_refsim_run_on_an_empty_cache_writes_the_compiled_loops_frames(tmp_path)
         assert '"kernel": "readable"' in str(written["settings"])
         for name in ("t", "position", "velocity", "angular_velocity", "orientation"):
             assert written[name].tobytes() == getattr(compiled, name).tobytes(), name
+
+
+BIG_MESHES = """
+[world]
+half_size = 5.0
+
+[integration]
+solver = "rk4"
+step = 0.001
+duration = 0.2
+
+[collision]
+level = "exact"
+
+[dynamics]
+rotation = "impulse"
+body_response = "impulse"
+wall_response = "impulse"
+
+[[body]]
+name = "a"
+model = "sphere-20k.ac"
+position = [0.0, 0.0, 0.0]
+
+[[body]]
+name = "b"
+model = "sphere-20k.ac"
+position = [0.0, 2.05, 0.0]
+velocity = [0.0, -1.0, 0.0]
+"""
+
+
+def test_large_meshes_that_can_meet_are_not_timed(cold, tmp_path, monkeypatch):
+    # the probe would meet the readable build of a 20 000-triangle hierarchy
+    path = tmp_path / "big.toml"
+    path.write_text(BIG_MESHES)
+    scene = load_scene(path)
+
+    def no_steps(self, n_steps):
+        raise AssertionError("the probe stepped")
+
+    monkeypatch.setattr(Simulation, "advance", no_steps)
+    assert start.start_kernel(scene, scene.integration.n_steps) is None
