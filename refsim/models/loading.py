@@ -51,7 +51,7 @@ SUFFIXES = (".ac",) + TRIMESH_SUFFIXES
 CACHED_MESHES = 32
 
 #: key -> (the Mesh, the warnings its reading gave)
-_loaded: OrderedDict[tuple, tuple[Mesh, tuple[Warning, ...]]] = OrderedDict()
+_loaded: OrderedDict[tuple, tuple[Mesh, tuple[Warning | str, ...]]] = OrderedDict()
 
 
 def load_model(path, *, weld_tolerance: float = 0.0) -> Mesh:
