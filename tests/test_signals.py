@@ -129,6 +129,17 @@ def _setup(tmp_path, duration: float):
     return work, scene, out
 
 
+def _start_child(tmp_path, script: str, marker_name: str, *args: str):
+    """``script`` run as a child with the marker file's path and ``args``:
+    ``(the process, the marker it touches when it is where to signal it)``."""
+    child_script = tmp_path / "child.py"
+    child_script.write_text(script)
+    marker = tmp_path / marker_name
+    child = subprocess.Popen([sys.executable, str(child_script), str(marker), *args],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return child, marker
+
+
 def _signal_and_check(child, signum, work, out):
     child.send_signal(signum)
     _, err = child.communicate(timeout=DEADLINE_SECONDS)
@@ -142,12 +153,8 @@ def _signal_and_check(child, signum, work, out):
                          ids=["SIGTERM", "SIGHUP", "SIGINT"])
 def test_a_signal_during_the_write_leaves_no_file(tmp_path, signum):
     work, scene, out = _setup(tmp_path, duration=1.0)
-    child_script = tmp_path / "child.py"
-    child_script.write_text(CHILD)
-    marker = tmp_path / "assembling"
-    child = subprocess.Popen(
-        [sys.executable, str(child_script), str(marker), "run", str(scene), "-o", str(out),
-         "--every", "1"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    child, marker = _start_child(tmp_path, CHILD, "assembling",
+                                 "run", str(scene), "-o", str(out), "--every", "1")
     _wait_for(child, marker.exists)
     # mid-write: the temporary .npz and the four spill files are there
     hidden = sorted(p.name for p in work.iterdir() if p.name.startswith(".out.npz."))
@@ -250,11 +257,7 @@ def test_a_signal_inside_a_constructor_gets_one_line(tmp_path, signum):
     # CI once printed llvmlite's "Exception ignored in: OutputString.__del__"
     # traceback after the one line: the signal had come as numba compiled
     work, scene, out = _setup(tmp_path, duration=1.0)
-    child_script = tmp_path / "child.py"
-    child_script.write_text(CHILD_IN_CONSTRUCTOR)
-    marker = tmp_path / "constructing"
-    child = subprocess.Popen(
-        [sys.executable, str(child_script), str(marker), "run", str(scene), "-o", str(out)],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    child, marker = _start_child(tmp_path, CHILD_IN_CONSTRUCTOR, "constructing",
+                                 "run", str(scene), "-o", str(out))
     _wait_for(child, marker.exists)
     _signal_and_check(child, signum, work, out)
