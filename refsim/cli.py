@@ -330,7 +330,8 @@ def _study(args) -> int:
     verdicts on the seed claims it backs (each with its facts)."""
     from refsim.errors import check_count
     from refsim.oracles import OracleUnavailable
-    from refsim.report.plan import STUDIES, Run
+    from refsim.report.plan import STUDIES
+    from refsim.report.run import Run
     from refsim.report.text import TIMING_NOTE, format_claim, format_records
 
     workers = None if args.workers is None else check_count("--workers", args.workers, 1)
@@ -360,7 +361,8 @@ def _study(args) -> int:
 
 def _add_study_command(commands) -> None:
     """``refsim study NAME``: the command each figure of the report names."""
-    from refsim.report.plan import REPORT_SEED, STUDIES
+    from refsim.report.plan import STUDIES
+    from refsim.report.run import REPORT_SEED
 
     study = commands.add_parser(
         "study", help="run one of the report's studies and print its records",

@@ -32,8 +32,9 @@ from pathlib import Path
 from refsim.bundled import templates_dir
 from refsim.claims import CLAIMS, TERMINOLOGY
 from refsim.io import write_text_atomic
-from refsim.report.plan import PARALLEL_ENTRIES, REPORT_SEED, SWEEP_ENTRIES, Run
+from refsim.report.plan import PARALLEL_ENTRIES, SWEEP_ENTRIES
 from refsim.report.progress import Progress
+from refsim.report.run import REPORT_SEED, Run
 from refsim.report.section import Section, to_json
 
 # (key, title, what the section will measure once its work lands)

@@ -114,13 +114,13 @@ def advise_scene(*, seed: int, scene: str, tolerances: list, duration: float | N
 
 def measure_entry(*, seed: int, name: str, quick: bool, report_seed: int) -> dict:
     """The records of the plan's entry ``name`` measured in a fresh
-    :class:`refsim.report.plan.Run` (quick or full, ``report_seed``), in
+    :class:`refsim.report.run.Run` (quick or full, ``report_seed``), in
     this process: ``{"records": <pickle as base64 text>, "missing": {engine:
     why}}`` (the engines it could not make). An entry whose records hold
     timing fields is refused: it must run alone (``Study.timed``), and this
     check keeps that flag true."""
     from refsim.errors import SweepError
-    from refsim.report.plan import Run
+    from refsim.report.run import Run
     from refsim.report.section import to_json
 
     run = Run(quick=quick, seed=report_seed)

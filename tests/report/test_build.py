@@ -89,17 +89,18 @@ def test_results_are_deterministic_and_the_same_on_workers(tmp_path, quick_repor
     workers change no result. This test's build is the session's only
     second one."""
     from refsim.report import plan
+    from refsim.report.run import Run
 
     _, _, first = quick_report
     sent, runs = [], []                       # what went to the workers, and from which run
-    measure_parallel = plan.Run._measure_parallel
+    measure_parallel = Run._measure_parallel
 
     def spy(run, futures):
         runs.append(run)
         sent.extend(futures)
         return measure_parallel(run, futures)
 
-    monkeypatch.setattr(plan.Run, "_measure_parallel", spy)
+    monkeypatch.setattr(Run, "_measure_parallel", spy)
     build_report(tmp_path, quick=True, stream=io.StringIO(), workers=2)
     assert len(runs) == 1 and runs[0].workers == 2 and runs[0].missing == {}
     assert sorted(sent) == sorted(plan.PARALLEL_ENTRIES) and len(sent) >= 15

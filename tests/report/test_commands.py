@@ -10,7 +10,8 @@ import re
 import pytest
 
 from refsim.cli import build_parser
-from refsim.report.plan import CLAIM_STUDY, STUDIES, Run, claim_command
+from refsim.report.plan import CLAIM_STUDY, STUDIES, claim_command
+from refsim.report.run import Run
 
 #: A command as the page prints it: "refsim" and its arguments, up to the
 #: end of the sentence or list it stands in.

@@ -16,6 +16,7 @@ from refsim.conformance.matrix import conformance_matrix, run_matrix
 from refsim.conformance.results import ConformanceResult, tally
 from refsim.report import plan
 from refsim.report.build import render
+from refsim.report.run import REPORT_SEED, Run
 from refsim.report.section import Section, to_json
 from refsim.report.sections import advisor as advisor_section
 from refsim.report.sections import conformance as conformance_section
@@ -64,7 +65,7 @@ def test_matrix_counts_match_an_independent_run(quick_report):
     _, _, results = quick_report
     table = _table(results, "conformance", "conformance-matrix")
     columns = table["columns"]
-    direct, _ = run_matrix(cases=plan.MATRIX_CASES[0], seed=plan.REPORT_SEED, only="triangles")
+    direct, _ = run_matrix(cases=plan.MATRIX_CASES[0], seed=REPORT_SEED, only="triangles")
     assert direct.checks
     shown = {row[0]: row for row in table["rows"]}
     for check in direct.checks:
@@ -164,7 +165,7 @@ def test_replays_are_written_and_shown_at_their_claims(quick_report):
 
 def test_without_viser_the_report_says_so_in_place(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "viser", None)          # import viser raises ImportError
-    records = plan.Run(quick=True, out_dir=tmp_path).get("replays")
+    records = Run(quick=True, out_dir=tmp_path).get("replays")
     assert {r.status for r in records} == {"unavailable"}
     assert all("viser" in r.reason for r in records)
     assert list((tmp_path / plan.REPLAY_FOLDER).iterdir()) == []
@@ -181,7 +182,7 @@ def test_without_viser_the_report_says_so_in_place(tmp_path, monkeypatch):
 
 
 def test_replays_without_an_output_directory_are_not_written_and_say_so():
-    records = plan.Run(quick=True).get("replays")
+    records = Run(quick=True).get("replays")
     assert {r.status for r in records} == {"not written"}
     assert all(r.file == "" and r.reason for r in records)
 
@@ -255,18 +256,18 @@ def test_a_timed_entry_is_refused_by_the_worker_task():
 
     with pytest.raises(SweepError, match="'particles-drag' holds timings .*timed=True"):
         measure_entry(seed=0, name="particles-drag", quick=True,
-                      report_seed=plan.REPORT_SEED)
+                      report_seed=REPORT_SEED)
 
 
 def test_an_entry_measured_in_a_worker_returns_its_records_to_the_bit():
     from refsim.report.tasks import entry_records, measure_entry
 
     answer = measure_entry(seed=123, name="solvers-energy", quick=True,
-                           report_seed=plan.REPORT_SEED)
+                           report_seed=REPORT_SEED)
     assert json.loads(json.dumps(answer)) == answer          # plain data for the sweep
     records, missing = entry_records(answer)
     assert missing == {}
-    here = plan.Run(quick=True).get("solvers-energy")
+    here = Run(quick=True).get("solvers-energy")
     assert json.dumps(to_json(records)) == json.dumps(to_json(here))
 
 
@@ -324,7 +325,7 @@ def test_cancel_stops_the_sweeps_of_the_background_thread(tmp_path):
 
     me = psutil.Process()
     before = {p.pid for p in me.children(recursive=True)}   # e.g. a Dask fixture's
-    run = plan.Run(quick=True, out_dir=tmp_path, workers=2)
+    run = Run(quick=True, out_dir=tmp_path, workers=2)
     run.prefetch(["advisor"])
     deadline = time.monotonic() + 120.0
     while len(new_workers(me, before)) < 2:
