@@ -56,7 +56,7 @@ def test_throughput_figures_are_consistent():
     # No timing assert: only that every kernel ran and agreed (the function
     # raises if the kernels disagree) and the figures are positive numbers.
     # The cold compile (a fresh interpreter, about 30 s) is the report's to
-    # measure: its build runs measure_throughput with it (report/plan.py).
+    # measure: its build runs measure_throughput with it (report/entries/collision.py).
     result = measure_throughput(n=2000, seed=0, cold_compile=False)
     print(f"\npairs/s readable={result.readable:.3g} batch={result.batch:.3g} "
           f"numba={result.numba:.3g}")

@@ -89,6 +89,7 @@ def test_results_are_deterministic_and_the_same_on_workers(tmp_path, quick_repor
     workers change no result. This test's build is the session's only
     second one."""
     from refsim.report import plan
+    from refsim.report.entries.replays import REPLAYS
     from refsim.report.run import Run
 
     _, _, first = quick_report
@@ -109,7 +110,7 @@ def test_results_are_deterministic_and_the_same_on_workers(tmp_path, quick_repor
     paths = [tuple(p) for p in first["timing_paths"]]
     assert _without_timings(first, paths) == _without_timings(second, paths)
     assert sorted(p.name for p in (tmp_path / "replays").iterdir()) == \
-        sorted(f"{name}.html" for name, _, _ in plan.REPLAYS)
+        sorted(f"{name}.html" for name, _, _ in REPLAYS)
 
 
 def _timed(path: tuple, patterns: list[tuple]) -> bool:

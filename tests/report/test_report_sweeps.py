@@ -16,6 +16,9 @@ from refsim.conformance.matrix import conformance_matrix, run_matrix
 from refsim.conformance.results import ConformanceResult, tally
 from refsim.report import plan
 from refsim.report.build import render
+from refsim.report.entries import advisor as advisor_entry
+from refsim.report.entries import conformance as conformance_entry
+from refsim.report.entries import replays as replays_entry
 from refsim.report.run import REPORT_SEED, Run
 from refsim.report.section import Section, to_json
 from refsim.report.sections import advisor as advisor_section
@@ -65,7 +68,8 @@ def test_matrix_counts_match_an_independent_run(quick_report):
     _, _, results = quick_report
     table = _table(results, "conformance", "conformance-matrix")
     columns = table["columns"]
-    direct, _ = run_matrix(cases=plan.MATRIX_CASES[0], seed=REPORT_SEED, only="triangles")
+    direct, _ = run_matrix(cases=conformance_entry.MATRIX_CASES[0], seed=REPORT_SEED,
+                           only="triangles")
     assert direct.checks
     shown = {row[0]: row for row in table["rows"]}
     for check in direct.checks:
@@ -107,7 +111,7 @@ def test_an_unavailable_engine_is_listed_with_its_reason():
     why = "mujoco: not installed (pip install mujoco)"
     matrix = conformance_matrix({"refsim-seed": _result("refsim-seed", 0),
                                  "fcl": _result("fcl", 2)}, unavailable={"mujoco": why})
-    record = plan.MatrixRun(matrix, 5, "", "refsim conform --all")
+    record = conformance_entry.MatrixRun(matrix, 5, "", "refsim conform --all")
     ctx = SimpleNamespace(quick=True, run=SimpleNamespace(get=lambda name: record))
     section = conformance_section.build(ctx)
     matrix_table, unavailable = section.tables
@@ -144,7 +148,7 @@ def test_a_missing_engine_in_the_sweep_is_unavailable_not_an_error():
 def test_replays_are_written_and_shown_at_their_claims(quick_report):
     out, html, results = quick_report
     replays = _section(results, "dynamics")["results"]["replays"]
-    assert [r["name"] for r in replays] == [name for name, _, _ in plan.REPLAYS]
+    assert [r["name"] for r in replays] == [name for name, _, _ in replays_entry.REPLAYS]
     for r in replays:
         assert r["status"] == "written", r["reason"]
         page = out / r["file"]
@@ -168,7 +172,7 @@ def test_without_viser_the_report_says_so_in_place(tmp_path, monkeypatch):
     records = Run(quick=True, out_dir=tmp_path).get("replays")
     assert {r.status for r in records} == {"unavailable"}
     assert all("viser" in r.reason for r in records)
-    assert list((tmp_path / plan.REPLAY_FOLDER).iterdir()) == []
+    assert list((tmp_path / replays_entry.REPLAY_FOLDER).iterdir()) == []
     from refsim.report.sections.dynamics import _replay
 
     section = Section(key="dynamics", title="Rigid-body dynamics",
@@ -220,16 +224,16 @@ def test_the_advisor_lists_every_bundled_scene(quick_report):
         assert costs == sorted(costs, reverse=True)
     assert [s["scene"] for s in advisor["scenes"] if s["refused"]] == ["particles.toml"]
     assert [s["scene"] for s in advisor["scenes"] if s["skipped"]] == \
-        list(plan.ADVISOR_QUICK_SKIP)
+        list(advisor_entry.ADVISOR_QUICK_SKIP)
     by_name = {s["scene"]: s for s in advisor["scenes"]}
     assert "the scene has no [[body]]" in by_name["particles.toml"]["refused"]
-    assert advisor["duration"] == plan.ADVISOR_DURATION[0]
+    assert advisor["duration"] == advisor_entry.ADVISOR_DURATION[0]
     assert "Quick run: the first 1 s of each scene" in html
 
 
 def test_the_advisor_section_lists_a_refused_scene():
-    record = plan.AdvisorRun((plan.AdvisedScene("p.toml", refused="no bodies"),),
-                             (1e-2, 1e-3), 1.0, 1)
+    record = advisor_entry.AdvisorRun(
+        (advisor_entry.AdvisedScene("p.toml", refused="no bodies"),), (1e-2, 1e-3), 1.0, 1)
     ctx = SimpleNamespace(quick=True, run=SimpleNamespace(get=lambda name: record))
     section = advisor_section.build(ctx)
     assert section.tables[0].rows[0][:3] == ("p.toml", "-", "not advised: no bodies")

@@ -13,7 +13,7 @@ from refsim.conformance.checks_rigid import (
     TEXTBOOK_PROBLEMS,
 )
 from refsim.conformance.matrix import Cell, Matrix
-from refsim.report.plan import TextbookConvergence
+from refsim.report.entries.conformance import TextbookConvergence
 from refsim.report.sections.textbook import build
 
 STRIKE = {"largest_miss_of_closing_speed": 0.095, "momentum_drift": 2e-4}

@@ -8,12 +8,12 @@ that turn on a threshold come from :mod:`refsim.claims.dynamics`. This module
 only arranges them (STYLE.md, rule 9).
 
 A quick run has fewer restitutions, step sizes and solvers, shorter C11 and
-C12 runs and fewer timed steps (:mod:`refsim.report.plan`); the captions say
-what the quick run leaves out. Without pybullet the section still measures
-refsim against the analytic answers and says that the oracle's columns are
-missing. Everything is deterministic but the wall times, which the study
-records mark (the step-cost table is marked ``timing``); no verdict sentence
-quotes a time.
+C12 runs and fewer timed steps (:mod:`refsim.report.entries.dynamics`); the
+captions say what the quick run leaves out. Without pybullet the section
+still measures refsim against the analytic answers and says that the
+oracle's columns are missing. Everything is deterministic but the wall
+times, which the study records mark (the step-cost table is marked
+``timing``); no verdict sentence quotes a time.
 """
 
 from __future__ import annotations

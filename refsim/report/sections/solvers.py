@@ -10,9 +10,10 @@ The full report runs each measurement with the parameters of its command
 (``refsim study solvers-orders``, ``refsim study particles-jitter``, ...), so
 each table can be checked with the command named under it. A quick run
 drops the Kepler problem from the order study, caps step counts and shrinks
-the particle systems (:mod:`refsim.report.plan`): the section then takes
-seconds, not a minute, and its numbers differ from the full run's where its
-captions say so.
+the particle systems (:mod:`refsim.report.entries.solvers`,
+:mod:`refsim.report.entries.particles`): the section then takes seconds, not
+a minute, and its numbers differ from the full run's where its captions say
+so.
 
 The measurement functions seed their own random states (the particle
 systems' ``seed``); none depends on the report's seed, so their figures are

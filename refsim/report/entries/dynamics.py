@@ -1,0 +1,122 @@
+"""The report's rigid-body dynamics entries (seeds S5, S7, S8, S9, claims
+C11 and C12).
+
+The bounce studies of :mod:`refsim.studies.bounce` against the analytic
+answers and pybullet (apexes, oblique bounces, time to rest, energy, error
+against cost, pybullet's settings, step cost) and the C11/C12 measurements
+of :mod:`refsim.studies.dynamics`. Each runs without pybullet
+(``run.optional``), its pybullet columns then empty; the pybullet engines
+are the plan's (:mod:`refsim.report.plan`). A quick run has fewer
+restitutions, step sizes and solvers, a shorter C11 run and fewer timed
+steps.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from refsim.report.run import Run
+
+#: The scene of C12 (a cube dropped with spin).
+SPIN_SCENE = "spinning-cube.toml"
+
+
+@dataclass(frozen=True)
+class CostRun:
+    """Error against cost over step sizes, and the fitted order of each series."""
+
+    study: Any                  # refsim.studies.bounce.CostStudy
+    orders: dict                # series -> slope of log error against log h
+
+
+def dynamics_apex(run: Run):
+    from refsim.studies import bounce
+
+    pb = run.optional("pybullet")
+    if run.quick:
+        rows = bounce.measure_apexes(models=(bounce.SPHERE,), oracle=pb)
+        rows.append(bounce.measure_apex_row(bounce.CUBE, 0.8, rotation="seed", oracle=pb))
+        return rows
+    return bounce.measure_apexes(oracle=pb)
+
+
+def dynamics_oblique(run: Run):
+    from refsim.studies import bounce
+
+    return bounce.measure_oblique(oracle=run.optional("pybullet"))
+
+
+def dynamics_rest(run: Run):
+    from refsim.studies import bounce
+
+    return bounce.measure_rest(restitutions=run.size((0.5,), (0.5, 0.8)),
+                               oracle=run.optional("pybullet"))
+
+
+def dynamics_energy(run: Run):
+    from refsim.studies import bounce
+
+    return bounce.measure_drop_energy(oracle=run.optional("pybullet"))
+
+
+def dynamics_cost(run: Run):
+    from refsim.studies import bounce
+
+    study = bounce.measure_cost(run.size(bounce.COST_STEPS_QUICK, bounce.COST_STEPS),
+                                run.size(bounce.COST_SOLVERS_QUICK, bounce.COST_SOLVERS),
+                                oracle=run.optional("pybullet"))
+    return CostRun(study, bounce.fit_error_orders(study))
+
+
+def dynamics_pybullet_settings(run: Run):
+    """Empty in a quick run and without pybullet."""
+    from refsim.report.plan import pybullet_variants
+    from refsim.studies import bounce
+
+    if run.optional("pybullet") is None or run.quick:
+        return []
+    return bounce.measure_engine_variants(pybullet_variants())
+
+
+def dynamics_step_cost(run: Run):
+    from refsim.studies import bounce
+
+    pb = run.optional("pybullet")
+    rows = bounce.measure_step_cost(steps=run.size(50, 200), warmup=run.size(10, 20),
+                                    repeats=run.size(3, 5), oracle=pb)
+    if not run.quick:
+        rows += bounce.measure_step_cost(counts=(bounce.BENCH_COUNTS[-1],),
+                                         warmup=bounce.LATE_WARMUP, repeats=3, oracle=pb)
+    return rows
+
+
+def dynamics_spin(run: Run):
+    """C12 runs its full 6 s in the quick report too: a shorter run stops
+    before the corrected model comes to rest and would change the verdict.
+    pybullet runs the same scene in a client of its own (a second engine
+    from the plan's factory, not the run's shared one)."""
+    from refsim.bundled import scenes_dir
+    from refsim.dynamics.simulation import default_every
+    from refsim.report.plan import ENGINES
+    from refsim.scenes.loader import load_scene
+    from refsim.studies import dynamics
+
+    if run.optional("pybullet") is None:
+        return dynamics.measure_spin()
+    scene = load_scene(scenes_dir() / SPIN_SCENE)
+    with ENGINES["pybullet"]() as oracle:
+        external = oracle.simulate(scene, every=default_every(scene.integration.n_steps))
+    return dynamics.measure_spin(scene, external=external)
+
+
+def dynamics_interpenetration(run: Run):
+    from refsim.studies import dynamics
+
+    return dynamics.measure_interpenetration(duration=run.size(1.0, 2.0))
+
+
+def dynamics_rotation_energy(run: Run):
+    from refsim.studies import dynamics
+
+    return dynamics.measure_energy()
