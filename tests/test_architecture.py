@@ -47,8 +47,8 @@ RULES: tuple[tuple[str, tuple[str, ...], tuple[str, ...], tuple[str, ...]], ...]
      ("refsim.oracles", "refsim.claims", "refsim.report", "refsim.cli", "refsim.viewer"), ()),
     ("a claim imports nothing of refsim but study records and plain value types",
      ("refsim.claims",), ("refsim",), ("refsim.claims", "refsim.studies", "refsim.types")),
-    ("a report section imports no oracle (the plan chooses engines)",
-     ("refsim.report.sections",), ("refsim.oracles",), ()),
+    ("a report section or entry imports no oracle (the plan chooses engines)",
+     ("refsim.report.sections", "refsim.report.entries"), ("refsim.oracles",), ()),
 )
 
 #: Imports that break a rule today, each with the reason and whose work
@@ -139,6 +139,8 @@ def test_the_walk_sees_nested_and_relative_imports(tmp_path):
     ("refsim.claims.bounds", "refsim.bounds.aabb_linear", True),
     ("refsim.report.sections.models", "refsim.oracles.trimesh_adapter", True),
     ("refsim.report.plan", "refsim.oracles.trimesh_adapter", False),
+    ("refsim.report.entries.dynamics", "refsim.oracles.pybullet_adapter", True),
+    ("refsim.report.run", "refsim.oracles", False),
 ])
 def test_the_rules_table(module, target, broken):
     hits = [rule for rule, who, forbidden, exempt in RULES
