@@ -6,9 +6,8 @@ once, makes each engine of :data:`refsim.report.plan.ENGINES` once, and
 judges each seed claim from the records of the entry that backs it
 (:data:`refsim.report.plan.CLAIM_STUDY`). A :class:`Study` is one entry of
 that table. The plan imports this module to build its table, so a run reads
-the table (and the engines) from the plan when it first uses them: an import
-inside each method, which also keeps the command line's start-up free of
-the entries' studies.
+the table and the engines from the plan inside the methods that use them
+(an import at the top would be circular).
 
 With ``workers``, :meth:`Run.prefetch` sends the entries that may run
 elsewhere (:data:`refsim.report.plan.SWEEP_ENTRIES` and
