@@ -67,3 +67,50 @@ def test_a_verdict_is_a_badge_then_a_sentence_then_the_numbers_behind_a_click():
     hidden = row[details:].split("</details>", 1)[0]
     assert "1.03 against 1" in hidden and "refsim study x" in hidden
     assert "1.03 against 1" not in row[:details]
+
+
+#: Elements HTML closes by itself, or that the page never closes by design.
+VOID = {"area", "base", "br", "col", "embed", "hr", "img", "input", "link", "meta", "source",
+        "track", "wbr", "p", "li", "tr", "td", "th", "option"}
+
+
+def misnested(html: str) -> list[str]:
+    """The tags of ``html`` that close an element other than the innermost
+    open one, or that stay open at the end (``p``, ``li`` and table cells,
+    which HTML may leave open, aside)."""
+    from html.parser import HTMLParser
+
+    problems: list[str] = []
+    stack: list[str] = []
+
+    class Nesting(HTMLParser):
+        def handle_starttag(self, tag, attrs):
+            if tag not in VOID:
+                stack.append(tag)
+
+        def handle_endtag(self, tag):
+            if tag in VOID:
+                return
+            if not stack or stack[-1] != tag:
+                problems.append(f"</{tag}> closes <{stack[-1] if stack else 'nothing'}> "
+                                f"at line {self.getpos()[0]}")
+                if tag in stack:
+                    del stack[len(stack) - 1 - stack[::-1].index(tag):]
+                return
+            stack.pop()
+
+    Nesting().feed(html)
+    return problems + [f"<{tag}> never closed" for tag in stack]
+
+
+def test_the_nesting_check_finds_a_table_left_open():
+    assert misnested("<section><table><tr><td>a</table></section>") == []
+    assert misnested("<section><table><p>x</p><table><tr><td>a</table></section>") == \
+        ["</section> closes <table> at line 1"]
+
+
+def test_every_element_of_the_page_is_closed_where_it_was_opened():
+    verdict = Verdict("C1", measured="1.03", verdict="confirmed", evidence="some",
+                      summary="It holds.")
+    some = Table(id="some", title="A table", columns=("a", "b"), rows=(("1", "2"),))
+    assert misnested(page(some, verdicts=[verdict])) == []

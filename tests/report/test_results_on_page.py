@@ -99,3 +99,10 @@ def test_cross_cutting_parts_hold_their_items_once(quick_report):
         assert html.count(anchor) == 1, item["id"]
         if item["part"]:
             assert anchor in _section_html(html, item["part"]), item["id"]
+
+
+def test_every_element_of_the_built_page_is_closed_where_it_was_opened(quick_report):
+    from tests.report.test_page import misnested
+
+    _, html, _ = quick_report
+    assert misnested(html) == []
