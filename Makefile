@@ -6,7 +6,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: test typecheck docs report bench lint models fuzz clean
+.PHONY: test typecheck docs report report-full bench lint models fuzz clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -29,8 +29,13 @@ docs: $(STAMP)
 	$(SPHINX) -b doctest docs/_build/doctest
 	$(SPHINX) -b html docs/_build/html
 
+# The quick report (about a minute); report-full measures everything, its
+# sweeps on two processes (about twelve minutes on two cores).
 report: $(STAMP)
 	$(BIN)/refsim report
+
+report-full: $(STAMP)
+	$(BIN)/refsim report --full --workers 2
 
 bench: $(STAMP)
 	$(BIN)/python -m pytest tests/benchmarks --benchmark-only --benchmark-columns=min,median,max,rounds

@@ -128,6 +128,10 @@ def row_text(row) -> str:
             f"meets TOL: {'yes' if row.meets else 'no'}")
 
 
+#: What the ``proxy`` column and figures count, said where they are shown.
+PROXY_MEANING = ("a run's cost counted, not timed: force evaluations x bodies + "
+                 "narrow-phase calls (the same on every machine and every run)")
+
 TABLE_COLUMNS = ("role", "solver", "step s", "level", "aabb", "proxy", "wall s", "pos err m",
                  "event err m", "events", "energy gap", "meets")
 
@@ -158,6 +162,7 @@ def advice_text(advice, chart: str | None = None) -> str:
              f"saving: {_saving(advice.proxy_saving)} by the proxy, "
              f"{_saving(advice.wall_saving)} by wall time (medians; noisy)"
              + ("" if own.meets else "; the scene's own settings do not meet TOL"),
+             f"proxy: {PROXY_MEANING}",
              "", "paste into the scene:", toml_snippet(advice),
              f"runs: {advice.computed} simulated, {advice.resumed} read from the store, "
              f"{len(advice.pruned)} pruned (their force evaluations alone cost more than "

@@ -84,18 +84,56 @@ def bundled_if_bare(path: Path, directory: Path) -> Path:
 
 
 def refuse_missing_bundled(path: Path, directory: Path, kind: str, error: type) -> None:
-    """Nothing, unless ``path`` names no file while ``directory`` holds a
-    bundled ``kind`` ("model", "scene") of the same base name; then the
-    usual ``error("no such file", path)`` with the bare name that works from
-    any directory added, since a path such as ``models/cube.ac`` only exists
-    in a source checkout."""
+    """Nothing, unless ``path`` names no file and ``directory`` holds a
+    bundled ``kind`` ("model", "scene") of the same base name or of a
+    similar one; then the usual ``error("no such file", path)`` with the
+    bare name that works from any directory added (a path such as
+    ``models/cube.ac`` only exists in a source checkout), or the similar
+    bundled names (``sphere.ac``: ``sphere-2k.ac``)."""
     try:
-        if os.path.lexists(path) or not (directory / path.name).is_file():
+        if os.path.lexists(path):
             return
+        namesake = (directory / path.name).is_file()
     except (OSError, ValueError):       # ValueError: a NUL byte in the name
         return
-    raise error(f"no such file (a bundled {kind} of that name exists: use '{path.name}')",
-                path)
+    if namesake:
+        raise error(f"no such file (a bundled {kind} of that name exists: use "
+                    f"'{path.name}')", path)
+    similar = similar_bundled(path.name, directory, BUNDLED_SUFFIX[kind])
+    if similar:
+        raise error(f"no such file ({similar_hint(similar, kind)})", path)
+
+
+#: At most this many similar bundled names are suggested.
+SIMILAR_NAMES = 3
+
+#: The suffix of each kind of bundled file.
+BUNDLED_SUFFIX = {"model": ".ac", "scene": ".toml"}
+
+
+def similar_bundled(name: str, directory: Path, suffix: str) -> list[str]:
+    """The bundled ``suffix`` files of ``directory`` whose names or stems are
+    close to ``name``'s (``difflib``'s ratio at least 0.6, its default; the
+    closest first, at most ``SIMILAR_NAMES``): a typo or a remembered stem
+    (``sphere.ac``, ``cube.obj``) finds the bundled file."""
+    import difflib
+
+    try:
+        names = sorted(p.name for p in directory.glob(f"*{suffix}") if p.is_file())
+    except OSError:
+        return []
+    stems = {Path(n).stem: n for n in names}
+    close = difflib.get_close_matches(name, names, n=SIMILAR_NAMES)
+    close += [stems[s] for s in difflib.get_close_matches(Path(name).stem, list(stems),
+                                                           n=SIMILAR_NAMES)]
+    return list(dict.fromkeys(close))[:SIMILAR_NAMES]
+
+
+def similar_hint(similar: list[str], kind: str) -> str:
+    """``bundled models with a similar name: 'a.ac', 'b.ac'`` and how to list them all."""
+    names = ", ".join(f"'{n}'" for n in similar)
+    return (f"bundled {kind}s with a similar name: {names}; refsim info --bundled "
+            f"lists them all")
 
 
 def decode_utf8(data: bytes, path, error: type) -> str:

@@ -90,6 +90,26 @@ def _c_order(value, dtype) -> np.ndarray:
     return a if a.flags.c_contiguous else np.ascontiguousarray(a)
 
 
+class CountedSink:
+    """A sink that hands every frame to ``inner`` and then tells ``progress``
+    (a :class:`refsim.sweep.progress.Progress`) how many frames it has: the
+    command line's progress line for a long run. Cost: O(1) per frame."""
+
+    def __init__(self, inner: FrameSink, progress):
+        self.inner, self.progress = inner, progress
+
+    @property
+    def n_frames(self) -> int:
+        return self.inner.n_frames
+
+    def append(self, frame: Mapping[str, object]) -> None:
+        self.inner.append(frame)
+        self.progress.update(self.inner.n_frames, 0)
+
+    def arrays(self) -> Mapping[str, FrameArray]:
+        return self.inner.arrays()
+
+
 class _Layout:
     """The names, frame shapes and dtypes fixed by the first frame; checks
     later frames against them (a producer's bug, not a user's)."""

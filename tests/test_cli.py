@@ -280,6 +280,28 @@ def test_a_missing_path_with_no_bundled_namesake_gets_no_hint(tmp_path, monkeypa
     assert capsys.readouterr().err == "refsim: error: models/no-such-model.ac: no such file\n"
 
 
+def test_a_missing_name_close_to_a_bundled_one_gets_the_close_names(tmp_path, monkeypatch,
+                                                                    capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["info", "tors.ac"]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (
+        "refsim: error: tors.ac: no such file (bundled models with a similar name: "
+        "'torus.ac'; refsim info --bundled lists them all)\n")
+    assert main(["info", "sphere.obj"]) == EXIT_USER_ERROR        # the stem is compared too
+    err = capsys.readouterr().err
+    assert "bundled models with a similar name: 'sphere-" in err and err.count("\n") == 1
+    assert main(["run", "spining-cube.toml"]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err == (
+        "refsim: error: spining-cube.toml: no such file (bundled scenes with a similar name: "
+        "'spinning-cube.toml'; refsim info --bundled lists them all)\n")
+    scene = _scene_naming(tmp_path, "sphere.ac")
+    assert main(["run", str(scene), "-o", str(tmp_path / "out.npz")]) == EXIT_USER_ERROR
+    assert capsys.readouterr().err.endswith(
+        "; bundled models with a similar name: 'sphere-5k.ac', 'sphere-2k.ac', "
+        "'sphere-20k.ac'; refsim info --bundled lists them all\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [scene.name]
+
+
 def test_a_scenes_model_path_to_a_bundled_model_names_the_bare_name(tmp_path, capsys):
     scene = _scene_naming(tmp_path, "models/cube.ac")
     assert main(["run", str(scene), "-o", str(tmp_path / "out.npz")]) == EXIT_USER_ERROR
@@ -341,3 +363,50 @@ def test_the_oracles_hint_is_for_an_installed_refsim(monkeypatch):
         import_engine("pybullet", "pybullet")
     assert str(info.value).startswith("oracle engine 'pybullet' is not installed "
                                       "(pip install 'refsim[oracles]'): ")
+
+
+@pytest.mark.parametrize(("scene", "frames"), [("spinning-cube.toml", 6),   # h = 1e-3
+                                               ("particles.toml", 4)])      # h = 2e-3
+def test_a_long_run_writes_its_progress_off_a_terminal(scene, frames, tmp_path, capsys,
+                                                       monkeypatch):
+    """``refsim run`` piped to a log is never silent: its frames so far, as
+    whole lines, at most every LOG_SECONDS (here 0, so every frame), and
+    nothing on stdout but the closing line."""
+    from refsim.sweep import progress
+
+    monkeypatch.setattr(progress, "LOG_SECONDS", 0.0)
+    out = tmp_path / "run.npz"
+    assert main(["run", scene, "-o", str(out), "--duration", "0.05", "--every", "10"]) == 0
+    captured = capsys.readouterr()
+    assert captured.out.startswith(f"wrote {out}") and captured.out.count("\n") == 1
+    lines = [line for line in captured.err.splitlines() if line.startswith("refsim run: ")]
+    assert lines[0].startswith(f"refsim run: 1/{frames} frames, about ")
+    assert lines[-1] == f"refsim run: {frames}/{frames} frames"
+    assert [int(line.split()[2].split("/")[0]) for line in lines] == \
+        list(range(1, frames + 1))
+
+
+def test_a_short_run_writes_no_progress(tmp_path, capsys):
+    out = tmp_path / "run.npz"
+    assert main(["run", "spinning-cube.toml", "-o", str(out), "--duration", "0.05"]) == 0
+    assert "refsim run: " not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("flags", "quick"), [([], True), (["--quick"], True),
+                                              (["--full"], False)])
+def test_the_report_is_the_quick_one_unless_full_is_asked(flags, quick, tmp_path, capsys,
+                                                          monkeypatch):
+    """A newcomer's first ``refsim report`` (and ``make report``) shows the
+    quick report within about a minute; the full one is asked for."""
+    from refsim.report import build
+
+    asked = []
+    monkeypatch.setattr(build, "build_report",
+                        lambda out, *, quick, workers: asked.append(quick) or out / "index.html")
+    assert main(["report", *flags, "-o", str(tmp_path / "r")]) == 0
+    assert asked == [quick]
+    with pytest.raises(SystemExit) as stopped:              # a usage error, from argparse
+        main(["report", "--quick", "--full", "-o", str(tmp_path / "r")])
+    assert stopped.value.code == EXIT_USER_ERROR
+    assert capsys.readouterr().err == ("refsim: error: argument --full: not allowed with "
+                                       "argument --quick (see refsim report --help)\n")

@@ -92,6 +92,9 @@ def test_text_shows_the_snippet_the_table_and_a_text_chart(scene, store, capsys)
     assert "runs: 0 simulated" in out             # every run came from the store
     assert "role" in out and "pos err m" in out
     assert "work-precision: proxy" in out and "* recommended" in out
+    # the proxy is defined before the table that shows it
+    assert out.index("\nproxy: a run's cost counted, not timed: force evaluations x bodies") \
+        < out.index("\nrole ")
 
 
 def test_an_output_directory_gets_the_snippet_the_document_and_the_svg(scene, store,
@@ -209,3 +212,19 @@ def test_the_console_script_exits_2_on_a_bad_tolerance(scene):
                              "--tolerance", "0"], capture_output=True, text=True)
     assert result.returncode == EXIT_USER_ERROR
     assert result.stderr.count("\n") == 1 and "--tolerance" in result.stderr
+
+
+def test_an_advice_says_how_many_runs_it_has_made_as_it_goes(scene, store, capsys,
+                                                             monkeypatch):
+    """Each round's sweep shows only its own runs; off a terminal the advice
+    also says, after a round, how many runs it has so far (here every round:
+    LOG_SECONDS is 0), so that a long advice is never silent."""
+    from refsim.sweep import progress
+
+    monkeypatch.setattr(progress, "LOG_SECONDS", 0.0)
+    assert main(["advise", str(scene), "--repeats", "1", "--store", str(store)]) == 0
+    said = [line for line in capsys.readouterr().err.splitlines()
+            if line.startswith("advise: ")]
+    counts = [int(line.split()[1]) for line in said]
+    assert len(said) >= 2 and counts == sorted(counts) and counts[0] > 0
+    assert all(" from the store), " in line and line.endswith(" elapsed") for line in said)

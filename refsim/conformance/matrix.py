@@ -225,7 +225,8 @@ def engine_task(*, seed: int, name: str, spec: str, cases: int, case_seed: int,
 def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=None,
                only=None, expected: dict | None = None, backend: str | None = None,
                workers: int | None = None, scheduler: str | None = None,
-               progress: bool = False, cancel=None) -> tuple[Matrix, dict]:
+               progress: bool = False, cancel=None,
+               announce=None) -> tuple[Matrix, dict]:
     """Run every engine of ``specs`` (name -> ``module:factory``; default the
     shipped engines) with shared case sets, and write the pages under ``out_dir``
     when given (module docstring).
@@ -273,7 +274,9 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
     for engine in engines.values():
         caps = capabilities(engine) if only is None else (only,)
         needed.update(needed_case_sets(caps))
+    say = announce or (lambda text: None)
     start = time.perf_counter()
+    say(f"case sets: building {', '.join(sorted(needed))}")
     shared = build_cases(needed, cases, seed)
     seconds = {"cases": time.perf_counter() - start}
     results, pages = {}, {}
@@ -281,7 +284,8 @@ def run_matrix(specs: dict | None = None, *, cases: int, seed: int = 0, out_dir=
         file = expected.get(name) if expected is not None else \
             shipped_expected_failures(engine.name)
         result = check_engine(engine, cases=cases, seed=seed, only=only,
-                              expected_failures=file, case_sets=shared, spec=specs[name])
+                              expected_failures=file, case_sets=shared, spec=specs[name],
+                              progress=lambda text, name=name: say(f"{name}: {text}"))
         results[name] = result
         seconds[name] = result.seconds
         if out_dir is not None:

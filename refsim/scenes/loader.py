@@ -32,6 +32,8 @@ from refsim.files import (
     decode_utf8,
     read_regular_file,
     refuse_missing_bundled,
+    similar_bundled,
+    similar_hint,
 )
 from refsim.limits import (
     DEFAULT_MAX_STEPS,
@@ -476,6 +478,8 @@ def _resolve_model(name: str, scene_path: Path | None, key: str) -> Path:
     hint = ""
     if bare != name and (models_dir() / bare).is_file():
         hint = f"; a bundled model of that name exists: use {bare!r}"
+    elif similar := similar_bundled(bare, models_dir(), ".ac"):
+        hint = f"; {similar_hint(similar, 'model')}"
     raise SceneError(f"model {name!r} not found (looked in {looked}){hint}", scene_path, key)
 
 

@@ -155,6 +155,8 @@ from __future__ import annotations
 
 import math
 import statistics
+import sys
+import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, replace
 from fractions import Fraction
@@ -499,6 +501,8 @@ class _Runner:
         self.roles: dict[Setting, list[str]] = {}
         self.computed = 0
         self.resumed = 0
+        self.progress = progress
+        self._started = self._said = time.monotonic()
 
     def run(self, wanted: list[tuple[Setting, str]], *, once=()) -> None:
         """Make the runs of ``wanted`` not made yet, timed ``repeats`` times
@@ -528,6 +532,22 @@ class _Runner:
             self.runs[setting] = metrics.Run.from_record(task_result.value)
             self.resumed += task_result.resumed
             self.computed += not task_result.resumed
+        self._say_progress()
+
+    def _say_progress(self) -> None:
+        """With progress on: a line on stderr after a round of runs, at most
+        every ``LOG_SECONDS`` (and not in the first ones), with the runs made
+        so far: each round's sweep shows only its own runs, and an advice
+        takes many rounds."""
+        from refsim.sweep.progress import LOG_SECONDS
+
+        now = time.monotonic()
+        if not self.progress or now - self._said < LOG_SECONDS:
+            return
+        self._said = now
+        minutes, seconds = divmod(int(now - self._started), 60)
+        print(f"advise: {self.computed + self.resumed} runs so far ({self.resumed} from the "
+              f"store), {minutes}:{seconds:02d} elapsed", file=sys.stderr, flush=True)
 
 
 # -- the reference ------------------------------------------------------------------------

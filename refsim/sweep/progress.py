@@ -1,4 +1,5 @@
-"""The progress line of a sweep, on stderr: done/total, failures, time left.
+"""The progress line of a sweep or a long run, on stderr: done/total,
+failures, time left.
 
 ``sweep: 12/16 done, 1 failed, about 0:00:07 left`` is redrawn in place
 (carriage return) as results arrive and at least every
@@ -51,10 +52,19 @@ class Progress:
         Where to draw; default ``sys.stderr``.
     clock : callable, optional
         Seconds, monotonic; default ``time.monotonic`` (tests pass their own).
+    label, unit : str
+        The line reads ``{label}: {done}/{total} {unit}``; default a sweep's
+        ``sweep: 12/16 done`` (``refsim run``: ``refsim run: 230/1001 frames``).
+    delay : float
+        On a terminal, draw nothing before this many seconds (s), and at the
+        end only if something was drawn: a run that ends sooner leaves no
+        line (default 0: a sweep draws at once).
     """
 
     def __init__(self, total: int, resumed: int = 0, *, enabled: bool = True, stream=None,
-                 clock=time.monotonic):
+                 clock=time.monotonic, label: str = "sweep", unit: str = "done",
+                 delay: float = 0.0):
+        self.label, self.unit, self.delay = label, unit, delay
         self.stream = sys.stderr if stream is None else stream
         self.enabled = bool(enabled)
         self.terminal = _is_terminal(self.stream)
@@ -67,6 +77,7 @@ class Progress:
         self._drawn_at = None
         self._width = 0
         self._logged = False
+        self._last_logged = ""
 
     def update(self, done: int, failed: int, *, force: bool = False) -> None:
         """Record ``done`` finished tasks (resumed ones included; failures
@@ -81,6 +92,8 @@ class Progress:
                 self._log(self.line(now))
                 self._drawn_at = now
             return
+        if self._drawn_at is None and now - self._start < self.delay:
+            return
         if not force and self._drawn_at is not None and now - self._drawn_at < MIN_REDRAW_SECONDS:
             return
         self._draw(self.line(now))
@@ -89,7 +102,7 @@ class Progress:
     def line(self, now: float | None = None) -> str:
         """The text of the line at time ``now`` (default: the clock's now)."""
         now = self._clock() if now is None else now
-        text = f"sweep: {self.done}/{self.total} done"
+        text = f"{self.label}: {self.done}/{self.total} {self.unit}"
         if self.failed:
             text += f", {self.failed} failed"
         left = self.seconds_left(now)
@@ -111,8 +124,11 @@ class Progress:
         if not self.enabled:
             return
         if not self.terminal:
-            if self._logged:
-                self._log(self.line())
+            final = self.line()
+            if self._logged and final != self._last_logged:    # not the same line twice
+                self._log(final)
+            return
+        if self.delay and self._drawn_at is None:
             return
         self._draw(self.line())
         self.stream.write("\n")
@@ -122,6 +138,7 @@ class Progress:
         self.stream.write(text + "\n")
         self.stream.flush()
         self._logged = True
+        self._last_logged = text
 
     def _draw(self, text: str) -> None:
         pad = " " * max(0, self._width - len(text))     # wipe a longer previous line

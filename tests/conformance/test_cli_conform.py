@@ -100,7 +100,15 @@ def test_malformed_expected_failures_names_its_line(tmp_path, capsys):
 def test_all_runs_the_shipped_engines_with_a_capability(tmp_path, capsys):
     out = tmp_path / "all"
     assert main(["conform", "--all", "--only", "ode", "-o", str(out)]) == 0
-    printed = capsys.readouterr().out
+    captured = capsys.readouterr()
+    printed = captured.out
+    # the progress, on stderr: each engine's checks as they start and end
+    progress = captured.err.splitlines()
+    assert progress[0] == "refsim conform: case sets: building ode"
+    assert "refsim conform: refsim-seed: ode.order: running" in progress
+    assert progress.index("refsim conform: refsim-seed: ode.order: running") < \
+        progress.index("refsim conform: refsim-corrected: ode.order: running")
+    assert all(line.startswith("refsim conform: ") for line in progress)
     header = printed.splitlines()[0].split()
     assert header == ["check", "refsim-seed", "refsim-corrected"]    # the two with "ode"
     matrix = json.loads((out / "matrix.json").read_text())

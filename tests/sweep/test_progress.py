@@ -79,5 +79,48 @@ def test_off_a_terminal_a_long_sweep_writes_a_line_every_log_seconds_and_at_the_
     assert stream.getvalue().splitlines() == [
         "sweep: 1/4 done, about 0:00:30 left",
         "sweep: 3/4 done, 1 failed, about 0:00:08 left",
-        "sweep: 3/4 done, 1 failed, about 0:00:08 left",
-    ]
+    ]                                # the closing line, the same, is not written again
+    clock.now += 1.0
+    shown.update(4, 1)
+    shown.close()
+    assert stream.getvalue().splitlines()[-1] == "sweep: 4/4 done, 1 failed"
+
+
+def test_a_delayed_line_stays_hidden_on_a_terminal_for_a_short_run():
+    """``refsim run``'s line: nothing for a run shorter than the delay, not
+    even at the end; after it, redrawn with the run's own words."""
+    clock, stream = Clock(), Terminal()
+    shown = Progress(1001, stream=stream, clock=clock, label="refsim run", unit="frames",
+                     delay=2.0)
+    clock.now += 1.9
+    shown.update(500, 0)
+    shown.close()
+    assert stream.getvalue() == ""
+    clock, stream = Clock(), Terminal()
+    shown = Progress(1001, stream=stream, clock=clock, label="refsim run", unit="frames",
+                     delay=2.0)
+    clock.now += 2.5
+    shown.update(500, 0)                 # 500 frames in 2.5 s: 501 left, 2.505 s
+    assert stream.getvalue() == "\rrefsim run: 500/1001 frames, about 0:00:03 left"
+    shown.update(1001, 0, force=True)
+    shown.close()
+    assert stream.getvalue().endswith("\rrefsim run: 1001/1001 frames\n")
+
+
+def test_a_counted_sink_passes_every_frame_on_and_reports_the_count():
+    import numpy as np
+
+    from refsim.frames import CountedSink, MemorySink
+
+    clock, log = Clock(), io.StringIO()
+    shown = Progress(3, stream=log, clock=clock, label="refsim run", unit="frames")
+    sink = CountedSink(MemorySink(), shown)
+    for k in range(3):
+        clock.now += LOG_SECONDS
+        sink.append({"t": np.float64(k)})
+    shown.close()
+    assert sink.n_frames == 3 and np.array_equal(sink.arrays()["t"], [0.0, 1.0, 2.0])
+    assert log.getvalue().splitlines() == [
+        "refsim run: 1/3 frames, about 0:00:20 left",
+        "refsim run: 2/3 frames, about 0:00:10 left",
+        "refsim run: 3/3 frames"]            # the closing line is not written twice
