@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import tomllib
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -150,9 +151,14 @@ def head_on(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def chaos(tmp_path_factory):
-    path = _write(tmp_path_factory, "chaos.toml", CHAOS)
-    return path, advise(path, TOL, repeats=1)
+def chaos(chaos_series):
+    """(path, advice) of CHAOS at TOL: the series' strictest advice, which
+    :func:`advisor.advice_by_tolerance` makes first, as ``advise(path, TOL)``
+    would (its own reference, no candidates handed down), so the chaotic
+    scene is advised once for both fixtures."""
+    strict = chaos_series.advice[chaos_series.tolerances.index(TOL)]
+    assert strict.tolerance == TOL and not any("stricter" in r.roles for r in strict.runs)
+    return Path(chaos_series.scene), strict
 
 
 def _fresh(path, fidelity: Fidelity, duration: float):
