@@ -90,6 +90,8 @@ def refuse_missing_bundled(path: Path, directory: Path, kind: str, error: type) 
     bare name that works from any directory added (a path such as
     ``models/cube.ac`` only exists in a source checkout), or the similar
     bundled names (``sphere.ac``: ``sphere-2k.ac``)."""
+    if "\0" in str(path):
+        return                          # the reader refuses the name itself
     try:
         if os.path.lexists(path):
             return
