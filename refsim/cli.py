@@ -762,8 +762,8 @@ def build_parser() -> argparse.ArgumentParser:
     report = commands.add_parser(
         "report", help="write the HTML accuracy report (the quick one unless --full)",
         description="Measure and write the HTML accuracy report. By default the quick "
-                    "report: fewer sizes, repeats and seconds, about a minute on two idle "
-                    "cores once numba has compiled. --full measures everything (about twelve "
+                    "report: fewer sizes, repeats and seconds, about a minute and a half "
+                    "on two idle cores once numba has compiled. --full measures everything (about twelve "
                     "minutes with --workers 2 on two cores).")
     size = report.add_mutually_exclusive_group()
     size.add_argument("--quick", dest="full", action="store_false",
