@@ -441,6 +441,7 @@ def _conform(args) -> int:
     backend = ("dask" if args.scheduler is not None
                else "processes" if args.workers is not None else None)
     workers = None if args.workers is None else check_count("--workers", args.workers, 1)
+
     def say(text: str) -> None:
         print(f"refsim conform: {text}", file=sys.stderr, flush=True)
 
@@ -763,8 +764,8 @@ def build_parser() -> argparse.ArgumentParser:
         "report", help="write the HTML accuracy report (the quick one unless --full)",
         description="Measure and write the HTML accuracy report. By default the quick "
                     "report: fewer sizes, repeats and seconds, about a minute and a half "
-                    "on two idle cores once numba has compiled. --full measures everything (about twelve "
-                    "minutes with --workers 2 on two cores).")
+                    "on two idle cores once numba has compiled. --full measures "
+                    "everything (about twelve minutes with --workers 2 on two cores).")
     size = report.add_mutually_exclusive_group()
     size.add_argument("--quick", dest="full", action="store_false",
                       help="the quick report (the default)")
