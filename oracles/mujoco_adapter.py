@@ -74,6 +74,25 @@ Every setting, and why (:class:`MujocoSettings` holds them)
   0.69 s); a soft reference (``"0.02 1"``) keeps the cube down but barely
   acts within a one-step impact (4.857 m/s). docs/decisions/conformance.md
   has the table.
+- MuJoCo's other friction options, measured one at a time on the kit's
+  friction problems (docs/decisions/mujoco-friction.md), none nearer
+  Coulomb: ``cone="elliptic"`` is kept because a pyramidal cone mixes the
+  normal and friction rows and so gives friction the restitution damper
+  (the rolling impact leaves at 0.973 m/s where Coulomb gives 1.430);
+  ``impratio`` 1 and ``noslip_iterations`` 0 (MuJoCo's defaults) because
+  both act on the friction rows' regularisation, which the impedance
+  ``d ~ 1`` already makes negligible (neither moves an oblique bounce by
+  more than 1e-4 m/s);
+  ``condim=3`` because torsional friction (condim 4, ``mu`` times the
+  body's spin lever, as the pybullet oracle's) slows the spinning cube's
+  stop instead of hastening it. What lifts the spinning and the sliding
+  cube is MuJoCo's convex contact model: a contact starts to slip only by
+  moving along its normal (MuJoCo's Computation chapter, "Physical realism
+  and soft contacts"), and a friction reference that asks for more than the
+  cone allows sends the body off the floor at about ``mu`` times its slip
+  speed. ``impratio``, ``noslip_iterations``, ``condim`` and
+  ``solreffriction`` are :class:`MujocoSettings` fields too, for that
+  page's script.
 - ``integrator="Euler"`` (semi-implicit Euler, as Bullet's); ``margin=0``
   and ``gap=0`` on every pair (no contact before the shapes touch).
 - Drag: the scene's drag as a force at the centre of mass each step
@@ -139,6 +158,20 @@ class MujocoSettings:
     #: kept explicit.
     iterations: int = 100
     tolerance: float = 1e-8
+    #: ``<option impratio>``: the friction rows' impedance over the normal
+    #: rows' (elliptic cones).
+    impratio: float = 1.0
+    #: ``<option noslip_iterations>``: 0 leaves MuJoCo's post-processing
+    #: pass of the friction rows off.
+    noslip_iterations: int = 0
+    #: Each pair's ``condim``: 3 (sliding friction), 4 (and torsional
+    #: friction ``mu`` times the contact's spin lever), 6 (and rolling
+    #: friction, MuJoCo's least coefficient).
+    condim: int = 3
+    #: Each pair's ``solreffriction``: None is the one-step damper
+    #: ``"0 -1/h"``; a pair of numbers is used as given (``(0, 0)``:
+    #: MuJoCo's default, the normal rows' ``solref``).
+    solreffriction: tuple | None = None
 
 
 def _floats(values) -> str:
@@ -188,15 +221,18 @@ class MujocoOracle:
 
     def mjcf(self, scene) -> str:
         """The MJCF document of ``scene`` (module docstring: every setting)."""
-        from refsim.oracles.pybullet_adapter import mass_properties
+        from refsim.oracles.pybullet_adapter import mass_properties, spin_lever
 
         s = self.settings
         h = scene.integration.step
         world = scene.world
         H = world.half_size
-        solreffriction = f"0 {-1.0 / h!r}"
+        solreffriction = (f"0 {-1.0 / h!r}" if s.solreffriction is None
+                          else _floats(s.solreffriction))
+        if s.condim not in (3, 4, 6):
+            raise ValueError(f"condim must be 3, 4 or 6, not {s.condim!r}")
         solimp = _floats(s.solimp)
-        assets, bodies, pairs = [], [], []
+        assets, bodies, pairs, levers = [], [], [], []
         self.properties = []
         meshes = {}
         for i, body in enumerate(scene.bodies):
@@ -207,6 +243,8 @@ class MujocoOracle:
                 assets.append(f'<mesh name="{meshes[key]}" vertex="{_floats(mesh.vertices)}" '
                               f'scale="{_floats([body.scale] * 3)}"/>')
             props = mass_properties(mesh.vertices, mesh.faces, body.mass, body.scale)
+            if s.condim > 3:
+                levers.append(spin_lever(mesh.vertices, body.scale))
             self.properties.append(props)
             r = np.asarray(body.orientation, dtype=np.float64)
             joint = "" if body.fixed else f'<freejoint name="j{i}"/>'   # fixed: welded to the world
@@ -231,11 +269,12 @@ class MujocoOracle:
                          f'pos="{_floats(pos)}" zaxis="{_floats(zaxis)}" contype="0" '
                          f'conaffinity="0"/>')
 
-        def pair(geom1: str, geom2: str, e: float, mu: float) -> str:
+        def pair(geom1: str, geom2: str, e: float, mu: float, lever: float = 0.0) -> str:
             # the pair's own coefficients: restitution through the one-step
-            # damper, Coulomb's mu in both tangent directions
-            return (f'<pair geom1="{geom1}" geom2="{geom2}" condim="3" '
-                    f'friction="{_floats([mu, mu, 0.0, 0.0, 0.0])}" '
+            # damper, Coulomb's mu in both tangent directions (and, condim 4
+            # and 6, mu times the spin lever about the normal)
+            return (f'<pair geom1="{geom1}" geom2="{geom2}" condim="{s.condim}" '
+                    f'friction="{_floats([mu, mu, mu * lever, 0.0, 0.0])}" '
                     f'solref="0 {-(1.0 + e) / h!r}" solreffriction="{solreffriction}" '
                     f'solimp="{solimp}" margin="{s.margin!r}" gap="0"/>')
 
@@ -244,18 +283,21 @@ class MujocoOracle:
             if not a.fixed:                              # a fixed body never meets a wall
                 for k, wall in enumerate(WALL_NAMES):
                     if wall in world.walls:
-                        pairs.append(pair(f"g{i}", f"w{k}", *scene.coefficients(a)))
+                        pairs.append(pair(f"g{i}", f"w{k}", *scene.coefficients(a),
+                                          levers[i] if levers else 0.0))
             for j in range(i + 1, n):
                 b = scene.bodies[j]
                 if not (a.fixed and b.fixed):
-                    pairs.append(pair(f"g{i}", f"g{j}", *scene.coefficients(a, b)))
+                    pairs.append(pair(f"g{i}", f"g{j}", *scene.coefficients(a, b),
+                                      min(levers[i], levers[j]) if levers else 0.0))
         return (
             '<mujoco model="refsim">'
             '<compiler angle="radian" inertiafromgeom="false"/>'
             f'<option timestep="{h!r}" gravity="{_floats(world.gravity_vector)}" '
             f'integrator={quoteattr(s.integrator)} '
             f'cone={quoteattr(s.cone)} iterations="{s.iterations}" '
-            f'tolerance="{s.tolerance!r}"/>'
+            f'tolerance="{s.tolerance!r}" impratio="{float(s.impratio)!r}" '
+            f'noslip_iterations="{int(s.noslip_iterations)}"/>'
             f'<asset>{"".join(assets)}</asset>'
             f'<worldbody>{"".join(walls)}{"".join(bodies)}</worldbody>'
             f'<contact>{"".join(pairs)}</contact>'

@@ -89,6 +89,27 @@ def test_model_carries_the_one_step_damper_and_inward_walls():
             assert position @ inward == -5.0                 # the normal points at the centre
 
 
+def test_friction_settings_reach_the_model():
+    """The friction options docs/decisions/mujoco-friction.md measured: off
+    (MuJoCo's defaults, condim 3) unless asked for; condim 4 carries the
+    torsional coefficient mu times the cube's spin lever (a unit square's
+    mean lever arm, 0.3826); a given solreffriction replaces the one-step
+    damper; condim 2 or 5 is refused."""
+    scene = R._scene("cube.ac", 0.5, 0.5, 0.0, 0.01)
+    option = ET.fromstring(engine().mjcf(scene)).find("option")
+    assert float(option.get("impratio")) == 1.0 and option.get("noslip_iterations") == "0"
+    root = ET.fromstring(engine(condim=4, impratio=10.0, noslip_iterations=5,
+                                solreffriction=(0.02, 1.0)).mjcf(scene))
+    option = root.find("option")
+    assert float(option.get("impratio")) == 10.0 and option.get("noslip_iterations") == "5"
+    for pair in root.findall("./contact/pair"):
+        assert pair.get("condim") == "4"
+        assert float(pair.get("friction").split()[2]) == pytest.approx(0.5 * 0.38260, abs=1e-4)
+        assert pair.get("solreffriction") == "0.02 1.0"
+    with pytest.raises(ValueError, match="condim"):
+        engine(condim=5).mjcf(scene)
+
+
 def test_a_drop_bounces_and_reports_the_floor_contact():
     cases = R.rigid_cases()
     drop = cases.of_kind("drop")[1]                          # the sphere, e = 0.8
