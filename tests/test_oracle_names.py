@@ -16,9 +16,10 @@ from refsim.conformance.shipped import SHIPPED_ENGINES
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 
-#: How each shipped external engine is named in prose.
+#: How each shipped external engine is named in prose (Drake's two contact
+#: models, point and hydroelastic, are one package: "Drake" names both).
 NAMES = {"fcl": r"FCL|python-fcl", "coal": r"coal", "trimesh": r"trimesh", "pybullet": r"pybullet",
-         "mujoco": r"MuJoCo", "drake": r"Drake"}
+         "mujoco": r"MuJoCo", "drake": r"Drake", "drake-hydroelastic": r"Drake"}
 
 
 def _texts() -> dict[str, str]:

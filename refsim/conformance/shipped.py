@@ -1,20 +1,21 @@
 """The engines refsim ships, as ``module:factory`` specs (a composition root:
 the kit itself never chooses an engine).
 
-=================  ==============================================  ==================
-engine             spec                                            capabilities
-=================  ==============================================  ==================
-refsim-seed        refsim.engines.refsim_engines:seed              all six
-refsim-corrected   refsim.engines.refsim_engines:corrected         all six
-fcl                refsim.oracles.fcl_adapter:engine               triangles, pairs,
-                                                                   collide
-coal               refsim.oracles.coal_adapter:engine              triangles, pairs,
-                                                                   collide
-trimesh            refsim.conformance.shipped:trimesh              collide, aabb
-pybullet           refsim.oracles.pybullet_adapter:engine          rigid
-mujoco             refsim.oracles.mujoco_adapter:engine            rigid
-drake              refsim.oracles.drake_adapter:engine             rigid
-=================  ==============================================  ==================
+==================  ================================================  ==================
+engine              spec                                              capabilities
+==================  ================================================  ==================
+refsim-seed         refsim.engines.refsim_engines:seed                all six
+refsim-corrected    refsim.engines.refsim_engines:corrected           all six
+fcl                 refsim.oracles.fcl_adapter:engine                 triangles, pairs,
+                                                                      collide
+coal                refsim.oracles.coal_adapter:engine                triangles, pairs,
+                                                                      collide
+trimesh             refsim.conformance.shipped:trimesh                collide, aabb
+pybullet            refsim.oracles.pybullet_adapter:engine            rigid
+mujoco              refsim.oracles.mujoco_adapter:engine              rigid
+drake               refsim.oracles.drake_adapter:engine               rigid
+drake-hydroelastic  refsim.oracles.drake_adapter:engine_hydroelastic  rigid
+==================  ================================================  ==================
 
 trimesh has two adapters, one per question it answers (its boxes,
 :mod:`refsim.oracles.trimesh_adapter`; its CollisionManager,

@@ -40,6 +40,8 @@ SHIPPED: tuple[EngineEntry, ...] = (
     EngineEntry("pybullet", "pybullet", "refsim.oracles.pybullet_adapter:engine", "oracles"),
     EngineEntry("mujoco", "MuJoCo", "refsim.oracles.mujoco_adapter:engine", "oracles"),
     EngineEntry("drake", "Drake", "refsim.oracles.drake_adapter:engine", "drake"),
+    EngineEntry("drake-hydroelastic", "Drake (hydroelastic)",
+                "refsim.oracles.drake_adapter:engine_hydroelastic", "drake"),
 )
 
 #: Each shipped engine's title by name.

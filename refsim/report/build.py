@@ -57,7 +57,8 @@ AREAS: tuple[tuple[str, str, str], ...] = (
      "against the corrected one (C12), body-body interpenetration (C11)."),
     ("conformance", "Engines side by side: the conformance kit",
      "The shipped engines (refsim's seed and corrected models, python-fcl, coal, "
-     "trimesh, pybullet, MuJoCo, Drake) through the same checks against exact answers."),
+     "trimesh, pybullet, MuJoCo, Drake with point and with hydroelastic contact) through "
+     "the same checks against exact answers."),
     ("textbook", "Textbook mechanics",
      "Problems with closed-form answers (drops, oblique impacts with friction, a spin "
      "stopped by friction, torque-free rotation, an off-centre strike, resting stacks) "

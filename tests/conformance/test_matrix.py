@@ -14,12 +14,13 @@ from refsim.conformance.shipped import SHIPPED_ENGINES
 
 #: The shipped engines, in the matrix's order.
 SHIPPED = ("refsim-seed", "refsim-corrected", "fcl", "coal", "trimesh", "pybullet", "mujoco",
-           "drake")
+           "drake", "drake-hydroelastic")
 
 #: What each engine is checked on (its capabilities' checks).
 GEOMETRY = {"fcl": ("triangles", "pairs", "collide"),
             "coal": ("triangles", "pairs", "collide"), "trimesh": ("collide", "aabb"),
-            "pybullet": ("rigid",), "mujoco": ("rigid",), "drake": ("rigid",)}
+            "pybullet": ("rigid",), "mujoco": ("rigid",), "drake": ("rigid",),
+            "drake-hydroelastic": ("rigid",)}
 
 #: The expected failures each engine's declarations turn into xfails at
 #: 40 cases, seed 0 (measured; each reason is in refsim/conformance/expected/).
@@ -37,6 +38,8 @@ XFAILED = {
     "drake": {"rigid.apex_ratio", "rigid.no_spin", "rigid.oblique_bounce",
               "rigid.resting_contact", "rigid.free_rotation", "rigid.off_centre", "rigid.stack",
               "rigid.incline"},
+    "drake-hydroelastic": {"rigid.apex_ratio", "rigid.oblique_bounce", "rigid.free_rotation",
+                           "rigid.off_centre", "rigid.incline", "rigid.stack"},
 }
 #: The checks whose scenes an engine cannot pose (status n/a, the key named).
 NOT_POSED = {"refsim-seed": {"rigid.incline"}}

@@ -25,4 +25,6 @@ def test_each_extra_named_exists_and_the_hint_installs_those_engines():
     assert {e.extra for e in SHIPPED if e.extra} <= set(extras)
     assert install_hint(["mujoco", "drake"]) == "pip install 'refsim[oracles,drake]'"
     assert install_hint(["coal"]) == "pip install 'refsim[coal]'"
+    # Drake's two contact models are one package, one extra
+    assert install_hint(["drake", "drake-hydroelastic"]) == "pip install 'refsim[drake]'"
     assert install_hint(["my-engine"]) == "pip install 'refsim[oracles]'"

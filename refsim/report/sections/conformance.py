@@ -1,11 +1,12 @@
 """Report section: the shipped engines side by side (the conformance kit).
 
 Arranges the plan's ``conformance-matrix``: each shipped engine (refsim's
-seed and corrected models, python-fcl, coal, trimesh, pybullet, MuJoCo) run
-through every check its capabilities call for, against answers that depend
-on no float engine (:mod:`refsim.conformance`). One table, a row per check
-and a column per engine that could be loaded, each heading a link to the
-engine's own conformance page, written beside the report; the engines that
+seed and corrected models, python-fcl, coal, trimesh, pybullet, MuJoCo, Drake
+with point and with hydroelastic contact) run through every check its
+capabilities call for, against answers that depend on no float engine
+(:mod:`refsim.conformance`). One table, a row per check and a column per
+engine that could be loaded, each heading a link to the engine's own
+conformance page, written beside the report; the engines that
 could not be loaded, with the reason; and every failing or declared
 (expected-failure) check in the divergence catalogue, with its classes
 counted. Which checks fail, and how each failure is classified, is decided
