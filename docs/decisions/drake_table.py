@@ -42,7 +42,7 @@ SLIDE_SPEED = 2.0
 SLIDE_MU = 0.5
 
 
-def _lowest(scene, trajectory, i: int = 0) -> np.ndarray:
+def lowest(scene, trajectory, i: int = 0) -> np.ndarray:
     """Height of body ``i``'s lowest vertex above the floor, per frame."""
     body = scene.bodies[i]
     v = np.asarray(scene.mesh(body).vertices, dtype=np.float64) * body.scale
@@ -93,7 +93,7 @@ def main(specs, **drake_settings) -> None:
         for case in cases.of_kind("oblique"):
             tr = run(case.scene)
             _, v_t, w_z = R.oblique_answer(case)
-            low = _lowest(case.scene, tr)
+            low = lowest(case.scene, tr)
             touching = np.flatnonzero(low <= 1e-9)
             k = len(low) - 1
             if case.e > 0 and len(touching):
@@ -126,7 +126,7 @@ def main(specs, **drake_settings) -> None:
                   f"(kit's limit {C.spin_rest_time(case):.3f} s)")
         for case in cases.of_kind("rest"):
             tr = run(case.scene)
-            low = _lowest(case.scene, tr)
+            low = lowest(case.scene, tr)
             w = np.linalg.norm(np.asarray(tr.angular_velocity)[:, 0], axis=1).max()
             drift = np.abs(np.asarray(tr.position)[-1, 0] - np.asarray(tr.position)[0, 0])
             print(f"resting cube: deepest {-low.min():.2e} m (kit allows "

@@ -16,6 +16,8 @@ from __future__ import annotations
 import argparse
 import ast
 import math
+import sys
+from pathlib import Path
 
 import numpy as np
 from refsim.oracles.mujoco_adapter import engine
@@ -24,6 +26,10 @@ from refsim.conformance import cases_rigid as R
 from refsim.conformance import checks_rigid as C
 from refsim.conformance.expected import shipped_expected_failures
 from refsim.conformance.runner import check_engine
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import drake_table  # noqa: E402  (the Drake page's sliding cube and lowest vertex)
+from drake_table import SLIDE_MU, SLIDE_SPEED, lowest  # noqa: E402
 
 #: The adapter's settings, one option changed at a time, then combinations.
 VARIANTS = {
@@ -52,17 +58,8 @@ CHECKS = ("rigid.oblique_bounce", "rigid.spin_to_rest", "rigid.incline",
           "rigid.resting_contact", "rigid.no_spin", "rigid.apex_ratio", "rigid.energy",
           "rigid.determinism", "rigid.free_rotation", "rigid.off_centre", "rigid.stack")
 
-SLIDE_SPEED = 2.0
-SLIDE_MU = 0.5
 
 
-def lowest(scene, trajectory, i: int = 0) -> np.ndarray:
-    """Height of body ``i``'s lowest vertex above the floor, per frame."""
-    body = scene.bodies[i]
-    v = np.asarray(scene.mesh(body).vertices, dtype=np.float64) * body.scale
-    y = np.asarray(trajectory.position)[:, i, 1, None] + np.einsum(
-        "fj,vj->fv", np.asarray(trajectory.orientation)[:, i, 1, :], v)
-    return y.min(axis=1) + scene.world.half_size
 
 
 def rise(trajectory) -> float:
@@ -72,12 +69,9 @@ def rise(trajectory) -> float:
 
 
 def slide_scene(step: float):
-    """The cube face down on the floor, sliding at SLIDE_SPEED along x, mu 0.5."""
-    scene = R._bodies_scene([{"name": "cube", "model": R.CUBE,
-                              "position": [0.0, -R.HALF_SIZE + 0.5, 0.0],
-                              "velocity": [SLIDE_SPEED, 0.0, 0.0]}],
-                            R.GRAVITY, 0.5, SLIDE_MU, 0.6)
-    return R.with_step(R.RigidScene("slide-cube", "slide", scene, 0.5, SLIDE_MU), step).scene
+    """The Drake page's sliding cube (drake_table.slide_scene) at ``step``."""
+    return R.with_step(R.RigidScene("slide-cube", "slide", drake_table.slide_scene(), 0.5,
+                                    SLIDE_MU), step).scene
 
 
 def verdict(check) -> str:
