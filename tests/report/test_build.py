@@ -84,12 +84,13 @@ def test_the_entries_are_deterministic_and_the_same_on_workers(tmp_path, quick_r
     untimed studies there, one task each, and the replays as their sweep; the
     timed and gathering entries here after them) give the records the
     report's own run gave, timings aside: the report is deterministic, and its
-    workers change no result. Two sweeps are not measured again: the
-    conformance matrix and the advisor, the report's longest entries, are
-    held equal on workers by tests/conformance/test_cli_conform.py
-    (``--all --workers 2``) and tests/studies/test_advisor.py (the same
-    advice on two processes); a second build of the whole report would
-    double the suite's longest fixture."""
+    workers change no result. Two sweeps are not measured again, the
+    conformance matrix and the advisor, the report's longest entries (a
+    second build of the whole report would double the suite's longest
+    fixture): tests/studies/test_advisor.py holds the advice equal in one
+    process and on two, and tests/conformance/test_cli_conform.py the
+    matrix's aabb checks (``--all --workers 2``); the matrix's rigid checks
+    on workers are not compared."""
     from refsim.report import plan
     from refsim.report.entries.replays import REPLAYS
     from refsim.report.run import REPORT_SEED, Run
