@@ -207,6 +207,11 @@ class MujocoOracle:
     def __init__(self, settings: MujocoSettings | None = None):
         self.mujoco = import_engine("mujoco", "mujoco")
         self.settings = settings or MujocoSettings()
+        if self.settings.condim not in (3, 4, 6):
+            from refsim.errors import OptionError
+
+            raise OptionError(f"engine mujoco: condim must be 3, 4 or 6, not "
+                              f"{self.settings.condim!r}")
         self.model = None
         self.data = None
         self.properties: list = []
@@ -229,8 +234,6 @@ class MujocoOracle:
         H = world.half_size
         solreffriction = (f"0 {-1.0 / h!r}" if s.solreffriction is None
                           else _floats(s.solreffriction))
-        if s.condim not in (3, 4, 6):
-            raise ValueError(f"condim must be 3, 4 or 6, not {s.condim!r}")
         solimp = _floats(s.solimp)
         assets, bodies, pairs, levers = [], [], [], []
         self.properties = []

@@ -15,6 +15,7 @@ from refsim.oracles import OracleUnavailable
 from refsim.oracles.mujoco_adapter import engine
 
 from refsim.conformance import cases_rigid as R
+from refsim.errors import OptionError
 from refsim.scenes.loader import scene_from_dict
 from refsim.types import rotation_about_axis
 
@@ -106,8 +107,10 @@ def test_friction_settings_reach_the_model():
         assert pair.get("condim") == "4"
         assert float(pair.get("friction").split()[2]) == pytest.approx(0.5 * 0.38260, abs=1e-4)
         assert pair.get("solreffriction") == "0.02 1.0"
-    with pytest.raises(ValueError, match="condim"):
-        engine(condim=5).mjcf(scene)
+    for condim in (2, 5):                            # refused as the engine is made
+        with pytest.raises(OptionError,
+                           match=rf"^engine mujoco: condim must be 3, 4 or 6, not {condim}$"):
+            engine(condim=condim)
 
 
 def test_a_drop_bounces_and_reports_the_floor_contact():
