@@ -837,6 +837,13 @@ def main(argv: list[str] | None = None) -> int:
                 sys.unraisablehook = unraisable_hook
 
 
+#: Commands that make many calls of the tiered kernel families
+#: (:class:`refsim.kernels.Tier`): on a cold numba cache they compile them
+#: in a background process (:mod:`refsim.warm`) while their first calls
+#: run readable.
+LONG_COMMANDS = (_conform, _report, _advise, _study)
+
+
 def _main(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -847,6 +854,10 @@ def _main(argv: list[str] | None) -> int:
         # `info` computes nothing numba compiles: it does not pay numba's import
         with signals_raise(), (contextlib.nullcontext() if args.run is _info
                                else compile_notices(sys.stderr)):
+            if args.run in LONG_COMMANDS:
+                from refsim.warm import start_in_background
+
+                start_in_background(sys.stderr)
             return args.run(args)
     except DivergenceError as exc:
         if args.debug:

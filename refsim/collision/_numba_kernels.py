@@ -697,16 +697,21 @@ def exact_query(floats_a, ints_a, rotation_a, translation_a,
 
 
 #: The one signature ``exact_collide`` is compiled for: packed mesh arrays,
-#: float64 C-contiguous poses. numba refuses any other argument types with a
-#: TypeError instead of compiling for them, so the caller need not check a
-#: pose's layout before the call (bvh_exact.collide_bvh).
+#: float64 C-contiguous poses. The caller compiles it (or loads it from
+#: numba's cache) for this signature alone and then turns compiling off
+#: (bvh_exact's ``_compiled``), so that numba refuses any other argument
+#: types with a TypeError instead of compiling for them, and the caller need
+#: not check a pose's layout before the call (bvh_exact.collide_bvh). It is
+#: not compiled as this module is imported: importing the module must stay
+#: cheap, so that whether numba's cache holds its kernels can be asked
+#: without compiling them (refsim.kernels.Tier).
 EXACT_COLLIDE_SIGNATURE = numba.int64(
     numba.float64[::1], numba.int64[::1], numba.float64[:, ::1], numba.float64[::1],
     numba.float64[::1], numba.int64[::1], numba.float64[:, ::1], numba.float64[::1],
     numba.float64, numba.float64, numba.float64)
 
 
-@numba.njit(EXACT_COLLIDE_SIGNATURE, cache=True)
+@numba.njit(cache=True)
 def exact_collide(floats_a, ints_a, rotation_a, translation_a,
                   floats_b, ints_b, rotation_b, translation_b,
                   tol, margin_rounding, margin_per_deviation):

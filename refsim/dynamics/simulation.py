@@ -58,6 +58,7 @@ for the broad phase and the narrow-phase cost of the k candidate pairs.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass, replace
@@ -97,6 +98,7 @@ from refsim.dynamics.rotation_seed import (
     contact_vertex_seed,
     orientation_step_seed_kernel,
 )
+from refsim.dynamics.start import LOOP, start_kernel
 from refsim.dynamics.trajectory import FRAME_ENTRIES, Event, Trajectory
 from refsim.dynamics.walls import SPEEDS, wall_name, wall_response_seed, wall_speed
 from refsim.errors import (
@@ -928,8 +930,10 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
         the steps; the trajectory's frames are then views of its files, to be
         saved before the sink closes. Both give the same frames, bit for bit.
     kernel : {"readable", "compiled"}, optional
-        See :class:`Simulation` (``refsim run`` passes
-        :func:`refsim.dynamics.start.start_kernel`'s choice).
+        See :class:`Simulation`. The default runs the compiled loop, or the
+        readable step when numba's cache does not hold the loop yet and the
+        run is short (:func:`refsim.dynamics.start.start_kernel`): the same
+        frames either way.
 
     Raises
     ------
@@ -951,11 +955,18 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
     if sink is None:
         # the initial state, every every-th step, and the last step
         sink = MemorySink(capacity=frame_count(n_steps, every))
+    charge = contextlib.nullcontext()
+    if kernel is None:
+        # a short run on a cold numba cache runs readable (the same frames)
+        kernel = start_kernel(scene, n_steps, wall_speed=wall_speed, boxes=boxes)
+        if kernel == "readable":
+            charge = LOOP.charged()
     sim = Simulation(scene, wall_speed=wall_speed, boxes=boxes, sink=sink, kernel=kernel)
-    sim.record()
-    sim.run(n_steps, every=every)
-    if sim.steps % every:
-        sim.record()                                  # always end on the last state
+    with charge:
+        sim.record()
+        sim.run(n_steps, every=every)
+        if sim.steps % every:
+            sim.record()                              # always end on the last state
     traj = sim.trajectory()
     traj.settings["every"] = every
     return traj
