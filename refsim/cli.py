@@ -593,15 +593,15 @@ def _add_viewer_commands(commands) -> None:
 
 def _advise(args) -> int:
     """``refsim advise``: the cheapest fidelity settings within TOL
-    (:func:`refsim.studies.advisor.advise`), shown by :mod:`refsim.advise_view`."""
+    (:func:`refsim.advisor.advice.advise`), shown by :mod:`refsim.advisor.view`."""
     import math
     import warnings
 
-    from refsim.advise_view import advice_document, advice_text, svg_available, svg_chart
+    from refsim.advisor.advice import advise
+    from refsim.advisor.view import advice_document, advice_text, svg_available, svg_chart
     from refsim.errors import StateError
     from refsim.io import output_error, write_text_atomic
     from refsim.scenes.loader import load_scene
-    from refsim.studies.advisor import advise
 
     if not (math.isfinite(args.tolerance) and args.tolerance > 0.0):
         raise StateError(f"--tolerance must be a finite number of metres > 0, "
@@ -644,14 +644,14 @@ def _advise(args) -> int:
         else:
             warnings.warn("the SVG chart needs matplotlib (pip install 'refsim[report]'); "
                           "writing it as text", stacklevel=1)
-            from refsim.advise_view import text_chart
+            from refsim.advisor.view import text_chart
 
             chart_path = write_text_atomic(out / f"{stem}-work-precision.txt",
                                            text_chart(advice) + "\n")
     document = advice_document(advice, None if chart_path is None else str(chart_path))
     text = json.dumps(document, indent=1, allow_nan=False)
     if out is not None:
-        from refsim.advise_view import toml_snippet
+        from refsim.advisor.view import toml_snippet
 
         write_text_atomic(out / f"{stem}-advice.json", text + "\n")
         write_text_atomic(out / f"{stem}-advice.toml", toml_snippet(advice))
@@ -664,7 +664,7 @@ def _advise(args) -> int:
 
 
 def _add_advise_command(commands) -> None:
-    """``refsim advise`` (refsim.studies.advisor; the chart needs the report extra)."""
+    """``refsim advise`` (refsim.advisor; the chart needs the report extra)."""
     advise = commands.add_parser(
         "advise", help="the cheapest solver, step, collision level and box update within TOL",
         description="Hold SCENE's physics fixed and search its fidelity settings (solver, "

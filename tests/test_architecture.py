@@ -34,7 +34,7 @@ ALGORITHMS = tuple(f"refsim.{name}" for name in (
 #: Everything to the right of the algorithms.
 ABOVE_ALGORITHMS = ("refsim.engines", "refsim.oracles", "refsim.studies", "refsim.claims",
                     "refsim.report", "refsim.viewer", "refsim.sweep", "refsim.conformance",
-                    "refsim.cli")
+                    "refsim.advisor", "refsim.cli")
 
 #: (rule, modules it applies to, imports they may not make, imports exempt
 #: from that). A module or import "is" a prefix when it equals it or lies
@@ -42,9 +42,14 @@ ABOVE_ALGORITHMS = ("refsim.engines", "refsim.oracles", "refsim.studies", "refsi
 RULES: tuple[tuple[str, tuple[str, ...], tuple[str, ...], tuple[str, ...]], ...] = (
     ("an algorithm imports no engine, oracle, study, claim or view",
      ALGORITHMS, ABOVE_ALGORITHMS, ()),
-    ("a study imports no oracle, claim or view (it receives engines)",
+    ("a study imports no oracle, claim or view (it receives engines), nor the advisor",
      ("refsim.studies",),
-     ("refsim.oracles", "refsim.claims", "refsim.report", "refsim.cli", "refsim.viewer"), ()),
+     ("refsim.oracles", "refsim.claims", "refsim.report", "refsim.cli", "refsim.viewer",
+      "refsim.advisor"), ()),
+    ("the advisor imports no oracle, claim or view, its own view included (it runs studies)",
+     ("refsim.advisor",),
+     ("refsim.oracles", "refsim.claims", "refsim.report", "refsim.cli", "refsim.viewer",
+      "refsim.advisor.view"), ()),
     ("a claim imports nothing of refsim but study records and plain value types",
      ("refsim.claims",), ("refsim",), ("refsim.claims", "refsim.studies", "refsim.types")),
     ("a report section or entry imports no oracle (the plan chooses engines)",
@@ -135,6 +140,10 @@ def test_the_walk_sees_nested_and_relative_imports(tmp_path):
     ("refsim.collision.bodies", "refsim.studies.levels", True),
     ("refsim.collision.bodies", "refsim.types", False),
     ("refsim.studies.levels", "refsim.report.plan", True),
+    ("refsim.studies.levels", "refsim.advisor.advice", True),
+    ("refsim.advisor.search", "refsim.advisor.view", True),
+    ("refsim.advisor.runs", "refsim.dynamics.simulation", False),
+    ("refsim.cli", "refsim.advisor.view", False),
     ("refsim.claims.bounds", "refsim.studies.bounds", False),
     ("refsim.claims.bounds", "refsim.bounds.aabb_linear", True),
     ("refsim.report.sections.models", "refsim.oracles.trimesh_adapter", True),
