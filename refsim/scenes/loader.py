@@ -25,6 +25,7 @@ import numpy as np
 
 from refsim.bundled import models_dir, scenes_dir
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
+from refsim.dynamics.world import DOWN, WALL_NAMES
 from refsim.errors import ModelError, SceneError, StateError, check_count
 from refsim.files import (
     as_path,
@@ -56,7 +57,6 @@ from refsim.scenes.schema import (
     ParticleConfig,
     Scene,
 )
-from refsim.scenes.world import DOWN, WALL_NAMES
 from refsim.solvers.integrate import STEP_COUNT_RTOL, whole_steps
 from refsim.types import transform_points
 
