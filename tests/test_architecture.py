@@ -41,11 +41,11 @@ SOURCES = ((ROOT / "refsim", "refsim"), (ROOT / "oracles", "refsim.oracles"))
 #: The algorithm layer (docs/design.md, Architecture: "Algorithms"), lowest
 #: first: the shared modules (the error tree, the input limits, plain value
 #: types, rounding bounds, signal holding, the readable/compiled switch, the
-#: bundled data, reading files, the .npz format, writing files, run frames),
-#: then one package per area. Each imports only those before it.
+#: bundled data, files in and out), then one package per area. Each imports
+#: only those before it.
 ALGORITHMS = tuple(f"refsim.{name}" for name in (
-    "errors", "limits", "types", "rounding", "signals", "kernels", "bundled", "files", "npz",
-    "io", "frames", "models", "bounds", "collision", "solvers", "dynamics", "particles", "scenes"))
+    "errors", "limits", "types", "rounding", "signals", "kernels", "bundled", "storage",
+    "models", "bounds", "collision", "solvers", "dynamics", "particles", "scenes"))
 
 #: Every package and top-level module of refsim by layer, lowest first. A
 #: module imports nothing of a later layer.
@@ -249,8 +249,8 @@ def test_a_name_lies_in_its_package_or_the_root():
     ("refsim.oracles.fcl_adapter", "refsim.cli", True),
     # the order of the algorithms
     ("refsim.errors", "refsim.limits", True),
-    ("refsim.npz", "refsim.errors", False),
-    ("refsim.npz", "refsim.models.mesh", True),
+    ("refsim.storage.npz", "refsim.errors", False),
+    ("refsim.storage.npz", "refsim.models.mesh", True),
     ("refsim.models.ear_index", "refsim.rounding.O2D_ERRBOUND_A", False),
     ("refsim.models.ear_index", "refsim.collision.predicates", True),
     ("refsim.collision.bodies", "refsim.models.mesh", False),
