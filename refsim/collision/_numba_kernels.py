@@ -24,17 +24,13 @@ import numba
 import numpy as np
 
 from refsim.collision._numba_exact import triangles_intersect_exact
-from refsim.collision.predicates import (
-    FILTER_MAX_ABS,
-    FILTER_MIN_ABS,
-    O2D_ERRBOUND_A,
-    O3D_ERRBOUND_A,
-)
+from refsim.collision.predicates import FILTER_MAX_ABS, FILTER_MIN_ABS
+from refsim.rounding import O2D_ERRBOUND_A, O3D_ERRBOUND_A
 
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "1488c50bc7187b63"
+SOURCES_DIGEST = "5d17816dcc8dab8e"
 
 # -- the certified triangle-pair filter (triangle_numba's steps 1-4) -------------------
 #

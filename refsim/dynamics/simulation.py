@@ -109,7 +109,6 @@ from refsim.errors import (
     check_number,
     check_option,
 )
-from refsim.frames import FrameSink, MemorySink, frame_count
 from refsim.kernels import choose_kernel, compile_kernel
 from refsim.limits import MAX_STEPS
 from refsim.models.mesh import Mesh
@@ -117,6 +116,7 @@ from refsim.scenes.schema import Scene
 from refsim.signals import SignalHold, held_signals
 from refsim.solvers.explicit_rk import rk_step
 from refsim.solvers.integrate import resolve_method, whole_steps
+from refsim.storage.frames import FrameSink, MemorySink, frame_count
 
 #: At most about this many frames by default (``every`` is chosen so).
 MAX_FRAMES = 1000
@@ -234,10 +234,10 @@ class Simulation:
     kernel : {"readable", "compiled"}, optional
         The kernels of every stage (:mod:`refsim.kernels`); the same
         trajectory, bit for bit, on either.
-    sink : refsim.frames.FrameSink, optional
-        Where :meth:`record` puts frames: a :class:`refsim.frames.MemorySink`
+    sink : refsim.storage.frames.FrameSink, optional
+        Where :meth:`record` puts frames: a :class:`refsim.storage.frames.MemorySink`
         by default (growing by doubling), or e.g. a
-        :class:`refsim.frames.SpillSink` that writes them to disk as they come.
+        :class:`refsim.storage.frames.SpillSink` that writes them to disk as they come.
 
     Attributes
     ----------
@@ -856,7 +856,7 @@ class Simulation:
 
         Its arrays are what the sink holds: with the default memory sink,
         views of its buffers (no copy; later records do not change them);
-        with a spill sink, :class:`refsim.frames.SpilledArray` views of its
+        with a spill sink, :class:`refsim.storage.frames.SpilledArray` views of its
         files, valid while the sink is open.
         """
         B = len(self.bodies)
@@ -922,11 +922,11 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
     wall_speed, boxes : str, optional
         See :class:`Simulation` (``wall_speed``: default the scene's
         ``world.wall_speed``).
-    sink : refsim.frames.FrameSink, optional
+    sink : refsim.storage.frames.FrameSink, optional
         Where the frames go as they are computed. Default: a
-        :class:`refsim.frames.MemorySink` sized for the run's frames, and the
+        :class:`refsim.storage.frames.MemorySink` sized for the run's frames, and the
         trajectory holds numpy arrays. ``refsim run`` passes a
-        :class:`refsim.frames.SpillSink`, so that memory does not grow with
+        :class:`refsim.storage.frames.SpillSink`, so that memory does not grow with
         the steps; the trajectory's frames are then views of its files, to be
         saved before the sink closes. Both give the same frames, bit for bit.
     kernel : {"readable", "compiled"}, optional

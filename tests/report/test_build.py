@@ -10,10 +10,10 @@ import pytest
 
 from refsim.bundled import bundled_models
 from refsim.claims import CLAIMS
-from refsim.io import write_text_atomic
 from refsim.report import build as report_build
 from refsim.report.build import AREAS, build_report
 from refsim.report.section import Section
+from refsim.storage.writing import write_text_atomic
 
 
 def test_every_area_has_a_section(quick_report):
