@@ -66,7 +66,9 @@ def _compile_particles() -> None:
     from refsim.particles.system import ParticleSystem
     from refsim.scenes.loader import load_scene
 
-    ParticleSystem(load_scene("particles.toml").particles, kernel="compiled").run(1)
+    config = load_scene("particles.toml").particles
+    assert config is not None                 # the bundled scene has particles
+    ParticleSystem(config, kernel="compiled").run(1)
 
 
 #: What compiles each family, by the tier's name.

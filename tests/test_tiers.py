@@ -6,6 +6,7 @@ it on, and fake a cold cache by making ``compiled_here`` answer False."""
 
 from __future__ import annotations
 
+import io
 import os
 import subprocess
 import sys
@@ -16,6 +17,7 @@ import pytest
 
 import refsim
 from refsim.collision import bodies
+from refsim.dynamics import start
 from refsim.kernels import Tier
 from refsim.particles import system as particles
 from refsim.types import rotation_about_axis
@@ -32,7 +34,7 @@ def cold(monkeypatch):
     monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: False)
     monkeypatch.delenv("REFSIM_KERNELS", raising=False)
     monkeypatch.delenv("REFSIM_TIERED_START", raising=False)
-    for tier in (bodies.EXACT_QUERY, particles.FUSED_STEPS):
+    for tier in (bodies.EXACT_QUERY, start.LOOP, particles.FUSED_STEPS):
         monkeypatch.setattr(tier, "spent", 0.0)
         monkeypatch.setattr(tier, "settled", False)
 
@@ -149,3 +151,43 @@ def test_the_readme_snippet_on_an_empty_cache_compiles_neither_query_nor_loop(tm
                    "_numba_build.build_tree"):
         assert kernel not in indexes, sorted(indexes)
     assert "_numba_kernels.aabb_linear_numba" in indexes     # a small kernel still compiles
+
+
+def test_warm_compiles_the_cold_families_by_name(cold, monkeypatch):
+    from refsim import warm
+
+    assert set(warm.COMPILERS) == {tier.name for tier in warm.tiers()}
+    called = []
+    for name in warm.COMPILERS:
+        monkeypatch.setitem(warm.COMPILERS, name, lambda name=name: called.append(name))
+    monkeypatch.setattr(bodies.EXACT_QUERY, "settled", True)      # as if compiled already
+    out = io.StringIO()
+    assert warm.warm(out) == ["simulation loop", "fused particle steps"] == called
+    assert out.getvalue().splitlines() == ["refsim.warm: compiled the simulation loop",
+                                           "refsim.warm: compiled the fused particle steps"]
+
+
+def test_the_particle_compiler_leaves_the_family_compiled():
+    from refsim import warm
+    from refsim.kernels import compiled_here
+    from refsim.particles import _numba_kernels
+
+    warm.COMPILERS["fused particle steps"]()
+    assert compiled_here(_numba_kernels.rk_steps_fused)
+
+
+def test_a_long_command_starts_the_compile_in_the_background_only_when_cold(cold, monkeypatch):
+    from refsim import warm
+
+    started = []
+    monkeypatch.setattr(warm.subprocess, "Popen", lambda args, **kw: started.append(args))
+    err = io.StringIO()
+    warm.start_in_background(err)
+    assert started == [[sys.executable, "-m", "refsim.warm"]]
+    assert err.getvalue().startswith("refsim: compiling kernels for this machine in the "
+                                     "background (exact collision query, simulation loop, "
+                                     "fused particle steps;")
+    monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: True)
+    err = io.StringIO()
+    assert warm.start_in_background(err) is None and err.getvalue() == ""
+    assert len(started) == 1

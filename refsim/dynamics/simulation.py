@@ -955,7 +955,7 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
     if sink is None:
         # the initial state, every every-th step, and the last step
         sink = MemorySink(capacity=frame_count(n_steps, every))
-    charge = contextlib.nullcontext()
+    charge: contextlib.AbstractContextManager = contextlib.nullcontext()
     if kernel is None:
         # a short run on a cold numba cache runs readable (the same frames)
         kernel = start_kernel(scene, n_steps, wall_speed=wall_speed, boxes=boxes)
