@@ -219,9 +219,9 @@ TIERED_ENV = "REFSIM_TIERED_START"
 class Tier:
     """A family of compiled kernels that a process can start without.
 
-    numba compiles a family on its first call on a machine (tens of seconds
-    for the exact collision query, about ten for the simulation loop) and
-    keeps the machine code on disk for later processes. Until then a call
+    numba compiles a family on its first call on a machine (seconds to
+    tens of seconds: docs/decisions/cold-start.md) and keeps the machine
+    code on disk for later processes. Until then a call
     with the default kernel (``kernel=None``) runs the readable kernels,
     which give the same answers bit for bit, as long as their time summed
     over the process stays under the family's compile time
@@ -230,9 +230,9 @@ class Tier:
     "Competitive snoopy caching", Algorithmica 3, 1988): whatever the
     calls still to come, the process never spends more than twice the time
     of the better of "compile at once" and "never compile", known in
-    hindsight. A short script gets its answers in a second instead of
-    waiting for a compile; a long loop of calls pays at most one compile's
-    worth of readable time before it runs compiled.
+    hindsight. A short script gets its answers without waiting for a
+    compile; a long loop of calls pays at most one compile's worth of
+    readable time before it runs compiled.
 
     The family counts as compiled when numba holds every kernel in
     ``dispatchers`` (dotted ``"module:function"`` names) for this processor,

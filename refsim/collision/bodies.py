@@ -51,10 +51,9 @@ BOOLEAN_BATCH = 256
 
 #: The exact hierarchy query's compiled kernels as one family
 #: (:class:`refsim.kernels.Tier`): until numba's cache holds them, the
-#: default query runs readable (about 0.03 s a query, tree included on a
-#: body's first) for up to this many seconds in a process before it
-#: compiles them (about 35 s on a two-core machine, rounded down:
-#: docs/decisions/cold-start.md).
+#: default query runs readable for up to ``compile_seconds`` in a process
+#: before it compiles them (their compile time as measured in
+#: docs/decisions/cold-start.md, rounded down).
 EXACT_QUERY = Tier("exact collision query",
                    ("refsim.collision._numba_kernels:exact_query",
                     "refsim.collision._numba_kernels:exact_collide",
@@ -62,8 +61,9 @@ EXACT_QUERY = Tier("exact collision query",
                     "refsim.collision._numba_build:frame_boxes"), compile_seconds=30.0)
 
 #: A body with more triangles than this takes the compiled query even on a
-#: cold cache: the readable build of its hierarchy would take seconds (tens
-#: for 20 000 triangles), more than the compile it is meant to spare.
+#: cold cache: the readable build of its hierarchy, in one call, would cost
+#: a good part of the compile it is meant to spare
+#: (docs/decisions/tree-build.md).
 READABLE_FACES = 5000
 
 

@@ -53,14 +53,14 @@ FUSED_PARTICLE_STEPS = 50_000_000
 
 #: The fused step as a family of compiled kernels (:class:`refsim.kernels.Tier`):
 #: until numba's cache holds it, a system made with the default kernel
-#: steps readable for up to this many seconds in a process (its compile
-#: takes about two on a two-core machine: docs/decisions/cold-start.md),
-#: then compiles and goes on fused, with the same bits.
+#: steps readable for up to ``compile_seconds`` in a process (its compile
+#: time as measured in docs/decisions/cold-start.md), then compiles and goes
+#: on fused, with the same bits.
 FUSED_STEPS = Tier("fused particle steps", ("refsim.particles._numba_kernels:rk_steps_fused",),
                    compile_seconds=2.0)
 
 #: Particle-steps between two looks at the readable budget while a run is
-#: readable on a cold cache (a few milliseconds of steps).
+#: readable on a cold cache.
 READABLE_PARTICLE_STEPS = 200_000
 
 
