@@ -841,7 +841,7 @@ def main(argv: list[str] | None = None) -> int:
 #: (:class:`refsim.kernels.Tier`): on a cold numba cache they compile them
 #: in a background process (:mod:`refsim.warm`) while their first calls
 #: run readable.
-LONG_COMMANDS = (_conform, _report, _advise, _study)
+LONG_COMMANDS = (_conform, _report, _advise)
 
 
 def _main(argv: list[str] | None) -> int:
