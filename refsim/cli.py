@@ -38,7 +38,7 @@ from dataclasses import asdict
 from pathlib import Path
 
 from refsim.errors import DivergenceError, OutputError, RefsimError, SceneError
-from refsim.kernels import compile_notices, notices_on
+from refsim.kernels import TIERED_ENV, compile_notices, notices_on
 from refsim.signals import Interrupted, signals_raise
 
 EXIT_USER_ERROR = 2
@@ -841,7 +841,13 @@ def main(argv: list[str] | None = None) -> int:
 #: (:class:`refsim.kernels.Tier`): on a cold numba cache they compile them
 #: in a background process (:mod:`refsim.warm`) while their first calls
 #: run readable.
-LONG_COMMANDS = (_conform, _report, _advise)
+LONG_COMMANDS = (_conform, _advise)
+
+#: Commands that time refsim's kernels: they run without the tiered start
+#: (``REFSIM_TIERED_START=0``, inherited by their worker processes), so
+#: that on a cold cache they compile first and time the compiled kernels,
+#: not readable calls made while the compile was pending.
+TIMED_COMMANDS = (_report, _study)
 
 
 def _main(argv: list[str] | None) -> int:
@@ -854,7 +860,9 @@ def _main(argv: list[str] | None) -> int:
         # `info` computes nothing numba compiles: it does not pay numba's import
         with signals_raise(), (contextlib.nullcontext() if args.run is _info
                                else compile_notices(sys.stderr)):
-            if args.run in LONG_COMMANDS:
+            if args.run in TIMED_COMMANDS:
+                os.environ[TIERED_ENV] = "0"
+            elif args.run in LONG_COMMANDS:
                 from refsim.warm import start_in_background
 
                 start_in_background(sys.stderr)

@@ -238,9 +238,11 @@ class Tier:
     ``dispatchers`` (dotted ``"module:function"`` names) for this processor,
     in memory or in its disk cache (:func:`compiled_here`). An explicit
     ``kernel=``, ``REFSIM_KERNELS``, a missing numba and
-    ``REFSIM_TIERED_START=0`` all bypass the tier. Its state is the
-    process's: ``spent`` (readable seconds charged) and ``settled`` (compiled
-    from now on).
+    ``REFSIM_TIERED_START=0`` all bypass the tier; code that times refsim's
+    calls should use one of them (``refsim report`` and ``refsim study`` set
+    the variable), or it times readable calls on a cold cache. Its state is
+    the process's: ``spent`` (readable seconds charged) and ``settled``
+    (compiled from now on).
     """
 
     def __init__(self, name: str, dispatchers: tuple[str, ...], compile_seconds: float):

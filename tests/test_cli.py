@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 
@@ -77,6 +78,24 @@ def test_study_prints_records_and_the_verdict_they_back(capsys):
     assert header[:6] == ["mesh", "n_triangles", "convex", "motion", "frames", "wrong_frames"]
     assert "\nC2: partly\n" in out                # the quick run's verdict, as the report's
     assert "  convex_wrong_frames: 0\n" in out
+
+
+def test_a_timing_command_turns_the_tiered_start_off_and_a_long_one_warms(capsys, monkeypatch,
+                                                                          tmp_path):
+    # a study times refsim's kernels: the compiled ones, not readable calls
+    # made while a compile is pending (refsim.kernels.Tier)
+    from refsim import warm
+
+    started = []
+    monkeypatch.setattr(warm, "start_in_background", lambda stream: started.append(stream))
+    monkeypatch.setenv("REFSIM_TIERED_START", "1")
+    assert main(["study", "models-facts", "--quick"]) == 0
+    assert os.environ["REFSIM_TIERED_START"] == "0" and started == []
+    monkeypatch.setenv("REFSIM_TIERED_START", "1")
+    assert main(["conform", "refsim.engines.refsim_engines:corrected", "--only", "ode",
+                 "--cases", "2", "-o", str(tmp_path / "c")]) == 0
+    assert len(started) == 1 and os.environ["REFSIM_TIERED_START"] == "1"
+    capsys.readouterr()
 
 
 def test_study_marks_timing_fields(capsys):
