@@ -239,8 +239,8 @@ class Tier:
     in memory or in its disk cache (:func:`compiled_here`). An explicit
     ``kernel=``, ``REFSIM_KERNELS``, a missing numba and
     ``REFSIM_TIERED_START=0`` all bypass the tier; code that times refsim's
-    calls should use one of them (``refsim report`` and ``refsim study`` set
-    the variable), or it times readable calls on a cold cache. Its state is
+    calls should use one of them (``refsim report``, ``study`` and ``advise``
+    set the variable), or it times readable calls on a cold cache. Its state is
     the process's: ``spent`` (readable seconds charged) and ``settled``
     (compiled from now on).
     """

@@ -2,7 +2,7 @@
 
 A default call runs the readable kernels while numba's cache lacks its
 family's machine code (:class:`refsim.kernels.Tier`). A long command
-(``refsim conform``, ``refsim report``, ``refsim advise``) would then spend
+(``refsim conform``) would then spend
 up to one compile's time per family on readable calls before compiling in
 the foreground. Instead it starts this module in a second process
 (:func:`start_in_background`): the compile runs beside the readable calls,
