@@ -3,6 +3,8 @@ one line with exit status 2 for a user's mistake."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import json
 import subprocess
 import sys
@@ -61,9 +63,13 @@ def scene(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def store(tmp_path_factory):
-    """One store for the module: the runs are made once, then resumed."""
-    return tmp_path_factory.mktemp("advise-store") / "store"
+def store(scene, tmp_path_factory):
+    """One store for the module, filled here by one advice: every test's
+    runs come from it, whichever test runs first and on whichever worker."""
+    path = tmp_path_factory.mktemp("advise-store") / "store"
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        assert main(["advise", str(scene), "--repeats", "1", "--store", str(path)]) == 0
+    return path
 
 
 def test_json_is_one_document_with_the_documented_keys(scene, store, capsys):
