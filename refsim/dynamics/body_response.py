@@ -128,13 +128,15 @@ def contact_geometry(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a,
     candidates = [d] + [axes_a[:, k] for k in range(3)] + [axes_b[:, k] for k in range(3)]
     best = None
     for axis in candidates:
-        length = np.linalg.norm(axis)
+        # sums written out (refsim.dynamics.products), not BLAS: the same
+        # normal and depth on every processor
+        length = float(norm(axis))
         if length == 0.0:
             continue
         n = axis / length
-        if np.dot(n, d) < 0.0:
+        if dot(n, d) < 0.0:
             n = -n                                   # from B into A
-        pa, pb = world_a @ n, world_b @ n
+        pa, pb = dot(world_a, n), dot(world_b, n)
         depth = pb.max() - pa.min()                  # A lies above B along n
         if best is None or depth < best[1]:
             best = (n, depth, pa, pb)

@@ -117,7 +117,8 @@ def point_mass_properties(vertices: np.ndarray, mass: float) -> MassProperties:
     vertices = np.ldexp(vertices, -e)                    # unit coordinates (see Scale)
     center = vertices.mean(axis=0)
     d = vertices - center
-    C = (mass / len(vertices)) * d.T @ d
+    # (m/n) d^T d by numpy's own loop, not BLAS: the same bits on every processor
+    C = np.einsum("ij,il->jl", (mass / len(vertices)) * d, d)
     inertia = np.trace(C) * np.eye(3) - C
     return MassProperties(mass=float(mass), volume=0.0, center=np.ldexp(center, e),
                           inertia=np.ldexp(inertia, 2 * e))
