@@ -44,7 +44,7 @@ SOURCES = ((ROOT / "refsim", "refsim"), (ROOT / "oracles", "refsim.oracles"))
 #: bundled data, files in and out), then one package per area. Each imports
 #: only those before it.
 ALGORITHMS = tuple(f"refsim.{name}" for name in (
-    "errors", "limits", "types", "rounding", "signals", "kernels", "bundled", "storage",
+    "errors", "lazy", "limits", "types", "rounding", "signals", "kernels", "bundled", "storage",
     "models", "bounds", "collision", "solvers", "dynamics", "particles", "scenes"))
 
 #: Every package and top-level module of refsim by layer, lowest first. A

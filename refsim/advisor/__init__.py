@@ -33,7 +33,7 @@ so that the view loads without the simulation.
 
 from __future__ import annotations
 
-import importlib
+from refsim.lazy import exports
 
 _EXPORTS = {
     "advise": "refsim.advisor.advice",
@@ -47,15 +47,4 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
-
-def __getattr__(name: str):
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'refsim.advisor' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_EXPORTS))
+__getattr__, __dir__ = exports(__name__, _EXPORTS)

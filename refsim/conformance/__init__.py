@@ -32,7 +32,7 @@ pytest run where refsim is installed) costs nothing.
 
 from __future__ import annotations
 
-import importlib
+from refsim.lazy import exports
 
 _EXPORTS = {
     "check_engine": "refsim.conformance.runner",
@@ -53,15 +53,4 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
-
-def __getattr__(name: str):
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'refsim.conformance' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__():
-    return sorted(set(globals()) | set(_EXPORTS))
+__getattr__, __dir__ = exports(__name__, _EXPORTS)
