@@ -101,7 +101,7 @@ from refsim.dynamics.rotation_seed import axes_step_seed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "ca7837193ecec9d2"
+SOURCES_DIGEST = "6ef86e8c7ae760bf"
 
 #: The kernel took every step it was asked for.
 DONE = 0

@@ -79,6 +79,35 @@ def matmul(A: np.ndarray, B: np.ndarray) -> np.ndarray:
             + A[..., :, 2:3] * B[..., 2:3, :])
 
 
+def inverse(M: np.ndarray) -> np.ndarray:
+    """``M^-1`` of invertible 3x3 matrices: (..., 3, 3) -> (..., 3, 3), by
+    the adjugate over the determinant, each cofactor ``(a d - b c)`` and the
+    determinant ``(M_00 C_00 + M_01 C_10) + M_02 C_20`` rounded in one order
+    (``np.linalg.inv`` goes to LAPACK, whose last bits depend on the
+    processor's kernels). Each matrix is first scaled by a power of two that
+    brings its largest entry near 1 (exact), so that the determinant, a
+    product of three entries, neither overflows nor underflows for a body
+    of any size; the inverse is scaled back by the same power."""
+    M = np.asarray(M, dtype=np.float64)
+    largest = np.abs(M).max(axis=(-2, -1), keepdims=True)
+    e = np.frexp(np.where(largest > 0.0, largest, 1.0))[1]
+    A = np.ldexp(M, -e)
+    a = [[A[..., i, j] for j in range(3)] for i in range(3)]
+
+    def cofactor(i0, j0, i1, j1):                 # a[i0][j0] a[i1][j1] - a[i0][j1] a[i1][j0]
+        return a[i0][j0] * a[i1][j1] - a[i0][j1] * a[i1][j0]
+
+    # each entry a difference, none negated: an exact zero stays +0.0
+    adjugate = np.stack([
+        np.stack([cofactor(1, 1, 2, 2), cofactor(0, 2, 2, 1), cofactor(0, 1, 1, 2)], axis=-1),
+        np.stack([cofactor(1, 2, 2, 0), cofactor(0, 0, 2, 2), cofactor(0, 2, 1, 0)], axis=-1),
+        np.stack([cofactor(1, 0, 2, 1), cofactor(0, 1, 2, 0), cofactor(0, 0, 1, 1)], axis=-1),
+    ], axis=-2)
+    det = (a[0][0] * adjugate[..., 0, 0] + a[0][1] * adjugate[..., 1, 0]) \
+        + a[0][2] * adjugate[..., 2, 0]
+    return np.ldexp(adjugate / det[..., np.newaxis, np.newaxis], -e)
+
+
 @jitable
 def orthonormalize_columns(A, out):
     """Gram-Schmidt on the columns of A (3, 3), into out (3, 3), which may be

@@ -85,7 +85,7 @@ from refsim.dynamics.energy import EnergyParts, mechanical_energy
 from refsim.dynamics.forces import field_rhs, translational_rhs
 from refsim.dynamics.loads import apply_torques, field_potential, keep_walls, scene_loads
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
-from refsim.dynamics.products import matvec
+from refsim.dynamics.products import inverse, matvec
 from refsim.dynamics.rotation_impulse import (
     free_rotation_steps,
     past_wall,
@@ -311,7 +311,7 @@ class Simulation:
         self.center = np.array([b.center for b in bodies])                  # (B, 3)
         self._centred = not self.center.any()          # every centroid at the mesh origin
         self.I_body = np.array([b.inertia for b in bodies])                 # (B, 3, 3)
-        self.I_body_inv = np.linalg.inv(self.I_body)
+        self.I_body_inv = inverse(self.I_body)           # not LAPACK: the same bits anywhere
         self.I_body_inv[self.loads.fixed] = 0.0           # fixed: no turn either
         self._torqued = bool(self.loads.torque.any())
         # the principal axes (mesh frame) and moments of the corrected
@@ -696,7 +696,7 @@ class Simulation:
             for i, b in enumerate(self.bodies):
                 c, radii[i] = bounding_sphere(b.mesh)
                 R, origin = self.pose(i)
-                centres[i] = R @ c + origin
+                centres[i] = matvec(R, c) + origin
             return overlapping_pairs(centres - radii[:, None], centres + radii[:, None],
                                      kernel=self.kernel)
         return overlapping_pairs(self.lo, self.hi, kernel=self.kernel)

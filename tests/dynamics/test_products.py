@@ -44,3 +44,23 @@ def test_transposed_matvec_and_matmul_sum_left_to_right_bit_for_bit():
         assert matmul(A[i], M[i]).tolist() == product
     assert matmul(A, M).tobytes() == np.array([matmul(A[i], M[i]) for i in range(300)]).tobytes()
     assert np.allclose(matmul(A, M), A @ M, rtol=0, atol=1e-14)
+
+
+def test_the_inverse_is_the_adjugate_over_the_determinant_at_any_scale():
+    # against LAPACK's to a few ulps of the largest entry (LAPACK's last bits
+    # are the processor's; the written-out inverse's are not), at scales from
+    # 1e-150 to 1e150, where det (a product of three entries) would underflow
+    # or overflow unscaled
+    from refsim.dynamics.products import inverse
+
+    rng = np.random.default_rng(3)
+    for scale in (1e-150, 1e-3, 1.0, 1e5, 1e150):
+        a = rng.normal(size=(100, 3, 3))
+        inertia = (a @ np.swapaxes(a, 1, 2) + 0.1 * np.eye(3)) * scale
+        ours, lapack = inverse(inertia), np.linalg.inv(inertia)
+        largest = np.abs(lapack).max(axis=(1, 2), keepdims=True)
+        assert np.all(np.abs(ours - lapack) <= 1e-13 * largest), scale
+    diagonal = inverse(np.diag([2.0, 4.0, 8.0]))
+    assert diagonal.tobytes() == np.diag([0.5, 0.25, 0.125]).tobytes()   # exact, and +0.0
+    one = np.array([[1.0, 2.0, 3.0], [0.0, 1.0, 4.0], [5.0, 6.0, 0.0]])
+    assert inverse(one).tolist() == [[-24.0, 18.0, 5.0], [20.0, -15.0, -4.0], [-5.0, 4.0, 1.0]]
