@@ -242,11 +242,11 @@ class Simulation:
     ----------
     x, v, w : (B, 3) float64
         Centroid positions, velocities, angular velocities (rad/s); views that
-        tests may write to construct states.
+        tests may write to construct states, in place (on the compiled loop
+        these and ``R``, ``lo``, ``hi`` are views of the loop's packed arrays:
+        an array bound in their place would not be the one the loop steps).
     R : (B, 3, 3) float64
         Orientations.
-    t : float; steps : int
-    events : list of Event (onsets of wall and body contacts)
     stages : tuple of str (the stages this scene runs)
     timer : StageTimer (``timer.seconds``: dict of stage -> seconds)
     """
@@ -397,7 +397,7 @@ class Simulation:
 
     @property
     def steps(self) -> int:
-        """The steps taken since the start."""
+        """The steps taken since the start (int)."""
         return int(self._counters[slot.C_STEPS])
 
     @steps.setter
@@ -406,7 +406,7 @@ class Simulation:
 
     @property
     def t(self) -> float:
-        """The time: ``steps * h``."""
+        """The time, ``steps * h`` (float, seconds)."""
         return int(self._counters[slot.C_STEPS]) * self.h
 
     @property

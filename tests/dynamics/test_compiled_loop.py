@@ -320,6 +320,34 @@ def test_ctrl_c_during_the_loop_leaves_the_simulation_consistent():
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler   # restored
 
 
+def test_ctrl_c_during_one_step_calls_leaves_the_simulation_consistent():
+    # the same with advance(1) in a Python loop, the fast path without the
+    # signal hold: wherever the interrupt lands, the kernel has counted the
+    # steps it took and its event rows, and they show in steps, t and events
+    import os
+    import signal
+    import threading
+
+    scene = cubes_scene(10, "seed", seed=3, solver="rk4")
+    sim = Simulation(scene, kernel="compiled")
+    sim.advance(1)
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            while True:
+                sim.advance(1)
+    finally:
+        timer.cancel()
+    assert 10 < sim.steps and sim.t == sim.steps * sim.h
+    again = Simulation(scene, kernel="compiled")
+    again.run(sim.steps)
+    for name in ("x", "v", "w", "R"):
+        assert getattr(sim, name).tobytes() == getattr(again, name).tobytes(), name
+    assert sim.events == again.events and sim.events
+    assert sim.loop_steps == sim.steps
+
+
 # -- the corrected rotation model ("impulse") and its wall impulses -------------------------
 
 def _one_body_scene(model: str, *, solver: str = "rk4", world: dict | None = None,
