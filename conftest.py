@@ -18,7 +18,10 @@ test's result never depends on a file an earlier run left in the user's
 cache. The cache's own tests give it a directory of their own. For the
 same reason the command line's notice of numba compiling
 (``REFSIM_COMPILE_NOTICE``) is off: whether a command compiles depends on
-numba's cache, not on the command.
+numba's cache, not on the command. So is the tiered start
+(``REFSIM_TIERED_START``, :class:`refsim.kernels.Tier`): a default call
+takes the compiled kernels as it did, whatever the cache holds; the tier's
+own tests turn it on.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ import pytest
 
 os.environ["REFSIM_CACHE_DIR"] = ""
 os.environ["REFSIM_COMPILE_NOTICE"] = "0"
+os.environ["REFSIM_TIERED_START"] = "0"
 
 
 def pytest_configure(config) -> None:

@@ -142,8 +142,8 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 from refsim.oracles import import_engine, run_recorded, seconds_per_step
 
+from refsim.dynamics.world import WALL_NAMES
 from refsim.scenes.support import LOAD_KEYS, refuse_unhonoured
-from refsim.scenes.world import WALL_NAMES
 
 
 @dataclass(frozen=True)

@@ -186,9 +186,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from refsim.oracles import c_banner_dropped, import_engine, run_recorded, seconds_per_step
 
+from refsim.dynamics.world import WALL_NAMES
 from refsim.errors import SceneError
 from refsim.scenes.support import LOAD_KEYS, keys_in_use, refuse_unhonoured
-from refsim.scenes.world import WALL_NAMES
 
 #: Bullet clamps a contact's combined friction (the product) to this
 #: (``MAX_FRICTION`` in ``btManifoldResult::calculateCombinedFriction``;

@@ -55,12 +55,12 @@ FILE_SUFFIXES = (".npz", ".html", ".htm", ".json", ".svg", ".toml", ".txt")
 
 
 def _output_file(path, suffixes: tuple[str, ...], command: str) -> Path:
-    """``path`` as a Path when it can be written (:func:`refsim.io.output_target`:
+    """``path`` as a Path when it can be written (:func:`refsim.storage.writing.output_target`:
     not a directory, device or FIFO, in a directory that exists) and its
     suffix is one of ``suffixes`` (in any case): the command writes that
     format whatever the name says, so another suffix is refused
     (OutputError naming the path) before any work."""
-    from refsim.io import output_error, output_target
+    from refsim.storage.writing import output_error, output_target
 
     out = Path(path)
     output_target(out)
@@ -74,7 +74,7 @@ def _output_directory(path, command: str, writes: str) -> Path:
     """``path`` as a Path for a command that writes a directory (``writes``
     says what goes in it); a name with a file's suffix (FILE_SUFFIXES) that
     is not already a directory is refused before any work."""
-    from refsim.io import output_error
+    from refsim.storage.writing import output_error
 
     out = Path(path)
     if out.suffix.lower() in FILE_SUFFIXES and not out.is_dir():
@@ -179,8 +179,8 @@ def _with_duration(scene, duration: float, max_steps: int | None = None):
 
 def _write(out: Path, save) -> None:
     """``save(out)``; an ``OSError`` (a full disk, a refused target) becomes
-    an :class:`OutputError` naming ``out`` (refsim.io leaves no file)."""
-    from refsim.io import output_error
+    an :class:`OutputError` naming ``out`` (refsim.storage.writing leaves no file)."""
+    from refsim.storage.writing import output_error
 
     try:
         save(out)
@@ -200,7 +200,7 @@ def _frame_progress(n_steps: int, every: int, sink):
     """``sink`` wrapped so that a long run shows its frames so far on stderr
     (redrawn on a terminal after ``RUN_PROGRESS_DELAY``; elsewhere a line
     every ten seconds once it has run that long: never silent)."""
-    from refsim.frames import CountedSink, frame_count
+    from refsim.storage.frames import CountedSink, frame_count
     from refsim.sweep.progress import Progress
 
     progress = Progress(frame_count(n_steps, every), label="refsim run", unit="frames",
@@ -213,14 +213,14 @@ def _frame_progress(n_steps: int, every: int, sink):
 
 def _run_bodies(scene, text: str, out: Path, every: int | None) -> int:
     """Rigid bodies: ``refsim.simulate`` with the frames spilled beside
-    ``out`` as they are computed (:class:`refsim.frames.SpillSink`: memory
+    ``out`` as they are computed (:class:`refsim.storage.frames.SpillSink`: memory
     does not grow with the steps), then written as a Trajectory (.npz) whose
     settings record the scene: its file and its ``text``, from which
     ``refsim replay`` rebuilds the meshes."""
     from refsim.dynamics.simulation import default_every, simulate
     from refsim.dynamics.start import start_kernel
-    from refsim.frames import SpillSink, check_disk_space
-    from refsim.io import output_target
+    from refsim.storage.frames import SpillSink, check_disk_space
+    from refsim.storage.writing import output_target
     from refsim.viewer.replay import recorded_scene_settings
 
     output_target(out)                  # a FIFO, device or directory: refused before running
@@ -264,9 +264,9 @@ def _run_particles(scene, out: Path, every: int | None) -> int:
     (uncompressed: random floats do not compress, and it is faster)."""
     import numpy as np
 
-    from refsim.frames import SpillSink, check_disk_space
-    from refsim.io import output_target, write_npz_atomic
     from refsim.particles.run import FRAME_BYTES_PER_PARTICLE, frame_stride, run_particles
+    from refsim.storage.frames import SpillSink, check_disk_space
+    from refsim.storage.writing import output_target, write_npz_atomic
 
     output_target(out)                  # a FIFO, device or directory: refused before running
     config = scene.particles
@@ -593,15 +593,15 @@ def _add_viewer_commands(commands) -> None:
 
 def _advise(args) -> int:
     """``refsim advise``: the cheapest fidelity settings within TOL
-    (:func:`refsim.studies.advisor.advise`), shown by :mod:`refsim.advise_view`."""
+    (:func:`refsim.advisor.advice.advise`), shown by :mod:`refsim.advisor.view`."""
     import math
     import warnings
 
-    from refsim.advise_view import advice_document, advice_text, svg_available, svg_chart
+    from refsim.advisor.advice import advise
+    from refsim.advisor.view import advice_document, advice_text, svg_available, svg_chart
     from refsim.errors import StateError
-    from refsim.io import output_error, write_text_atomic
     from refsim.scenes.loader import load_scene
-    from refsim.studies.advisor import advise
+    from refsim.storage.writing import output_error, write_text_atomic
 
     if not (math.isfinite(args.tolerance) and args.tolerance > 0.0):
         raise StateError(f"--tolerance must be a finite number of metres > 0, "
@@ -644,14 +644,14 @@ def _advise(args) -> int:
         else:
             warnings.warn("the SVG chart needs matplotlib (pip install 'refsim[report]'); "
                           "writing it as text", stacklevel=1)
-            from refsim.advise_view import text_chart
+            from refsim.advisor.view import text_chart
 
             chart_path = write_text_atomic(out / f"{stem}-work-precision.txt",
                                            text_chart(advice) + "\n")
     document = advice_document(advice, None if chart_path is None else str(chart_path))
     text = json.dumps(document, indent=1, allow_nan=False)
     if out is not None:
-        from refsim.advise_view import toml_snippet
+        from refsim.advisor.view import toml_snippet
 
         write_text_atomic(out / f"{stem}-advice.json", text + "\n")
         write_text_atomic(out / f"{stem}-advice.toml", toml_snippet(advice))
@@ -664,7 +664,7 @@ def _advise(args) -> int:
 
 
 def _add_advise_command(commands) -> None:
-    """``refsim advise`` (refsim.studies.advisor; the chart needs the report extra)."""
+    """``refsim advise`` (refsim.advisor; the chart needs the report extra)."""
     advise = commands.add_parser(
         "advise", help="the cheapest solver, step, collision level and box update within TOL",
         description="Hold SCENE's physics fixed and search its fidelity settings (solver, "
@@ -837,6 +837,13 @@ def main(argv: list[str] | None = None) -> int:
                 sys.unraisablehook = unraisable_hook
 
 
+#: Commands that make many calls of the tiered kernel families
+#: (:class:`refsim.kernels.Tier`): on a cold numba cache they compile them
+#: in a background process (:mod:`refsim.warm`) while their first calls
+#: run readable.
+LONG_COMMANDS = (_conform, _report, _advise, _study)
+
+
 def _main(argv: list[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -847,6 +854,10 @@ def _main(argv: list[str] | None) -> int:
         # `info` computes nothing numba compiles: it does not pay numba's import
         with signals_raise(), (contextlib.nullcontext() if args.run is _info
                                else compile_notices(sys.stderr)):
+            if args.run in LONG_COMMANDS:
+                from refsim.warm import start_in_background
+
+                start_in_background(sys.stderr)
             return args.run(args)
     except DivergenceError as exc:
         if args.debug:

@@ -96,7 +96,7 @@ class NpzFileError(RefsimError, ValueError):
     """An .npz that cannot be read as the expected content: missing,
     unreadable, truncated, another format, an entry missing or of the wrong
     shape. ``path`` is the file, ``entry`` the entry's name when one is at
-    fault (:mod:`refsim.npz` raises it)."""
+    fault (:mod:`refsim.storage.npz` raises it)."""
 
     def __init__(self, message: str, path: str | PathLike, entry: str | None = None):
         self.message = message

@@ -15,6 +15,13 @@ The environment variable ``REFSIM_KERNELS`` (``readable`` or ``compiled``)
 changes the default for a whole run, e.g. to time or debug the readable path
 under the command line; an explicit ``kernel=`` wins over it.
 
+Three families whose first compile takes seconds to tens of seconds (the
+exact collision query, the simulation loop, the fused particle step) start
+tiered (:class:`Tier`): while numba's cache does not hold them, a default
+call runs readable until the process has spent about one compile's time
+that way, so that a short script does not wait for a compile.
+``REFSIM_TIERED_START=0`` turns that off.
+
 :data:`PAIRS` lists every kernel pair, readable and compiled, by dotted
 name; tests/test_kernels.py walks it and checks each pair bit for bit on its
 own cases. A compiled twin is the readable function itself compiled
@@ -200,6 +207,80 @@ def compiled_here(dispatcher) -> bool:
     except Exception:    # no disk cache, or another numba's layout
         return False
     return any(key[1] == machine for key in index)
+
+
+#: Set to "0" to turn the tiered start off (:class:`Tier`): a default call
+#: then takes the compiled kernels at once, compiling them if numba's cache
+#: does not hold them. The test suite does, so that the kernel a test runs
+#: does not depend on what numba's cache holds.
+TIERED_ENV = "REFSIM_TIERED_START"
+
+
+class Tier:
+    """A family of compiled kernels that a process can start without.
+
+    numba compiles a family on its first call on a machine (tens of seconds
+    for the exact collision query, about ten for the simulation loop) and
+    keeps the machine code on disk for later processes. Until then a call
+    with the default kernel (``kernel=None``) runs the readable kernels,
+    which give the same answers bit for bit, as long as their time summed
+    over the process stays under the family's compile time
+    (``compile_seconds``); after that it compiles. This is the break-even
+    rule of the ski-rental problem (Karlin, Manasse, Rudolph and Sleator,
+    "Competitive snoopy caching", Algorithmica 3, 1988): whatever the
+    calls still to come, the process never spends more than twice the time
+    of the better of "compile at once" and "never compile", known in
+    hindsight. A short script gets its answers in a second instead of
+    waiting for a compile; a long loop of calls pays at most one compile's
+    worth of readable time before it runs compiled.
+
+    The family counts as compiled when numba holds every kernel in
+    ``dispatchers`` (dotted ``"module:function"`` names) for this processor,
+    in memory or in its disk cache (:func:`compiled_here`). An explicit
+    ``kernel=``, ``REFSIM_KERNELS``, a missing numba and
+    ``REFSIM_TIERED_START=0`` all bypass the tier. Its state is the
+    process's: ``spent`` (readable seconds charged) and ``settled`` (compiled
+    from now on).
+    """
+
+    def __init__(self, name: str, dispatchers: tuple[str, ...], compile_seconds: float):
+        self.name = name
+        self.dispatchers = dispatchers
+        self.compile_seconds = compile_seconds
+        self.spent = 0.0
+        self.settled = False
+
+    def readable_first(self) -> bool:
+        """Whether a default call should run the readable kernels now (and be
+        charged: :meth:`charged`). Once it answers False for a compiled
+        family or a spent budget, it answers False at once from then on."""
+        if self.settled:
+            return False
+        if (_environment_kernel() is not None or not numba_usable()
+                or os.environ.get(TIERED_ENV, "1") == "0"):
+            return False
+        if self.spent >= self.compile_seconds or all(
+                compiled_here(resolve(name)) for name in self.dispatchers):
+            self.settled = True
+            return False
+        return True
+
+    def remaining(self) -> float:
+        """The readable seconds left before the family compiles."""
+        return max(self.compile_seconds - self.spent, 0.0)
+
+    def settle(self) -> None:
+        """Compiled from now on (a caller that knows a long run comes)."""
+        self.settled = True
+
+    @contextlib.contextmanager
+    def charged(self):
+        """Adds the body's wall time to the readable seconds spent."""
+        began = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.spent += time.perf_counter() - began
 
 
 @functools.cache

@@ -2,7 +2,7 @@
 
 Python turns SIGINT into ``KeyboardInterrupt``, which unwinds the stack and
 runs every ``finally`` and ``except BaseException`` on the way: the
-temporary and spill files of :mod:`refsim.io` and :mod:`refsim.frames` are
+temporary and spill files of :mod:`refsim.storage.writing` and :mod:`refsim.storage.frames` are
 removed. SIGTERM (``kill``, a batch system's time limit) and SIGHUP (a
 closed terminal) kill the process by default without any of that, leaving
 the hidden files behind. :func:`signals_raise` installs handlers that raise

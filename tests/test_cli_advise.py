@@ -10,9 +10,11 @@ import tomllib
 
 import pytest
 
+from refsim.advisor.advice import DEFAULT_TOLERANCE
+from refsim.advisor.reference import MAX_REFERENCE_STEPS
+from refsim.advisor.runner import TIMING_REPEATS
 from refsim.cli import EXIT_USER_ERROR, build_parser, main
 from refsim.scenes.loader import scene_from_dict
-from refsim.studies.advisor import DEFAULT_TOLERANCE, MAX_REFERENCE_STEPS, TIMING_REPEATS
 
 #: A cube dropped onto the floor for 0.6 s: one wall impact (a short run).
 SCENE = """\
@@ -36,7 +38,7 @@ position = [0.0, 0.2, 0.0]
 velocity = [0.5, 0.0, 0.0]
 """
 
-#: The keys of the --json document (refsim.advise_view.advice_document).
+#: The keys of the --json document (refsim.advisor.view.advice_document).
 DOCUMENT_KEYS = {"format", "scene", "tolerance", "duration", "scene_duration",
                  "sample_interval", "energy_scale", "energy_allowance", "count_allowance",
                  "reference", "recommended", "own", "proxy_saving", "wall_saving", "runs",
@@ -117,9 +119,9 @@ def test_an_output_directory_gets_the_snippet_the_document_and_the_svg(scene, st
 
 def test_without_matplotlib_the_chart_is_written_as_text(scene, store, tmp_path, capsys,
                                                          monkeypatch):
-    import refsim.advise_view
+    import refsim.advisor.view
 
-    monkeypatch.setattr(refsim.advise_view, "svg_available", lambda: False)
+    monkeypatch.setattr(refsim.advisor.view, "svg_available", lambda: False)
     out_dir = tmp_path / "out"
     assert main(["advise", str(scene), "--repeats", "1", "--store", str(store),
                  "-o", str(out_dir)]) == 0

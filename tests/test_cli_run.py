@@ -259,14 +259,14 @@ def test_divergence_names_step_and_time_and_keeps_the_frames(tmp_path, capsys):
 
 def test_an_interrupted_write_leaves_no_file(tmp_path, monkeypatch):
     import refsim.cli as cli
-    import refsim.npz
+    import refsim.storage.npz
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
     # Ctrl-C while the .npz is assembled from the spilled frames: neither the
     # temporary .npz nor the spill files stay
-    monkeypatch.setattr(refsim.npz, "npy_header", interrupted)
+    monkeypatch.setattr(refsim.storage.npz, "npy_header", interrupted)
     scene = write(tmp_path, TINY)
     out = tmp_path / "out.npz"
     assert cli.main(["run", str(scene), "-o", str(out)]) == 130

@@ -24,8 +24,8 @@ import pytest
 
 import refsim
 from refsim.conformance.results import CLASS_DEFINITIONS
+from refsim.dynamics.world import IntegrationConfig, WorldConfig
 from refsim.scenes import schema
-from refsim.scenes.world import IntegrationConfig, WorldConfig
 
 ROOT = Path(__file__).resolve().parents[1]
 SITE = ROOT / "docs" / "site"

@@ -1,4 +1,4 @@
-"""refsim.frames: frames kept in memory or spilled beside the output give the
+"""refsim.storage.frames: frames kept in memory or spilled beside the output give the
 same arrays, bit for bit; spill files never outlive their sink; the disk
 guard's arithmetic."""
 
@@ -11,14 +11,14 @@ import numpy as np
 import pytest
 
 from refsim.errors import OutputError, StateError
-from refsim.frames import (
+from refsim.storage.frames import (
     MemorySink,
     SpillSink,
     check_disk_space,
     frame_count,
     spill_disk_bound,
 )
-from refsim.npz import write_npz
+from refsim.storage.npz import write_npz
 
 
 def _frames(n, B=2, seed=3):

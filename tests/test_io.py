@@ -1,4 +1,4 @@
-"""refsim.io: where an output goes (symlinks written through, special files
+"""refsim.storage.writing: where an output goes (symlinks written through, special files
 refused), written whole or not at all, no temporary file left."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import socket
 import pytest
 
 from refsim.errors import OutputError, RefsimError
-from refsim.io import atomic_output, output_target, write_text_atomic
+from refsim.storage.writing import atomic_output, output_target, write_text_atomic
 
 
 def names(directory):

@@ -1,4 +1,4 @@
-"""refsim.npz: an .npz written entry by entry that numpy reads back exactly,
+"""refsim.storage.npz: an .npz written entry by entry that numpy reads back exactly,
 and errors on reading that name the file and the entry."""
 
 from __future__ import annotations
@@ -9,9 +9,9 @@ import zipfile
 import numpy as np
 import pytest
 
-import refsim.npz
+import refsim.storage.npz
 from refsim.errors import NpzFileError
-from refsim.npz import read_npz, write_npz
+from refsim.storage.npz import read_npz, write_npz
 
 ARRAYS = {
     "t": np.linspace(0.0, 1.0, 7),
@@ -59,17 +59,17 @@ def test_the_same_arrays_give_the_same_bytes():
 
 def test_a_large_entry_goes_through_in_chunks(monkeypatch):
     # 3 chunks of 64 bytes and a part: the chunk boundaries leave no trace
-    monkeypatch.setattr(refsim.npz, "CHUNK_BYTES", 64)
+    monkeypatch.setattr(refsim.storage.npz, "CHUNK_BYTES", 64)
     a = np.arange(25, dtype=np.float64)           # 200 bytes
     written = []
-    real = refsim.npz._array_chunks
+    real = refsim.storage.npz._array_chunks
 
     def counted(array, size):
         for chunk in real(array, size):
             written.append(len(chunk))
             yield chunk
 
-    monkeypatch.setattr(refsim.npz, "_array_chunks", counted)
+    monkeypatch.setattr(refsim.storage.npz, "_array_chunks", counted)
     with np.load(io.BytesIO(_bytes({"a": a}, False))) as loaded:
         assert np.array_equal(loaded["a"], a)
     assert written == [64, 64, 64, 8]

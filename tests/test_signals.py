@@ -45,11 +45,11 @@ CHILD = """
 import signal, sys
 from pathlib import Path
 
-import refsim.npz
+import refsim.storage.npz
 from refsim.cli import main
 
 marker = Path(sys.argv[1])
-real = refsim.npz.npy_header
+real = refsim.storage.npz.npy_header
 calls = []
 
 
@@ -62,7 +62,7 @@ def header_then_wait(shape, dtype):
     return real(shape, dtype)
 
 
-refsim.npz.npy_header = header_then_wait
+refsim.storage.npz.npy_header = header_then_wait
 sys.exit(main(sys.argv[2:]))
 """
 
@@ -73,7 +73,7 @@ CHILD_IN_CONSTRUCTOR = """
 import signal, sys
 from pathlib import Path
 
-import refsim.npz
+import refsim.storage.npz
 from refsim.cli import main
 
 marker = Path(sys.argv[1])
@@ -95,7 +95,7 @@ def header_in_a_constructor(shape, dtype):
     HalfBuilt()
 
 
-refsim.npz.npy_header = header_in_a_constructor
+refsim.storage.npz.npy_header = header_in_a_constructor
 sys.exit(main(sys.argv[2:]))
 """
 

@@ -27,10 +27,11 @@ from pathlib import Path
 import numpy as np
 
 import refsim
-from refsim.studies.fidelity_runs import Fidelity, with_fidelity
+from refsim.advisor.records import Fidelity
+from refsim.advisor.runs import with_fidelity
 
 ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "tests" / "studies"))
+sys.path.insert(0, str(ROOT / "tests" / "advisor"))
 from test_advisor import CHAOS, DROP  # noqa: E402  (the tests' scenes, one definition)
 
 

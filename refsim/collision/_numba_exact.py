@@ -67,17 +67,13 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from refsim.collision.predicates import (
-    FILTER_MAX_ABS,
-    FILTER_MIN_ABS,
-    O2D_ERRBOUND_A,
-    O3D_ERRBOUND_A,
-)
+from refsim.collision.predicates import FILTER_MAX_ABS, FILTER_MIN_ABS
+from refsim.rounding import O2D_ERRBOUND_A, O3D_ERRBOUND_A
 
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "deb19c759b880566"
+SOURCES_DIGEST = "f4f4684f592ca82e"
 
 #: Dekker's splitter for float64: 2**ceil(53 / 2) + 1 (Shewchuk, section 2.5).
 SPLITTER = 134217729.0

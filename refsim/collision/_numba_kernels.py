@@ -24,17 +24,13 @@ import numba
 import numpy as np
 
 from refsim.collision._numba_exact import triangles_intersect_exact
-from refsim.collision.predicates import (
-    FILTER_MAX_ABS,
-    FILTER_MIN_ABS,
-    O2D_ERRBOUND_A,
-    O3D_ERRBOUND_A,
-)
+from refsim.collision.predicates import FILTER_MAX_ABS, FILTER_MIN_ABS
+from refsim.rounding import O2D_ERRBOUND_A, O3D_ERRBOUND_A
 
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "1488c50bc7187b63"
+SOURCES_DIGEST = "5d17816dcc8dab8e"
 
 # -- the certified triangle-pair filter (triangle_numba's steps 1-4) -------------------
 #
@@ -697,16 +693,21 @@ def exact_query(floats_a, ints_a, rotation_a, translation_a,
 
 
 #: The one signature ``exact_collide`` is compiled for: packed mesh arrays,
-#: float64 C-contiguous poses. numba refuses any other argument types with a
-#: TypeError instead of compiling for them, so the caller need not check a
-#: pose's layout before the call (bvh_exact.collide_bvh).
+#: float64 C-contiguous poses. The caller compiles it (or loads it from
+#: numba's cache) for this signature alone and then turns compiling off
+#: (bvh_exact's ``_compiled``), so that numba refuses any other argument
+#: types with a TypeError instead of compiling for them, and the caller need
+#: not check a pose's layout before the call (bvh_exact.collide_bvh). It is
+#: not compiled as this module is imported: importing the module must stay
+#: cheap, so that whether numba's cache holds its kernels can be asked
+#: without compiling them (refsim.kernels.Tier).
 EXACT_COLLIDE_SIGNATURE = numba.int64(
     numba.float64[::1], numba.int64[::1], numba.float64[:, ::1], numba.float64[::1],
     numba.float64[::1], numba.int64[::1], numba.float64[:, ::1], numba.float64[::1],
     numba.float64, numba.float64, numba.float64)
 
 
-@numba.njit(EXACT_COLLIDE_SIGNATURE, cache=True)
+@numba.njit(cache=True)
 def exact_collide(floats_a, ints_a, rotation_a, translation_a,
                   floats_b, ints_b, rotation_b, translation_b,
                   tol, margin_rounding, margin_per_deviation):

@@ -36,7 +36,7 @@ from refsim.collision.bvh_exact import collide_bvh, intersecting_pairs_bvh
 from refsim.collision.seed_levels import exact_pairs, triangle_box_pairs
 from refsim.collision.spheres import spheres_overlap
 from refsim.errors import check_option
-from refsim.kernels import choose_kernel
+from refsim.kernels import Tier, choose_kernel
 from refsim.models.mesh import require_mesh
 from refsim.types import as_pose
 
@@ -48,6 +48,33 @@ METHODS = ("bvh", "seed")
 #: the first batch with a hit: small enough to stop early, large enough that
 #: numpy's per-call overhead is amortized.
 BOOLEAN_BATCH = 256
+
+#: The exact hierarchy query's compiled kernels as one family
+#: (:class:`refsim.kernels.Tier`): until numba's cache holds them, the
+#: default query runs readable (about 0.03 s a query, tree included on a
+#: body's first) for up to this many seconds in a process before it
+#: compiles them (about 35 s on a two-core machine, rounded down:
+#: docs/decisions/cold-start.md).
+EXACT_QUERY = Tier("exact collision query",
+                   ("refsim.collision._numba_kernels:exact_query",
+                    "refsim.collision._numba_kernels:exact_collide",
+                    "refsim.collision._numba_build:build_tree",
+                    "refsim.collision._numba_build:frame_boxes"), compile_seconds=30.0)
+
+#: A body with more triangles than this takes the compiled query even on a
+#: cold cache: the readable build of its hierarchy would take seconds (tens
+#: for 20 000 triangles), more than the compile it is meant to spare.
+READABLE_FACES = 5000
+
+
+def _exact_kernel(kernel: str | None, mesh_a, mesh_b):
+    """How the exact hierarchy query runs: ``(kernel, tier)``, the tier to
+    charge (:data:`EXACT_QUERY`) when a default call runs readable on a cold
+    cache, else None."""
+    if (kernel is None and max(mesh_a.n_faces, mesh_b.n_faces) <= READABLE_FACES
+            and EXACT_QUERY.readable_first()):
+        return "readable", EXACT_QUERY
+    return choose_kernel(kernel), None
 
 
 def _check(level: str, allowed: tuple[str, ...], method: str, mesh_a, mesh_b) -> None:
@@ -70,16 +97,21 @@ def intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
     method : "bvh" (hierarchy) or "seed" (pairwise triangle boxes)
     kernel : "compiled" (compiled traversal and exact filter; the default
         where numba works) or "readable" (readable traversal, numpy filter);
-        see :mod:`refsim.kernels`
+        see :mod:`refsim.kernels`. The default at level "exact" runs
+        readable while numba's cache lacks the query (:data:`EXACT_QUERY`).
 
     Returns
     -------
     (k, 2) int64 array, rows sorted.
     """
     _check(level, PAIR_LEVELS, method, mesh_a, mesh_b)
-    kernel = choose_kernel(kernel)
     if level == "exact" and method == "bvh":
+        kernel, tier = _exact_kernel(kernel, mesh_a, mesh_b)
+        if tier is not None:
+            with tier.charged():
+                return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
         return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
+    kernel = choose_kernel(kernel)
     pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
     if method == "seed":
         world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
@@ -109,7 +141,9 @@ def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
     method : {"bvh", "seed"}
         The deeper hierarchy or the seed's levels; the same answers.
     kernel : {"readable", "compiled"}, optional
-        See :mod:`refsim.kernels`; the same answers.
+        See :mod:`refsim.kernels`; the same answers. The default at level
+        "exact" runs readable while numba's cache lacks the query
+        (:data:`EXACT_QUERY`).
 
     Returns
     -------
@@ -126,9 +160,13 @@ def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
         one that puts the body's world coordinates beyond float64's range.
     """
     _check(level, LEVELS, method, mesh_a, mesh_b)
-    kernel = choose_kernel(kernel)
     if level == "exact" and method == "bvh":
+        kernel, tier = _exact_kernel(kernel, mesh_a, mesh_b)
+        if tier is not None:
+            with tier.charged():
+                return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
         return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
+    kernel = choose_kernel(kernel)
     pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
     if level == "sphere":
         return spheres_overlap(mesh_a, pose_a, mesh_b, pose_b)

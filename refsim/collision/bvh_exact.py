@@ -502,11 +502,16 @@ def descend(mesh_a, pose_a, mesh_b, pose_b, *,
 def _compiled():
     """The compiled kernels module (``exact_query``, ``exact_collide``), or
     None without numba (looked up once: a query costs a few microseconds, and
-    an import statement a fraction)."""
+    an import statement a fraction). ``exact_collide`` is compiled here for
+    its one signature, and numba may compile it for no other
+    (``EXACT_COLLIDE_SIGNATURE``)."""
     try:
         from refsim.collision import _numba_kernels as nk
     except ImportError:
         return None
+    if not nk.exact_collide.signatures:
+        nk.exact_collide.compile(nk.EXACT_COLLIDE_SIGNATURE)
+        nk.exact_collide.disable_compile()
     return nk
 
 

@@ -20,7 +20,7 @@ input: **exact predicates, filtered**.
 Reference: J. R. Shewchuk, "Adaptive Precision Floating-Point Arithmetic and
 Fast Robust Geometric Predicates", Discrete & Computational Geometry 18
 (1997), section 4 (the error bounds ``ccwerrboundA`` and ``o3derrboundA`` of
-the first, non-adaptive stage).
+the first, non-adaptive stage, in :mod:`refsim.rounding`).
 
 The filter
 ----------
@@ -62,15 +62,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from refsim.errors import StateError
-
-#: Machine epsilon in Shewchuk's sense: half an ulp of 1, 2**-53 for float64.
-EPSILON = 2.0 ** -53
-
-#: Shewchuk (1997) ``ccwerrboundA``: relative error bound of the float orient2d.
-O2D_ERRBOUND_A = (3.0 + 16.0 * EPSILON) * EPSILON
-
-#: Shewchuk (1997) ``o3derrboundA``: relative error bound of the float orient3d.
-O3D_ERRBOUND_A = (7.0 + 56.0 * EPSILON) * EPSILON
+from refsim.rounding import O2D_ERRBOUND_A, O3D_ERRBOUND_A
 
 #: Smallest nonzero coordinate magnitude the filter trusts. A nonzero
 #: difference of two such floats is at least 2**-292 (one ulp of 2**-240), a

@@ -39,14 +39,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from refsim.collision.predicates import (
-    FILTER_MAX_ABS,
-    FILTER_MIN_ABS,
-    O2D_ERRBOUND_A,
-    O3D_ERRBOUND_A,
-)
+from refsim.collision.predicates import FILTER_MAX_ABS, FILTER_MIN_ABS
 from refsim.collision.triangle import triangles_intersect
 from refsim.errors import StateError
+from refsim.rounding import O2D_ERRBOUND_A, O3D_ERRBOUND_A
 
 
 def triangles_intersect_batch(A, B) -> np.ndarray:

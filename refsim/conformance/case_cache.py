@@ -104,7 +104,7 @@ def cached(name: str, n: int, seed: int, build: Callable[[], object]):
 def _store(path: Path, value) -> None:
     """Write ``value`` whole or not at all (a temporary file renamed over
     the name); a failure to write is not an error, only no saving."""
-    from refsim.io import write_atomic
+    from refsim.storage.writing import write_atomic
 
     try:
         path.parent.mkdir(parents=True, exist_ok=True)

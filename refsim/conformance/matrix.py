@@ -150,10 +150,10 @@ def write_engine_pages(result, out_dir) -> tuple[Path, Path]:
     """``out_dir/conformance.json``, ``out_dir/failures.jsonl`` (every
     failing case, one a line: :meth:`ConformanceResult.failure_lines`) and
     ``out_dir/index.html`` of one engine's result, each written whole or not
-    at all (:mod:`refsim.io`); ``out_dir`` is created if missing. Returns
+    at all (:mod:`refsim.storage.writing`); ``out_dir`` is created if missing. Returns
     the JSON record's path and the page's."""
     from refsim.conformance.page import engine_page
-    from refsim.io import write_atomic, write_text_atomic
+    from refsim.storage.writing import write_atomic, write_text_atomic
 
     out_dir = make_directory(out_dir)
     write_atomic(out_dir / "failures.jsonl",
@@ -166,7 +166,7 @@ def make_directory(path) -> Path:
     """``path`` as a directory, created with its parents if missing;
     :class:`~refsim.errors.OutputError` naming it when that fails (a file in
     the way, no permission)."""
-    from refsim.io import output_error
+    from refsim.storage.writing import output_error
 
     path = Path(path)
     try:
@@ -299,7 +299,7 @@ def _finish(results: dict, pages: dict, unavailable: dict, seconds: dict, out_di
     matrix = conformance_matrix(results, pages, unavailable, seconds)
     if out_dir is not None:
         from refsim.conformance.page import matrix_page
-        from refsim.io import write_text_atomic
+        from refsim.storage.writing import write_text_atomic
 
         make_directory(out_dir)
         write_text_atomic(Path(out_dir) / "matrix.json", matrix.to_json())

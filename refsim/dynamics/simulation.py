@@ -58,6 +58,7 @@ for the broad phase and the narrow-phase cost of the k candidate pairs.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass, replace
@@ -98,6 +99,7 @@ from refsim.dynamics.rotation_seed import (
     contact_vertex_seed,
     orientation_step_seed_kernel,
 )
+from refsim.dynamics.start import LOOP, start_kernel
 from refsim.dynamics.trajectory import FRAME_ENTRIES, Event, Trajectory
 from refsim.dynamics.walls import SPEEDS, wall_name, wall_response_seed, wall_speed
 from refsim.errors import (
@@ -108,7 +110,6 @@ from refsim.errors import (
     check_number,
     check_option,
 )
-from refsim.frames import FrameSink, MemorySink, frame_count
 from refsim.kernels import choose_kernel, compile_kernel
 from refsim.limits import MAX_STEPS
 from refsim.models.mesh import Mesh
@@ -116,6 +117,7 @@ from refsim.scenes.schema import Scene
 from refsim.signals import SignalHold, held_signals
 from refsim.solvers.explicit_rk import rk_step
 from refsim.solvers.integrate import resolve_method, whole_steps
+from refsim.storage.frames import FrameSink, MemorySink, frame_count
 
 #: At most about this many frames by default (``every`` is chosen so).
 MAX_FRAMES = 1000
@@ -233,10 +235,10 @@ class Simulation:
     kernel : {"readable", "compiled"}, optional
         The kernels of every stage (:mod:`refsim.kernels`); the same
         trajectory, bit for bit, on either.
-    sink : refsim.frames.FrameSink, optional
-        Where :meth:`record` puts frames: a :class:`refsim.frames.MemorySink`
+    sink : refsim.storage.frames.FrameSink, optional
+        Where :meth:`record` puts frames: a :class:`refsim.storage.frames.MemorySink`
         by default (growing by doubling), or e.g. a
-        :class:`refsim.frames.SpillSink` that writes them to disk as they come.
+        :class:`refsim.storage.frames.SpillSink` that writes them to disk as they come.
 
     Attributes
     ----------
@@ -908,7 +910,7 @@ class Simulation:
 
         Its arrays are what the sink holds: with the default memory sink,
         views of its buffers (no copy; later records do not change them);
-        with a spill sink, :class:`refsim.frames.SpilledArray` views of its
+        with a spill sink, :class:`refsim.storage.frames.SpilledArray` views of its
         files, valid while the sink is open.
         """
         B = len(self.bodies)
@@ -974,16 +976,18 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
     wall_speed, boxes : str, optional
         See :class:`Simulation` (``wall_speed``: default the scene's
         ``world.wall_speed``).
-    sink : refsim.frames.FrameSink, optional
+    sink : refsim.storage.frames.FrameSink, optional
         Where the frames go as they are computed. Default: a
-        :class:`refsim.frames.MemorySink` sized for the run's frames, and the
+        :class:`refsim.storage.frames.MemorySink` sized for the run's frames, and the
         trajectory holds numpy arrays. ``refsim run`` passes a
-        :class:`refsim.frames.SpillSink`, so that memory does not grow with
+        :class:`refsim.storage.frames.SpillSink`, so that memory does not grow with
         the steps; the trajectory's frames are then views of its files, to be
         saved before the sink closes. Both give the same frames, bit for bit.
     kernel : {"readable", "compiled"}, optional
-        See :class:`Simulation` (``refsim run`` passes
-        :func:`refsim.dynamics.start.start_kernel`'s choice).
+        See :class:`Simulation`. The default runs the compiled loop, or the
+        readable step when numba's cache does not hold the loop yet and the
+        run is short (:func:`refsim.dynamics.start.start_kernel`): the same
+        frames either way.
 
     Raises
     ------
@@ -1005,11 +1009,18 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
     if sink is None:
         # the initial state, every every-th step, and the last step
         sink = MemorySink(capacity=frame_count(n_steps, every))
+    charge = contextlib.nullcontext()
+    if kernel is None:
+        # a short run on a cold numba cache runs readable (the same frames)
+        kernel = start_kernel(scene, n_steps, wall_speed=wall_speed, boxes=boxes)
+        if kernel == "readable":
+            charge = LOOP.charged()
     sim = Simulation(scene, wall_speed=wall_speed, boxes=boxes, sink=sink, kernel=kernel)
-    sim.record()
-    sim.run(n_steps, every=every)
-    if sim.steps % every:
-        sim.record()                                  # always end on the last state
+    with charge:
+        sim.record()
+        sim.run(n_steps, every=every)
+        if sim.steps % every:
+            sim.record()                              # always end on the last state
     traj = sim.trajectory()
     traj.settings["every"] = every
     return traj

@@ -1,5 +1,4 @@
-"""The kernel a command-line run starts on: a short run does not wait for a
-compile.
+"""The kernel a run starts on: a short run does not wait for a compile.
 
 numba compiles the simulation loop (:mod:`refsim.dynamics._numba_kernels`)
 on its first call on a machine and keeps the machine code on disk; that
@@ -7,15 +6,18 @@ first compile takes longer than the bundled scenes' whole runs on the
 readable kernels (docs/decisions/cold-start.md has the figures). The
 readable and compiled kernels give the same results bit for bit
 (tests/dynamics/test_compiled_loop.py), so which one a run takes changes
-its time only. :func:`start_kernel` picks:
+its time only. The loop is a :class:`refsim.kernels.Tier` (:data:`LOOP`):
+a process spends at most :data:`LOOP_COMPILE_SECONDS` on readable runs
+before it compiles. :func:`start_kernel` picks:
 
 - the default (the compiled loop) when numba already holds the loop's
   machine code for this processor, in memory or in its disk cache, or when
-  ``REFSIM_KERNELS`` chooses, or the loop cannot run the scene;
+  ``REFSIM_KERNELS`` or ``REFSIM_TIERED_START=0`` chooses, or the loop
+  cannot run the scene, or the process has spent its readable budget;
 - else "readable" when the run's readable steps, timed on a few of them,
-  would take less than :data:`LOOP_COMPILE_SECONDS`; else the default
-  (also, untimed, for bodies of more than :data:`PROBE_FACES` triangles
-  that can meet at a triangle level).
+  would take less than the budget left; else the default, and the process
+  compiles from then on (also, untimed, for bodies of more than
+  :data:`PROBE_FACES` triangles that can meet at a triangle level).
 
 The estimate is the first steps' rate: a scene whose bodies meet only
 later (each readable body contact costs far more than a step in flight)
@@ -23,10 +25,11 @@ can run readable for longer than the compile would have taken. The probe
 looks at the clock every :data:`PROBE_CHUNK` steps, so it can pass
 :data:`PROBE_SECONDS` by up to that many steps.
 
-``refsim run`` and the viewer's runs (:mod:`refsim.viewer.runs`) ask it;
-:func:`refsim.simulate` itself keeps its default (a library caller chooses
-with ``kernel=``). A run started readable compiles nothing, so numba's cache
-stays empty until a run long enough to pay for the compile comes.
+``refsim run``, the viewer's runs (:mod:`refsim.viewer.runs`) and
+:func:`refsim.simulate` with its default kernel ask it (a
+:class:`refsim.Simulation` made directly keeps the compiled default: how
+many steps it will take is not known). A run started readable compiles
+nothing, so numba's cache stays empty until a long enough run comes.
 """
 
 from __future__ import annotations
@@ -34,11 +37,17 @@ from __future__ import annotations
 import time
 
 from refsim.errors import RefsimError
+from refsim.kernels import Tier
 
 #: About the loop's first compile on a two-core machine, rounded down
 #: (docs/decisions/cold-start.md): a run whose readable steps take less
 #: starts readable.
 LOOP_COMPILE_SECONDS = 12.0
+
+#: The simulation loop as a family of compiled kernels: the process's
+#: readable budget before it compiles (:class:`refsim.kernels.Tier`).
+LOOP = Tier("simulation loop", ("refsim.dynamics._numba_kernels:advance",),
+            compile_seconds=LOOP_COMPILE_SECONDS)
 
 #: The readable steps timed to estimate a run's readable time: at most this
 #: many, and no more once this much time has passed.
@@ -57,19 +66,15 @@ PROBE_FACES = 5000
 def start_kernel(scene, n_steps: int, *, wall_speed: str | None = None,
                  boxes: str = "auto") -> str | None:
     """"readable" when a run of ``n_steps`` of ``scene`` would end sooner on
-    the readable kernels than numba would compile the loop; else None (the
-    default kernel). Costs a file read when the loop is compiled, else up to
-    :data:`PROBE_SECONDS` of readable steps on a copy of the run."""
+    the readable kernels than the readable budget left to :data:`LOOP`;
+    else None (the default kernel). Costs a file read when the loop is
+    compiled, else up to :data:`PROBE_SECONDS` of readable steps on a copy
+    of the run (charged to the budget)."""
     from refsim.collision.bodies import PAIR_LEVELS
     from refsim.dynamics.compiled_loop import loop_support
     from refsim.dynamics.simulation import Simulation
-    from refsim.kernels import _environment_kernel, compiled_here, numba_usable
 
-    if _environment_kernel() is not None or not numba_usable():
-        return None
-    from refsim.dynamics import _numba_kernels
-
-    if compiled_here(_numba_kernels.advance):
+    if not LOOP.readable_first():
         return None
     probe = Simulation(scene, wall_speed=wall_speed, boxes=boxes, kernel="readable")
     if loop_support(probe) is not None:     # stage kernels then, not the loop
@@ -79,11 +84,15 @@ def start_kernel(scene, n_steps: int, *, wall_speed: str | None = None,
         return None
     began = time.perf_counter()
     try:
-        while probe.steps < min(PROBE_STEPS, n_steps):
-            probe.advance(min(PROBE_CHUNK, n_steps - probe.steps))
-            if time.perf_counter() - began > PROBE_SECONDS:
-                break
+        with LOOP.charged():
+            while probe.steps < min(PROBE_STEPS, n_steps):
+                probe.advance(min(PROBE_CHUNK, n_steps - probe.steps))
+                if time.perf_counter() - began > PROBE_SECONDS:
+                    break
     except RefsimError:                      # the run itself will say it
         return None
     per_step = (time.perf_counter() - began) / max(probe.steps, 1)
-    return "readable" if per_step * n_steps < LOOP_COMPILE_SECONDS else None
+    if per_step * n_steps < LOOP.remaining():
+        return "readable"
+    LOOP.settle()                            # a long run: compile now, and from now on
+    return None

@@ -26,7 +26,7 @@ the loop that ran; ``stage_seconds`` the wall time spent in each.
 
 The frame arrays are numpy arrays, except in a trajectory whose frames were
 spilled to disk as they were computed (``simulate(scene, sink=SpillSink(out))``,
-what ``refsim run`` does): there they are :class:`refsim.frames.SpilledArray`
+what ``refsim run`` does): there they are :class:`refsim.storage.frames.SpilledArray`
 views of the spill files, enough to :meth:`Trajectory.save` it in bounded
 memory, and valid while the sink is open.
 
@@ -46,8 +46,8 @@ from typing import Any
 import numpy as np
 
 from refsim.errors import NpzFileError
-from refsim.io import write_npz_atomic
-from refsim.npz import read_npz
+from refsim.storage.npz import read_npz
+from refsim.storage.writing import write_npz_atomic
 
 #: The .npz entries of a trajectory, in the order they are written.
 FRAME_ENTRIES = ("t", "position", "velocity", "angular_velocity", "orientation")
@@ -101,13 +101,13 @@ class Trajectory:
 
     def save(self, path) -> Path:
         """Write the trajectory as a compressed .npz, atomically (never half a
-        file), in bounded memory (:func:`refsim.io.write_npz_atomic`).
+        file), in bounded memory (:func:`refsim.storage.writing.write_npz_atomic`).
 
         Raises
         ------
         OutputError
             ``path`` is a directory, device, FIFO or socket, or its directory
-            is missing (a symlink is written through, see :mod:`refsim.io`).
+            is missing (a symlink is written through, see :mod:`refsim.storage.writing`).
         OSError
             As the file system reports it (e.g. a full disk); no file left.
         """
@@ -126,7 +126,7 @@ class Trajectory:
 
         Raises
         ------
-        refsim.npz.NpzFileError
+        refsim.storage.npz.NpzFileError
             (a :class:`~refsim.errors.RefsimError` and ``ValueError``) naming
             ``path`` and the entry: no such file, not an .npz (another
             format, or truncated), an entry missing or corrupt, or content

@@ -96,10 +96,10 @@ from pathlib import Path
 import numpy as np
 
 from refsim.errors import ModelError, ModelWarning
-from refsim.files import read_regular_file
-from refsim.io import write_text_atomic
 from refsim.models.mesh import Material, Mesh
 from refsim.models.triangulate import ear_clip
+from refsim.storage.reading import read_regular_file
+from refsim.storage.writing import write_text_atomic
 
 #: The header the writer emits (version 0xb, the spec's version).
 HEADER = "AC3Db"
@@ -701,7 +701,7 @@ def write_ac3d(mesh: Mesh, path) -> None:
     mesh : Mesh
     path : str or PathLike
         A symlink is written through; a directory, FIFO or device is refused
-        (:mod:`refsim.io`).
+        (:mod:`refsim.storage.writing`).
 
     Raises
     ------
@@ -713,7 +713,7 @@ def write_ac3d(mesh: Mesh, path) -> None:
     Notes
     -----
     The text is formatted first (a mesh AC3D cannot hold raises before any
-    file is touched), then written by :func:`refsim.io.write_text_atomic`: a
+    file is touched), then written by :func:`refsim.storage.writing.write_text_atomic`: a
     reader sees the old file or the new one, never half of one.
     """
     text = format_ac3d(mesh)

@@ -139,8 +139,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from refsim.collision.predicates import O2D_ERRBOUND_A
 from refsim.kernels import choose_kernel
+from refsim.rounding import O2D_ERRBOUND_A
 
 #: Corners per leaf of the k-d tree. Smaller leaves prune closer to the
 #: triangle but cost more nodes per query; on the 100 000-corner benchmark

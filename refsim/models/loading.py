@@ -38,9 +38,14 @@ import numpy as np
 
 from refsim.bundled import models_dir
 from refsim.errors import ModelError
-from refsim.files import as_path, bundled_if_bare, read_regular_file, refuse_missing_bundled
 from refsim.models.ac3d import parse_ac3d_bytes
 from refsim.models.mesh import Mesh
+from refsim.storage.reading import (
+    as_path,
+    bundled_if_bare,
+    read_regular_file,
+    refuse_missing_bundled,
+)
 
 #: Suffixes read by trimesh (the formats trimesh reads).
 TRIMESH_SUFFIXES = (".obj", ".stl", ".ply", ".off")

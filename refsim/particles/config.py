@@ -22,9 +22,9 @@ import numpy as np
 
 from refsim.dynamics.forces import DRAG_MODELS
 from refsim.dynamics.walls import SPEEDS
+from refsim.dynamics.world import IntegrationConfig, WorldConfig
 from refsim.errors import SceneError
 from refsim.limits import MAX_MAGNITUDE, MAX_PARTICLES, MIN_POSITIVE
-from refsim.scenes.world import IntegrationConfig, WorldConfig
 
 
 @dataclass(frozen=True)
@@ -78,7 +78,7 @@ class ParticleConfig:
     box_hi: tuple = (1.0, 1.0, 1.0)
     speed_min: float = 0.0
     speed_max: float = 5.0
-    # the world's and the integration's, with their defaults (refsim.scenes.world)
+    # the world's and the integration's, with their defaults (refsim.dynamics.world)
     gravity: float = WorldConfig.gravity
     drag: float = WorldConfig.drag
     drag_model: str = WorldConfig.drag_model

@@ -1,7 +1,7 @@
 """Running a particle scene and keeping its frames (seed S10), for
 ``refsim run`` and for anyone who wants the frames of a particle scene.
 
-The frames go to a sink (:mod:`refsim.frames`): in memory by default (one
+The frames go to a sink (:mod:`refsim.storage.frames`): in memory by default (one
 buffer of exactly the run's frames), or spilled to disk as they come, which
 ``refsim run`` does, so that its memory is the system's state and buffers
 plus one frame, whatever the number of steps.
@@ -45,7 +45,7 @@ def frame_stride(scene, every: int | None) -> tuple[int, int]:
 @dataclass(frozen=True)
 class ParticleFrames:
     """Stored frames of a particle run: numpy arrays, or, from a run with a
-    :class:`refsim.frames.SpillSink`, :class:`refsim.frames.SpilledArray`
+    :class:`refsim.storage.frames.SpillSink`, :class:`refsim.storage.frames.SpilledArray`
     views of its files (valid while it is open).
 
     Attributes
@@ -74,11 +74,11 @@ def run_particles(config, n_steps: int, every: int, *, sink=None) -> ParticleFra
     ----------
     config : ParticleConfig
     n_steps, every : int
-    sink : refsim.frames.FrameSink, optional
+    sink : refsim.storage.frames.FrameSink, optional
         Where the frames go (``t``, ``step``, ``position``, ``velocity``).
-        Default: a :class:`refsim.frames.MemorySink` of exactly the run's
+        Default: a :class:`refsim.storage.frames.MemorySink` of exactly the run's
         frames, and the result holds numpy arrays. With a
-        :class:`refsim.frames.SpillSink` the result holds views of its
+        :class:`refsim.storage.frames.SpillSink` the result holds views of its
         files (valid while it is open); the frames are the same, bit for bit.
 
     Raises
@@ -92,8 +92,8 @@ def run_particles(config, n_steps: int, every: int, *, sink=None) -> ParticleFra
     """
     import numpy as np
 
-    from refsim.frames import MemorySink, frame_count
     from refsim.particles.system import ParticleSystem
+    from refsim.storage.frames import MemorySink, frame_count
 
     h = config.step
     if sink is None:

@@ -39,7 +39,7 @@ import numpy as np
 from refsim.dynamics.forces import acceleration, acceleration_into
 from refsim.dynamics.walls import wall_response_points, wall_response_points_inplace
 from refsim.errors import DivergenceError, OptionError, StateError, as_numbers, check_count
-from refsim.kernels import choose_kernel
+from refsim.kernels import Tier, choose_kernel
 from refsim.limits import MAX_STEPS
 from refsim.particles.config import ParticleConfig
 from refsim.solvers.explicit_rk import rk_step, rk_step_into, stages_with_own_state
@@ -50,6 +50,18 @@ from refsim.solvers.integrate import resolve_method
 #: which Python sees Ctrl-C) while each call still takes a block of
 #: particles through many steps.
 FUSED_PARTICLE_STEPS = 50_000_000
+
+#: The fused step as a family of compiled kernels (:class:`refsim.kernels.Tier`):
+#: until numba's cache holds it, a system made with the default kernel
+#: steps readable for up to this many seconds in a process (its compile
+#: takes about two on a two-core machine: docs/decisions/cold-start.md),
+#: then compiles and goes on fused, with the same bits.
+FUSED_STEPS = Tier("fused particle steps", ("refsim.particles._numba_kernels:rk_steps_fused",),
+                   compile_seconds=2.0)
+
+#: Particle-steps between two looks at the readable budget while a run is
+#: readable on a cold cache (a few milliseconds of steps).
+READABLE_PARTICLE_STEPS = 200_000
 
 
 def particle_rhs(config: ParticleConfig, count: int | None = None):
@@ -94,7 +106,10 @@ class ParticleSystem:
         (:func:`refsim.particles._numba_kernels.rk_steps_fused`; the tableaux
         :func:`fused_tableau` takes). The two give the same bits. Default
         (:mod:`refsim.kernels`): ``"compiled"`` where numba works and the
-        tableau is of the fused loop's shape, else ``"readable"``.
+        tableau is of the fused loop's shape, else ``"readable"``; while
+        numba's cache does not hold the fused loop, the default starts
+        readable and turns compiled once the process has spent
+        :data:`FUSED_STEPS`' budget.
 
     Attributes
     ----------
@@ -115,6 +130,11 @@ class ParticleSystem:
         self.config = config
         self.method = resolve_method(config.solver)
         self.kernel = _choose_kernel(kernel, self.method)
+        #: The tier a default system charges while it steps readable on a
+        #: cold cache (:data:`FUSED_STEPS`), else None.
+        self._tier: Tier | None = None
+        if kernel is None and self.kernel == "compiled" and FUSED_STEPS.readable_first():
+            self.kernel, self._tier = "readable", FUSED_STEPS
         self._fused_arguments = _fused_arguments(config, self.method)
         if positions is None and velocities is None:
             positions, velocities = config.initial_state()
@@ -238,9 +258,9 @@ class ParticleSystem:
             an integer.
         """
         steps = check_count("steps", steps, maximum=MAX_STEPS)
-        if self.kernel == "compiled" and steps > 0:
+        done = self._run_tiered(steps)
+        if self.kernel == "compiled" and steps > done:
             per_call = max(1, FUSED_PARTICLE_STEPS // self.count)
-            done = 0
             while done < steps:
                 block = min(per_call, steps - done)
                 non_finite = self._steps_fused(block)
@@ -248,17 +268,38 @@ class ParticleSystem:
             # the last call counted the final state's non-finite numbers
             finite = non_finite == 0
         else:
-            # Overflow on the way to inf is what the check below reports, once;
-            # numpy's warnings would print it again, per operation.
-            with np.errstate(over="ignore", invalid="ignore"):
-                for _ in range(steps):
-                    self.step()
+            self._steps_readable(steps - done)
             # max and min propagate NaN and see +-inf, without the (2, N, 3)
             # bool temporary of np.isfinite(state).all().
             finite = bool(np.isfinite(self.state.max()) and np.isfinite(self.state.min()))
         if not finite:
             raise DivergenceError("particle state is not finite", step=self.steps,
                                   time=self.t)
+
+    def _steps_readable(self, steps: int) -> None:
+        # Overflow on the way to inf is what run's check reports, once;
+        # numpy's warnings would print it again, per operation.
+        with np.errstate(over="ignore", invalid="ignore"):
+            for _ in range(steps):
+                self.step()
+
+    def _run_tiered(self, steps: int) -> int:
+        """The first of ``steps`` steps of a default system on a cold numba
+        cache: readable, in blocks, while :data:`FUSED_STEPS` has budget
+        left; once it has none, the kernel becomes "compiled" for the rest
+        (the same bits: tests/particles/test_fused_step.py). Returns the
+        steps taken."""
+        done = 0
+        per_block = max(1, READABLE_PARTICLE_STEPS // self.count)
+        while self._tier is not None and done < steps:
+            if not self._tier.readable_first():
+                self.kernel, self._tier = "compiled", None
+                break
+            block = min(per_block, steps - done)
+            with self._tier.charged():
+                self._steps_readable(block)
+            done += block
+        return done
 
     def kinetic_energy(self) -> float:
         return 0.5 * self.config.mass * float(np.einsum("ij,ij->", self.velocities,

@@ -14,7 +14,7 @@ only values that may differ between two runs besides the items marked
 ``"timing": true``.
 
 Both files are rendered in memory first and then written atomically
-(:mod:`refsim.io`), so a failed run never leaves a half-written page.
+(:mod:`refsim.storage.writing`), so a failed run never leaves a half-written page.
 """
 
 from __future__ import annotations
@@ -31,11 +31,11 @@ from pathlib import Path
 
 from refsim.bundled import templates_dir
 from refsim.claims import CLAIMS, TERMINOLOGY
-from refsim.io import write_text_atomic
 from refsim.report.plan import PARALLEL_ENTRIES, SWEEP_ENTRIES
 from refsim.report.progress import Progress
 from refsim.report.run import REPORT_SEED, Run
 from refsim.report.section import Section, to_json
+from refsim.storage.writing import write_text_atomic
 
 # (key, title, what the section will measure once its work lands)
 AREAS: tuple[tuple[str, str, str], ...] = (

@@ -12,7 +12,7 @@ what they return. The conformance matrix's task is
   (claims C11 and C12, a wall bounce beside pybullet or MuJoCo) written into
   the report's directory;
 - :func:`advise_scene`: the fidelity advisor
-  (:func:`refsim.studies.advisor.advice_by_tolerance`) on one scene at each
+  (:func:`refsim.advisor.advice.advice_by_tolerance`) on one scene at each
   tolerance.
 
 - :func:`measure_entry`: any other entry of the plan
@@ -99,8 +99,9 @@ def advise_scene(*, seed: int, scene: str, tolerances: list, duration: float | N
     ``tolerances``, or ``{"refused": message}`` for a scene the advisor does
     not tune (a particle scene: its StateError, one line).
     """
+    from refsim.advisor.advice import advice_by_tolerance
+    from refsim.advisor.reference import MAX_REFERENCE_STEPS
     from refsim.errors import StateError
-    from refsim.studies.advisor import MAX_REFERENCE_STEPS, advice_by_tolerance
 
     try:
         (series,) = advice_by_tolerance(

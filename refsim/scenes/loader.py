@@ -25,16 +25,8 @@ import numpy as np
 
 from refsim.bundled import models_dir, scenes_dir
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
+from refsim.dynamics.world import DOWN, WALL_NAMES
 from refsim.errors import ModelError, SceneError, StateError, check_count
-from refsim.files import (
-    as_path,
-    bundled_if_bare,
-    decode_utf8,
-    read_regular_file,
-    refuse_missing_bundled,
-    similar_bundled,
-    similar_hint,
-)
 from refsim.limits import (
     DEFAULT_MAX_STEPS,
     MAX_MAGNITUDE,
@@ -56,8 +48,16 @@ from refsim.scenes.schema import (
     ParticleConfig,
     Scene,
 )
-from refsim.scenes.world import DOWN, WALL_NAMES
 from refsim.solvers.integrate import STEP_COUNT_RTOL, whole_steps
+from refsim.storage.reading import (
+    as_path,
+    bundled_if_bare,
+    decode_utf8,
+    read_regular_file,
+    refuse_missing_bundled,
+    similar_bundled,
+    similar_hint,
+)
 from refsim.types import transform_points
 
 

@@ -33,9 +33,9 @@ from typing import Any
 import numpy as np
 
 from refsim.dynamics.forces import DRAG_MODELS
+from refsim.dynamics.world import WALL_NAMES, IntegrationConfig, WorldConfig
 from refsim.limits import MIN_POSITIVE
 from refsim.particles.config import ParticleConfig
-from refsim.scenes.world import WALL_NAMES, IntegrationConfig, WorldConfig
 
 SOLVER_NAMES = ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4")
 COLLISION_LEVELS = ("none", "sphere", "aabb", "triangle-aabb", "exact")

@@ -27,7 +27,7 @@ LOAD_KEYS = ("world.gravity_direction", "world.walls", "world.mu",
 def keys_in_use(scene) -> dict[str, str]:
     """The :data:`LOAD_KEYS` that ``scene`` sets to other than their
     default, each with the first place it is set (``"body[2].force"``)."""
-    from refsim.scenes.world import DOWN, WALL_NAMES, WorldConfig
+    from refsim.dynamics.world import DOWN, WALL_NAMES, WorldConfig
 
     world = scene.world
     found: dict[str, str] = {}

@@ -30,15 +30,16 @@ def bounce(*, seed: int, scene: str = "bounce.toml", duration: float = 0.2,
         body reached in a frame; ``wall_hits``: the number of wall events;
         ``lift``: the draws.
     """
-    import refsim
+    from refsim.dynamics.simulation import simulate
+    from refsim.scenes.loader import load_scene
 
-    loaded = refsim.load_scene(scene)
+    loaded = load_scene(scene)
     rng = np.random.default_rng(seed)
     lifts = rng.uniform(0.0, lift, size=len(loaded.bodies))
     bodies = tuple(replace(body, position=(body.position[0], body.position[1] + float(dy),
                                            body.position[2]))
                    for body, dy in zip(loaded.bodies, lifts, strict=True))
-    trajectory = refsim.simulate(replace(loaded, bodies=bodies), duration=duration)
+    trajectory = simulate(replace(loaded, bodies=bodies), duration=duration)
     return {
         "t": float(trajectory.t[-1]),
         "height": trajectory.position[-1, :, 1].tolist(),

@@ -7,7 +7,7 @@ Layout of a store directory::
                              wall_seconds; <h> = the first 32 hex digits of
                              SHA-256(key)
 
-Each file is written whole or not at all (:func:`refsim.io.write_atomic`:
+Each file is written whole or not at all (:func:`refsim.storage.writing.write_atomic`:
 a temporary file moved over the name), so an interrupted sweep leaves only
 whole results, and running the sweep again with the same store runs only the
 tasks without one. A file is named by a hash of its key, not the key itself,
@@ -39,7 +39,7 @@ import json
 from pathlib import Path
 
 from refsim.errors import OutputError, SweepError
-from refsim.io import write_text_atomic
+from refsim.storage.writing import write_text_atomic
 from refsim.sweep.records import decode, digest, encode
 
 #: Written into the manifest; a store of another format is refused, not guessed at.

@@ -323,7 +323,7 @@ def write_replay(runs, path, *, overlay: bool = False, max_bytes: int = DEFAULT_
     OutputError
         The file cannot be written.
     """
-    from refsim.io import write_text_atomic
+    from refsim.storage.writing import write_text_atomic
 
     runs = list(runs)
     if not runs:

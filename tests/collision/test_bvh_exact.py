@@ -348,8 +348,7 @@ def test_pairs_the_exact_stage_cannot_take_go_to_the_readable_kernel(poses, expe
     geometry the same bits times a power of two) with candidate pairs: the
     compiled boolean query answers UNDECIDED, and the readable kernel gives
     the seed's answer."""
-    from refsim.collision import _numba_kernels as nk
-
+    nk = bvh_exact._compiled()       # exact_collide compiled for its one signature
     side = 2.0 ** -245
     tiny = TORUS.scaled(side)
     (ra, ta), (rb, tb) = poses()

@@ -22,9 +22,13 @@ SPIN = scenes_dir() / "spinning-cube.toml"
 
 @pytest.fixture
 def cold(monkeypatch):
-    """As if numba's cache held no loop for this machine."""
+    """As if numba's cache held no loop for this machine, in a process that
+    has spent none of its readable budget, with the tiered start on."""
     monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: False)
     monkeypatch.delenv("REFSIM_KERNELS", raising=False)
+    monkeypatch.delenv("REFSIM_TIERED_START", raising=False)
+    monkeypatch.setattr(start.LOOP, "spent", 0.0)
+    monkeypatch.setattr(start.LOOP, "settled", False)
 
 
 def test_a_short_run_starts_readable_when_the_loop_is_not_compiled(cold):
@@ -38,13 +42,53 @@ def test_a_long_run_waits_for_the_compile(cold):
     assert start.start_kernel(scene, 10**8) is None
 
 
-def test_the_environment_and_the_compiled_loop_decide_first(monkeypatch):
+def test_the_environment_and_the_compiled_loop_decide_first(cold, monkeypatch):
     scene = load_scene(SPIN)
-    monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: True)
-    assert start.start_kernel(scene, scene.integration.n_steps) is None
-    monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: False)
     monkeypatch.setenv("REFSIM_KERNELS", "compiled")
     assert start.start_kernel(scene, scene.integration.n_steps) is None
+    monkeypatch.delenv("REFSIM_KERNELS")
+    monkeypatch.setenv("REFSIM_TIERED_START", "0")
+    assert start.start_kernel(scene, scene.integration.n_steps) is None
+    assert not start.LOOP.settled              # neither settles the process
+    monkeypatch.delenv("REFSIM_TIERED_START")
+    monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: True)
+    assert start.start_kernel(scene, scene.integration.n_steps) is None
+    assert start.LOOP.settled                  # compiled here: compiled from now on
+
+
+def test_a_process_runs_readable_until_its_budget_is_spent(cold, monkeypatch):
+    # the budget left, not the whole compile time, bounds the next run
+    scene = load_scene(SPIN)
+    assert start.start_kernel(scene, scene.integration.n_steps) == "readable"
+    spent = start.LOOP.spent
+    assert 0.0 < spent < start.PROBE_SECONDS + 1.0       # the probe, charged
+    monkeypatch.setattr(start.LOOP, "spent", start.LOOP.compile_seconds - 1e-3)
+    assert start.start_kernel(scene, scene.integration.n_steps) is None
+    assert start.LOOP.settled
+
+
+def test_simulate_by_default_runs_readable_on_a_cold_cache_with_the_same_frames(cold,
+                                                                                monkeypatch):
+    chosen = []
+    original = Simulation.__init__
+
+    def spy(self, *args, **kwargs):
+        original(self, *args, **kwargs)
+        chosen.append(self.kernel)
+
+    monkeypatch.setattr(Simulation, "__init__", spy)
+    scene = load_scene(SPIN)
+    tiered = simulate(scene)
+    probe_and_run = start.LOOP.spent
+    assert chosen == ["readable", "readable"]            # the probe, then the run
+    compiled = simulate(scene, kernel="compiled")
+    assert start.LOOP.spent == probe_and_run             # an explicit kernel is not charged
+    for name in ("t", "position", "velocity", "angular_velocity", "orientation"):
+        assert getattr(tiered, name).tobytes() == getattr(compiled, name).tobytes(), name
+    assert tiered.settings["kernel"] == "readable"
+    monkeypatch.setattr(start.LOOP, "spent", start.LOOP.compile_seconds)
+    simulate(scene, duration=0.01)
+    assert chosen[-1] == "compiled"                      # the budget is spent: compiled
 
 
 def test_a_scene_the_loop_cannot_run_keeps_the_default(cold, tmp_path):
@@ -61,6 +105,7 @@ def test_refsim_run_on_an_empty_cache_writes_the_compiled_loops_frames(tmp_path)
     # a fresh numba cache: the run says it starts readable and compiles nothing
     env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"), REFSIM_COMPILE_NOTICE="1")
     env.pop("REFSIM_KERNELS", None)
+    env.pop("REFSIM_TIERED_START", None)
     out = tmp_path / "spin.npz"
     done = subprocess.run([sys.executable, "-m", "refsim.cli", "run", str(SPIN), "-o", str(out)],
                           env=env, capture_output=True, text=True, timeout=300)

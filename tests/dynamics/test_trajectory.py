@@ -13,9 +13,9 @@ import refsim
 from refsim.dynamics.simulation import simulate
 from refsim.dynamics.trajectory import ENTRIES, FRAME_ENTRIES
 from refsim.errors import DivergenceError, NpzFileError, RefsimError
-from refsim.frames import SpillSink
-from refsim.npz import write_npz
 from refsim.scenes.loader import scene_from_dict
+from refsim.storage.frames import SpillSink
+from refsim.storage.npz import write_npz
 
 #: Two bodies that rotate, meet and hit the walls: every stage of the loop runs.
 TWO_BODIES = {

@@ -86,7 +86,7 @@ CASES = [
     pytest.param("special:scene-model-is-not-a-model", REFUSED),
     pytest.param("special:model-polygon-20000-star", ACCEPTED),
     pytest.param("output:symlink", ACCEPTED),
-    # refsim writes regular files only (refsim/io.py: an -o naming a device
+    # refsim writes regular files only (refsim/storage/writing.py: an -o naming a device
     # is refused, not written through; nothing is replaced either way)
     pytest.param("output:device", REFUSED),
     pytest.param("signal:SIGTERM", REFUSED),

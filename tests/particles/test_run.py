@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from refsim.errors import DivergenceError
-from refsim.frames import SpillSink
 from refsim.particles.config import ParticleConfig
 from refsim.particles.run import run_particles
 from refsim.particles.system import ParticleSystem
+from refsim.storage.frames import SpillSink
 
 CONFIG = ParticleConfig(count=50, seed=11, half_size=1.0, box_lo=(-0.5, -0.5, -0.5),
                         box_hi=(0.5, 0.5, 0.5), speed_min=1.0, speed_max=4.0, drag=0.1,

@@ -10,10 +10,10 @@ import pytest
 
 from refsim.bundled import bundled_models
 from refsim.claims import CLAIMS
-from refsim.io import write_text_atomic
 from refsim.report import build as report_build
 from refsim.report.build import AREAS, build_report
 from refsim.report.section import Section
+from refsim.storage.writing import write_text_atomic
 
 
 def test_every_area_has_a_section(quick_report):
@@ -87,7 +87,7 @@ def test_the_entries_are_deterministic_and_the_same_on_workers(tmp_path, quick_r
     workers change no result. Two sweeps are not measured again, the
     conformance matrix and the advisor, the report's longest entries (a
     second build of the whole report would double the suite's longest
-    fixture): tests/studies/test_advisor.py holds the advice equal in one
+    fixture): tests/advisor/test_advisor.py holds the advice equal in one
     process and on two, and tests/conformance/test_cli_conform.py the
     matrix's aabb checks (``--all --workers 2``); the matrix's rigid checks
     on workers are not compared."""

@@ -410,10 +410,10 @@ def test_the_textbook_keys_load_into_the_scene(tmp_path):
 
 def test_a_scene_with_every_key_survives_its_plain_data(tmp_path):
     """The advisor ships a scene to its workers as plain data
-    (refsim.studies.fidelity_runs.scene_data): shapes, fixed bodies, forces,
+    (refsim.advisor.runs.scene_data): shapes, fixed bodies, forces,
     coefficients and pairs come back equal, and unset keys stay unset."""
+    from refsim.advisor.runs import scene_data
     from refsim.scenes.loader import scene_from_dict
-    from refsim.studies.fidelity_runs import scene_data
 
     scene = load_scene(write(tmp_path, EVERY_KEY))
     data = scene_data(scene)

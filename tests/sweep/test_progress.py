@@ -110,7 +110,7 @@ def test_a_delayed_line_stays_hidden_on_a_terminal_for_a_short_run():
 def test_a_counted_sink_passes_every_frame_on_and_reports_the_count():
     import numpy as np
 
-    from refsim.frames import CountedSink, MemorySink
+    from refsim.storage.frames import CountedSink, MemorySink
 
     clock, log = Clock(), io.StringIO()
     shown = Progress(3, stream=log, clock=clock, label="refsim run", unit="frames")

@@ -1,6 +1,6 @@
 """The report's advisor entry: the fidelity advisor on every bundled scene.
 
-:mod:`refsim.studies.advisor` at each tolerance, one sweep task per scene
+:mod:`refsim.advisor` at each tolerance, one sweep task per scene
 (:func:`refsim.report.tasks.advise_scene`). A quick run asks for fewer
 tolerances, simulates 1 s of each scene and skips the costliest one
 (:data:`ADVISOR_QUICK_SKIP`).
@@ -30,7 +30,7 @@ ADVISOR_QUICK_SKIP = {"mixed.toml": "three bodies in contact, the costliest advi
 @dataclass(frozen=True)
 class AdvisedScene:
     """The advisor on one bundled scene: ``advice``, one
-    :meth:`refsim.studies.advisor.Advice.as_dict` per tolerance; or
+    :meth:`refsim.advisor.records.Advice.as_dict` per tolerance; or
     ``refused``, the advisor's reason for not tuning the scene; or
     ``skipped``, why this run did not ask (:data:`ADVISOR_QUICK_SKIP`)."""
 

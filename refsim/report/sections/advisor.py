@@ -1,7 +1,7 @@
 """Report section: the fidelity advisor on every bundled scene.
 
 Arranges the plan's ``advisor``: for each bundled scene, the answer of
-:func:`refsim.studies.advisor.advise` at each of the report's tolerances
+:func:`refsim.advisor.advice.advise` at each of the report's tolerances
 (the cheapest solver, step, collision level and box update whose run stays
 within TOL of a reference run), its cost against the scene's own settings,
 and whether the reference converged (or up to which horizon positions are

@@ -1,10 +1,10 @@
 """How far one run of a scene is from another: positions, events, energy.
 
-What: the advisor (:mod:`refsim.studies.advisor`) measures every candidate
+What: the advisor (:mod:`refsim.advisor`) measures every candidate
 run against a reference run with these functions; it also measures the
 reference against its check run (the same at twice the step) with them, to
 find how long the reference is predictable (:func:`agreement_horizon`).
-Runs are the records of :func:`refsim.studies.fidelity_runs.measure_run`,
+Runs are the records of :func:`refsim.advisor.runs.measure_run`,
 decoded by :meth:`Run.from_record`; both runs are sampled on one grid of
 times.
 
@@ -36,7 +36,7 @@ One tolerance TOL, in metres, covers all three measures:
   changed velocity while the other still moves with the old one, until it
   responds too: the timing difference alone can put them up to ``u dt``
   apart, ``u`` the **response speed** (the largest change of a point's
-  velocity that the response made, :mod:`refsim.studies.fidelity_runs`).
+  velocity that the response made, :mod:`refsim.advisor.runs`).
   So two events "agree within TOL" when ``|t_a - t_b| * u <= TOL``: a time
   difference is judged by the largest distance it can put between the
   runs, in the same metres as the positions, and a hard impact needs a
@@ -129,7 +129,7 @@ class RunEvent:
 
 @dataclass(frozen=True)
 class Run:
-    """A decoded run record (:func:`refsim.studies.fidelity_runs.measure_run`).
+    """A decoded run record (:func:`refsim.advisor.runs.measure_run`).
 
     Arrays for S samples of B bodies: ``t`` (S,), ``position`` (S, B, 3),
     ``orientation`` (S, B, 3, 3), ``radius`` (B,), ``energy`` (S,).
@@ -170,7 +170,7 @@ class Run:
     @property
     def proxy(self) -> int:
         """The machine-independent cost: force evaluations times bodies plus
-        narrow-phase calls (:mod:`refsim.studies.advisor` argues the weights)."""
+        narrow-phase calls (docs/advisor.md argues the weights)."""
         return self.force_evaluations + self.narrow_phase_calls
 
 

@@ -13,7 +13,7 @@ every step (:class:`refsim.Trajectory`), and measures
   body's radius about its reference point, computed here from its mesh.
   The every-step figure can exceed TOL for an instant where the two runs
   push a body out of a contact at different steps (a jump of position, see
-  :mod:`refsim.studies.fidelity_metrics`);
+  :mod:`refsim.advisor.metrics`);
 - the impacts: every event of either run up to the horizon whose response
   speed (``|dv| + r |dw|`` between the frames before and after the step
   that found it, which here includes one step of gravity and drag) is at
@@ -25,9 +25,9 @@ every step (:class:`refsim.Trajectory`), and measures
   last frame put into a simulation of the scene, against the allowance the
   advisor states.
 
-``python -m refsim.studies.advisor_check`` advises every bundled rigid-body
-scene at the tolerances given as the report does (one series per scene,
-:func:`refsim.studies.advisor.advice_by_tolerance`), checks each answer and
+``python -m refsim.advisor.check`` advises every bundled rigid-body scene
+at the tolerances given as the report does (one series per scene,
+:func:`refsim.advisor.advice.advice_by_tolerance`), checks each answer and
 prints one row per answer.
 
 Cost: two simulations recorded at every step (memory: 19 float64 per body
@@ -44,9 +44,10 @@ from math import gcd
 
 import numpy as np
 
+from refsim.advisor.metrics import REST_SPEED
+from refsim.advisor.records import Fidelity
+from refsim.advisor.runs import with_fidelity
 from refsim.dynamics.simulation import Simulation, simulate
-from refsim.studies.fidelity_metrics import REST_SPEED
-from refsim.studies.fidelity_runs import Fidelity, with_fidelity
 
 #: Impacts at least this fast must have a twin (twice the resting speed, as
 #: the advisor excuses unpaired events below it).
@@ -169,10 +170,10 @@ def check_advice(scene, advice) -> AdviceCheck:
 def main(argv: list[str] | None = None) -> None:
     """Advise and check every bundled rigid-body scene at the tolerances given
     (a series per scene, as the report's advisor section)."""
+    from refsim.advisor.advice import BUNDLED_RIGID_SCENES, advice_by_tolerance
     from refsim.scenes.loader import load_scene
-    from refsim.studies.advisor import BUNDLED_RIGID_SCENES, advice_by_tolerance
 
-    parser = argparse.ArgumentParser(prog="python -m refsim.studies.advisor_check")
+    parser = argparse.ArgumentParser(prog="python -m refsim.advisor.check")
     parser.add_argument("scenes", nargs="*", default=list(BUNDLED_RIGID_SCENES))
     parser.add_argument("--tolerances", type=float, nargs="+", default=[1e-2, 1e-3])
     parser.add_argument("--workers", type=int)

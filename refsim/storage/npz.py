@@ -11,7 +11,7 @@ It differs from ``savez`` in two ways, both deliberate:
 
 - the data of an entry comes in chunks of at most :data:`CHUNK_BYTES`,
   either from an in-memory array (slices of its bytes, no copy) or from a
-  *spilled* array whose frames sit in a raw file (:class:`refsim.frames.
+  *spilled* array whose frames sit in a raw file (:class:`refsim.storage.frames.
   SpilledArray`, anything with ``shape``, ``dtype`` and ``chunks(size)``),
   so writing costs O(chunk) memory whatever the array's size;
 - every entry carries the same fixed date (:data:`ZIP_DATE`), so the same
@@ -30,7 +30,7 @@ from collections.abc import Iterator, Mapping
 import numpy as np
 
 from refsim.errors import NpzFileError
-from refsim.files import require_regular_file
+from refsim.storage.reading import require_regular_file
 
 #: Bytes handed to the zip writer at a time: large enough that the Python
 #: work per chunk is small next to CRC-32 and the copy of the chunk itself,
@@ -92,7 +92,7 @@ def write_npz(handle, entries: Mapping[str, object], *, compressed: bool) -> Non
 
     An exception on the way (a full disk, or Ctrl-C or SIGTERM raised by
     their handlers) abandons the archive unclosed and propagates: the caller
-    discards the half-written file (:func:`refsim.io.write_atomic`). Closing
+    discards the half-written file (:func:`refsim.storage.writing.write_atomic`). Closing
     it would be wrong twice: a signal raised inside ``archive.open`` leaves
     zipfile unable to close, and its own error ("an open writing handle")
     would replace the interruption."""

@@ -27,7 +27,7 @@ frames, models) goes through this module, in three steps:
    signal can land between the two and leak the file.
 
 Hidden temporary files for other purposes (the frame spill of
-:mod:`refsim.frames`) are made by :func:`hidden_temporary`, by the same
+:mod:`refsim.storage.frames`) are made by :func:`hidden_temporary`, by the same
 rules. A hard link to the old file keeps the old content (``os.replace``
 makes a new inode), as with every atomic writer.
 
@@ -207,9 +207,9 @@ def write_text_atomic(path, text: str) -> Path:
 
 def write_npz_atomic(path, arrays: dict, *, compressed: bool = False) -> Path:
     """An .npz of ``arrays`` (name -> array, or a spilled array of
-    :mod:`refsim.frames`) at ``path``, written by :func:`refsim.npz.write_npz`
+    :mod:`refsim.storage.frames`) at ``path``, written by :func:`refsim.storage.npz.write_npz`
     in bounded chunks; ``numpy.load`` reads it."""
-    from refsim.npz import write_npz
+    from refsim.storage.npz import write_npz
 
     return write_atomic(path, lambda handle: write_npz(handle, arrays, compressed=compressed),
                         binary=True)

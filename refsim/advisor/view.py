@@ -1,4 +1,4 @@
-"""The view of ``refsim advise``: an :class:`~refsim.studies.advisor.Advice`
+"""The view of ``refsim advise``: an :class:`~refsim.advisor.records.Advice`
 as text, as a TOML snippet to paste into the scene, as one JSON document,
 and as a work-precision chart (SVG with matplotlib, or text).
 

@@ -1,4 +1,4 @@
-"""The fidelity advisor (refsim.studies.advisor) and what it measures.
+"""The fidelity advisor (refsim.advisor) and what it measures.
 
 Scenes are short (0.6-0.8 s) and light (cubes and icosahedra), so that the
 whole file runs in well under a minute on two shared cores. Every advice is
@@ -17,18 +17,14 @@ import numpy as np
 import pytest
 
 import refsim
+from refsim.advisor import metrics, reference, search
+from refsim.advisor.advice import advice_by_tolerance, advise
+from refsim.advisor.check import check_advice
+from refsim.advisor.records import Fidelity
+from refsim.advisor.runner import Ladder
+from refsim.advisor.runs import measure_run, scene_data, with_fidelity
 from refsim.errors import ArgumentTypeError, StateError
 from refsim.scenes.loader import load_scene, scene_from_dict
-from refsim.studies import advisor
-from refsim.studies import fidelity_metrics as metrics
-from refsim.studies.advisor import Ladder, advise
-from refsim.studies.advisor_check import check_advice
-from refsim.studies.fidelity_runs import (
-    Fidelity,
-    measure_run,
-    scene_data,
-    with_fidelity,
-)
 
 #: A cube dropped 0.55 m onto the floor, sliding: one wall impact at ~0.33 s
 #: (3.3 m/s), then a lower bounce. Midpoint at 2 ms, the scene's own choice.
@@ -153,7 +149,7 @@ def head_on(tmp_path_factory):
 @pytest.fixture(scope="module")
 def chaos(chaos_series):
     """(path, advice) of CHAOS at TOL: the series' strictest advice, which
-    :func:`advisor.advice_by_tolerance` makes first, as ``advise(path, TOL)``
+    :func:`advice_by_tolerance` makes first, as ``advise(path, TOL)``
     would (its own reference, no candidates handed down), so the chaotic
     scene is advised once for both fixtures."""
     strict = chaos_series.advice[chaos_series.tolerances.index(TOL)]
@@ -235,7 +231,7 @@ def test_a_coarse_level_is_kept_only_when_the_events_stay_the_same(head_on):
 
 def test_the_snippet_loads_as_a_scene_merged_into_the_original(drop):
     path, _, advice = drop
-    from refsim.advise_view import toml_snippet
+    from refsim.advisor.view import toml_snippet
 
     data = tomllib.loads(path.read_text())
     for table, keys in tomllib.loads(toml_snippet(advice)).items():
@@ -254,12 +250,12 @@ def test_the_snippet_loads_as_a_scene_merged_into_the_original(drop):
 def test_a_chaotic_scene_is_not_converged_and_has_a_horizon(chaos):
     path, advice = chaos
     ref = advice.reference
-    assert not ref.converged and ref.stop == advisor.NOT_CONVERGING
+    assert not ref.converged and ref.stop == reference.NOT_CONVERGING
     assert 0.0 < ref.horizon < advice.duration
     # halving did not shrink the difference by REDUCTION_MIN (here the impacts
     # never pair: an infinite difference, twice)
     (_, before, _), (_, after, _) = ref.halvings[-2:]
-    assert math.isinf(after) or after * advisor.REDUCTION_MIN > before
+    assert math.isinf(after) or after * reference.REDUCTION_MIN > before
     # fresh runs at the reference's step and its check's agree within TOL up to
     # the horizon at the sample times, and not beyond it. (At every step they
     # are 1.03 cm apart for one 0.19 ms instant at 0.034 s: the corrected
@@ -319,7 +315,7 @@ def test_another_tolerance_reuses_the_runs_it_shares(drop):
 def test_the_report_hook_gives_the_advice_at_each_tolerance(tmp_path):
     path = tmp_path / "drop.toml"
     path.write_text(DROP)
-    (series,) = advisor.advice_by_tolerance(scenes=[path], tolerances=(2 * TOL, TOL),
+    (series,) = advice_by_tolerance(scenes=[path], tolerances=(2 * TOL, TOL),
                                             store=tmp_path / "stores", repeats=1)
     assert series.scene == str(path) and series.tolerances == (2 * TOL, TOL)
     coarse, fine = series.advice
@@ -375,7 +371,7 @@ def test_a_step_that_meets_tol_by_chance_is_not_recommended(head_on):
 def chaos_series(tmp_path_factory):
     path = _write(tmp_path_factory, "chaos.toml", CHAOS)
     store = tmp_path_factory.mktemp("store")
-    (series,) = advisor.advice_by_tolerance(scenes=[path], tolerances=(2 * TOL, TOL),
+    (series,) = advice_by_tolerance(scenes=[path], tolerances=(2 * TOL, TOL),
                                             store=store, repeats=1)
     return series
 
@@ -457,23 +453,23 @@ def test_the_ladder_holds_the_scene_step_to_the_bit_and_divides_the_run():
     ("euler", [(20, 1.9, False), (59, 0.287, True)], 34),
 ])
 def test_the_next_step_proposed(solver, measured, expected):
-    assert advisor._propose(solver, measured) == expected
+    assert search.propose(solver, measured) == expected
 
 
 def test_a_proposal_past_the_affordable_becomes_the_last_chance():
     # midpoint's impacts pair only at 40 (6.2 x TOL): first order predicts 355,
     # which costs more than the best run (rk4 at 80, say)
     measured = [(10, math.inf, False), (20, math.inf, False), (40, 6.2, False)]
-    assert advisor._propose("midpoint", measured) == 355
+    assert search.propose("midpoint", measured) == 355
     # the last chance: the step at which another solver met TOL, when affordable
-    assert advisor._last_chance(measured, passing={80, 200}, m_max=159) == 80
+    assert search.last_chance(measured, passing={80, 200}, m_max=159) == 80
     # else the finest step that could still cost less than the best
-    assert advisor._last_chance(measured, passing={200}, m_max=159) == 159
-    assert advisor._propose("midpoint", measured, m_max=159) == 159
+    assert search.last_chance(measured, passing={200}, m_max=159) == 159
+    assert search.propose("midpoint", measured, m_max=159) == 159
     # both measured (and failed): the solver is done
     tried = [*measured, (80, 2.0, False), (159, 1.5, False)]
-    assert advisor._last_chance(tried, passing={80}, m_max=159) is None
-    assert advisor._propose("midpoint", tried, m_max=159) is None
+    assert search.last_chance(tried, passing={80}, m_max=159) is None
+    assert search.propose("midpoint", tried, m_max=159) is None
 
 
 def test_the_counting_simulation_is_the_loop_bit_for_bit(tmp_path):
@@ -560,9 +556,9 @@ def test_the_horizon_is_the_last_sample_before_the_runs_part():
 
 
 def test_the_check_command_checks_each_answer_of_a_series(tmp_path, capsys):
-    """``python -m refsim.studies.advisor_check``: the report's series for a
+    """``python -m refsim.advisor.check``: the report's series for a
     scene, each answer re-run independently, one row per tolerance."""
-    from refsim.studies.advisor_check import main
+    from refsim.advisor.check import main
 
     path = tmp_path / "drop.toml"
     path.write_text(DROP)

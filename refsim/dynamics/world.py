@@ -1,7 +1,7 @@
 """The world and the integration settings of a scene (S5, S6, S11), with
 their defaults: the one place they are written, shared by the scene schema
 (:mod:`refsim.scenes.schema`) and the particle system's configuration
-(:mod:`refsim.particles.config`).
+(:mod:`refsim.particles.config`). They live with the dynamics, below both.
 """
 
 from __future__ import annotations

@@ -1,13 +1,13 @@
 """One run of a scene at chosen fidelity settings, measured for the advisor
-(:mod:`refsim.studies.advisor`): sampled positions, orientations and
-energy, the events with their response speeds, and the work the run did.
+(:mod:`refsim.advisor`): sampled positions, orientations and energy, the
+events with their response speeds, and the work the run did.
 
 What: :func:`measure_run` is a sweep task (:mod:`refsim.sweep`): a
 module-level function of plain arguments that returns a plain record. It
 rebuilds the scene from plain data (:func:`scene_data`, so that a worker
 process or a Dask worker needs no file but the models), replaces the four
-fidelity choices (:class:`Fidelity`: solver, step, collision level, box
-update; nothing else), steps a :class:`refsim.Simulation` and records
+fidelity choices (:class:`~refsim.advisor.records.Fidelity`: solver, step,
+collision level, box update; nothing else), steps a :class:`refsim.Simulation` and records
 
 - every ``every``-th step (a common grid of sample times, so that runs at
   different steps compare at the same instants, never interpolated): the
@@ -52,11 +52,12 @@ from __future__ import annotations
 
 import statistics
 import time
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
 
+from refsim.advisor.records import Fidelity
 from refsim.bundled import models_dir
 from refsim.dynamics.simulation import BATCH_VERTICES, Simulation
 from refsim.errors import DivergenceError, StateError, check_count
@@ -64,26 +65,6 @@ from refsim.scenes.loader import SHAPE_KEYS, scene_from_dict
 from refsim.scenes.schema import Scene
 from refsim.solvers.integrate import whole_steps
 from refsim.solvers.methods import SOLVERS
-
-
-@dataclass(frozen=True)
-class Fidelity:
-    """The four choices the advisor varies; everything else in a scene is
-    physics and stays as the scene has it.
-
-    ``solver``: a key of :data:`refsim.SOLVERS`; ``step``: seconds;
-    ``level``: a collision level ("none" .. "exact"); ``aabb``: the box
-    update ("linear" | "incremental" | "auto").
-    """
-
-    solver: str
-    step: float
-    level: str
-    aabb: str
-
-    def label(self) -> str:
-        """``"rk4 h=0.00025 exact linear"``: one line for tables and keys."""
-        return f"{self.solver} h={self.step!r} {self.level} {self.aabb}"
 
 
 def scene_fidelity(scene: Scene) -> Fidelity:

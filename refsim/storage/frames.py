@@ -17,7 +17,7 @@ not know where the frames go:
 - :class:`SpillSink` appends each name's frames to its own raw file (the
   bytes of the frames in C order, no header) beside the output, and
   ``arrays()`` returns :class:`SpilledArray` views of those files. Writing
-  the .npz (:func:`refsim.npz.write_npz`) then puts each entry's ``.npy``
+  the .npz (:func:`refsim.storage.npz.write_npz`) then puts each entry's ``.npy``
   header, whose shape is known only now (also after a divergence that
   stopped early), in front of that file's bytes, copied in bounded chunks.
   Memory: one frame and one chunk, whatever the number of steps.
@@ -35,7 +35,7 @@ Why this design, and not another:
   disk that fills, and /tmp may be a RAM disk (which would put the frames
   back in memory). The files are hidden (``.NAME.XXXXXXXX.ENTRY.spill``)
   and removed when the sink closes, whatever happened (see
-  :mod:`refsim.io` for signals).
+  :mod:`refsim.storage.writing` for signals).
 - *Why one interface for both?* The producer's loop is the same code in
   both cases, so the arrays are the same bytes; the tests compare them.
 
@@ -54,7 +54,7 @@ from typing import BinaryIO, Protocol, TypeAlias
 import numpy as np
 
 from refsim.errors import StateError
-from refsim.io import hidden_temporary, output_error, output_target, remove_quietly
+from refsim.storage.writing import hidden_temporary, output_error, output_target, remove_quietly
 
 #: Write buffer of each spill file: small frames (one body: 8 to 72 bytes)
 #: reach the disk in few system calls; large frames go straight through.
@@ -187,7 +187,7 @@ class SpilledArray:
     Enough of an array for writing and reporting: ``shape``, ``dtype``,
     ``len()``, ``a[i]`` and ``a[i:j]`` (read from the file),
     ``chunks(size)`` (the bytes in order, ``size`` at a time, for
-    :func:`refsim.npz.write_npz`) and ``numpy.asarray(a)`` (reads it all:
+    :func:`refsim.storage.npz.write_npz`) and ``numpy.asarray(a)`` (reads it all:
     O(size) memory, the thing spilling avoids).
     """
 
@@ -257,7 +257,7 @@ class SpillSink:
     ----------
     out : path
         The output the frames are for: the files go in its target's
-        directory (after symlinks, :func:`refsim.io.output_target`).
+        directory (after symlinks, :func:`refsim.storage.writing.output_target`).
 
     Raises
     ------
@@ -328,10 +328,10 @@ class SpillSink:
 def spill_disk_bound(entry_frame_bytes, n_frames: int, *, compressed: bool) -> int:
     """Most bytes on disk while a run of ``n_frames`` frames is written
     through a :class:`SpillSink`: the spill files, plus the .npz assembled
-    from them before they are removed (:func:`refsim.npz.npz_size_bound`).
+    from them before they are removed (:func:`refsim.storage.npz.npz_size_bound`).
     ``entry_frame_bytes`` lists the bytes of each entry of one frame; the
     small entries written at the end (names, JSON) count as overhead."""
-    from refsim.npz import npz_size_bound
+    from refsim.storage.npz import npz_size_bound
 
     spill = n_frames * sum(entry_frame_bytes)
     return spill + npz_size_bound([n_frames * b for b in entry_frame_bytes],
@@ -341,7 +341,7 @@ def spill_disk_bound(entry_frame_bytes, n_frames: int, *, compressed: bool) -> i
 def check_disk_space(out, entry_frame_bytes, n_steps: int, every: int, *,
                      compressed: bool, frames_of: str, size_hint: str) -> None:
     """Refuse, before running, a run whose frames cannot fit on the disk of
-    ``out`` (its free space now, :func:`refsim.io.free_bytes`).
+    ``out`` (its free space now, :func:`refsim.storage.writing.free_bytes`).
 
     Why a guard at all, now that memory does not grow with the steps: the
     disk does (:func:`spill_disk_bound`, about twice the frame data at the
@@ -369,7 +369,7 @@ def check_disk_space(out, entry_frame_bytes, n_steps: int, every: int, *,
         One line naming ``out``, the bytes needed and free, and the fix: the
         smallest ``--every`` that fits, or ``size_hint``.
     """
-    from refsim.io import free_bytes
+    from refsim.storage.writing import free_bytes
 
     def need(k: int) -> int:
         return spill_disk_bound(entry_frame_bytes, frame_count(n_steps, k),
