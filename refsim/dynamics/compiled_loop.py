@@ -20,8 +20,9 @@ above a peer engine's whole step for a few bodies. One call for K steps pays
 it once (docs/decisions/compiled-loop.md has the figures).
 
 Seed sections: as the readable step (S2, S3, S5-S9). Cost: the kernel's
-per step, plus O(B + events) per call here, plus O(B^2) when the contacts
-were changed by a readable step since the last call.
+per step, plus O(1) per call here (O(events) when the call found some),
+plus O(B^2) when the contacts were changed by a readable step since the
+last call.
 """
 
 from __future__ import annotations
@@ -420,8 +421,9 @@ class CompiledLoop:
                 found.append((step, names[i], names[j], "body", row))
         found.sort(key=lambda r: (r[0], r[1], r[2]))
         listed = sim._events
+        noted = max(0, len(listed) - int(counters[slot.C_EVENT_BASE]))   # by a cut call
         new = []
-        for step, body, other, kind, row in found[len(listed) - int(counters[slot.C_EVENT_BASE]):]:
+        for step, body, other, kind, row in found[noted:]:
             n = step + 1
             J, point = impulse.impulse_and_point(self.event_data[row])
             new.append(Event(kind=kind, step=n, time=n * sim.h, body=body, other=other,
