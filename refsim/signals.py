@@ -29,7 +29,8 @@ from contextlib import contextmanager
 try:
     # The C functions behind signal.getsignal and signal.signal, without
     # their conversions of numbers to enums, which cost ten times the call
-    # itself: held_signals swaps handlers at every Simulation.advance call
+    # itself: held_signals swaps handlers at every Simulation.run call and
+    # every Simulation.advance call but the compiled loop's short ones
     # (docs/decisions/compiled-loop.md, "One step per call"). They take and
     # return the same handlers (SIG_DFL and SIG_IGN as plain numbers).
     from _signal import getsignal as _getsignal  # type: ignore[import-not-found]

@@ -69,8 +69,14 @@ all but name, and the readable step then decides exactly.
 Events: the kernel keeps the previous step's contacts as flags, ``walls``
 (B, 6) (axis k, low wall at 2k, high wall at 2k + 1) and ``bodies`` (B, B)
 (pair i < j at [i, j]), and writes one row ``(step, kind, i, j)`` per
-contact that began (kind 0: wall 2k or 2k + 1; kind 1: body j); the caller
-sorts a step's rows by names as :meth:`Simulation._note_events` does.
+contact that began (``step`` the simulation's step count before it; kind 0:
+wall 2k or 2k + 1; kind 1: body j), after the rows still pending; the
+caller sorts a step's rows by names as :meth:`Simulation._note_events` does.
+
+Arguments: :func:`advance`, the entry from Python, takes three flat arrays
+and views them as the forty-odd arrays of :func:`_steps`, the loop itself
+(:mod:`refsim.dynamics.loop_layout` says why and how), and counts the steps
+and event rows of the call in them before it returns.
 
 Seed sections: S2, S3, S5-S9 (as the readable stages), and their
 correction (the corrected rotation model and wall impulses).
@@ -92,8 +98,11 @@ import math
 
 import numba
 import numpy as np
+from numba.core import types
+from numba.extending import intrinsic
 
 from refsim.bounds._numba_kernels import incremental_update_numba
+from refsim.dynamics import loop_layout as slot
 from refsim.dynamics.impulse import contact_sum_python, solve_contacts_python
 from refsim.dynamics.rotation_impulse import WALL_DEEPEST_FRACTION, free_rotation_step
 from refsim.dynamics.rotation_seed import axes_step_seed
@@ -101,7 +110,7 @@ from refsim.dynamics.rotation_seed import axes_step_seed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "6ef86e8c7ae760bf"
+SOURCES_DIGEST = "fab84b0cbc14b488"
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -128,19 +137,118 @@ _contact_sum = numba.njit(cache=True, nogil=True)(contact_sum_python)
 
 
 @numba.njit(cache=True, nogil=True)
-def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
-            restitution, friction, wall_speed_at_wall, wall_impulse, threshold, iterations,
-            half_size, vertices_t, first_vertex, centred, center, lam, mass, inv_mass,
-            Q, moments, I_body_inv, energy_limit, leaf_order, leaf_start, leaf_spheres,
-            first_leaf, body_mode,
-            x, v, w, R, lo, hi, walls, bodies, events, tracked, tracker_rows, trackers_f,
-            trackers_i, impulse_now, event_data):
+def advance(n_steps, floats, ints, flags):
+    """Mirrors :meth:`refsim.dynamics.simulation.Simulation.step`, up to
+    ``n_steps`` times: the compiled loop's entry from Python, which runs
+    :func:`_steps` on the arrays packed in ``floats``, ``ints`` and
+    ``flags`` (:mod:`refsim.dynamics.loop_layout`: each a view, no copy),
+    in place. Before returning it counts what it did in ``COUNTERS``: the
+    steps (``C_STEPS``, ``C_LOOP_STEPS``), the event rows written
+    (``C_PENDING``; a call appends to rows still pending), and the steps
+    it did not take and why (``C_LEFT``, ``C_STOP``). Returns 0 when it took
+    every step and there is no event row to read, else 1 (read the
+    counters)."""
+    counters = _view1(ints, ints, slot.COUNTERS)
+    settings = _view1(ints, ints, slot.SETTINGS)
+    scalars = _view1(floats, ints, slot.SCALARS)
+    done, n_events, stop = _steps(
+        n_steps, counters[slot.C_STEPS], counters[slot.C_PENDING],
+        scalars[slot.S_H], _view2(floats, ints, slot.HA), _view1(floats, ints, slot.HB),
+        scalars[slot.S_GRAVITY], _view1(floats, ints, slot.DRAG_RATE),
+        settings[slot.G_QUADRATIC], settings[slot.G_ROTATION_MODE], scalars[slot.S_RESTITUTION],
+        scalars[slot.S_FRICTION], settings[slot.G_WALL_SPEED_AT_WALL],
+        settings[slot.G_WALL_IMPULSE], scalars[slot.S_THRESHOLD], settings[slot.G_ITERATIONS],
+        scalars[slot.S_HALF_SIZE], _view2(floats, ints, slot.VERTICES_T),
+        _view1(ints, ints, slot.FIRST_VERTEX), settings[slot.G_CENTRED],
+        _view2(floats, ints, slot.CENTER), _view1(floats, ints, slot.LAM),
+        _view1(floats, ints, slot.MASS), _view1(floats, ints, slot.INV_MASS),
+        _view3(floats, ints, slot.Q), _view2(floats, ints, slot.MOMENTS),
+        _view3(floats, ints, slot.I_BODY_INV), scalars[slot.S_ENERGY_LIMIT],
+        _view1(ints, ints, slot.LEAF_ORDER), _view1(ints, ints, slot.LEAF_START),
+        _view2(floats, ints, slot.LEAF_SPHERES), _view1(ints, ints, slot.FIRST_LEAF),
+        settings[slot.G_BODY_MODE],
+        # the state and what is read and written
+        _view2(floats, ints, slot.X), _view2(floats, ints, slot.V), _view2(floats, ints, slot.W),
+        _view3(floats, ints, slot.R), _view2(floats, ints, slot.LO), _view2(floats, ints, slot.HI),
+        _view2(flags, ints, slot.WALLS), _view2(flags, ints, slot.BODIES),
+        _view2(ints, ints, slot.EVENTS), _view1(ints, ints, slot.TRACKED),
+        _view2(ints, ints, slot.TRACKER_ROWS), _view1(floats, ints, slot.TRACKERS_F),
+        _view1(ints, ints, slot.TRACKERS_I), _view3(floats, ints, slot.IMPULSE_NOW),
+        _view2(floats, ints, slot.EVENT_DATA),
+        # scratch
+        _view1(floats, ints, slot.Y), _view1(floats, ints, slot.Y_I), _view2(floats, ints, slot.K),
+        _view2(floats, ints, slot.X0), _view2(floats, ints, slot.V0), _view2(floats, ints, slot.W0),
+        _view3(floats, ints, slot.R0), _view2(floats, ints, slot.A), _view2(floats, ints, slot.E),
+        _view1(floats, ints, slot.L), _view1(floats, ints, slot.CORR),
+        _view1(ints, ints, slot.PAST), _view2(floats, ints, slot.R_A),
+        _view2(floats, ints, slot.P), _view1(floats, ints, slot.N),
+        _view2(floats, ints, slot.ORIGIN), _view2(flags, ints, slot.NOW_WALLS),
+        _view2(ints, ints, slot.PAIRS))
+    counters[slot.C_STEPS] += done
+    counters[slot.C_LOOP_STEPS] += done
+    counters[slot.C_PENDING] = n_events
+    counters[slot.C_LEFT] = n_steps - done
+    counters[slot.C_STOP] = stop
+    return 0 if done == n_steps and n_events == 0 else 1
+
+
+# Views of the packed arrays (refsim.dynamics.loop_layout: the header of
+# ``ints`` holds each array's offset and shape), made by ``numba.carray``
+# from the address of their first element: C-contiguous arrays with the
+# shapes and dtypes of separate ones, so the loop compiles to the same
+# arithmetic. Not slices and ``reshape``: a reshape checks its strides
+# through a C helper, and a slice holds a reference to the flat array,
+# which every function it is passed to takes and drops again (an atomic
+# operation each time), some tens of nanoseconds per array and call, more
+# than a step of one cube for the sixty arrays of a call. These views hold
+# none (the flat arrays, the call's arguments, outlive them).
+
+@intrinsic
+def _address(typingctx, flat, at):
+    """The address of ``flat[at]`` (a C pointer to its dtype), unchecked."""
+    def codegen(context, builder, signature, args):
+        array = context.make_array(signature.args[0])(context, builder, args[0])
+        return builder.gep(array.data, [args[1]])
+    return types.CPointer(flat.dtype)(flat, at), codegen
+
+
+@numba.njit(cache=True, nogil=True)
+def _view1(flat, ints, k):
+    return numba.carray(_address(flat, ints[4 * k]), ints[4 * k + 1])
+
+
+@numba.njit(cache=True, nogil=True)
+def _view2(flat, ints, k):
+    return numba.carray(_address(flat, ints[4 * k]), (ints[4 * k + 1], ints[4 * k + 2]))
+
+
+@numba.njit(cache=True, nogil=True)
+def _view3(flat, ints, k):
+    return numba.carray(_address(flat, ints[4 * k]),
+                        (ints[4 * k + 1], ints[4 * k + 2], ints[4 * k + 3]))
+
+
+@numba.njit(cache=True, nogil=True)
+def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadratic,
+           rotation_mode, restitution, friction, wall_speed_at_wall, wall_impulse, threshold,
+           iterations, half_size, vertices_t, first_vertex, centred, center, lam, mass,
+           inv_mass, Q, moments, I_body_inv, energy_limit, leaf_order, leaf_start,
+           leaf_spheres, first_leaf, body_mode,
+           x, v, w, R, lo, hi, walls, bodies, events, tracked, tracker_rows, trackers_f,
+           trackers_i, impulse_now, event_data,
+           y, y_i, K, x0, v0, w0, R0, A, E, L, corr, past, r_a, P, n, origin, now_walls,
+           pairs):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation.step`, up to
     ``n_steps`` times, in place; returns ``(steps, events, stop)`` (module
-    docstring: the readable function of each stage, and the hand-back).
+    docstring: the readable function of each stage, and the hand-back),
+    ``events`` the number of event rows now written (:func:`advance`
+    unpacks the arguments).
 
     Parameters (B bodies, s solver stages; float64 unless said)
     ----------
+    first_step : int, the simulation's steps before this call (an event
+        row's step is ``first_step`` plus the step of the call, from 0)
+    n_events : int, the event rows already written (appended to)
     hA : (s, s) ``h * A`` of the tableau; hb : (s,) ``h * b``
     drag_rate : (B,) ``drag / mass``; quadratic : bool
     rotation_mode : int (``ROTATION_*``)
@@ -177,35 +285,20 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
     tracker_rows : (T, 14) int64, where each tracker's arrays start in the
         flat ``trackers_f`` (float64) and ``trackers_i`` (int64) (``T_*``;
         :class:`refsim.dynamics.compiled_loop.CompiledLoop` lays them out)
+    y, y_i, K, x0, v0, w0, R0, A, E, L, corr, past, r_a, P, n, origin, now_walls,
+    pairs : scratch: ``y``, ``y_i`` (2 3B,), ``K`` (s, 2 3B) of the solver;
+        ``x0``, ``v0``, ``w0``, ``R0`` the state at the start of the step;
+        ``A``, ``E`` (3, 3), ``L`` (3,) of the rotation step (``E`` also a
+        body's world inverse inertia); ``corr`` (3,) a wall correction; the
+        wall impulses' vertices past a wall ``past`` (M,) int64, contacts
+        ``r_a`` (M, 3), impulses ``P`` (M, 4) and normal ``n`` (3,), M the
+        most vertices of a body; ``origin`` (B, 3); ``now_walls`` (B, 6)
+        bool; ``pairs`` (max(B (B - 1) / 2, 1), 2) int64
     """
     B = x.shape[0]
     s = hb.shape[0]
     d = 3 * B
-    y = np.empty(2 * d)
-    y_i = np.empty(2 * d)
-    K = np.empty((s, 2 * d))
-    x0 = np.empty((B, 3))
-    v0 = np.empty((B, 3))
-    w0 = np.empty((B, 3))
-    R0 = np.empty((B, 3, 3))
-    A = np.empty((3, 3))
-    E = np.empty((3, 3))            # scratch of the rotation step; a body's world I^-1
-    L = np.empty(3)
-    corr = np.empty(3)
-    # the wall impulses' arrays: the vertices past a wall, contacts r_a, the
-    # normal n and the impulses P
-    most = 1
-    for b in range(B):
-        most = max(most, first_vertex[b + 1] - first_vertex[b])
-    past = np.empty(most, np.int64)
-    r_a = np.empty((most, 3))
-    P = np.empty((most, 4))
-    n = np.zeros(3)
-    origin = np.empty((B, 3))
-    now_walls = np.zeros((B, 6), np.bool_)
-    pairs = np.empty((max(B * (B - 1) // 2, 1), 2), np.int64)
     per_step = 6 * B + B * (B - 1) // 2
-    n_events = 0
     k_friction = 1.0 - friction
     for step in range(n_steps):
         if n_events + per_step > events.shape[0]:
@@ -366,7 +459,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
         for b in range(B):
             for k in range(6):
                 if now_walls[b, k] and not walls[b, k]:
-                    events[n_events, 0] = step
+                    events[n_events, 0] = first_step + step
                     events[n_events, 1] = 0
                     events[n_events, 2] = b
                     events[n_events, 3] = k
@@ -389,7 +482,7 @@ def advance(n_steps, h, hA, hb, gravity, drag_rate, quadratic, rotation_mode,
                     if now:
                         q += 1
                         if not bodies[i, j]:
-                            events[n_events, 0] = step
+                            events[n_events, 0] = first_step + step
                             events[n_events, 1] = 1
                             events[n_events, 2] = i
                             events[n_events, 3] = j
@@ -410,19 +503,20 @@ T_N, T_XYZ, T_VALUE, T_TIE, T_OFFSETS, T_INDICES, T_INDICES_END, T_EXTREMES, T_S
 @numba.njit(cache=True, nogil=True)
 def _tracker_update(row, trackers_f, trackers_i, rotation, translation, lo, hi):
     """One incremental box update of a tracked body, its arrays slices of
-    the flat ones: :func:`incremental_update_numba`, which mirrors
+    the flat ones (the two-dimensional ones made as :func:`_view2` makes
+    its views): :func:`incremental_update_numba`, which mirrors
     :meth:`refsim.bounds.aabb_incremental.IncrementalAABB.update`."""
     n = row[T_N]
     f, i = trackers_f, trackers_i
     incremental_update_numba(
-        f[row[T_XYZ]:row[T_XYZ] + 3 * n].reshape(3, n),
+        numba.carray(_address(f, row[T_XYZ]), (3, n)),
         i[row[T_OFFSETS]:row[T_OFFSETS] + n + 1],
         i[row[T_INDICES]:row[T_INDICES_END]],
         rotation, translation,
-        i[row[T_EXTREMES]:row[T_EXTREMES] + 6].reshape(2, 3),
+        numba.carray(_address(i, row[T_EXTREMES]), (2, 3)),
         f[row[T_TIE]],
-        f[row[T_VALUE]:row[T_VALUE] + 3 * n].reshape(3, n),
-        i[row[T_STAMP]:row[T_STAMP] + 3 * n].reshape(3, n),
+        numba.carray(_address(f, row[T_VALUE]), (3, n)),
+        numba.carray(_address(i, row[T_STAMP]), (3, n)),
         i[row[T_TOUCHED]:row[T_TOUCHED] + n],
         i[row[T_SEEN]:row[T_SEEN] + n],
         i[row[T_QUEUE]:row[T_QUEUE] + n],

@@ -8,9 +8,10 @@ to the readable stages whenever that step needs something it does not do
 (:func:`loop_support` says which scenes it covers;
 :mod:`refsim.dynamics._numba_kernels` says when it hands back). What this
 module adds is bookkeeping: the arrays the kernel reads (tableau, masses,
-vertices), the contacts as flags instead of a set, and the kernel's event
-rows turned into :class:`~refsim.dynamics.trajectory.Event` in the readable
-order.
+vertices), packed with the simulation's state in three flat arrays
+(:mod:`refsim.dynamics.loop_layout`), the contacts as flags instead of a
+set, and the kernel's event rows turned into
+:class:`~refsim.dynamics.trajectory.Event` in the readable order.
 
 Why a loop and not faster stages: the readable step's cost is mostly the
 interpreter's calls between little arithmetic; stage kernels keep the calls,
@@ -19,19 +20,21 @@ above a peer engine's whole step for a few bodies. One call for K steps pays
 it once (docs/decisions/compiled-loop.md has the figures).
 
 Seed sections: as the readable step (S2, S3, S5-S9). Cost: the kernel's
-per step, plus O(B + events) per call here, plus O(B^2) when the contacts
-were changed by a readable step since the last call.
+per step, plus O(1) per call here (O(events) when the call found some),
+plus O(B^2) when the contacts were changed by a readable step since the
+last call.
 """
 
 from __future__ import annotations
 
-import time
+from time import perf_counter
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from refsim.bounds.aabb_incremental import IncrementalAABB
 from refsim.dynamics import impulse
+from refsim.dynamics import loop_layout as slot
 from refsim.dynamics.trajectory import Event
 
 if TYPE_CHECKING:
@@ -120,52 +123,137 @@ def vertex_leaves(vertices: np.ndarray, size: int = LEAF_VERTICES):
     return order, start, spheres
 
 
+class _Packing:
+    """Arrays laid out in the loop's three flat arrays
+    (:mod:`refsim.dynamics.loop_layout`): :meth:`put` each, then :meth:`pack`."""
+
+    def __init__(self) -> None:
+        self.header = np.zeros(4 * slot.ARRAYS, np.int64)
+        self.parts: dict[type, list[np.ndarray]] = {np.float64: [], np.int64: [], np.bool_: []}
+        self.size: dict[type, int] = {np.float64: 0, np.int64: len(self.header), np.bool_: 0}
+        self.placed: dict[int, tuple[type, int, tuple[int, ...]]] = {}   # dtype, offset, shape
+
+    def put(self, k: int, array, dtype: type) -> None:
+        """Array number ``k`` (a copy of ``array``, as ``dtype``)."""
+        array = np.ascontiguousarray(array, dtype=dtype)
+        self.placed[k] = (dtype, self.size[dtype], array.shape)
+        self.header[4 * k] = self.size[dtype]
+        self.header[4 * k + 1:4 * k + 4] = array.shape + (1,) * (3 - array.ndim)
+        self.parts[dtype].append(array.ravel())
+        self.size[dtype] += array.size
+
+    def pack(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(floats, ints, flags)``."""
+        ints = np.concatenate([self.header, *self.parts[np.int64]])
+        return (np.concatenate([np.zeros(0), *self.parts[np.float64]]), ints,
+                np.concatenate([np.zeros(0, np.bool_), *self.parts[np.bool_]]))
+
+
 class CompiledLoop:
-    """The compiled loop of one simulation: its constant arrays, the contact
-    flags, and :meth:`advance`."""
+    """The compiled loop of one simulation: its arrays, packed (the constant
+    ones, the simulation's state, the contact flags, the event buffer, the
+    kernel's scratch), and :meth:`advance`.
+
+    The simulation's ``x``, ``v``, ``w``, ``R``, ``lo``, ``hi`` and its
+    counters become views of the packed arrays here (their values kept), so
+    that a call of the kernel passes four arguments
+    (:mod:`refsim.dynamics.loop_layout` says why)."""
 
     def __init__(self, sim: Simulation):
         from refsim.dynamics import _numba_kernels as kernels
 
         self.kernels = kernels
-        self.STOP_READABLE = kernels.STOP_READABLE
+        self.DONE, self.STOP_READABLE = kernels.DONE, kernels.STOP_READABLE
         self.sim = sim
         B = len(sim.bodies)
-        h = sim.h
         world = sim.scene.world
         method = sim.method
-        self.hA = np.ascontiguousarray(h * method.A_)
-        self.hb = np.ascontiguousarray(h * method.b_)
-        # the drag rate r = k / m, as translational_rhs divides it
-        self.drag_rate = np.ascontiguousarray(world.drag / np.asarray(sim.mass, np.float64))
-        self.quadratic = world.drag_model == "quadratic"
         vertices = [b.mesh.vertices for b in sim.bodies]
         self.first_vertex = np.zeros(B + 1, np.int64)
         self.first_vertex[1:] = np.cumsum([len(vs) for vs in vertices])
-        self.vertices_t = np.ascontiguousarray(np.concatenate(vertices).T)
-        self.center = np.ascontiguousarray(sim.center, dtype=np.float64)
-        self.rotation_mode = {"off": kernels.ROTATION_OFF, "seed": kernels.ROTATION_SEED,
-                              "impulse": kernels.ROTATION_EXACT}[sim.rotation]
-        self.Q = np.ascontiguousarray(sim.Q, dtype=np.float64)
-        self.moments = np.ascontiguousarray(sim.moments, dtype=np.float64)
-        self.I_body_inv = np.ascontiguousarray(sim.I_body_inv, dtype=np.float64)
         self._lay_out_trackers()
         # the leaves serve the corrected wall response only
         self._lay_out_leaves(vertices if sim.wall_response == "impulse" else [])
         if not sim.body_body:
-            self.body_mode = kernels.BODY_NONE
+            body_mode = kernels.BODY_NONE
         elif sim.level == "aabb" and sim.body_response == "seed":
-            self.body_mode = kernels.BODY_EXCHANGE
+            body_mode = kernels.BODY_EXCHANGE
         else:
-            self.body_mode = kernels.BODY_HAND_BACK
-        self.walls = np.zeros((B, 6), np.bool_)
-        self.bodies = np.zeros((B, B), np.bool_)
-        self.events = np.zeros((max(EVENT_ROWS, 4 * (6 * B + B * (B - 1) // 2)), 4), np.int64)
-        self.event_data = np.zeros((len(self.events), impulse.IMPULSE_RECORD))
-        self.impulse_now = np.zeros((B, 6, impulse.IMPULSE_RECORD))
+            body_mode = kernels.BODY_HAND_BACK
+        capacity = max(EVENT_ROWS, 4 * (6 * B + B * (B - 1) // 2))
+        most = max(1, max(len(vs) for vs in vertices))     # vertices of a body, at most
+        s = len(method.b_)
+        f, i, b = np.float64, np.int64, np.bool_
+        scalars = np.zeros(7)
+        scalars[[slot.S_H, slot.S_GRAVITY, slot.S_RESTITUTION, slot.S_FRICTION,
+                 slot.S_THRESHOLD, slot.S_HALF_SIZE, slot.S_ENERGY_LIMIT]] = (
+            sim.h, world.gravity, world.restitution,
+            world.coulomb_mu if sim.wall_response == "impulse" else world.friction,
+            sim.loads.threshold, world.half_size, sim._energy_limit)
+        settings = np.zeros(7, np.int64)
+        settings[[slot.G_QUADRATIC, slot.G_ROTATION_MODE, slot.G_WALL_SPEED_AT_WALL,
+                  slot.G_WALL_IMPULSE, slot.G_ITERATIONS, slot.G_CENTRED, slot.G_BODY_MODE]] = (
+            world.drag_model == "quadratic",
+            {"off": kernels.ROTATION_OFF, "seed": kernels.ROTATION_SEED,
+             "impulse": kernels.ROTATION_EXACT}[sim.rotation],
+            sim.wall_speed == "wall", sim.wall_response == "impulse", impulse.ITERATIONS,
+            sim._centred, body_mode)
+        packing = _Packing()
+        for k, array, dtype in (
+                (slot.SCALARS, scalars, f), (slot.HA, sim.h * method.A_, f),
+                (slot.HB, sim.h * method.b_, f),
+                # the drag rate r = k / m, as translational_rhs divides it
+                (slot.DRAG_RATE, world.drag / np.asarray(sim.mass, np.float64), f),
+                (slot.VERTICES_T, np.concatenate(vertices).T, f), (slot.CENTER, sim.center, f),
+                (slot.LAM, sim._lambda_max, f), (slot.MASS, sim.mass, f),
+                (slot.INV_MASS, sim.inv_mass, f), (slot.Q, sim.Q, f),
+                (slot.MOMENTS, sim.moments, f), (slot.I_BODY_INV, sim.I_body_inv, f),
+                (slot.LEAF_SPHERES, self.leaf_spheres, f), (slot.TRACKERS_F, self.trackers_f, f),
+                (slot.IMPULSE_NOW, np.zeros((B, 6, impulse.IMPULSE_RECORD)), f),
+                (slot.EVENT_DATA, np.zeros((capacity, impulse.IMPULSE_RECORD)), f),
+                (slot.X, sim.x, f), (slot.V, sim.v, f), (slot.W, sim.w, f), (slot.R, sim.R, f),
+                (slot.LO, sim.lo, f), (slot.HI, sim.hi, f),
+                (slot.Y, np.zeros(6 * B), f), (slot.Y_I, np.zeros(6 * B), f),
+                (slot.K, np.zeros((s, 6 * B)), f), (slot.X0, np.zeros((B, 3)), f),
+                (slot.V0, np.zeros((B, 3)), f), (slot.W0, np.zeros((B, 3)), f),
+                (slot.R0, np.zeros((B, 3, 3)), f), (slot.A, np.zeros((3, 3)), f),
+                (slot.E, np.zeros((3, 3)), f), (slot.L, np.zeros(3), f),
+                (slot.CORR, np.zeros(3), f), (slot.R_A, np.zeros((most, 3)), f),
+                (slot.P, np.zeros((most, 4)), f), (slot.N, np.zeros(3), f),
+                (slot.ORIGIN, np.zeros((B, 3)), f),
+                (slot.SETTINGS, settings, i), (slot.COUNTERS, sim._counters, i),
+                (slot.FIRST_VERTEX, self.first_vertex, i), (slot.LEAF_ORDER, self.leaf_order, i),
+                (slot.LEAF_START, self.leaf_start, i), (slot.FIRST_LEAF, self.first_leaf, i),
+                (slot.TRACKED, self.tracked, i), (slot.TRACKER_ROWS, self.tracker_rows, i),
+                (slot.TRACKERS_I, self.trackers_i, i), (slot.EVENTS, np.zeros((capacity, 4)), i),
+                (slot.PAST, np.zeros(most), i),
+                (slot.PAIRS, np.zeros((max(B * (B - 1) // 2, 1), 2)), i),
+                (slot.WALLS, np.zeros((B, 6)), b), (slot.BODIES, np.zeros((B, B)), b),
+                (slot.NOW_WALLS, np.zeros((B, 6)), b)):
+            packing.put(k, array, dtype)
+        self.floats, self.ints, self.flags = packing.pack()
+        self._placed = packing.placed
+        # the simulation's state and counters from here on: views of the packed arrays
+        sim.x, sim.v, sim.w, sim.R, sim.lo, sim.hi = (
+            self.view(k) for k in (slot.X, slot.V, slot.W, slot.R, slot.LO, slot.HI))
+        sim._counters = self.counters = self.view(slot.COUNTERS)
+        self.walls = self.view(slot.WALLS)
+        self.bodies = self.view(slot.BODIES)
+        self.events = self.view(slot.EVENTS)
+        self.event_data = self.view(slot.EVENT_DATA)
+        self._call = (kernels.advance, self.floats, self.ints, self.flags)
         self._index = {name: i for i, name in enumerate(sim.names)}
         self._flags_stale = False        # the set changed since the flags were built
         self._set_stale = False          # the flags changed since the set was built
+        #: Why the last call of :meth:`advance` stopped short (``STOP_READABLE``:
+        #: the next step is the readable step's), else ``DONE``.
+        self.stop = self.DONE
+
+    def view(self, k: int) -> np.ndarray:
+        """Array number ``k`` of :mod:`refsim.dynamics.loop_layout`: a view."""
+        dtype, at, shape = self._placed[k]
+        flat = {np.float64: self.floats, np.int64: self.ints, np.bool_: self.flags}[dtype]
+        return flat[at:at + int(np.prod(shape))].reshape(shape)
 
     def _lay_out_trackers(self) -> None:
         """The incremental trackers of the bodies that have one (the readable
@@ -281,43 +369,50 @@ class CompiledLoop:
 
     # -- the loop ---------------------------------------------------------------------------
 
-    def advance(self, n_steps: int) -> tuple[int, int]:
-        """Up to ``n_steps`` steps in the compiled loop: ``(steps taken, stop)``,
-        ``stop`` one of the kernel's ``DONE``, ``STOP_READABLE``, ``STOP_EVENTS``."""
-        sim = self.sim
-        world = sim.scene.world
-        self._sync_flags()
-        start = time.perf_counter()
-        done, n_events, stop = self.kernels.advance(
-            n_steps, sim.h, self.hA, self.hb, world.gravity, self.drag_rate, self.quadratic,
-            self.rotation_mode, world.restitution,
-            world.coulomb_mu if sim.wall_response == "impulse" else world.friction,
-            sim.wall_speed == "wall", sim.wall_response == "impulse",
-            sim.loads.threshold, impulse.ITERATIONS, world.half_size,
-            self.vertices_t, self.first_vertex, sim._centred, self.center, sim._lambda_max,
-            sim.mass, sim.inv_mass, self.Q, self.moments, self.I_body_inv, sim._energy_limit,
-            self.leaf_order, self.leaf_start, self.leaf_spheres, self.first_leaf,
-            self.body_mode, sim.x, sim.v, sim.w, sim.R, sim.lo, sim.hi, self.walls,
-            self.bodies, self.events, self.tracked, self.tracker_rows, self.trackers_f,
-            self.trackers_i, self.impulse_now, self.event_data)
-        sim.loop_seconds += time.perf_counter() - start
-        if done:
-            self._note_events(n_events)
-            sim.steps += done
-            sim.t = sim.steps * sim.h
-            sim.loop_steps += done
-            self._set_stale = True
-        return done, stop
+    def advance(self, n_steps: int) -> int:
+        """Up to ``n_steps`` (at least 1) steps in the compiled loop; returns
+        how many of them it did not take (0: all), and :attr:`stop` says why.
 
-    def _note_events(self, n_events: int) -> None:
-        """The kernel's rows as Events, each step's sorted by (body, other)
-        names as :meth:`Simulation._note_events` sorts them."""
-        if not n_events:
+        The kernel counts the steps and event rows itself
+        (:mod:`refsim.dynamics.loop_layout`), and the contacts are the
+        kernel's flags from the call on (``_set_stale`` is set before it), so
+        whatever interrupts this method leaves steps, time and contacts
+        accounting for the state, and the events are added at the next
+        :meth:`note_events` (:attr:`Simulation.events` calls it).
+        """
+        if self._flags_stale:
+            self._sync_flags()
+        self._set_stale = True
+        kernel, floats, ints, flags = self._call
+        start = perf_counter()
+        busy = kernel(n_steps, floats, ints, flags)
+        self.sim.loop_seconds += perf_counter() - start
+        if not busy:                       # every step taken, no event
+            return 0
+        self.note_events()
+        counters = self.counters
+        left = int(counters[slot.C_LEFT])
+        self.stop = int(counters[slot.C_STOP]) if left else self.DONE
+        return left
+
+    def note_events(self) -> None:
+        """The kernel's pending event rows as Events in the simulation's list,
+        each step's sorted by (body, other) names as
+        :meth:`Simulation._note_events` sorts them; then no row is pending.
+
+        It may be cut short (a signal) and called again: the rows are sorted
+        the same way each time, and those after the first ``C_EVENT_BASE``
+        events that the list already holds are not added again. The list
+        grows in one ``extend`` and the two counters are reset in one
+        assignment, so no event is lost or added twice.
+        """
+        counters = self.counters
+        pending = int(counters[slot.C_PENDING])
+        if not pending:
             return
         sim = self.sim
         names = sim.names
-        rows = self.events[:n_events].tolist()
-        base = sim.steps
+        rows = self.events[:pending].tolist()
         found = []
         for row, (step, kind, i, j) in enumerate(rows):
             if kind == 0:
@@ -325,8 +420,13 @@ class CompiledLoop:
             else:
                 found.append((step, names[i], names[j], "body", row))
         found.sort(key=lambda r: (r[0], r[1], r[2]))
-        for step, body, other, kind, row in found:
-            n = base + step + 1
+        listed = sim._events
+        noted = max(0, len(listed) - int(counters[slot.C_EVENT_BASE]))   # by a cut call
+        new = []
+        for step, body, other, kind, row in found[noted:]:
+            n = step + 1
             J, point = impulse.impulse_and_point(self.event_data[row])
-            sim.events.append(Event(kind=kind, step=n, time=n * sim.h, body=body, other=other,
-                                    impulse=J, point=point))
+            new.append(Event(kind=kind, step=n, time=n * sim.h, body=body, other=other,
+                             impulse=J, point=point))
+        listed.extend(new)
+        counters[slot.C_EVENT_BASE:slot.C_PENDING + 1] = (len(listed), 0)

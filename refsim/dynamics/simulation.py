@@ -73,6 +73,7 @@ from refsim.collision.bodies import bodies_collide
 from refsim.collision.broad_phase import overlapping_pairs
 from refsim.collision.contact import contact_points
 from refsim.dynamics import impulse
+from refsim.dynamics import loop_layout as slot
 from refsim.dynamics.body_response import (
     WALL_TOUCH,
     contact_geometry,
@@ -243,11 +244,11 @@ class Simulation:
     ----------
     x, v, w : (B, 3) float64
         Centroid positions, velocities, angular velocities (rad/s); views that
-        tests may write to construct states.
+        tests may write to construct states, in place (on the compiled loop
+        these and ``R``, ``lo``, ``hi`` are views of the loop's packed arrays:
+        an array bound in their place would not be the one the loop steps).
     R : (B, 3, 3) float64
         Orientations.
-    t : float; steps : int
-    events : list of Event (onsets of wall and body contacts)
     stages : tuple of str (the stages this scene runs)
     timer : StageTimer (``timer.seconds``: dict of stage -> seconds)
     """
@@ -349,8 +350,9 @@ class Simulation:
         self.w = np.array([c.angular_velocity for c in scene.bodies], dtype=np.float64)
         if self.rotation == "off":
             self.w[:] = 0.0                       # DEVIATION D7: rotation off, no turning
-        self.t = 0.0
-        self.steps = 0
+        # the steps taken and the loop's event bookkeeping (refsim.dynamics.loop_layout;
+        # on the compiled loop, a view of its packed arrays that the kernel writes)
+        self._counters = np.zeros(slot.COUNTER_COUNT, np.int64)
         if not (np.isfinite(self.x).all() and np.isfinite(self.v).all()
                 and np.isfinite(self.w).all()):
             raise StateError("initial state has a non-finite value")
@@ -360,7 +362,7 @@ class Simulation:
                    field_rhs(self.loads.accel, world.drag, self.mass, world.drag_model))
         self.lo = np.empty((B, 3))
         self.hi = np.empty((B, 3))
-        self.events: list[Event] = []
+        self._events: list[Event] = []
         self._touching: set[Contact] = set()
         # what each contact's impulses did in this step, (body index, other
         # name) -> impulse.contact_sum_python's record
@@ -380,7 +382,6 @@ class Simulation:
         # The compiled loop (many steps per call), when the kernel is compiled
         # and the loop does this scene's choices (loop_support).
         self.loop_seconds = 0.0
-        self.loop_steps = 0
         self._loop: CompiledLoop | None = None
         if self.kernel == "compiled" and loop_support(self) is None:
             self._loop = CompiledLoop(self)
@@ -395,6 +396,34 @@ class Simulation:
         if stage == "narrow-phase":
             return self.body_body and self.level != "aabb"
         return True
+
+    @property
+    def steps(self) -> int:
+        """The steps taken since the start (int)."""
+        return int(self._counters[slot.C_STEPS])
+
+    @steps.setter
+    def steps(self, value: int) -> None:
+        self._counters[slot.C_STEPS] = value
+
+    @property
+    def t(self) -> float:
+        """The time, ``steps * h`` (float, seconds)."""
+        return int(self._counters[slot.C_STEPS]) * self.h
+
+    @property
+    def loop_steps(self) -> int:
+        """The steps the compiled loop took (the others: :meth:`step`)."""
+        return int(self._counters[slot.C_LOOP_STEPS])
+
+    @property
+    def events(self) -> list[Event]:
+        """The onsets of wall and body contacts so far (the compiled loop's
+        last ones added first, :meth:`CompiledLoop.note_events
+        <refsim.dynamics.compiled_loop.CompiledLoop.note_events>`)."""
+        if self._loop is not None:
+            self._loop.note_events()
+        return self._events
 
     @property
     def stage_seconds(self) -> dict[str, float]:
@@ -473,6 +502,7 @@ class Simulation:
         """
         if self._loop is not None:
             self._loop.sync_set()     # the contacts of the loop's last step, as a set
+            self._loop.note_events()  # its events, before this step's
         timer = self.timer
         timer.start()
         self._integrate()
@@ -501,7 +531,6 @@ class Simulation:
                 timer.lap("narrow-phase")
             self._body_response(pairs, touching)
             timer.lap("body-response")
-        self.t = (self.steps + 1) * self.h
         self.steps += 1
         self._note_events(touching)
 
@@ -529,7 +558,27 @@ class Simulation:
         """Take ``n_steps`` steps and record no frame (:meth:`run` without
         frames): on the compiled kernel, through the compiled loop where the
         scene allows it (:attr:`loop`), else one :meth:`step` at a time. The
-        same state, events and frames either way, bit for bit."""
+        same state, events and frames either way, bit for bit.
+
+        The fast path, for a caller that steps a few times per call (a
+        control loop, a viewer's frame): on the compiled loop, a plain
+        ``int`` of steps from 1 to ``LOOP_CHUNK`` goes straight to one call
+        of the kernel (:meth:`CompiledLoop.advance
+        <refsim.dynamics.compiled_loop.CompiledLoop.advance>`), without the
+        signal hold and the general check of the count. The same bits: it
+        is the same kernel call on the same arrays that :meth:`_advance`
+        makes for these steps. No hold is needed around it: the kernel
+        counts its steps and event rows itself before returning
+        (:mod:`refsim.dynamics.loop_layout`), so a signal acted on after it
+        finds steps, time and events accounting for the state. When the
+        kernel stops short (a step that needs the readable stages, a full
+        event buffer), the rest of the steps go the general way below.
+        """
+        loop = self._loop
+        if loop is not None and n_steps.__class__ is int and 0 < n_steps <= LOOP_CHUNK:
+            n_steps = loop.advance(n_steps)          # the steps it did not take
+            if not n_steps:
+                return
         n_steps = check_count("n_steps", n_steps, maximum=MAX_STEPS)
         with held_signals() as hold:
             self._advance(n_steps, hold)
@@ -551,8 +600,10 @@ class Simulation:
         """Go back to a :meth:`snapshot` of this simulation (in place)."""
         for name in ("x", "v", "w", "R", "lo", "hi"):
             getattr(self, name)[...] = snapshot[name]
-        self.t, self.steps = snapshot["t"], snapshot["steps"]
-        del self.events[snapshot["events"]:]
+        self.steps = snapshot["steps"]
+        del self._events[snapshot["events"]:]
+        # no event row of the loop pending (those after the snapshot are dropped)
+        self._counters[slot.C_EVENT_BASE:slot.C_PENDING + 1] = (len(self._events), 0)
         self._touching = set(snapshot["touching"])
         if self._loop is not None:
             self._loop.touching_changed()
@@ -578,14 +629,16 @@ class Simulation:
                     hold.check()
             return
         while n_steps:
-            # at most LOOP_CHUNK steps per call, so a held signal waits at
-            # most one call (milliseconds)
-            done, stop = loop.advance(min(n_steps, LOOP_CHUNK))
-            n_steps -= done
-            if stop == loop.STOP_READABLE:
+            if loop.stop == loop.STOP_READABLE:
+                loop.stop = loop.DONE
                 with _quiet_overflow():
                     self.step()       # a step the loop does not take: the readable stages
                 n_steps -= 1
+            else:
+                # at most LOOP_CHUNK steps per call, so a held signal waits at
+                # most one call (milliseconds)
+                chunk = min(n_steps, LOOP_CHUNK)
+                n_steps -= chunk - loop.advance(chunk)
             hold.check()
 
     # 1. forces and the solver, all bodies at once (S5, S6)
@@ -835,9 +888,10 @@ class Simulation:
         for contact in sorted(touching - self._touching, key=lambda c: (c.body, c.other)):
             J, point = impulse.impulse_and_point(
                 self._impulses.get((self._index[contact.body], contact.other)))
-            self.events.append(Event(kind=contact.kind, step=self.steps, time=self.t,
-                                     body=contact.body, other=contact.other, impulse=J,
-                                     point=point))
+            self._events.append(Event(kind=contact.kind, step=self.steps, time=self.t,
+                                      body=contact.body, other=contact.other, impulse=J,
+                                      point=point))
+        self._counters[slot.C_EVENT_BASE] = len(self._events)    # the loop's rows come after
         self._touching = touching
         if self._loop is not None:
             self._loop.touching_changed()

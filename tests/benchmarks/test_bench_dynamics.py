@@ -200,7 +200,8 @@ def test_one_step_per_call(benchmark, oracle, engine, bodies):
 
 def test_restore_repeats_the_same_steps_bit_for_bit():
     # what makes the rounds comparable: from a restored snapshot, refsim takes
-    # the same steps again, to the bit, on either kernel
+    # the same steps again, to the bit, on either kernel, in one call or one
+    # step per call
     from refsim.dynamics.simulation import Simulation
 
     scene, _ = bench_scene("10 cubes", "seed")
@@ -210,9 +211,15 @@ def test_restore_repeats_the_same_steps_bit_for_bit():
         start = sim.snapshot()
         sim.advance(300)
         first = (sim.x.copy(), sim.v.copy(), sim.w.copy(), list(sim.events))
-        sim.restore(start)
-        sim.advance(300)
-        assert sim.x.tobytes() == first[0].tobytes()
-        assert sim.v.tobytes() == first[1].tobytes()
-        assert sim.w.tobytes() == first[2].tobytes()
-        assert sim.events == first[3] and len(first[3]) > len(scene.bodies)
+        for one_call in (True, False):       # test_step's rounds, and test_one_step_per_call's
+            sim.restore(start)
+            if one_call:
+                sim.advance(300)
+            else:
+                for _ in range(300):
+                    sim.advance(1)
+            assert sim.x.tobytes() == first[0].tobytes()
+            assert sim.v.tobytes() == first[1].tobytes()
+            assert sim.w.tobytes() == first[2].tobytes()
+            assert sim.events == first[3] and len(first[3]) > len(scene.bodies)
+            assert sim.steps == start["steps"] + 300

@@ -152,6 +152,83 @@ def test_advance_then_step_then_advance_keeps_events_in_order():
     assert compiled.w.tobytes() == readable.w.tobytes()
 
 
+def _two_cubes_at_level_exact():
+    # two cubes meeting head-on at level "exact": the loop hands back the
+    # steps whose boxes overlap
+    return scene_from_dict({
+        "world": {"half_size": 5.0, "gravity": 0.0},
+        "integration": {"step": 1e-3, "duration": 1.0},
+        "collision": {"level": "exact"},
+        "dynamics": {"rotation": "off", "body_response": "impulse"},
+        "body": [{"name": "a", "model": "cube.ac", "position": [-2.0, 0.0, 0.0],
+                  "velocity": [3.0, 0.0, 0.0]},
+                 {"name": "b", "model": "cube.ac", "position": [2.0, 0.1, 0.0],
+                  "velocity": [-3.0, 0.0, 0.0]}]})
+
+
+@pytest.mark.parametrize("case", ["1 cube", "10 cubes", "sphere-2k", "40 cubes seed",
+                                  "exact level"])
+def test_one_step_per_call_is_one_call_and_the_readable_step_bit_for_bit(case):
+    # Simulation.advance's fast path (one kernel call, no signal hold) against
+    # one advance of all the steps and against the readable step: the same
+    # state, counts and events, with wall and body events and hand-backs
+    from refsim.studies.bounce import bench_scene
+
+    if case == "exact level":
+        scene, n = _two_cubes_at_level_exact(), 1000
+    elif case == "40 cubes seed":
+        scene, n = cubes_scene(40, "seed", seed=4), 600
+    else:
+        scene, n = bench_scene(case, "impulse")[0], 2500
+    whole = Simulation(scene, kernel="compiled")
+    whole.advance(n)
+    calls = Simulation(scene, kernel="compiled")
+    for _ in range(n):
+        calls.advance(1)
+    readable = Simulation(scene, kernel="readable")
+    readable.advance(n)
+    for sim in (calls, whole):
+        for name in ("x", "v", "w", "R"):
+            assert getattr(sim, name).tobytes() == getattr(readable, name).tobytes(), name
+        assert (sim.steps, sim.t) == (readable.steps, readable.t) == (n, n * scene.integration.step)
+        assert sim.events == readable.events
+    assert calls.loop_steps == whole.loop_steps > 0
+    assert readable.events                    # wall contacts at least
+    if case == "exact level":
+        assert calls.loop_steps < n and any(e.kind == "body" for e in calls.events)
+
+
+def test_event_rows_left_by_an_interrupted_call_are_added_once():
+    # What a signal between the kernel's return and the bookkeeping leaves:
+    # the kernel has counted the steps and its event rows are pending. They
+    # become events when the list is read, and a second reading after a cut
+    # between the list's growth and the counters' reset adds nothing twice.
+    from refsim.dynamics import loop_layout as slot
+
+    scene = cubes_scene(10, "impulse", seed=3)
+    reference = Simulation(scene, kernel="compiled")
+    reference.advance(2500)
+    sim = Simulation(scene, kernel="compiled")
+    loop = sim._loop
+    kernel, floats, ints, flags = loop._call
+    counters = loop.counters
+    for done in range(500, 2501, 500):         # the kernel alone, nothing noted
+        kernel(500, floats, ints, flags)
+        assert counters[slot.C_LEFT] == 0 and sim.steps == done   # counted by the kernel
+    assert counters[slot.C_PENDING] > 1 and sim._events == []
+    before = counters.copy()
+    sim._events.extend(reference.events[:2])   # as if cut after part of a note
+    counters[...] = before
+    assert sim.events == reference.events      # the rest added, none twice
+    counters[...] = before                     # cut after the extend, before the reset
+    assert sim.events == reference.events and counters[slot.C_PENDING] == 0
+    for name in ("x", "v", "w", "R"):
+        assert getattr(sim, name).tobytes() == getattr(reference, name).tobytes(), name
+    sim.advance(300)
+    reference.advance(300)
+    assert sim.events == reference.events and sim.t == reference.t
+
+
 def test_what_the_loop_does_not_run_says_why():
     assert "readable" in Simulation(cubes_scene(1), kernel="readable").loop
     assert Simulation(cubes_scene(1, "impulse"), kernel="compiled").loop is None
@@ -241,6 +318,34 @@ def test_ctrl_c_during_the_loop_leaves_the_simulation_consistent():
         assert getattr(sim, name).tobytes() == getattr(again, name).tobytes(), name
     assert sim.events == again.events
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler   # restored
+
+
+def test_ctrl_c_during_one_step_calls_leaves_the_simulation_consistent():
+    # the same with advance(1) in a Python loop, the fast path without the
+    # signal hold: wherever the interrupt lands, the kernel has counted the
+    # steps it took and its event rows, and they show in steps, t and events
+    import os
+    import signal
+    import threading
+
+    scene = cubes_scene(10, "seed", seed=3, solver="rk4")
+    sim = Simulation(scene, kernel="compiled")
+    sim.advance(1)
+    timer = threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            while True:
+                sim.advance(1)
+    finally:
+        timer.cancel()
+    assert 10 < sim.steps and sim.t == sim.steps * sim.h
+    again = Simulation(scene, kernel="compiled")
+    again.run(sim.steps)
+    for name in ("x", "v", "w", "R"):
+        assert getattr(sim, name).tobytes() == getattr(again, name).tobytes(), name
+    assert sim.events == again.events and sim.events
+    assert sim.loop_steps == sim.steps
 
 
 # -- the corrected rotation model ("impulse") and its wall impulses -------------------------
