@@ -325,29 +325,6 @@ def classify_pairs(case, got, tolerance: float = 0.0, roundoff: float = 1.0) -> 
     return _classify_face_pairs(case, sorted(truth ^ answer), tolerance, roundoff)
 
 
-def _inside(point, mesh, pose) -> bool:
-    """Whether ``point`` (world) is inside the closed mesh under ``pose``: the
-    parity of crossings of a ray in a fixed, generic direction (float64; for
-    classifying a disagreement only, never for a ground truth)."""
-    from refsim.types import transform_points
-
-    world = transform_points(mesh.vertices, pose)
-    tri = world[mesh.faces]                                   # (m, 3, 3)
-    direction = np.array([0.5773502691896258, 0.5773502691896257, 0.5773502691896259])
-    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
-    p = np.cross(direction, e2)
-    det = (e1 * p).sum(axis=1)
-    ok = np.abs(det) > 1e-300
-    s = point - tri[:, 0]
-    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    u = (s * p).sum(axis=1) * inv
-    q = np.cross(s, e1)
-    v = (q * direction).sum(axis=1) * inv
-    t = (q * e2).sum(axis=1) * inv
-    hits = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
-    return bool(hits.sum() % 2)
-
-
 def _surface_gap(case, tolerance: float, roundoff: float = 1.0) -> dict:
     """The class of a false "collide" between surfaces that do not meet, by
     their smallest distance: the triangle distances of the face pairs whose
@@ -376,13 +353,15 @@ def classify_collide(case, got: bool, tolerance: float = 0.0, solid: bool = Fals
     body's centroid inside the other is "known-divergence" for an engine
     that declares itself ``solid`` and "bug" for any other (its surfaces do
     not meet); else it is classed by the surfaces' distance."""
+    from refsim.collision.containment import contains_point
+
     if len(case.truth) > 0:
         return _classify_face_pairs(case, [tuple(p) for p in np.asarray(case.truth)], tolerance,
                                     roundoff)
     centroid_a = np.asarray(case.pose_a[0]) @ case.mesh_a.vertices.mean(axis=0) + case.pose_a[1]
     centroid_b = np.asarray(case.pose_b[0]) @ case.mesh_b.vertices.mean(axis=0) + case.pose_b[1]
-    if (_inside(centroid_b, case.mesh_a, case.pose_a)
-            or _inside(centroid_a, case.mesh_b, case.pose_b)):
+    if (contains_point(case.mesh_a, case.pose_a, centroid_b)
+            or contains_point(case.mesh_b, case.pose_b, centroid_a)):
         return {"class": "known-divergence" if solid else "bug", "contained": True,
                 "solid_declared": solid}
     return _surface_gap(case, tolerance, roundoff)
