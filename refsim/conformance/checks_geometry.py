@@ -211,7 +211,7 @@ def classify_triangles(a, b, distance_tolerance: float = 0.0, roundoff: float = 
     float64's (:func:`_roundoff`), which scales the rounding bound."""
     from refsim.collision.sat_exact import triangles_intersect_sat
     from refsim.collision.triangle import triangles_intersect
-    from refsim.studies.triangles import _points_coplanar, _strict_crossing
+    from refsim.studies.triangles import exact_class
 
     t1 = tuple(map(tuple, np.asarray(a, np.float64).tolist()))
     t2 = tuple(map(tuple, np.asarray(b, np.float64).tolist()))
@@ -219,13 +219,12 @@ def classify_triangles(a, b, distance_tolerance: float = 0.0, roundoff: float = 
     truth = triangles_intersect_sat(t1, t2)
     bound = rounding_bound(a, b) * roundoff
     gap = signed_gap(a, b, refsim if truth is None else truth)
-    if truth is not None and truth != refsim:
-        kind = "bug"                       # the ground truth itself is wrong
-    elif _points_coplanar(t1 + t2):
-        kind = "coplanar"
-    elif refsim and not _strict_crossing(t1, t2):
-        kind, gap = "touching", 0.0
-    else:
+    # "bug" (the ground truth itself is wrong), "coplanar", "touching": the
+    # classes exact predicates decide, as in the studies' classifier
+    kind = exact_class(t1, t2, (refsim, truth))
+    if kind == "touching":
+        gap = 0.0
+    elif kind is None:
         kind = "tolerance" if abs(gap) <= max(bound, distance_tolerance) else "bug"
     return _verdict(kind, gap, bound, distance_tolerance, roundoff)
 
