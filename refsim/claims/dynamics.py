@@ -180,10 +180,9 @@ def step_cost_findings(rows: Sequence[StepCost]) -> dict:
     pybullet's time per step) and the largest stage of refsim's step in the
     first of them that was timed by stage (its share of the step); the rows
     timed after a longer warm-up (the cubes settled); refsim / pybullet by
-    body count, whether the mean
-    ratio falls as bodies are added (None when fewer than two counts or a
-    ratio is not finite), and at the largest body count whether each ratio
-    is within :data:`STEP_COST_TARGET`."""
+    body count, whether the mean ratio falls as bodies are added (None when
+    fewer than two counts or a ratio is not finite), and at the largest body
+    count whether each ratio is within :data:`STEP_COST_TARGET`."""
     early = [r for r in rows if r.warmup == min(x.warmup for x in rows)]
     counts = sorted(dict.fromkeys(r.bodies for r in early))
     ratios = {c: [r.ratio for r in early if r.bodies == c] for c in counts}

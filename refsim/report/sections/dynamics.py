@@ -3,9 +3,10 @@
 Every number comes from the plan's records: the bounce studies of
 :mod:`refsim.studies.bounce` (refsim against the analytic answers of
 :mod:`refsim.dynamics.analytic` and the pybullet oracle), and the C11/C12
-measurements of :mod:`refsim.studies.dynamics`; the verdicts and the findings
-that turn on a threshold come from :mod:`refsim.claims.dynamics`. This module
-only arranges them (STYLE.md, rule 9).
+measurements of :mod:`refsim.studies.dynamics`; the verdicts, every finding
+(worst cases, gaps, targets met) and the divergences with their classes come
+from :mod:`refsim.claims.dynamics`. This module only words them (STYLE.md,
+rule 9).
 
 A quick run has fewer restitutions, step sizes and solvers, shorter C11 and
 C12 runs and fewer timed steps (:mod:`refsim.report.entries.dynamics`); the
