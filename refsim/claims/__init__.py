@@ -24,10 +24,12 @@ but still turns on a threshold (an oracle agreeing within a tolerance, a
 target met, a spin large enough to count as tipping): they return facts
 only, and the report's sentences quote them.
 
-- :mod:`refsim.claims.bounds`: C1, C2;
+- :mod:`refsim.claims.models`: the models' facts against trimesh;
+- :mod:`refsim.claims.bounds`: C1, C2, the boxes against trimesh;
 - :mod:`refsim.claims.collision`: C3, C4, the hierarchy's speed findings;
 - :mod:`refsim.claims.solvers`: C5..C10, the solvers' oracle agreements;
-- :mod:`refsim.claims.dynamics`: C11, C12, the bounce findings;
+- :mod:`refsim.claims.dynamics`: C11, C12, the bounce findings, the
+  bounces' agreements and divergences (with their classes);
 - :mod:`refsim.claims.seed`: the claims' words and the seed's terminology.
 """
 

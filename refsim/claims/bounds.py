@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from refsim.claims.result import ClaimResult, by_timed_parts, comparison, spread
-from refsim.studies.bounds import IncrementalError, UpdateCostStudy
+from refsim.studies.bounds import BoundsAgreement, IncrementalError, UpdateCostStudy
 
 #: "Nearly equal" in the seed's C1: a scan / incremental time ratio within a
 #: factor of two either way. At a few microseconds per update a factor below
@@ -108,3 +108,28 @@ def c2(errors: Sequence[IncrementalError]) -> ClaimResult:
         "nonconvex_never_wrong": never,
         "sufficient_not_necessary": sufficient_not_necessary,
     })
+
+
+#: The class of trimesh's boxes differing from refsim's scan in the last bits
+#: (within the bound of the arithmetic: its BLAS 4x4 product rounds
+#: differently), in the divergence catalogue.
+TRIMESH_BITS_CLASS = "oracle disagreement: tolerance"
+
+
+def box_agreement(rows: Sequence[BoundsAgreement]) -> dict:
+    """The box agreement's findings over the meshes: trimesh's boxes against
+    the scan (poses within the arithmetic bound, bitwise equal, differing,
+    and, when some differ, the largest difference over the bound with its
+    divergence class :data:`TRIMESH_BITS_CLASS`); the incremental box
+    against the scan on the convex meshes (bitwise equal poses)."""
+    poses = sum(a.poses for a in rows)
+    bitwise = sum(a.trimesh_bitwise for a in rows)
+    convex = [a for a in rows if a.incremental_exact is not None]
+    found: dict = {"poses": poses, "trimesh_within": sum(a.trimesh_within for a in rows),
+                   "trimesh_bitwise": bitwise, "trimesh_differ": poses - bitwise,
+                   "convex_poses": sum(a.poses for a in convex),
+                   "incremental_exact": sum(a.incremental_exact or 0 for a in convex)}
+    if found["trimesh_differ"]:
+        found |= {"largest_over_bound": max(a.max_difference_over_tolerance for a in rows),
+                  "class": TRIMESH_BITS_CLASS}
+    return found

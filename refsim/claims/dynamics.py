@@ -18,7 +18,8 @@ from collections.abc import Sequence
 import numpy as np
 
 from refsim.claims.result import ClaimResult
-from refsim.studies.bounce import ApexRow, CostStudy, StepCost
+from refsim.studies import bounce
+from refsim.studies.bounce import ApexRow, CostStudy, DropEnergy, ObliqueRow, RestRow, StepCost
 from refsim.studies.dynamics import InterpenetrationRow, SpinSeries
 
 #: The C11 cases where bodies meet slowly or moving the same way (the claim's
@@ -43,6 +44,26 @@ STEP_COST_TARGET = 2.0
 
 #: The cube of the bounce studies (refsim.studies.bounce.CUBE).
 CUBE = "cube.ac"
+
+#: refsim's accuracy target for the bounce: with rotation off, at the
+#: reference step and solver (refsim.studies.bounce.STEP, SOLVER), each apex
+#: ratio within this relative error of e^2.
+APEX_RATIO_TARGET = 0.005
+
+#: Relative apex-ratio errors at or below this are rounding: the floor below
+#: which the bounce study leaves errors out of its fitted orders
+#: (refsim.studies.bounce.ROUNDING_ERROR), so that the findings and the fit
+#: call the same errors rounding.
+ROUNDING_ERROR = bounce.ROUNDING_ERROR
+
+#: The class of each divergence of refsim's seed model or pybullet from the
+#: analytic answers (:func:`divergences`), by the divergence's key.
+DIVERGENCE_CLASSES = {
+    "pybullet-apex": "oracle: contact model",
+    "literal-wall-flip": "seed ambiguity, resolved (D1)",
+    "lateral-friction": "model difference (seed against pybullet)",
+    "pybullet-tips": "oracle: contact model",
+}
 
 
 def c11(rows: Sequence[InterpenetrationRow]) -> ClaimResult:
@@ -105,7 +126,8 @@ def _finite(values) -> list[float]:
     return [float(v) for v in values if v is not None and math.isfinite(v)]
 
 
-def apex_findings(rows: Sequence[ApexRow], target: float, rounding: float) -> dict:
+def apex_findings(rows: Sequence[ApexRow], target: float = APEX_RATIO_TARGET,
+                  rounding: float = ROUNDING_ERROR) -> dict:
     """The apex table's findings: the largest error from e^2 with rotation
     off (at ``rounding``? within the apex-ratio ``target``?), of the seed's
     literal wall speed, of the cube face down; the cube with the seed's
@@ -144,7 +166,7 @@ def tipping_spin(rows: Sequence[ApexRow]) -> float | None:
     return max(spins) if spins else None
 
 
-def rounding_series(cost: CostStudy, rounding: float) -> list[str]:
+def rounding_series(cost: CostStudy, rounding: float = ROUNDING_ERROR) -> list[str]:
     """The series of the error-against-cost chart whose errors stay at or
     below ``rounding`` at every step size (finite errors only)."""
     return [solver for solver in dict.fromkeys(p.solver for p in cost.points)
@@ -154,10 +176,13 @@ def rounding_series(cost: CostStudy, rounding: float) -> list[str]:
 
 def step_cost_findings(rows: Sequence[StepCost]) -> dict:
     """The step-cost table's findings (timings), over the rows timed after
-    the shortest warm-up: refsim / pybullet by body count, whether the mean
-    ratio falls as bodies are added (None when fewer than two counts or a
-    ratio is not finite), and at the largest body count whether each ratio
-    is within :data:`STEP_COST_TARGET`."""
+    the shortest warm-up: the rows of the fewest bodies (refsim's and
+    pybullet's time per step) and the largest stage of refsim's step in the
+    first of them that was timed by stage (its share of the step); the rows
+    timed after a longer warm-up (the cubes settled); refsim / pybullet by
+    body count, whether the mean ratio falls as bodies are added (None when
+    fewer than two counts or a ratio is not finite), and at the largest body
+    count whether each ratio is within :data:`STEP_COST_TARGET`."""
     early = [r for r in rows if r.warmup == min(x.warmup for x in rows)]
     counts = sorted(dict.fromkeys(r.bodies for r in early))
     ratios = {c: [r.ratio for r in early if r.bodies == c] for c in counts}
@@ -166,7 +191,23 @@ def step_cost_findings(rows: Sequence[StepCost]) -> dict:
     if len(means) > 1 and all(math.isfinite(m) for m in means):
         falling = all(b < a for a, b in zip(means, means[1:], strict=False))
     biggest = max(r.bodies for r in rows)
+    single = [r for r in early if r.bodies == min(x.bodies for x in early)]
+    largest_stage = None
+    for r in single:
+        stages = r.refsim_stage_seconds
+        if stages:
+            top = max(stages, key=stages.__getitem__)
+            largest_stage = {"rotation": r.rotation, "stage": top,
+                             "fraction": stages[top] / r.refsim_seconds}
+            break
+    late = [r for r in rows if r.warmup > min(x.warmup for x in rows)]
     return {
+        "single": [{"bodies": r.bodies, "rotation": r.rotation,
+                    "refsim_seconds": r.refsim_seconds, "pybullet_seconds": r.pybullet_seconds}
+                   for r in single],
+        "largest_stage": largest_stage,
+        "settled": [{"warmup": r.warmup, "refsim_seconds": r.refsim_seconds,
+                     "pybullet_seconds": r.pybullet_seconds} for r in late],
         "ratios": ratios,
         "ratio_falls": falling,
         "target": STEP_COST_TARGET,
@@ -175,3 +216,97 @@ def step_cost_findings(rows: Sequence[StepCost]) -> dict:
                         "within_target": r.ratio <= STEP_COST_TARGET}
                        for r in rows if r.bodies == biggest],
     }
+
+
+def _max_gap(a, b) -> float:
+    """Largest |a - b| over the pairs where both are finite (nan if none)."""
+    gaps = _finite(abs(x - y) for x, y in zip(a, b, strict=False)
+                   if x is not None and y is not None)
+    return max(gaps) if gaps else math.nan
+
+
+def height_gaps(series: DropEnergy, rows: Sequence[ApexRow]) -> dict:
+    """The heights chart's findings: the largest height difference (m) of
+    refsim and of pybullet from the analytic curve and, from the apex row of
+    the same drop with rotation off, the largest difference of their apex
+    times from the analytic ones (ms) over the bounces measured."""
+    found: dict = {"refsim_height": _max_gap(series.refsim_height, series.analytic_height),
+                   "pybullet_height": _max_gap(series.pybullet_height, series.analytic_height)}
+    row = next((r for r in rows if r.body == series.body and r.e == series.e
+                and r.rotation == "off"), None)
+    if row is not None:
+        found |= {"bounces": len(row.analytic_times) - 1,
+                  "refsim_apex_ms": 1e3 * _max_gap(row.refsim_times, row.analytic_times),
+                  "pybullet_apex_ms": 1e3 * _max_gap(row.pybullet_times, row.analytic_times)}
+    return found
+
+
+def rest_findings(rows: Sequence[RestRow]) -> list[dict]:
+    """The time-to-rest table's findings, one per row: the bounce after which
+    each engine settles, refsim's settling time less the analytic one (ms)
+    and, when pybullet settles, its bounces after (+) or before (-) the
+    analytic bounce."""
+    found = []
+    for r in rows:
+        item = {"e": r.e, "analytic_bounces": r.analytic_bounces,
+                "refsim_bounces": r.refsim_bounces,
+                "refsim_offset_ms": 1e3 * (r.refsim_settle - r.analytic_settle)}
+        if r.pybullet_bounces:
+            item |= {"pybullet_bounces": r.pybullet_bounces,
+                     "pybullet_bounces_late": r.pybullet_bounces - r.analytic_bounces}
+        found.append(item)
+    return found
+
+
+def agreement_findings(apex: Sequence[ApexRow], oblique: Sequence[ObliqueRow]) -> dict:
+    """The summary's agreement figures: over the drops with rotation off, the
+    largest apex-ratio error of refsim (against :data:`APEX_RATIO_TARGET`) and
+    of pybullet; over the spheres' oblique bounces pybullet measured, its
+    largest relative difference from Coulomb's lateral speed for a ball."""
+    found: dict = {"target": APEX_RATIO_TARGET, "step": bounce.STEP}
+    off = [r for r in apex if r.rotation == "off"]
+    if off:
+        found |= {"restitutions": list(dict.fromkeys(r.e for r in off)),
+                  "refsim_worst": max(r.refsim_error for r in off), "drops": len(off)}
+        measured = [r for r in off if r.pybullet_error is not None]
+        if measured:
+            found |= {"pybullet_worst": max(r.pybullet_error for r in measured),
+                      "pybullet_drops": len(measured)}
+    sliding = [r for r in oblique if r.body.startswith("sphere") and r.pybullet is not None]
+    if sliding:
+        found |= {"coulomb_worst": max(abs(r.pybullet - r.coulomb_ball) / r.coulomb_ball
+                                       for r in sliding),
+                  "coulomb_bounces": len(sliding)}
+    return found
+
+
+def divergences(apex: Sequence[ApexRow], oblique: Sequence[ObliqueRow]) -> list[dict]:
+    """Where pybullet or the seed's literal words part from the analytic
+    answers, each with its key, its class (:data:`DIVERGENCE_CLASSES`) and
+    its figures: pybullet's worst apex ratio (rotation off), the seed's
+    literal wall flip's worst, the spheres' lateral speed after an oblique
+    bounce, and pybullet's cube tipping (:func:`tipping_spin`)."""
+    found = []
+
+    def add(key: str, **facts) -> None:
+        found.append({"key": key, "class": DIVERGENCE_CLASSES[key], **facts})
+
+    rounds = [r for r in apex if r.rotation == "off" and r.pybullet_error is not None]
+    if rounds:
+        worst = max(rounds, key=lambda r: abs(r.pybullet_error))
+        add("pybullet-apex", body=worst.body, e=worst.e, pybullet_error=worst.pybullet_error,
+            refsim_error=worst.refsim_error)
+    literal = [r for r in apex if r.seed_speed_error is not None and r.rotation == "off"]
+    if literal:
+        worst = max(literal, key=lambda r: abs(r.seed_speed_error))
+        add("literal-wall-flip", body=worst.body, e=worst.e,
+            seed_speed_error=worst.seed_speed_error)
+    slides = [r for r in oblique if r.body.startswith("sphere") and r.pybullet is not None]
+    if slides:
+        add("lateral-friction", bounces=[{"v_t": r.v_t, "refsim": r.refsim,
+                                          "pybullet": r.pybullet, "coulomb": r.coulomb_ball}
+                                         for r in slides])
+    spin = tipping_spin(apex)
+    if spin is not None:
+        add("pybullet-tips", spin=spin)
+    return found

@@ -211,7 +211,7 @@ def classify_triangles(a, b, distance_tolerance: float = 0.0, roundoff: float = 
     float64's (:func:`_roundoff`), which scales the rounding bound."""
     from refsim.collision.sat_exact import triangles_intersect_sat
     from refsim.collision.triangle import triangles_intersect
-    from refsim.studies.triangles import _points_coplanar, _strict_crossing
+    from refsim.studies.triangles import exact_class
 
     t1 = tuple(map(tuple, np.asarray(a, np.float64).tolist()))
     t2 = tuple(map(tuple, np.asarray(b, np.float64).tolist()))
@@ -219,13 +219,12 @@ def classify_triangles(a, b, distance_tolerance: float = 0.0, roundoff: float = 
     truth = triangles_intersect_sat(t1, t2)
     bound = rounding_bound(a, b) * roundoff
     gap = signed_gap(a, b, refsim if truth is None else truth)
-    if truth is not None and truth != refsim:
-        kind = "bug"                       # the ground truth itself is wrong
-    elif _points_coplanar(t1 + t2):
-        kind = "coplanar"
-    elif refsim and not _strict_crossing(t1, t2):
-        kind, gap = "touching", 0.0
-    else:
+    # "bug" (the ground truth itself is wrong), "coplanar", "touching": the
+    # classes exact predicates decide, as in the studies' classifier
+    kind = exact_class(t1, t2, (refsim, truth))
+    if kind == "touching":
+        gap = 0.0
+    elif kind is None:
         kind = "tolerance" if abs(gap) <= max(bound, distance_tolerance) else "bug"
     return _verdict(kind, gap, bound, distance_tolerance, roundoff)
 
@@ -325,29 +324,6 @@ def classify_pairs(case, got, tolerance: float = 0.0, roundoff: float = 1.0) -> 
     return _classify_face_pairs(case, sorted(truth ^ answer), tolerance, roundoff)
 
 
-def _inside(point, mesh, pose) -> bool:
-    """Whether ``point`` (world) is inside the closed mesh under ``pose``: the
-    parity of crossings of a ray in a fixed, generic direction (float64; for
-    classifying a disagreement only, never for a ground truth)."""
-    from refsim.types import transform_points
-
-    world = transform_points(mesh.vertices, pose)
-    tri = world[mesh.faces]                                   # (m, 3, 3)
-    direction = np.array([0.5773502691896258, 0.5773502691896257, 0.5773502691896259])
-    e1, e2 = tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]
-    p = np.cross(direction, e2)
-    det = (e1 * p).sum(axis=1)
-    ok = np.abs(det) > 1e-300
-    s = point - tri[:, 0]
-    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    u = (s * p).sum(axis=1) * inv
-    q = np.cross(s, e1)
-    v = (q * direction).sum(axis=1) * inv
-    t = (q * e2).sum(axis=1) * inv
-    hits = ok & (u >= 0) & (v >= 0) & (u + v <= 1) & (t > 0)
-    return bool(hits.sum() % 2)
-
-
 def _surface_gap(case, tolerance: float, roundoff: float = 1.0) -> dict:
     """The class of a false "collide" between surfaces that do not meet, by
     their smallest distance: the triangle distances of the face pairs whose
@@ -376,13 +352,15 @@ def classify_collide(case, got: bool, tolerance: float = 0.0, solid: bool = Fals
     body's centroid inside the other is "known-divergence" for an engine
     that declares itself ``solid`` and "bug" for any other (its surfaces do
     not meet); else it is classed by the surfaces' distance."""
+    from refsim.collision.containment import contains_point
+
     if len(case.truth) > 0:
         return _classify_face_pairs(case, [tuple(p) for p in np.asarray(case.truth)], tolerance,
                                     roundoff)
     centroid_a = np.asarray(case.pose_a[0]) @ case.mesh_a.vertices.mean(axis=0) + case.pose_a[1]
     centroid_b = np.asarray(case.pose_b[0]) @ case.mesh_b.vertices.mean(axis=0) + case.pose_b[1]
-    if (_inside(centroid_b, case.mesh_a, case.pose_a)
-            or _inside(centroid_a, case.mesh_b, case.pose_b)):
+    if (contains_point(case.mesh_a, case.pose_a, centroid_b)
+            or contains_point(case.mesh_b, case.pose_b, centroid_a)):
         return {"class": "known-divergence" if solid else "bug", "contained": True,
                 "solid_declared": solid}
     return _surface_gap(case, tolerance, roundoff)

@@ -65,11 +65,10 @@ GRAVITY = 9.81
 DROP_HEIGHT = 4.0
 #: Bounces whose apex ratios are averaged.
 BOUNCES = 3
-#: The reference step and solver (refsim's accuracy target: apex ratio
-#: within APEX_RATIO_TARGET of e^2 at this step with this solver).
+#: The reference step and solver (refsim's accuracy target, judged at this
+#: step with this solver: refsim.claims.dynamics.APEX_RATIO_TARGET).
 STEP = 1e-3
 SOLVER = "rk4"
-APEX_RATIO_TARGET = 0.005
 #: Relative apex-ratio errors below this are rounding (a few ulps per step
 #: over a few thousand steps): :func:`fit_error_orders` leaves them out.
 ROUNDING_ERROR = 1e-9

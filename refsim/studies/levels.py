@@ -49,6 +49,7 @@ import numpy as np
 
 from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
+from refsim.collision.containment import contains_point
 from refsim.collision.spheres import bounding_sphere
 from refsim.kernels import choose_kernel
 from refsim.studies import TIMED
@@ -443,23 +444,6 @@ BODY_DISAGREEMENT_KINDS = ("containment", "float32 transform", "touching", "tole
 BODY_TOLERANCE = 1e-6
 
 
-def solid_contains(mesh, pose: Pose, point) -> bool:
-    """Whether ``point`` lies inside the closed mesh at ``pose``: its winding
-    number, the sum of the signed solid angles of the triangles seen from the
-    point over 4 pi (A. van Oosterom, J. Strackee, "The Solid Angle of a Plane
-    Triangle", IEEE Trans. Biomed. Eng. 30(2), 1983), is +-1 inside and 0
-    outside. Float arithmetic; used only for points well away from the
-    surface (the callers know the surfaces do not meet)."""
-    t = world_vertices(mesh, pose)[mesh.faces] - np.asarray(point, dtype=np.float64)
-    a, b, c = t[:, 0], t[:, 1], t[:, 2]
-    la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
-    numerator = np.einsum("ij,ij->i", a, np.cross(b, c))
-    denominator = (la * lb * lc + np.einsum("ij,ij->i", a, b) * lc
-                   + np.einsum("ij,ij->i", b, c) * la + np.einsum("ij,ij->i", c, a) * lb)
-    winding = 2.0 * np.arctan2(numerator, denominator).sum() / (4.0 * np.pi)
-    return bool(abs(winding) > 0.5)
-
-
 def _moved(pose_a, pose_b, mesh_a, mesh_b, toward: bool) -> Pose:
     """B's pose moved by BODY_TOLERANCE * max radius along the line of
     bounding-sphere centres (toward A or away from it)."""
@@ -482,8 +466,8 @@ def classify_body_disagreement(mesh_a, pose_a, mesh_b, pose_b, ours: bool,
     Tried in order:
 
     - ``"containment"``: refsim False, engine True, one body lies inside the
-      other (:func:`solid_contains` of a vertex) and the engine treats the
-      container as a solid (volume against surface semantics);
+      other (:func:`refsim.collision.containment.contains_point` of a vertex)
+      and the engine treats the container as a solid (volume against surface semantics);
     - ``"float32 transform"``: refsim, run on the poses the engine really
       applies (``engine.pose_used``), gives the engine's answer;
     - ``"touching"``: refsim True, oracle False, and no intersecting triangle
@@ -500,9 +484,9 @@ def classify_body_disagreement(mesh_a, pose_a, mesh_b, pose_b, ours: bool,
     pose_used = getattr(engine, "pose_used", None)
     if not ours and is_solid is not None:
         if ((is_solid(mesh_a.vertices, mesh_a.faces)
-             and solid_contains(mesh_a, pose_a, world_vertices(mesh_b, pose_b)[0]))
+             and contains_point(mesh_a, pose_a, world_vertices(mesh_b, pose_b)[0]))
                 or (is_solid(mesh_b.vertices, mesh_b.faces)
-                    and solid_contains(mesh_b, pose_b, world_vertices(mesh_a, pose_a)[0]))):
+                    and contains_point(mesh_b, pose_b, world_vertices(mesh_a, pose_a)[0]))):
             return "containment"
     if pose_used is not None:
         if bodies_collide(mesh_a, pose_used(pose_a), mesh_b, pose_used(pose_b),

@@ -47,7 +47,12 @@ from refsim.solvers.problems import (
     kepler_orbit,
     projectile_linear_drag,
 )
-from refsim.solvers.stability import imaginary_axis_limit, real_axis_limit
+from refsim.solvers.stability import (
+    imaginary_axis_limit,
+    real_axis_limit,
+    stability_grid,
+    stability_polynomial,
+)
 from refsim.studies import TIMED
 
 EPS = np.finfo(np.float64).eps
@@ -393,6 +398,36 @@ def measure_stability(methods=tuple(SOLVERS)) -> list[StabilityLimit]:
             _largest_non_growing(lambda x, m=method: _oscillator_grows(m, x), 1e-3, 8.0),
         ))
     return out
+
+
+def stability_regions(re: tuple[float, float], im: tuple[float, float], n: int):
+    """Each method's stability polynomial R(z) (Fractions, lowest power
+    first) and |R| on an ``n`` x ``n`` grid of z = h lambda over ``re`` x
+    ``im``, one region per distinct R(z): methods with the same R share one
+    (averaged-euler and midpoint), labelled "a = b (same R)".
+    Returns ``(polynomials, x, y, regions)``: ``regions`` is a list of
+    ``(label, |R| (n, n))``, ``x`` and ``y`` the grid's axes (None when there
+    are no methods)."""
+    polynomials = {name: stability_polynomial(s) for name, s in SOLVERS.items()}
+    groups: dict[tuple, list[str]] = {}
+    for name in SOLVERS:
+        groups.setdefault(polynomials[name], []).append(name)
+    regions = []
+    x = y = None
+    for names in groups.values():
+        x, y, absR = stability_grid(SOLVERS[names[0]], re=re, im=im, n=n)
+        regions.append((" = ".join(names) + (" (same R)" if len(names) > 1 else ""), absR))
+    return polynomials, x, y, regions
+
+
+def failing_order_conditions(solver) -> list[str]:
+    """The order conditions up to the seed's stated order that the tableau
+    fails (empty when it meets them all)."""
+    if solver.row_sums() != solver.c:
+        return ["c_i != sum_j a_ij"]
+    return [f"{name.split(' = ')[0]} = {value}, not {want}"
+            for p, name, value, want in solver.order_conditions()
+            if p <= solver.seed_order and value != want]
 
 
 def energy_per_period(method, omega_h: float, periods: int = 10) -> float:

@@ -228,38 +228,66 @@ def decision_margin(t1, t2) -> float:
     return min(margins)
 
 
+#: The classes a disagreement on a triangle pair takes from exact predicates
+#: alone (:func:`exact_class`), shared by this study's classifier and the
+#: conformance kit's (:func:`refsim.conformance.checks_geometry.classify_triangles`).
+#: The two part only where no exact predicate decides: this study calls a
+#: pair "tolerance" by its dimensionless decision margin
+#: (:data:`NEAR_DEGENERATE_MARGIN`), the kit by its gap in metres against the
+#: rounding bound and the engine's declared tolerance.
+EXACT_CLASSES = ("bug", "coplanar", "touching")
+
+
+def exact_class(t1, t2, answers: tuple[bool, bool | None] | None = None) -> str | None:
+    """The class of a disagreement on the triangle pair ``(t1, t2)`` (tuples
+    of float coordinates) that exact predicates decide, or None when none
+    does and the class turns on a tolerance:
+
+    - ``"bug"``: refsim's exact answer differs from an independent exact
+      ground truth, the separating-axis test in rational arithmetic
+      (:mod:`refsim.collision.sat_exact`; not applicable, so never a bug, for
+      a degenerate triangle);
+    - ``"coplanar"``: all six vertices lie on one plane, exactly;
+    - ``"touching"``: refsim finds a common point, but no edge crosses the
+      other triangle's open interior with all signs strict: the contact
+      depends on an exact zero orientation (the exact minimum distance is 0).
+
+    ``answers``: ``(refsim, truth)`` when the caller has them already:
+    :func:`refsim.collision.triangle.triangles_intersect` and
+    :func:`refsim.collision.sat_exact.triangles_intersect_sat` on the pair.
+    """
+    refsim, truth = answers if answers is not None else (
+        triangles_intersect(t1, t2), triangles_intersect_sat(t1, t2))
+    if truth is not None and truth != refsim:
+        return "bug"
+    if _points_coplanar(t1 + t2):
+        return "coplanar"
+    if refsim and not _strict_crossing(t1, t2):
+        return "touching"
+    return None
+
+
 def classify_disagreement(a, b) -> str:
     """Why an engine's answer may differ from refsim's exact one on (a, b).
 
-    First, refsim's answer is checked against an independent exact ground
-    truth, the separating-axis test in rational arithmetic
-    (:mod:`refsim.collision.sat_exact`): if they differ, refsim is wrong and
-    the class is ``"bug"`` whatever the margins say. Otherwise refsim is right
-    and the oracle's answer is explained by the first that applies:
+    First the classes exact predicates decide (:func:`exact_class`):
+    ``"bug"`` when refsim's answer differs from the rational separating-axis
+    ground truth (refsim is wrong, whatever the margins say), then
+    ``"coplanar"`` and ``"touching"``. Otherwise:
 
-    - ``"coplanar"``: all six vertices lie on one plane, exactly.
-    - ``"touching"``: refsim finds a common point, but no edge crosses the
-      other triangle's open interior with all signs strict: the contact
-      depends on an exact zero orientation (touching at a vertex, an edge or
-      along a face boundary; the exact minimum distance is 0).
     - ``"tolerance"``: no exact zero decides it, but the decision is
       near-degenerate (:func:`decision_margin` <= ``NEAR_DEGENERATE_MARGIN``):
       within reach of a float engine's rounding and epsilons.
     - ``"bug"``: anything else: a well-conditioned pair answered differently.
 
-    (For a degenerate triangle the ground truth does not apply; such pairs go
-    straight to the classes above.) Call it only for pairs where the answers
-    differ; it does not look at them.
+    Call it only for pairs where the answers differ; it does not look at
+    them.
     """
     t1 = tuple(map(tuple, np.asarray(a, np.float64).tolist()))
     t2 = tuple(map(tuple, np.asarray(b, np.float64).tolist()))
-    truth = triangles_intersect_sat(t1, t2)
-    if truth is not None and truth != triangles_intersect(t1, t2):
-        return "bug"
-    if _points_coplanar(t1 + t2):
-        return "coplanar"
-    if triangles_intersect(t1, t2) and not _strict_crossing(t1, t2):
-        return "touching"
+    kind = exact_class(t1, t2)
+    if kind is not None:
+        return kind
     if decision_margin(t1, t2) <= NEAR_DEGENERATE_MARGIN:
         return "tolerance"
     return "bug"

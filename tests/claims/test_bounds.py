@@ -118,3 +118,17 @@ def test_c2_facts_name_the_meshes():
     assert facts["convex_wrong_frames"] == 0
     assert facts["nonconvex_wrong"] == ["l-beam", "torus"]
     assert facts["nonconvex_never_wrong"] == ["bumpy"]
+
+
+def test_box_agreement():
+    from refsim.claims.bounds import TRIMESH_BITS_CLASS, box_agreement
+    from refsim.studies.bounds import BoundsAgreement
+
+    rows = [BoundsAgreement("cube.ac", 12, 50, 50, 48, 50, 0.25),
+            BoundsAgreement("star.ac", 96, 50, None, 50, 50, 0.0)]
+    found = box_agreement(rows)
+    assert found == {"poses": 100, "trimesh_within": 100, "trimesh_bitwise": 98,
+                     "trimesh_differ": 2, "convex_poses": 50, "incremental_exact": 50,
+                     "largest_over_bound": 0.25, "class": TRIMESH_BITS_CLASS}
+    same = box_agreement([BoundsAgreement("star.ac", 96, 50, None, 50, 50, 0.0)])
+    assert same["trimesh_differ"] == 0 and "class" not in same

@@ -14,18 +14,34 @@ import numpy as np
 import pytest
 
 from refsim.claims.dynamics import (
+    APEX_RATIO_TARGET,
     C11_CLAIM_CASES,
     DETECTION_FRAMES,
+    DIVERGENCE_CLASSES,
     NOTICEABLE_SPIN,
+    ROUNDING_ERROR,
     STEP_COST_TARGET,
+    agreement_findings,
     apex_findings,
     c11,
     c12,
+    divergences,
+    height_gaps,
+    rest_findings,
     rounding_series,
     step_cost_findings,
     tipping_spin,
 )
-from refsim.studies.bounce import ApexRow, CostPoint, CostStudy, StepCost
+from refsim.studies import bounce
+from refsim.studies.bounce import (
+    ApexRow,
+    CostPoint,
+    CostStudy,
+    DropEnergy,
+    ObliqueRow,
+    RestRow,
+    StepCost,
+)
 from refsim.studies.dynamics import InterpenetrationRow, SpinSeries
 
 
@@ -158,3 +174,76 @@ def test_step_cost_ratio_must_fall_at_every_count():
     assert found["ratio_falls"] is False            # 6.0 then 6.0: not falling
     assert [r["warmup"] for r in found["at_largest"]] == [20, 3000]
     assert step_cost_findings([step(1, 30.0)])["ratio_falls"] is None
+
+
+def test_step_cost_single_body_stage_and_settled_rows():
+    rows = [step(1, 30.0), step(1, 20.0, rotation="seed"), step(40, 6.0),
+            step(40, 1.0, warmup=3000)]
+    rows[1] = StepCost(**{**rows[1].__dict__, "refsim_stage_seconds": {"a": 1e-5, "b": 3e-5}})
+    found = step_cost_findings(rows)
+    assert [r["rotation"] for r in found["single"]] == ["off", "seed"]
+    assert found["largest_stage"] == {"rotation": "seed", "stage": "b",
+                                      "fraction": 3e-5 / rows[1].refsim_seconds}
+    assert found["settled"] == [{"warmup": 3000, "refsim_seconds": 1e-5,
+                                 "pybullet_seconds": 1e-5}]
+
+
+def test_thresholds_sit_beside_the_claims():
+    assert APEX_RATIO_TARGET == 0.005
+    # the findings and the study's fitted orders call the same errors rounding
+    assert ROUNDING_ERROR == bounce.ROUNDING_ERROR
+    assert apex_findings([apex()])["target"] == APEX_RATIO_TARGET
+
+
+def test_height_gaps():
+    series = DropEnergy(body="sphere-2k.ac", e=0.8, t=[0.0, 1.0, 2.0],
+                        refsim_height=[1.0, 0.5, None], pybullet_height=[1.0, 0.2, 0.3],
+                        analytic_height=[1.0, 0.25, 0.5], refsim_energy=[], pybullet_energy=[],
+                        analytic_energy=[])
+    row = ApexRow(**{**apex().__dict__, "analytic_times": [0.0, 1.0, 2.0],
+                     "refsim_times": [0.0, 1.001, 2.0], "pybullet_times": [0.0, 1.0, 2.01]})
+    found = height_gaps(series, [row])
+    assert found["refsim_height"] == 0.25 and found["pybullet_height"] == 0.2
+    assert found["bounces"] == 2
+    assert found["refsim_apex_ms"] == pytest.approx(1.0)
+    assert found["pybullet_apex_ms"] == pytest.approx(10.0)
+    assert "bounces" not in height_gaps(series, [ApexRow(**{**row.__dict__, "rotation": "seed"})])
+
+
+def test_rest_findings():
+    rows = [RestRow(body="s", e=0.5, zeno=3.0, analytic_settle=2.0, refsim_settle=2.5,
+                    pybullet_settle=2.0, refsim_bounces=5, pybullet_bounces=7,
+                    analytic_bounces=5),
+            RestRow(body="s", e=0.8, zeno=3.0, analytic_settle=2.0, refsim_settle=2.0,
+                    pybullet_settle=math.nan, refsim_bounces=5, pybullet_bounces=0,
+                    analytic_bounces=5)]
+    found = rest_findings(rows)
+    assert found[0]["refsim_offset_ms"] == 500.0 and found[0]["pybullet_bounces_late"] == 2
+    assert "pybullet_bounces" not in found[1]
+
+
+def oblique(body="sphere-2k.ac", pybullet=1.0, coulomb=1.25) -> ObliqueRow:
+    return ObliqueRow(body=body, rotation="off", e=0.8, friction=0.3, v_t=2.0, v_n=5.0,
+                      seed_analytic=1.4,
+                      coulomb_point=1.0, coulomb_ball=coulomb, ball_slides=False, refsim=1.4,
+                      pybullet=pybullet, pybullet_spin=0.0)
+
+
+def test_agreement_findings():
+    found = agreement_findings([apex(error=1e-3), apex(error=2e-3),
+                                apex(rotation="seed", error=0.5)],
+                               [oblique(), oblique(pybullet=None), oblique("cube.ac", 0.0)])
+    assert found["refsim_worst"] == 2e-3 and found["drops"] == 2
+    assert found["pybullet_worst"] == 0.01 and found["pybullet_drops"] == 2
+    assert found["coulomb_worst"] == 0.2 and found["coulomb_bounces"] == 1
+    assert found["target"] == APEX_RATIO_TARGET and found["step"] == bounce.STEP
+    assert agreement_findings([], []) == {"target": APEX_RATIO_TARGET, "step": bounce.STEP}
+
+
+def test_divergences_are_classed():
+    found = divergences([apex(literal=-0.03), apex("cube.ac", pybullet_spin=1.0)], [oblique()])
+    assert [d["key"] for d in found] == ["pybullet-apex", "literal-wall-flip",
+                                         "lateral-friction", "pybullet-tips"]
+    assert all(d["class"] == DIVERGENCE_CLASSES[d["key"]] for d in found)
+    assert found[1]["seed_speed_error"] == -0.03 and found[3]["spin"] == 1.0
+    assert divergences([], []) == []

@@ -33,7 +33,6 @@ from refsim.studies.levels import (
     measure_body_oracles,
     measure_hierarchy_speed,
     measure_levels,
-    solid_contains,
 )
 
 IDENTITY = (np.eye(3), np.zeros(3))
@@ -189,15 +188,6 @@ def test_containment_in_a_non_convex_body_is_not_found_by_trimesh(trimesh_oracle
     (torus, cube), (pose_a, pose_b) = config.meshes(), config.poses()
     assert trimesh_oracle.is_solid(torus.vertices, torus.faces) is False
     assert engine_collides(trimesh_oracle, torus, pose_a, cube, pose_b) is False
-
-
-def test_solid_contains():
-    cube = bundled_mesh("cube")
-    assert solid_contains(cube, IDENTITY, [0.1, -0.2, 0.3]) is True
-    assert solid_contains(cube, IDENTITY, [0.6, 0.0, 0.0]) is False
-    torus = bundled_mesh("torus")
-    assert solid_contains(torus, IDENTITY, [1.0, 0.0, 0.0]) is True     # in the tube
-    assert solid_contains(torus, IDENTITY, [0.0, 0.0, 0.0]) is False    # in the hole
 
 
 # -- the classifier ----------------------------------------------------------------------

@@ -97,3 +97,23 @@ def test_integer_scaling_gives_the_rational_answers_on_every_family():
         for scale in (1.0, 2.0 ** -60, 2.0 ** 60):
             a, b = pair.a * scale, pair.b * scale
             assert triangles_intersect_sat(a, b) == _sat_in_fractions(a, b) == pair.truth
+
+
+def test_both_classifiers_share_the_exact_classes():
+    """The studies' classifier and the conformance kit's give the same class
+    wherever exact predicates decide (refsim.studies.triangles.exact_class)."""
+    from refsim.conformance.cases_triangles import triangle_cases
+    from refsim.conformance.checks_geometry import classify_triangles
+    from refsim.studies.triangles import EXACT_CLASSES, exact_class
+
+    decided = 0
+    for pair in triangle_cases(400, 0).pairs:
+        t1 = tuple(map(tuple, np.asarray(pair.a, np.float64).tolist()))
+        t2 = tuple(map(tuple, np.asarray(pair.b, np.float64).tolist()))
+        kind = exact_class(t1, t2)
+        if kind is not None:
+            decided += 1
+            assert kind in EXACT_CLASSES
+            assert classify_disagreement(pair.a, pair.b) == kind
+            assert classify_triangles(pair.a, pair.b)["class"] == kind
+    assert decided > 0

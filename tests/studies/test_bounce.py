@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
+from refsim.claims.dynamics import APEX_RATIO_TARGET
 from refsim.dynamics import analytic
 from refsim.studies.bounce import (
-    APEX_RATIO_TARGET,
     BOUNCES,
     CUBE,
     DROP_HEIGHT,

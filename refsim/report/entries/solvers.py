@@ -67,16 +67,6 @@ class AlikeRun:
     polynomials: dict
 
 
-def _failing_conditions(solver) -> list[str]:
-    """The order conditions up to the seed's stated order that the tableau
-    fails (empty when it meets them all)."""
-    if solver.row_sums() != solver.c:
-        return ["c_i != sum_j a_ij"]
-    return [f"{name.split(' = ')[0]} = {value}, not {want}"
-            for p, name, value, want in solver.order_conditions()
-            if p <= solver.seed_order and value != want]
-
-
 def solvers_orders(run: Run):
     from refsim.solvers.methods import SOLVERS
     from refsim.studies import solvers as sm
@@ -99,7 +89,7 @@ def solvers_orders(run: Run):
         convergence = sm.measure_orders(problems, oracle=run.engine("scipy"))
     return OrderRun(convergence, {k: s.order for k, s in SOLVERS.items()},
                     {k: s.seed_order for k, s in SOLVERS.items()},
-                    {k: _failing_conditions(s) for k, s in SOLVERS.items()})
+                    {k: sm.failing_order_conditions(s) for k, s in SOLVERS.items()})
 
 
 def solvers_seed_literal(run: Run):
@@ -113,22 +103,11 @@ def solvers_seed_literal(run: Run):
 
 
 def solvers_stability(run: Run):
-    from refsim.solvers.methods import SOLVERS
-    from refsim.solvers.stability import stability_grid, stability_polynomial
     from refsim.studies import solvers as sm
 
     limits = sm.measure_stability()
-    polynomials = {name: stability_polynomial(s) for name, s in SOLVERS.items()}
-    # Methods with the same R(z) share one curve (averaged-euler and midpoint).
-    groups: dict[tuple, list[str]] = {}
-    for name in SOLVERS:
-        groups.setdefault(polynomials[name], []).append(name)
-    regions = []
-    x = y = None
-    for names in groups.values():
-        x, y, absR = stability_grid(SOLVERS[names[0]], re=STABILITY_GRID_RE,
-                                    im=STABILITY_GRID_IM, n=STABILITY_GRID_N)
-        regions.append((" = ".join(names) + (" (same R)" if len(names) > 1 else ""), absR))
+    polynomials, x, y, regions = sm.stability_regions(STABILITY_GRID_RE, STABILITY_GRID_IM,
+                                                      STABILITY_GRID_N)
     return StabilityRun(limits, polynomials, STABILITY_GRID, x, y, regions)
 
 

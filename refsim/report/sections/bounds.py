@@ -6,6 +6,7 @@ records and the verdicts of :mod:`refsim.claims.bounds`.
 
 from __future__ import annotations
 
+from refsim.claims.bounds import box_agreement
 from refsim.report.charts import Series, line_chart
 from refsim.report.plan import command
 from refsim.report.section import Agreement, Divergence, Figure, Section, Table, Timing, Verdict
@@ -27,15 +28,15 @@ def build(ctx) -> Section:
     figures.append(_visits_figure(study))
     tables = [_cost_table(study, methods), _error_table(errors), _agreement_table(agreement)]
     verdicts = [_c1_verdict(ctx.run.claim("C1")), _c2_verdict(ctx.run.claim("C2"))]
-    agreements = _agreements(agreement)
-    poses = sum(a.poses for a in agreement)
-    differ = poses - sum(a.trimesh_bitwise for a in agreement)
+    found = box_agreement(agreement)
+    agreements = _agreements(found)
     divergences = [Divergence(
-        "trimesh's transformed boxes differ in the last bits", "oracle disagreement: tolerance",
-        f"{differ} of {poses} random poses differ from refsim's scan, every one within the "
-        f"arithmetic bound (largest {max(a.max_difference_over_tolerance for a in agreement):.2g}"
-        " of it): trimesh multiplies 4x4 matrices through BLAS, with fused multiply-adds and "
-        "its own order; refsim rounds each operation once", "bounds-agreement")] if differ else []
+        "trimesh's transformed boxes differ in the last bits", found["class"],
+        f"{found['trimesh_differ']} of {found['poses']} random poses differ from refsim's "
+        f"scan, every one within the arithmetic bound (largest "
+        f"{found['largest_over_bound']:.2g} of it): trimesh multiplies 4x4 matrices through "
+        "BLAS, with fused multiply-adds and its own order; refsim rounds each operation once",
+        "bounds-agreement")] if found["trimesh_differ"] else []
     return Section(
         key="bounds", title="Bounding boxes and the world cube",
         intro="The seed keeps each body's axis-aligned box up to date either by scanning "
@@ -151,18 +152,15 @@ def _agreement_table(agreement) -> Table:
 AGREEMENT_COMMAND = command("bounds-agreement")
 
 
-def _agreements(agreement) -> list[Agreement]:
-    poses = sum(a.poses for a in agreement)
-    within = sum(a.trimesh_within for a in agreement)
-    bitwise = sum(a.trimesh_bitwise for a in agreement)
-    convex = [a for a in agreement if a.incremental_exact is not None]
+def _agreements(found: dict) -> list[Agreement]:
+    """The summary lines (:func:`refsim.claims.bounds.box_agreement`)."""
     return [
         Agreement("trimesh", "AABB of a transformed mesh (linear scan)",
-                  f"{within} / {poses} within the arithmetic bound, {bitwise} bitwise equal",
-                  AGREEMENT_COMMAND),
+                  f"{found['trimesh_within']} / {found['poses']} within the arithmetic bound, "
+                  f"{found['trimesh_bitwise']} bitwise equal", AGREEMENT_COMMAND),
         Agreement("refsim (scan)", "incremental AABB on convex meshes, random jumps",
-                  f"{sum(a.incremental_exact for a in convex)} / "
-                  f"{sum(a.poses for a in convex)} bitwise equal", AGREEMENT_COMMAND),
+                  f"{found['incremental_exact']} / {found['convex_poses']} bitwise equal",
+                  AGREEMENT_COMMAND),
     ]
 
 

@@ -3,9 +3,10 @@
 Every number comes from the plan's records: the bounce studies of
 :mod:`refsim.studies.bounce` (refsim against the analytic answers of
 :mod:`refsim.dynamics.analytic` and the pybullet oracle), and the C11/C12
-measurements of :mod:`refsim.studies.dynamics`; the verdicts and the findings
-that turn on a threshold come from :mod:`refsim.claims.dynamics`. This module
-only arranges them (STYLE.md, rule 9).
+measurements of :mod:`refsim.studies.dynamics`; the verdicts, every finding
+(worst cases, gaps, targets met) and the divergences with their classes come
+from :mod:`refsim.claims.dynamics`. This module only words them (STYLE.md,
+rule 9).
 
 A quick run has fewer restitutions, step sizes and solvers, shorter C11 and
 C12 runs and fewer timed steps (:mod:`refsim.report.entries.dynamics`); the
@@ -91,7 +92,8 @@ def build(ctx) -> Section:
         ], xlabel="time (s)", ylabel="height of the lowest point above the floor (m)",
             size=CHART_SIZE),
         caption=f"{series.body}, e = {series.e}, dropped from {bounce.DROP_HEIGHT} m, "
-                f"h = {bounce.STEP} s, rotation off. {_height_gaps(series, apex_rows)}"
+                f"h = {bounce.STEP} s, rotation off. "
+                f"{_height_gaps(judged.height_gaps(series, apex_rows))}"
                 f"{pb_note} Reproduce: {CMD_ENERGY}; {CMD_APEX}"))
     figures.append(Figure(
         id="dynamics-energy", title="Mechanical energy over time",
@@ -120,8 +122,7 @@ def build(ctx) -> Section:
         rows=apex_table_rows,
         caption=f"Geometric mean of the first {bounce.BOUNCES} apex ratios, h = {bounce.STEP} "
                 f"s, RK4, drop height {bounce.DROP_HEIGHT} m. "
-                + _apex_findings(judged.apex_findings(apex_rows, bounce.APEX_RATIO_TARGET,
-                                                      bounce.ROUNDING_ERROR))
+                + _apex_findings(judged.apex_findings(apex_rows))
                 + " pybullet detects a contact only once the hull overlaps the wall and "
                 "restitutes that velocity (split impulse removes the overlap without "
                 "energy)."
@@ -157,7 +158,8 @@ def build(ctx) -> Section:
                     r.pybullet_bounces) for r in rest_rows),
         caption=f"The analytic bounces accumulate at the Zeno time t0 (1 + 2e/(1 - e)). "
                 f"Measured: the time of the bounce after which every apex stays below "
-                f"{bounce.REST_FRACTION} of the drop height. " + _rest_findings(rest_rows)
+                f"{bounce.REST_FRACTION} of the drop height. "
+                + _rest_findings(judged.rest_findings(rest_rows))
                 + (" Quick run: e = 0.5 only." if quick else "") + pb_note
                 + f" Reproduce: {CMD_REST}"))
 
@@ -179,8 +181,7 @@ def build(ctx) -> Section:
                 f"size from 1/{1 / max(cost_steps):.0f} to 1/{1 / min(cost_steps):.0f} s, in "
                 f"the manner of Erez, Tassa and Todorov "
                 f"(ICRA 2015). " + _order_findings(
-                    judged.rounding_series(cost, bounce.ROUNDING_ERROR), cost_run.orders,
-                    bounce.ROUNDING_ERROR)
+                    judged.rounding_series(cost), cost_run.orders, judged.ROUNDING_ERROR)
                 + " refsim's time is the whole simulate call; pybullet's the "
                 "stepSimulation calls alone. Timings vary from run to run."
                 + (f" Quick run: {len(cost_steps)} step sizes ("
@@ -215,7 +216,7 @@ def build(ctx) -> Section:
                 + "; ".join(f"{rep} runs of {n} steps after a warm-up of {w}"
                             for w, n, rep in dict.fromkeys((r.warmup, r.steps, r.repeats)
                                                            for r in step_rows))
-                + ". " + _step_cost_findings(step_rows, judged.step_cost_findings(step_rows))
+                + ". " + _step_cost_findings(judged.step_cost_findings(step_rows))
                 + " Timings vary from run to run. Reproduce: "
                 "make bench (tests/benchmarks/test_bench_dynamics.py) or " + CMD_STEP_COST))
 
@@ -286,7 +287,7 @@ def build(ctx) -> Section:
         "choices": [list(c) for c in choices()],
         "settings": {"step": bounce.STEP, "solver": bounce.SOLVER,
                      "drop_height": bounce.DROP_HEIGHT, "bounces": bounce.BOUNCES,
-                     "apex_ratio_target": bounce.APEX_RATIO_TARGET},
+                     "apex_ratio_target": judged.APEX_RATIO_TARGET},
     }
     intro = ("A body dropped onto the floor of the world cube is the seed's wall response "
              "(S7) in its simplest form: Newton's restitution law says each apex is e^2 "
@@ -302,9 +303,8 @@ def build(ctx) -> Section:
     return Section(key="dynamics", title="Rigid-body dynamics", intro=intro, figures=figures,
                    tables=tables, verdicts=verdicts, results=results,
                    replays=[_replay(r) for r in replay_rows],
-                   divergences=_divergences(apex_rows, oblique_rows,
-                                            judged.tipping_spin(apex_rows)),
-                   agreements=_agreements(apex_rows, oblique_rows))
+                   divergences=_divergences(judged.divergences(apex_rows, oblique_rows)),
+                   agreements=_agreements(judged.agreement_findings(apex_rows, oblique_rows)))
 
 
 #: The item of this section each replay is shown after (by the replay's name).
@@ -344,30 +344,15 @@ C11_CASE_NOTES = {
 }
 
 
-def _finite(values) -> list[float]:
-    return [float(v) for v in values if v is not None and math.isfinite(v)]
-
-
-def _max_gap(a, b) -> float:
-    """Largest |a - b| over the pairs where both are finite (nan if none)."""
-    gaps = _finite(abs(x - y) for x, y in zip(a, b, strict=False)
-                   if x is not None and y is not None)
-    return max(gaps) if gaps else math.nan
-
-
-def _height_gaps(series, apex_rows) -> str:
-    """The heights chart's finding: the largest gaps to the analytic curve."""
+def _height_gaps(found: dict) -> str:
+    """The heights chart's finding (:func:`refsim.claims.dynamics.height_gaps`)."""
     text = (f"Largest height difference from the analytic curve: refsim "
-            f"{_f(_max_gap(series.refsim_height, series.analytic_height), 3)} m, pybullet "
-            f"{_f(_max_gap(series.pybullet_height, series.analytic_height), 3)} m")
-    row = next((r for r in apex_rows if r.body == series.body and r.e == series.e
-                and r.rotation == "off"), None)
-    if row is not None:
-        ms = [1e3 * _max_gap(times, row.analytic_times)
-              for times in (row.refsim_times, row.pybullet_times)]
-        text += (f"; apex times over the first {len(row.analytic_times) - 1} bounces differ "
-                 f"from the analytic ones by up to {_f(ms[0], 3)} ms (refsim) and "
-                 f"{_f(ms[1], 3)} ms (pybullet)")
+            f"{_f(found['refsim_height'], 3)} m, pybullet "
+            f"{_f(found['pybullet_height'], 3)} m")
+    if "bounces" in found:
+        text += (f"; apex times over the first {found['bounces']} bounces differ "
+                 f"from the analytic ones by up to {_f(found['refsim_apex_ms'], 3)} ms (refsim) "
+                 f"and {_f(found['pybullet_apex_ms'], 3)} ms (pybullet)")
     return text + "."
 
 
@@ -409,20 +394,20 @@ def _apex_findings(found: dict) -> str:
     return " ".join(parts)
 
 
-def _rest_findings(rest_rows) -> str:
-    """The time-to-rest table's finding: the settling bounce of each engine."""
+def _rest_findings(found: list[dict]) -> str:
+    """The time-to-rest table's finding, the settling bounce of each engine
+    (:func:`refsim.claims.dynamics.rest_findings`)."""
     parts = []
-    for r in rest_rows:
-        text = (f"e = {r.e}: the analytic series settles after bounce {r.analytic_bounces}, "
-                f"refsim after bounce {r.refsim_bounces} "
-                f"({_f(1e3 * (r.refsim_settle - r.analytic_settle), 3)} ms from the analytic "
-                "time)")
-        if r.pybullet_bounces:
-            diff = r.pybullet_bounces - r.analytic_bounces
-            text += (f", pybullet after bounce {r.pybullet_bounces} ("
-                     + ("the same bounce" if diff == 0 else
-                        f"{abs(diff)} bounce{'s' if abs(diff) > 1 else ''} "
-                        + ("later" if diff > 0 else "earlier"))
+    for r in found:
+        text = (f"e = {r['e']}: the analytic series settles after bounce "
+                f"{r['analytic_bounces']}, refsim after bounce {r['refsim_bounces']} "
+                f"({_f(r['refsim_offset_ms'], 3)} ms from the analytic time)")
+        if "pybullet_bounces" in r:
+            late = r["pybullet_bounces_late"]
+            text += (f", pybullet after bounce {r['pybullet_bounces']} ("
+                     + ("the same bounce" if late == 0 else
+                        f"{abs(late)} bounce{'s' if abs(late) > 1 else ''} "
+                        + ("later" if late > 0 else "earlier"))
                      + ")")
         parts.append(text)
     return ("; ".join(parts) + ".") if parts else ""
@@ -452,26 +437,23 @@ def _stages(stages: dict) -> str:
     return "; ".join(timed) or "not timed by stage"
 
 
-def _step_cost_findings(step_rows, found: dict) -> str:
-    """The step-cost table's findings: refsim's 1-body time and the ratios
+def _step_cost_findings(found: dict) -> str:
+    """The step-cost table's findings: refsim's time with the fewest bodies,
+    its largest stage, the ratios and the settled cubes
     (:func:`refsim.claims.dynamics.step_cost_findings`)."""
-    early = [r for r in step_rows if r.warmup == min(x.warmup for x in step_rows)]
     parts = []
-    single = [r for r in early if r.bodies == min(x.bodies for x in early)]
+    single = found["single"]
     if single:
-        parts.append(f"refsim's step with {single[0].bodies} body: "
-                     + ", ".join(f"{_f(1e6 * r.refsim_seconds, 3)} us (rotation {r.rotation})"
-                                 for r in single)
+        parts.append(f"refsim's step with {single[0]['bodies']} body: "
+                     + ", ".join(f"{_f(1e6 * r['refsim_seconds'], 3)} us (rotation "
+                                 f"{r['rotation']})" for r in single)
                      + ", against pybullet's "
-                     + ", ".join(f"{_f(1e6 * r.pybullet_seconds, 3)} us" for r in single)
+                     + ", ".join(f"{_f(1e6 * r['pybullet_seconds'], 3)} us" for r in single)
                      + ".")
-        for r in single:
-            stages = r.refsim_stage_seconds
-            if stages:
-                top = max(stages, key=stages.get)
-                parts.append(f"Its largest stage (rotation {r.rotation}): {top}, "
-                             f"{_pct(stages[top] / r.refsim_seconds)} of the step.")
-                break
+        stage = found["largest_stage"]
+        if stage is not None:
+            parts.append(f"Its largest stage (rotation {stage['rotation']}): {stage['stage']}, "
+                         f"{_pct(stage['fraction'])} of the step.")
     ratios = found["ratios"]
     parts.append("refsim / pybullet by body count: "
                  + "; ".join(f"{c}: " + ", ".join(f"{x:.2g}x" for x in ratios[c])
@@ -484,13 +466,13 @@ def _step_cost_findings(step_rows, found: dict) -> str:
                  + ", ".join(f"{r['ratio']:.2g}x pybullet's (rotation {r['rotation']}, after step "
                              f"{r['warmup']}: {'within' if r['within_target'] else 'above'} a "
                              f"factor {found['target']:g})" for r in found["at_largest"]) + ".")
-    late = [r for r in step_rows if r.warmup > min(x.warmup for x in step_rows)]
+    late = found["settled"]
     if late:
         parts.append(f"Once the cubes have settled on the floor (timed after step "
-                     f"{late[0].warmup}): refsim "
-                     + ", ".join(f"{_f(1e6 * r.refsim_seconds, 3)} us" for r in late)
+                     f"{late[0]['warmup']}): refsim "
+                     + ", ".join(f"{_f(1e6 * r['refsim_seconds'], 3)} us" for r in late)
                      + ", pybullet "
-                     + ", ".join(f"{_f(1e6 * r.pybullet_seconds, 3)} us" for r in late)
+                     + ", ".join(f"{_f(1e6 * r['pybullet_seconds'], 3)} us" for r in late)
                      + " per step.")
     return " ".join(parts)
 
@@ -564,71 +546,68 @@ def _c12(result) -> Verdict:
                    summary=summary)
 
 
-def _agreements(apex_rows, oblique_rows) -> list[Agreement]:
-    """The summary lines: bounce ratios against the analytic answer and pybullet."""
-    from refsim.studies import bounce
+def _step(h: float) -> str:
+    """A step size as the summary writes it: 1e-3, not 0.001."""
+    mantissa, exponent = f"{h:.0e}".split("e")
+    return f"{mantissa}e{int(exponent)}"
 
-    rounds = [r for r in apex_rows if r.rotation == "off"]
+
+def _agreements(found: dict) -> list[Agreement]:
+    """The summary lines: bounce ratios against the analytic answer and
+    pybullet (:func:`refsim.claims.dynamics.agreement_findings`)."""
     rows = []
-    if rounds:
-        es = ", ".join(str(e) for e in dict.fromkeys(r.e for r in rounds))
+    if "refsim_worst" in found:
+        es = ", ".join(str(e) for e in found["restitutions"])
         rows.append(Agreement(
             "analytic", f"apex ratio against e^2 (e = {es}), refsim's seed model, RK4, "
-            "h = 1e-3", f"largest error {_pct(max(r.refsim_error for r in rounds))} over "
-            f"{len(rounds)} drops (tolerance {_pct(bounce.APEX_RATIO_TARGET)})", CMD_APEX))
-        measured = [r for r in rounds if r.pybullet_error is not None]
-        if measured:
+            f"h = {_step(found['step'])}", f"largest error {_pct(found['refsim_worst'])} over "
+            f"{found['drops']} drops (tolerance {_pct(found['target'])})", CMD_APEX))
+        if "pybullet_worst" in found:
             rows.append(Agreement(
                 "pybullet", f"apex ratio against e^2 (e = {es}), same scenes",
-                f"largest error {_pct(max(r.pybullet_error for r in measured))} over "
-                f"{len(measured)} drops", CMD_APEX))
-    sliding = [r for r in oblique_rows if r.body.startswith("sphere") and r.pybullet is not None]
-    if sliding:
-        worst = max(abs(r.pybullet - r.coulomb_ball) / r.coulomb_ball for r in sliding)
+                f"largest error {_pct(found['pybullet_worst'])} over "
+                f"{found['pybullet_drops']} drops", CMD_APEX))
+    if "coulomb_worst" in found:
         rows.append(Agreement(
             "pybullet", "lateral speed after an oblique bounce against Coulomb's law",
-            f"within {100 * worst:.2g}% on {len(sliding)} bounces (refsim's seed model keeps "
-            "(1 - friction) v_t instead: see the divergence catalogue)", CMD_OBLIQUE))
+            f"within {100 * found['coulomb_worst']:.2g}% on {found['coulomb_bounces']} bounces "
+            "(refsim's seed model keeps (1 - friction) v_t instead: see the divergence "
+            "catalogue)", CMD_OBLIQUE))
     return rows
 
 
-
-def _divergences(apex_rows, oblique_rows, tipping_spin) -> list[Divergence]:
-    """Where pybullet and refsim's seed model part, with the figures;
-    ``tipping_spin``: pybullet's cube's largest spin where it tips, or None
-    (:func:`refsim.claims.dynamics.tipping_spin`)."""
-    entries = []
-    rounds = [r for r in apex_rows if r.rotation == "off" and r.pybullet_error is not None]
-    if rounds:
-        worst = max(rounds, key=lambda r: abs(r.pybullet_error))
-        entries.append(Divergence(
-            "pybullet's apex ratios differ from e^2", "oracle: contact model",
-            f"largest |error| {_pct(worst.pybullet_error)} ({worst.body}, e = {worst.e}) "
-            f"against refsim's {_pct(worst.refsim_error)}: pybullet restitutes the velocity "
+def _divergence(d: dict) -> Divergence:
+    """One divergence of :func:`refsim.claims.dynamics.divergences` as the
+    catalogue words it."""
+    key = d["key"]
+    if key == "pybullet-apex":
+        return Divergence(
+            "pybullet's apex ratios differ from e^2", d["class"],
+            f"largest |error| {_pct(d['pybullet_error'])} ({d['body']}, e = {d['e']}) "
+            f"against refsim's {_pct(d['refsim_error'])}: pybullet restitutes the velocity "
             "it has once the hull overlaps the wall, a step after the ideal contact",
-            "dynamics-apex-ratios"))
-    literal = [r for r in apex_rows if r.seed_speed_error is not None and r.rotation == "off"]
-    if literal:
-        worst = max(literal, key=lambda r: abs(r.seed_speed_error))
-        entries.append(Divergence(
-            "the seed's literal wall flip gains energy", "seed ambiguity, resolved (D1)",
+            "dynamics-apex-ratios")
+    if key == "literal-wall-flip":
+        return Divergence(
+            "the seed's literal wall flip gains energy", d["class"],
             f"flipping the speed one step past the wall (the seed's words) gives apex ratios "
-            f"up to {_pct(worst.seed_speed_error)} high ({worst.body}, e = {worst.e}); refsim's "
-            "default flips the speed at the wall", "dynamics-apex-ratios"))
-    slides = [r for r in oblique_rows if r.body.startswith("sphere") and r.pybullet is not None]
-    if slides:
-        entries.append(Divergence(
-            "lateral friction: the seed's damping against Coulomb's law",
-            "model difference (seed against pybullet)",
-            "; ".join(f"v_t {r.v_t} m/s: refsim {_f(r.refsim)}, pybullet {_f(r.pybullet)}, "
-                      f"Coulomb {_f(r.coulomb_ball)}"
-                      for r in slides)
+            f"up to {_pct(d['seed_speed_error'])} high ({d['body']}, e = {d['e']}); refsim's "
+            "default flips the speed at the wall", "dynamics-apex-ratios")
+    if key == "lateral-friction":
+        return Divergence(
+            "lateral friction: the seed's damping against Coulomb's law", d["class"],
+            "; ".join(f"v_t {r['v_t']} m/s: refsim {_f(r['refsim'])}, pybullet "
+                      f"{_f(r['pybullet'])}, Coulomb {_f(r['coulomb'])}" for r in d["bounces"])
             + ": the seed keeps (1 - friction) v_t whatever the normal speed",
-            "dynamics-oblique"))
-    if tipping_spin is not None:
-        entries.append(Divergence(
-            "pybullet's falling cube tips and spins", "oracle: contact model",
-            f"max |w| {tipping_spin:.3g} rad/s after face-down "
-            "bounces that start with no spin: pybullet solves the four floor contacts one "
-            "after another, which breaks the symmetry", "dynamics-apex-ratios"))
-    return entries
+            "dynamics-oblique")
+    return Divergence(
+        "pybullet's falling cube tips and spins", d["class"],
+        f"max |w| {d['spin']:.3g} rad/s after face-down "
+        "bounces that start with no spin: pybullet solves the four floor contacts one "
+        "after another, which breaks the symmetry", "dynamics-apex-ratios")
+
+
+def _divergences(found: list[dict]) -> list[Divergence]:
+    """Where pybullet and refsim's seed model part, with the figures
+    (:func:`refsim.claims.dynamics.divergences`)."""
+    return [_divergence(d) for d in found]

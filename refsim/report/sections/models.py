@@ -6,6 +6,7 @@ model) and ``models-agreement`` (the same facts by trimesh).
 
 from __future__ import annotations
 
+from refsim.claims.models import facts_agreement
 from refsim.report.charts import bar_chart
 from refsim.report.plan import command
 from refsim.report.section import Agreement, Figure, Section, Table
@@ -51,13 +52,13 @@ def build(ctx) -> Section:
         caption="trimesh computes the same quantities with its own code (the mass "
                 "properties by a different summation), so agreement to rounding is expected. "
                 f"Reproduce: {AGREEMENT_COMMAND}")
-    worst_volume = max(a.volume_relative_difference for a in agreement)
-    worst_centroid = max(a.centroid_difference_over_diagonal for a in agreement)
+    found = facts_agreement(agreement)
     agreements = [Agreement(
         "trimesh", "convexity, closedness, volume, centre of mass of every bundled model",
-        f"{sum(a.convex_agrees and a.closed_agrees for a in agreement)} / {len(agreement)} "
-        f"agree on convex and closed; volume within {worst_volume:.1g} relative, centre of "
-        f"mass within {worst_centroid:.1g} of the diagonal", AGREEMENT_COMMAND)]
+        f"{found['convex_and_closed_agree']} / {found['models']} "
+        f"agree on convex and closed; volume within {found['worst_volume']:.1g} relative, "
+        f"centre of mass within {found['worst_centroid']:.1g} of the diagonal",
+        AGREEMENT_COMMAND)]
     offsets = [(f.name, f.centroid_offset) for f in facts if f.centroid_offset is not None]
     figure = Figure(
         id="models-centroid-offset",
