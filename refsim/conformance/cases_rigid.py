@@ -60,6 +60,13 @@ incline-*              a 1 x 0.5 x 1 m block (``shape = "box"``) resting on
                        t^2 / 2`` = 1.178 m; ``incline-stick`` (10 degrees,
                        mu 0.3) and ``incline-mu1.5`` (50 degrees, mu 1.5,
                        above 1) stay (tan a < mu)
+cradle-e1, cradle-e0.5 Newton's cradle: a row along x of equal balls (the
+                       sphere-2k model scaled to radius 0.25, mass 1), no
+                       gravity, no friction, 2.7 mm between neighbours, the
+                       first moving at 1 m/s toward the others: three balls
+                       at e = 1 leave the last at 1 m/s and the others at
+                       rest; two at e = 0.5 leave at 0.25 and 0.75 m/s
+                       (:func:`cradle_answer`)
 =====================  =====================================================
 
 Two choices keep the answers exact for every reasonable engine:
@@ -91,9 +98,9 @@ seed model) that cannot pose them refuses the scene
 (:class:`refsim.errors.UnposableKey`) and the check reports it as not
 posed, with the key.
 
-Cost: about 30,900 steps per engine in all (the drops are 1.8 to 3.0 s of
-simulated time, the free brick 12 s), and 1,700 more for the determinism
-check's reruns.
+Cost: about 30,940 steps per engine in all (the drops are 1.8 to 3.0 s of
+simulated time, the free brick 12 s, the cradles 20 ms), and 1,700 more for
+the determinism check's reruns.
 """
 
 from __future__ import annotations
@@ -191,10 +198,23 @@ INCLINE_BLOCK = (1.0, 0.5, 1.0)
 INCLINE_START_X = -3.0
 
 
+#: Newton's cradle (module docstring, :func:`cradle_answer`): name, balls,
+#: e; the balls' scale (radius, m), the gap between neighbours (m; not a
+#: whole number of steps' travel, so that an engine finds each contact
+#: 0.3 mm deep, as it would any impact), the first ball's speed (m/s) and
+#: the run (s: the pulse crosses three balls in 5.4 ms; the rest lets a
+#: contact an engine resolves over ten steps end before the run does).
+CRADLES = (("cradle-e1", 3, 1.0), ("cradle-e0.5", 2, 0.5))
+CRADLE_SCALE = 0.25
+CRADLE_GAP = 0.0027
+CRADLE_SPEED = 1.0
+CRADLE_DURATION = 0.02
+
+
 @dataclass(frozen=True)
 class RigidScene:
     """One scene of the set: its name, kind ("drop", "oblique", "spin",
-    "rest", "free", "strike", "stack", "incline"), the scene, and the
+    "rest", "free", "strike", "stack", "incline", "cradle"), the scene, and the
     parameters its answer needs (``angle``: an incline's, degrees)."""
 
     name: str
@@ -306,7 +326,57 @@ def rigid_scenes() -> tuple[RigidScene, ...]:
     for name, angle, mu in INCLINES:
         scenes.append(RigidScene(name, "incline", _incline_scene(angle, mu), 0.0, mu,
                                  angle=angle))
+    for name, balls, e in CRADLES:
+        scenes.append(RigidScene(name, "cradle", _cradle_scene(balls, e), e))
     return tuple(scenes)
+
+
+def _cradle_scene(balls: int, e: float):
+    """``balls`` equal balls in a row along x, centred on the origin,
+    CRADLE_GAP apart, the first (the most negative x) moving at
+    CRADLE_SPEED along +x; no gravity, no friction, restitution ``e``."""
+    pitch = 2.0 * CRADLE_SCALE + CRADLE_GAP
+    first = -0.5 * (balls - 1) * pitch
+    return _bodies_scene([
+        {"name": f"ball{i + 1}", "model": SPHERE, "scale": CRADLE_SCALE,
+         "position": [first + i * pitch, 0.0, 0.0],
+         "velocity": [CRADLE_SPEED if i == 0 else 0.0, 0.0, 0.0]}
+        for i in range(balls)], 0.0, e, 0.0, CRADLE_DURATION)
+
+
+def cradle_answer(scene: RigidScene) -> list[float]:
+    """The balls' velocities along the row after Newton's cradle, in order.
+
+    The balls start apart, so the impacts are a sequence of binary head-on
+    impacts, each of two equal masses, of which one is at rest, at one point
+    on their line of centres: Newton's law of restitution gives ``v1' = v (1
+    - e) / 2``, ``v2' = v (1 + e) / 2`` (Kleppner & Kolenkow, *An
+    Introduction to Mechanics*, collisions in one dimension; Stronge,
+    *Impact Mechanics*, 2000, ch. 2). At e = 1 each
+    impact hands the whole velocity on: the last ball leaves at v, the
+    others rest, momentum and energy are kept. With e < 1 a struck ball
+    leaves slower than its striker arrived, which still moves, and strikes
+    again later: the final state is a longer sequence, so the e < 1 case
+    has two balls, one impact.
+
+    Touching balls would make the answer depend on the contact model: a row
+    in contact transmits the pulse by its compliance (Hertzian contact
+    disperses it and the last ball does not leave alone), and a
+    simultaneous impact at several contacts has no answer from the
+    coefficient of restitution alone: it depends on how the contact model
+    orders or couples the contacts (R. M. Brach, *Mechanical Impact
+    Dynamics*, 1991; Stronge, *Impact Mechanics*; F. Herrmann and P.
+    Schmalzle, Am. J. Phys. 49, 761, 1981). The gaps make each impact one
+    pair's, at its own time."""
+    balls = len(scene.scene.bodies)
+    v = [CRADLE_SPEED] + [0.0] * (balls - 1)
+    if balls > 2 and scene.e != 1.0:
+        raise ValueError(f"{scene.name}: a cradle of {balls} balls at e = {scene.e} strikes "
+                         f"again after the first pass; its answer is not posed here")
+    for i in range(balls - 1):
+        u = v[i]
+        v[i], v[i + 1] = u * (1.0 - scene.e) / 2.0, u * (1.0 + scene.e) / 2.0
+    return v
 
 
 def _incline_scene(angle: float, mu: float):

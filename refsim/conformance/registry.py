@@ -32,6 +32,8 @@ rigid.free_rotation    rigid       torque-free flips and energy
 rigid.off_centre       rigid       an off-centre strike's impulse solution
 rigid.incline          rigid       Coulomb's incline: slide or stick
 rigid.stack            rigid       stable stacks stay where they are
+rigid.cradle           rigid       Newton's cradle: binary impacts hand
+                                   the velocity down the row
 =====================  ==========  =========================================
 
 ``--cases N`` sizes the generated sets (triangles, poses, boxes); the ODE
@@ -103,6 +105,7 @@ CHECKS: tuple[Check, ...] = (
     Check("rigid", "off_centre", "rigid", RB.check_rigid_off_centre),
     Check("rigid", "incline", "rigid", RB.check_rigid_incline, miss_unit="metres"),
     Check("rigid", "stack", "rigid", RB.check_rigid_stack, miss_unit="metres"),
+    Check("rigid", "cradle", "rigid", RB.check_rigid_cradle),
 )
 
 CHECK_KEYS = tuple(c.key for c in CHECKS)

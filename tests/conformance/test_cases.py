@@ -4,6 +4,7 @@ any float engine."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from fractions import Fraction
 
 import numpy as np
@@ -164,7 +165,8 @@ def test_rigid_scenes_and_their_tolerances():
                      "drop-icosahedron-e0.8", "oblique-sphere", "oblique-rolling",
                      "oblique-spin-e1", "oblique-backspin", "oblique-e0", "spin-cube", "rest-cube",
                      "free-brick", "strike-e1", "strike-e0.5", "offset-stack", "cantilever",
-                     "board", "incline-slide", "incline-stick", "incline-mu1.5"]
+                     "board", "incline-slide", "incline-stick", "incline-mu1.5", "cradle-e1",
+                     "cradle-e0.5"]
     for scene in cases.of_kind("drop"):
         body = scene.scene.bodies[0]
         vertices = R._body(body.model.name)[0]
@@ -217,6 +219,31 @@ def test_the_strike_and_its_impulse_solution():
         assert lowest - 0.125 == pytest.approx(0.0107)
         assert strike[name].scene.world.gravity == 0.0
         assert strike[name].scene.world.friction == 0.0
+
+
+def test_the_cradles_and_their_chain_of_binary_impacts():
+    """Equal balls in a row along x, 2.7 mm apart, the first at 1 m/s, no
+    gravity, no friction: at e = 1 three balls leave the last at 1 m/s; at
+    e = 0.5 two leave at v (1 - e) / 2 and v (1 + e) / 2; a row of three at
+    e < 1 strikes again and is refused."""
+    cradles = {s.name: s for s in R.rigid_cases().of_kind("cradle")}
+    assert R.cradle_answer(cradles["cradle-e1"]) == [0.0, 0.0, 1.0]
+    assert R.cradle_answer(cradles["cradle-e0.5"]) == [0.25, 0.75]
+    for cradle in cradles.values():
+        scene = cradle.scene
+        assert scene.world.gravity == 0.0 and scene.world.friction == 0.0
+        assert scene.world.restitution == cradle.e
+        balls = scene.bodies
+        assert [b.velocity for b in balls] == [(1.0, 0.0, 0.0)] + [(0.0, 0.0, 0.0)] * (
+            len(balls) - 1)
+        assert all(b.mass == 1.0 and b.position[1:] == (0.0, 0.0) for b in balls)
+        for a, b in zip(balls[:-1], balls[1:], strict=True):
+            right = a.position[0] + a.scale * R._body(a.model.name)[0][:, 0].max()
+            left = b.position[0] + b.scale * R._body(b.model.name)[0][:, 0].min()
+            assert left - right == pytest.approx(0.0027)
+    three = replace(cradles["cradle-e1"], e=0.5)
+    with pytest.raises(ValueError, match="strikes again"):
+        R.cradle_answer(three)
 
 
 def test_the_stacks_rest_on_each_other_with_their_centres_over_the_support():

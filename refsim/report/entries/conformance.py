@@ -54,7 +54,8 @@ TEXTBOOK_STEPS = ((2e-3, 1e-3), (2e-3, 1e-3, 5e-4))
 
 #: The problems a quick run follows in h (a full run: every one of
 #: refsim.conformance.checks_rigid.TEXTBOOK_PROBLEMS): the cheap ones.
-TEXTBOOK_QUICK = ("rigid.oblique_bounce", "rigid.free_rotation", "rigid.off_centre")
+TEXTBOOK_QUICK = ("rigid.oblique_bounce", "rigid.free_rotation", "rigid.off_centre",
+                  "rigid.cradle")
 
 
 @dataclass(frozen=True)
