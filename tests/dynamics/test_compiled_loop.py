@@ -106,18 +106,9 @@ def test_spinning_cube_scene_bit_for_bit():
 
 
 def test_exact_level_hands_contact_steps_back_bit_for_bit():
-    # two cubes meeting head-on at level "exact" with the corrected response:
-    # the loop takes the flight and hands back every step whose boxes overlap
-    scene = scene_from_dict({
-        "world": {"half_size": 5.0, "gravity": 0.0},
-        "integration": {"step": 1e-3, "duration": 1.0},
-        "collision": {"level": "exact"},
-        "dynamics": {"rotation": "off", "body_response": "impulse"},
-        "body": [{"name": "a", "model": "cube.ac", "position": [-2.0, 0.0, 0.0],
-                  "velocity": [3.0, 0.0, 0.0]},
-                 {"name": "b", "model": "cube.ac", "position": [2.0, 0.1, 0.0],
-                  "velocity": [-3.0, 0.0, 0.0]}]})
-    readable, compiled = _pair(scene, 1500, every=3)
+    # the corrected response: the loop takes the flight and hands back every
+    # step whose boxes overlap
+    readable, compiled = _pair(_two_cubes_at_level_exact(), 1500, every=3)
     assert 0 < compiled.loop_steps < 1500
     _assert_same(readable, compiled)
     assert any(e.kind == "body" for e in compiled.events)
