@@ -91,9 +91,8 @@ ALLOWANCES: dict[tuple[str, str], str] = {
     ("refsim.dynamics.simulation", "refsim.scenes.schema"):
         "the simulation loop runs a Scene, so it belongs above the scenes, while the rest "
         "of refsim.dynamics (forces, walls, impulses, mass properties) lies below them and "
-        "the scenes use it; moving the loop (simulation, start, energy, compiled_loop) to a "
-        "package above refsim.scenes waits for the work on the loop's per-call speed in "
-        "refsim.dynamics",
+        "the scenes use it; the fix is to move the loop (simulation, start, energy, "
+        "compiled_loop, loop_layout) to a package above refsim.scenes",
 }
 
 
