@@ -4,6 +4,7 @@ replays (issue 15) and the advisor (issue 17), and ``--workers``."""
 from __future__ import annotations
 
 import json
+import re
 import sys
 from types import SimpleNamespace
 
@@ -319,7 +320,7 @@ def test_a_stopped_report_stops_its_workers_at_once(tmp_path):
 def test_cancel_stops_the_sweeps_of_the_background_thread(tmp_path):
     """The advisor's sweep runs in the run's background thread, which
     signals do not reach; cancel() terminates its workers mid-task within
-    seconds (its tasks take tens of seconds each), and the entry raises."""
+    seconds (before the sweep's tasks have all ended), and the entry raises."""
     import time
 
     import psutil
@@ -342,8 +343,13 @@ def test_cancel_stops_the_sweeps_of_the_background_thread(tmp_path):
     assert time.monotonic() - start < 6.0    # without the cancel event: 15 s here
     _, alive = psutil.wait_procs(workers, timeout=30.0)
     assert not [p for p in alive if p.status() != psutil.STATUS_ZOMBIE]
-    with pytest.raises(SweepCancelled, match=r"sweep cancelled with 0 of \d+ tasks done"):
+    # how many tasks ended in the first seconds depends on the machine (a
+    # quick advice takes seconds); what matters is that not all of them did
+    with pytest.raises(SweepCancelled, match=r"sweep cancelled with \d+ of \d+ tasks done"
+                       ) as cancelled:
         run.get("advisor")
+    done, total = map(int, re.findall(r"\d+", str(cancelled.value))[:2])
+    assert done < total
 
 
 def test_report_command_takes_workers(tmp_path, capsys):
