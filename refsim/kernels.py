@@ -111,16 +111,21 @@ def choose_kernel(kernel: str | None) -> str:
 
 def _environment_kernel() -> str | None:
     """``REFSIM_KERNELS``'s value, or None when it is unset or empty; read
-    at every call (a test or a user may set it mid-run). Looked up in
-    ``os.environ``'s own mapping where it has one: ``os.environ.get`` raises
-    and catches a KeyError inside when the variable is unset, which made the
-    lookup a sixth of a small collision query
-    (docs/decisions/query-fixed-cost.md)."""
+    at every call (a test or a user may set it mid-run)."""
+    return _environment(KERNELS_ENV)
+
+
+def _environment(name: str) -> str | None:
+    """The environment variable ``name``'s value, or None when it is unset
+    or empty. Looked up in ``os.environ``'s own mapping where it has one:
+    ``os.environ.get`` raises and catches a KeyError inside when the
+    variable is unset, which made the lookup a sixth of a small collision
+    query (docs/decisions/query-fixed-cost.md)."""
     encodekey = getattr(os.environ, "encodekey", None)
     data = getattr(os.environ, "_data", None)
     if encodekey is None or data is None:                 # not CPython's os._Environ
-        return os.environ.get(KERNELS_ENV) or None
-    value = data.get(encodekey(KERNELS_ENV))
+        return os.environ.get(name) or None
+    value = data.get(encodekey(name))
     if value is None:
         return None
     return os.environ.decodevalue(value) or None
@@ -238,7 +243,8 @@ class Tier:
     ``dispatchers`` (dotted ``"module:function"`` names) for this processor,
     in memory or in its disk cache (:func:`compiled_here`). An explicit
     ``kernel=``, ``REFSIM_KERNELS``, a missing numba and
-    ``REFSIM_TIERED_START=0`` all bypass the tier; code that times refsim's
+    ``REFSIM_TIERED_START=0`` (read until the tier settles) all bypass the
+    tier; code that times refsim's
     calls should use one of them (``refsim report``, ``study`` and ``advise``
     set the variable), or it times readable calls on a cold cache. Its state is
     the process's: ``spent`` (readable seconds charged) and ``settled``
@@ -258,14 +264,14 @@ class Tier:
         family or a spent budget, it answers False at once from then on."""
         if self.settled:
             return False
-        if (_environment_kernel() is not None or not numba_usable()
-                or os.environ.get(TIERED_ENV, "1") == "0"):
-            return False
-        if self.spent >= self.compile_seconds or all(
-                compiled_here(resolve(name)) for name in self.dispatchers):
+        if (_environment(TIERED_ENV) == "0" or not numba_usable()
+                or self.spent >= self.compile_seconds
+                or all(compiled_here(resolve(name)) for name in self.dispatchers)):
+            # settled: from now on one attribute answers, not the environment
+            # (a compiled query takes a few microseconds)
             self.settled = True
             return False
-        return True
+        return _environment_kernel() is None      # REFSIM_KERNELS chooses, call by call
 
     def remaining(self) -> float:
         """The readable seconds left before the family compiles."""

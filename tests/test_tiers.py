@@ -64,12 +64,15 @@ def test_a_tier_charges_the_time_of_its_body(cold):
 
 def test_the_environment_and_a_compiled_family_bypass_a_tier(cold, monkeypatch):
     tier = Tier("test", ("refsim.collision._numba_build:build_tree",), compile_seconds=1.0)
-    monkeypatch.setenv("REFSIM_KERNELS", "compiled")
+    monkeypatch.setenv("REFSIM_KERNELS", "compiled")      # chooses call by call
     assert not tier.readable_first() and not tier.settled
     monkeypatch.delenv("REFSIM_KERNELS")
-    monkeypatch.setenv("REFSIM_TIERED_START", "0")
-    assert not tier.readable_first() and not tier.settled
+    assert tier.readable_first()
+    monkeypatch.setenv("REFSIM_TIERED_START", "0")        # off: settles the tier
+    assert not tier.readable_first() and tier.settled
     monkeypatch.delenv("REFSIM_TIERED_START")
+    assert not tier.readable_first()
+    tier.settled = False
     monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: True)
     assert not tier.readable_first() and tier.settled
 

@@ -71,8 +71,8 @@ def _exact_kernel(kernel: str | None, mesh_a, mesh_b):
     """How the exact hierarchy query runs: ``(kernel, tier)``, the tier to
     charge (:data:`EXACT_QUERY`) when a default call runs readable on a cold
     cache, else None."""
-    if (kernel is None and max(mesh_a.n_faces, mesh_b.n_faces) <= READABLE_FACES
-            and EXACT_QUERY.readable_first()):
+    if (kernel is None and EXACT_QUERY.readable_first()
+            and max(mesh_a.n_faces, mesh_b.n_faces) <= READABLE_FACES):
         return "readable", EXACT_QUERY
     return choose_kernel(kernel), None
 
