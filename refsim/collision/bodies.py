@@ -67,14 +67,12 @@ EXACT_QUERY = Tier("exact collision query",
 READABLE_FACES = 5000
 
 
-def _exact_kernel(kernel: str | None, mesh_a, mesh_b):
-    """How the exact hierarchy query runs: ``(kernel, tier)``, the tier to
-    charge (:data:`EXACT_QUERY`) when a default call runs readable on a cold
-    cache, else None."""
-    if (kernel is None and EXACT_QUERY.readable_first()
-            and max(mesh_a.n_faces, mesh_b.n_faces) <= READABLE_FACES):
-        return "readable", EXACT_QUERY
-    return choose_kernel(kernel), None
+def _readable_first(mesh_a, mesh_b) -> bool:
+    """Whether a default exact query runs readable now, charged to
+    :data:`EXACT_QUERY` (asked only while the tier has not settled, so that
+    a settled query pays one attribute for it)."""
+    return (EXACT_QUERY.readable_first()
+            and max(mesh_a.n_faces, mesh_b.n_faces) <= READABLE_FACES)
 
 
 def _check(level: str, allowed: tuple[str, ...], method: str, mesh_a, mesh_b) -> None:
@@ -106,11 +104,10 @@ def intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
     """
     _check(level, PAIR_LEVELS, method, mesh_a, mesh_b)
     if level == "exact" and method == "bvh":
-        kernel, tier = _exact_kernel(kernel, mesh_a, mesh_b)
-        if tier is not None:
-            with tier.charged():
-                return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
-        return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
+        if kernel is None and not EXACT_QUERY.settled and _readable_first(mesh_a, mesh_b):
+            with EXACT_QUERY.charged():
+                return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, "readable")
+        return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, choose_kernel(kernel))
     kernel = choose_kernel(kernel)
     pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
     if method == "seed":
@@ -161,11 +158,10 @@ def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
     """
     _check(level, LEVELS, method, mesh_a, mesh_b)
     if level == "exact" and method == "bvh":
-        kernel, tier = _exact_kernel(kernel, mesh_a, mesh_b)
-        if tier is not None:
-            with tier.charged():
-                return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
-        return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)
+        if kernel is None and not EXACT_QUERY.settled and _readable_first(mesh_a, mesh_b):
+            with EXACT_QUERY.charged():
+                return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, "readable")
+        return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, choose_kernel(kernel))
     kernel = choose_kernel(kernel)
     pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
     if level == "sphere":
