@@ -170,10 +170,12 @@ def test_playing_advances_the_frames(viewer):
     assert viewer.play_button.label == "Play"
 
 
-def test_the_page_stays_responsive_during_a_run():
-    # 6000 steps with the corrected rotation (the readable step, ~0.1 ms a
-    # step: the compiled loop would finish the seed's between two polls)
+def test_the_page_stays_responsive_during_a_run(monkeypatch):
+    # 6000 readable steps with the corrected rotation (the compiled loop
+    # would finish them between two polls), so that the bar is seen moving
     from dataclasses import replace
+
+    monkeypatch.setenv("REFSIM_KERNELS", "readable")
 
     scene = refsim.load_scene("spinning-cube.toml")
     scene = replace(scene, dynamics=replace(scene.dynamics, rotation="impulse"))
