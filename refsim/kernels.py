@@ -261,7 +261,9 @@ class Tier:
     def readable_first(self) -> bool:
         """Whether a default call should run the readable kernels now (and be
         charged: :meth:`charged`). Once it answers False for a compiled
-        family or a spent budget, it answers False at once from then on."""
+        family, a spent budget, ``REFSIM_TIERED_START=0`` or a missing numba,
+        the tier has settled and answers False at once from then on; for
+        ``REFSIM_KERNELS`` it answers False call by call."""
         if self.settled:
             return False
         if (_environment(TIERED_ENV) == "0" or not numba_usable()

@@ -19,19 +19,17 @@ from __future__ import annotations
 import numpy as np
 
 from refsim.collision.boxes import world_vertices
+from refsim.collision.contact import winding_numbers
 from refsim.types import Pose
 
 
 def winding_number(mesh, pose: Pose, point) -> float:
     """The winding number of the closed ``mesh`` at ``pose`` about the world
-    ``point``: the sum of its triangles' signed solid angles over 4 pi."""
-    t = world_vertices(mesh, pose)[mesh.faces] - np.asarray(point, dtype=np.float64)
-    a, b, c = t[:, 0], t[:, 1], t[:, 2]
-    la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
-    numerator = np.einsum("ij,ij->i", a, np.cross(b, c))
-    denominator = (la * lb * lc + np.einsum("ij,ij->i", a, b) * lc
-                   + np.einsum("ij,ij->i", b, c) * la + np.einsum("ij,ij->i", c, a) * lb)
-    return float(2.0 * np.arctan2(numerator, denominator).sum() / (4.0 * np.pi))
+    ``point``: the sum of its triangles' signed solid angles over 4 pi
+    (:func:`refsim.collision.contact.winding_numbers`, for one point)."""
+    triangles = world_vertices(mesh, pose)[mesh.faces]
+    point = np.asarray(point, dtype=np.float64).reshape(1, 3)
+    return float(winding_numbers(point, triangles)[0])
 
 
 def contains_point(mesh, pose: Pose, point) -> bool:
