@@ -240,9 +240,10 @@ def world_inertia(R: np.ndarray, I_body: np.ndarray) -> np.ndarray:
     return matmul(matmul(R, I_body), np.swapaxes(R, -1, -2))
 
 
-#: A vertex past a wall is a contact when it is at least this fraction as
-#: deep as the deepest (:func:`wall_contacts`): it crossed within the first
-#: half of the time the deepest has been across, about the same instant.
+#: A vertex past a wall is a contact of an impact when it is at least this
+#: fraction as deep as the deepest (:func:`wall_contacts`): it crossed within
+#: the first half of the time the deepest has been across, about the same
+#: instant. (A body at rest is held by every vertex past the wall.)
 WALL_DEEPEST_FRACTION = 0.5
 
 
@@ -257,7 +258,11 @@ def wall_contacts(world_vertices: np.ndarray, axis: int, wall: float, low_wall: 
     found a step's fall into the floor has its lowest vertex and a ring of
     others past it, and the ring, unevenly placed, turns a frictionless
     sphere that lands straight (docs/decisions/body-contact.md); a face
-    landing flat or resting has every vertex of the face equally deep."""
+    landing flat has every vertex of the face equally deep. The corrected wall
+    response asks this of an impact only: a body resting on the wall sinks
+    about ``g h^2`` a step, so a tilt of a few micro-radians would leave a
+    single edge as "deepest", and a cube at rest would rock from edge to
+    edge for ever instead of settling."""
     past = past_wall(world_vertices, axis, wall, low_wall)
     if not len(past):
         return past

@@ -101,7 +101,14 @@ from refsim.dynamics.rotation_seed import (
 )
 from refsim.dynamics.start import LOOP, start_kernel
 from refsim.dynamics.trajectory import FRAME_ENTRIES, Event, Trajectory
-from refsim.dynamics.walls import SPEEDS, wall_name, wall_response_seed, wall_speed
+from refsim.dynamics.walls import (
+    SPEEDS,
+    bounce_advance,
+    crossing_time,
+    wall_name,
+    wall_response_seed,
+    wall_speed,
+)
 from refsim.errors import (
     ArgumentTypeError,
     DivergenceError,
@@ -711,33 +718,48 @@ class Simulation:
 
     def _wall_impulse(self, i: int, correction: np.ndarray) -> None:
         """Corrected wall contact: push back, speed at the wall, impulses at
-        every vertex past the wall."""
+        the deepest vertices past the wall, and a bounce carried on from the
+        instant of the crossing to the end of the step
+        (:func:`~refsim.dynamics.walls.crossing_time`,
+        :func:`~refsim.dynamics.walls.bounce_advance`)."""
         world = self.scene.world
         H = world.half_size
         I_inv = world_inertia(self.R[i:i + 1], self.I_body_inv[i:i + 1])[0]
         for k in np.flatnonzero(correction).tolist():
             low = correction[k] > 0.0
             W = self.world_vertices(i)
-            r_a = W[wall_contacts(W, k, -H if low else H, low)] - self.x[i]
-            # every vertex past the wall supports the body in a body contact's solve
-            self._wall_contacts[i, k, low] = W[past_wall(W, k, -H if low else H, low)] - self.x[i]
-            self.x[i, k] += correction[k]                   # no interpenetration persists
             # DEVIATION (D6): the speed at the wall (energy of the push-back, as in S7), but
             # only for a real bounce: in resting contact this torque-free change
             # at the centroid would cancel gravity by itself and leave the
             # contact impulses (and with them friction and the torque that
             # topples a body balanced on an edge) with nothing to do.
-            if self.v[i, k] * correction[k] < -self.loads.threshold * abs(correction[k]):
-                self.v[i, k] = wall_speed(self.v[i, k], self.loads.accel[i, k], correction[k])
+            bounce = self.v[i, k] * correction[k] < -self.loads.threshold * abs(correction[k])
+            # every vertex past the wall supports a resting body (and the body
+            # in a body contact's solve); an impact began at the deepest ones
+            past = past_wall(W, k, -H if low else H, low)
+            self._wall_contacts[i, k, low] = W[past] - self.x[i]
+            r_a = W[wall_contacts(W, k, -H if low else H, low)] - self.x[i] if bounce \
+                else self._wall_contacts[i, k, low]
+            a_k = self.loads.accel[i, k]
+            # a bounce acts at the instant of the crossing, tau before the step's end
+            tau = crossing_time(r_a, len(r_a), k, low, self.v[i], self.w[i], a_k, correction[k],
+                                self.h) if bounce and len(r_a) else 0.0
+            self.x[i, k] += correction[k]                   # no interpenetration persists
+            if bounce:
+                self.v[i, k] = wall_speed(self.v[i, k], a_k, correction[k])
             if not len(r_a):
                 continue
             n = np.zeros(3)
             n[k] = 1.0 if low else -1.0
+            v_contact = self.v[i].copy()
             P = impulse.wall_impulses(r_a, n, self.inv_mass[i], I_inv, self.v[i], self.w[i],
                                       self.loads.wall_e[i], self.loads.wall_mu[i],
                                       self.loads.threshold, kernel=self.kernel)
             impulse.contact_sum_python(P, n, r_a, self.x[i],
                                        self._impulse_record(i, wall_name(k, correction[k])))
+            if tau > 0.0:
+                bounce_advance(self.x[i], self.v[i], v_contact, self.lo[i], self.hi[i], k, low,
+                               a_k, tau)
 
     # 6. broad phase (S4 test 1)
     def _broad_phase(self) -> np.ndarray:

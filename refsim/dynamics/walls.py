@@ -60,6 +60,8 @@ each wall that was hit (no allocation).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from refsim.errors import check_option
@@ -80,6 +82,81 @@ def wall_speed(v_k: float, a_k: float, correction_k: float) -> float:
     # DEVIATION: clamped at 0 (a body that could not have come from the wall
     # with this speed is in resting contact and keeps none of it).
     return float(np.copysign(np.sqrt(max(squared, 0.0)), v_k))
+
+
+def crossing_time(r_a, count, k, low, v, w, a_k, correction_k, h):
+    """How long before the end of the step the body crossed the wall (s,
+    in ``[0, h]``): the corrected wall response's time of impact.
+
+    The wall stage finds a body past the wall at the end of a step; it
+    reached the wall some time ``tau`` earlier. The deepest of its contacts
+    (``r_a[:count]``, offsets from the centroid; the first of equally deep
+    ones) crossed first. Its normal velocity now is ``u = v_k + (w x r)_k``,
+    and at the wall it was ``u_wall`` with ``u^2 = u_wall^2 - 2 a_k
+    correction_k`` (:func:`wall_speed`: the acceleration ``a_k`` constant
+    over the step, the rotation's part of ``u`` taken as constant too). Under
+    constant acceleration the distance covered is the mean speed times the
+    time, so ``tau = 2 |correction_k| / (|u| + |u_wall|)``, clamped to one
+    step. ``tau = 0`` when that contact does not move into the wall.
+
+    ``r_a`` (M, 3), ``v``, ``w`` (3,): the contacts' offsets, the centroid's
+    velocity and the angular velocity at the end of the step, before any
+    response; ``low``: the wall is the low one of axis ``k`` (its normal
+    +e_k). Written for numba as well: the compiled loop compiles this
+    function itself.
+    """
+    deepest = 0
+    for i in range(1, count):
+        if (r_a[i, k] < r_a[deepest, k]) if low else (r_a[i, k] > r_a[deepest, k]):
+            deepest = i
+    k1 = (k + 1) % 3
+    k2 = (k + 2) % 3
+    u = v[k] + (w[k1] * r_a[deepest, k2] - w[k2] * r_a[deepest, k1])
+    if (u >= 0.0) if low else (u <= 0.0):
+        return 0.0
+    squared = u * u + 2.0 * a_k * correction_k
+    speed = abs(u) + (math.sqrt(squared) if squared > 0.0 else 0.0)
+    tau = 2.0 * abs(correction_k) / speed
+    return tau if tau < h else h
+
+
+def bounce_advance(x, v, v_contact, lo, hi, k, low, a_k, tau):
+    """Carry a body that bounced off the wall of axis ``k`` on from the
+    instant of the impact to the end of the step, in place.
+
+    The corrected response acts at the wall, on the velocities at the wall
+    (:func:`wall_speed`), but at the end of the step: left there, the body
+    would restart from the wall ``tau`` (:func:`crossing_time`) late, and
+    every bounce would add up to a step's delay to the flight. Had the
+    impulse acted at the instant of the crossing, the body would since have
+    moved with its new velocity. Under the constant acceleration ``a_k``
+    along the normal (nothing along the wall changes it):
+
+    - along the normal, from the wall: ``x_k += v_k tau + a_k tau^2 / 2``
+      and ``v_k += a_k tau`` (``v_k`` the velocity after the impulse, at the
+      wall), which keeps the energy the impulse left;
+    - along the wall, ``x_j += (v_j - v_contact_j) tau``: the change the
+      impulse made, for the time it would have acted (``v_contact``: the
+      velocity the impulse acted on).
+
+    A body that would not have left the wall in ``tau`` (an inelastic
+    impact, a slow rebound) stays where it is, in contact. The orientation
+    is not carried on: it turned over ``tau`` with the spin before the
+    impact, an error of ``|dw| tau`` rad that a finer step shrinks. The box
+    ``lo``, ``hi`` (3,) moves with the body. Written for numba as well.
+    """
+    s = v[k] * tau + 0.5 * a_k * tau * tau
+    if (s <= 0.0) if low else (s >= 0.0):
+        return
+    for j in range(3):
+        if j == k:
+            d = s
+            v[k] += a_k * tau
+        else:
+            d = (v[j] - v_contact[j]) * tau
+        x[j] += d
+        lo[j] += d
+        hi[j] += d
 
 
 def wall_response_seed(x: np.ndarray, v: np.ndarray, correction: np.ndarray,

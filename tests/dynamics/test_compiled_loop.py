@@ -648,8 +648,10 @@ def test_impulse_sphere_rolling_on_the_floor_bit_for_bit(monkeypatch):
         sim.run(400, every=7)
     _assert_same(readable, compiled)
     assert compiled.loop_steps == SETTLE_STEPS["sphere"] + 400
-    # touching nearly every step, at the deepest of the vertices past the
-    # floor only (rotation_impulse.wall_contacts: the others, at less than
-    # half its depth, crossed later in the step)
-    assert len(contacts) >= 390 and max(contacts) == 1
+    # touching in most steps (a facet's edge it rolls over bumps it off the
+    # floor now and then: 320 of the 400 steps touch), at its lowest vertex
+    # or two: at rest every vertex past the floor holds it, and the impacts
+    # act at the deepest of them only (rotation_impulse.wall_contacts), never
+    # at the ring of vertices a deeper landing leaves past the floor
+    assert len(contacts) >= 300 and max(contacts) <= 2
     assert np.abs(compiled.w).max() > 0.05                        # rolling, not at rest
