@@ -106,12 +106,12 @@ from refsim.dynamics import loop_layout as slot
 from refsim.dynamics.impulse import contact_sum_python, solve_contacts_python
 from refsim.dynamics.rotation_impulse import WALL_DEEPEST_FRACTION, free_rotation_step
 from refsim.dynamics.rotation_seed import axes_step_seed
-from refsim.dynamics.walls import bounce_advance, crossing_time
+from refsim.dynamics.walls import bounce_advance, crossing_time, deepest_speed
 
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "1c61e1461f1939d3"
+SOURCES_DIGEST = "31207f442f38b14e"
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -135,6 +135,7 @@ ROTATION_EXACT = 2      # "impulse": the exact rotation with angular momentum
 #: as :func:`~refsim.dynamics.impulse.solve_contacts_compiled` compiles it).
 _solve_contacts = numba.njit(cache=True, nogil=True)(solve_contacts_python)
 _contact_sum = numba.njit(cache=True, nogil=True)(contact_sum_python)
+_deepest_speed = numba.njit(cache=True, nogil=True)(deepest_speed)
 _crossing_time = numba.njit(cache=True, nogil=True)(crossing_time)
 _bounce_advance = numba.njit(cache=True, nogil=True)(bounce_advance)
 
@@ -293,7 +294,7 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
         ``x0``, ``v0``, ``w0``, ``R0`` the state at the start of the step;
         ``A``, ``E`` (3, 3), ``L`` (3,) of the rotation step (``E`` also a
         body's world inverse inertia, ``L`` the velocity a wall impulse
-        acts on); ``corr`` (3,) a wall correction; the
+        acts on, ``A`` the turn after a bounce); ``corr`` (3,) a wall correction; the
         wall impulses' vertices past a wall ``past`` (M,) int64, contacts
         ``r_a`` (M, 3), impulses ``P`` (M, 4) and normal ``n`` (3,), M the
         most vertices of a body; ``origin`` (B, 3); ``now_walls`` (B, 6)
@@ -421,7 +422,7 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
                 _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres,
                               first_leaf, x, center, v, w, R, lo, hi, h, half_size, gravity,
                               restitution, friction, threshold, iterations, inv_mass[b], E,
-                              past, r_a, P, n, L, impulse_now)
+                              past, r_a, P, n, L, A, impulse_now)
             else:
                 if rotation_mode == ROTATION_SEED:
                     _wall_spin_seed(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1],
@@ -754,20 +755,37 @@ def _deepest(b, k, low, wall, o_k, R, vertices_t, past, count):
 
 
 @numba.njit(cache=True, nogil=True)
+def _offsets(b, x, R, vertices_t, o, past, count, r_a):
+    """``r_a[:count]``: body b's vertices ``past[:count]`` in world
+    coordinates (as :func:`refsim.types.transform_points` computes them,
+    about the mesh origin ``o``) less the centroid ``x[b]``."""
+    for i in range(count):
+        q = past[i]
+        for j in range(3):
+            r_a[i, j] = (((R[b, j, 0] * vertices_t[0, q] + R[b, j, 1] * vertices_t[1, q])
+                          + R[b, j, 2] * vertices_t[2, q]) + o[j]) - x[b, j]
+
+
+@numba.njit(cache=True, nogil=True)
 def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, first_leaf, x,
                   center, v, w, R, lo, hi, h, half_size, gravity, restitution, friction,
                   threshold, iterations, inv_mass, I_inv, past, r_a, P, n, v_contact,
-                  impulse_now):
+                  turn, impulse_now):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation._wall_impulse` for
-    body b, in place: for each crossed wall, the vertices past it
-    (:func:`refsim.dynamics.rotation_impulse.wall_contacts`, found by
+    body b, in place: for each crossed wall, the vertices past it (found by
     :func:`_vertices_past_wall`, world coordinates as
-    :func:`refsim.types.transform_points` computes them), the push-back, the
-    speed at the wall (D6) and the contact solve
+    :func:`refsim.types.transform_points` computes them; for an impact the
+    deepest of them, :func:`refsim.dynamics.rotation_impulse.wall_contacts`),
+    the push-back, the speed at the wall (D6), the contact solve
     (:func:`refsim.dynamics.impulse.wall_impulses`, the wall static: B's
-    arrays None), and its impulses into ``impulse_now[b, wall]``
-    (:func:`refsim.dynamics.impulse.contact_sum_python`). ``I_inv`` is the
-    body's world inverse inertia."""
+    arrays None) and its impulses into ``impulse_now[b, wall]``
+    (:func:`refsim.dynamics.impulse.contact_sum_python`), then a bounce
+    carried on from its instant (:func:`refsim.dynamics.walls.deepest_speed`,
+    :func:`~refsim.dynamics.walls.crossing_time`,
+    :func:`~refsim.dynamics.walls.bounce_advance`, compiled from the same
+    source), the box ``lo``, ``hi`` moving with the body. ``I_inv`` is the
+    body's world inverse inertia; ``v_contact`` (3,) and ``turn`` (3, 3)
+    scratch."""
     for k in range(3):
         if corr[k] == 0.0:
             continue
@@ -776,19 +794,18 @@ def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, fir
         o = _origin(b, x, R, center)
         count = _vertices_past_wall(b, k, low, wall, o[k], R, vertices_t, leaf_order,
                                     leaf_start, leaf_spheres, first_leaf, past)
-        # D6: the speed at the wall, only for a real bounce; an impact began
-        # at the deepest vertices, every vertex past the wall holds a body at rest
+        # D6: the speed at the wall, only for a real bounce
         bounce = v[b, k] * corr[k] < -threshold * abs(corr[k])
-        if bounce:
+        # every vertex past the wall holds a body at rest; an impact (its
+        # deepest contact moving into the wall faster than the threshold)
+        # began at the deepest ones
+        _offsets(b, x, R, vertices_t, o, past, count, r_a)
+        u = _deepest_speed(r_a, count, k, low, v[b], w[b]) if count else 0.0
+        if bounce or (u < -threshold if low else u > threshold):
             count = _deepest(b, k, low, wall, o[k], R, vertices_t, past, count)
-        for i in range(count):
-            q = past[i]
-            for j in range(3):
-                r_a[i, j] = (((R[b, j, 0] * vertices_t[0, q] + R[b, j, 1] * vertices_t[1, q])
-                              + R[b, j, 2] * vertices_t[2, q]) + o[j]) - x[b, j]
+            _offsets(b, x, R, vertices_t, o, past, count, r_a)
         a_k = -gravity if k == 1 else 0.0
-        tau = _crossing_time(r_a, count, k, low, v[b], w[b], a_k, corr[k], h) \
-            if bounce and count else 0.0
+        tau = _crossing_time(u, a_k, corr[k], low, h) if bounce else 0.0
         x[b, k] += corr[k]
         if bounce:
             v[b, k] = _wall_speed(v[b, k], a_k, corr[k])
@@ -797,9 +814,11 @@ def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, fir
         for j in range(3):
             n[j] = 0.0
             v_contact[j] = v[b, j]
+        w0, w1, w2 = w[b, 0], w[b, 1], w[b, 2]
         n[k] = 1.0 if low else -1.0
         _solve_contacts(r_a[:count], None, n, inv_mass, I_inv, v[b], w[b], 0.0, None, None,
                         None, restitution, friction, threshold, iterations, P[:count])
         _contact_sum(P[:count], n, r_a[:count], x[b], impulse_now[b, 2 * k + (0 if low else 1)])
         if tau > 0.0:
-            _bounce_advance(x[b], v[b], v_contact, lo[b], hi[b], k, low, a_k, tau)
+            _bounce_advance(x[b], v[b], v_contact, R[b], w[b], w[b, 0] - w0, w[b, 1] - w1,
+                            w[b, 2] - w2, turn, lo[b], hi[b], k, low, a_k, tau)

@@ -88,6 +88,14 @@ D9 Retired. Friction acted during compression only (phase 1 of the impulse
    3.7948). The solve now runs its friction sweeps again after restitution,
    in the cone of the whole impact (refsim.dynamics.impulse, phase 3); the
    number is kept so that older reports' references stay readable.
+D10 Time of impact (corrected wall response): a body found past a wall at
+   the end of a step crossed it some time tau earlier; the impulse acts on
+   the velocities at the wall, and the body is then carried on over tau with
+   its new velocity (refsim.dynamics.walls.crossing_time, bounce_advance),
+   so that a bounce is not up to a step late. The orientation is not carried
+   on (it turned with the spin before the impact over tau). A body resting
+   on the wall is held by every vertex past it; an impact acts at the
+   deepest of them (refsim.dynamics.rotation_impulse.wall_contacts).
 """
 
 from __future__ import annotations

@@ -105,6 +105,7 @@ from refsim.dynamics.walls import (
     SPEEDS,
     bounce_advance,
     crossing_time,
+    deepest_speed,
     wall_name,
     wall_response_seed,
     wall_speed,
@@ -718,7 +719,8 @@ class Simulation:
 
     def _wall_impulse(self, i: int, correction: np.ndarray) -> None:
         """Corrected wall contact: push back, speed at the wall, impulses at
-        the deepest vertices past the wall, and a bounce carried on from the
+        the vertices past the wall (the deepest of them for an impact), and a
+        bounce carried on from the
         instant of the crossing to the end of the step
         (:func:`~refsim.dynamics.walls.crossing_time`,
         :func:`~refsim.dynamics.walls.bounce_advance`)."""
@@ -734,16 +736,17 @@ class Simulation:
             # contact impulses (and with them friction and the torque that
             # topples a body balanced on an edge) with nothing to do.
             bounce = self.v[i, k] * correction[k] < -self.loads.threshold * abs(correction[k])
-            # every vertex past the wall supports a resting body (and the body
-            # in a body contact's solve); an impact began at the deepest ones
-            past = past_wall(W, k, -H if low else H, low)
-            self._wall_contacts[i, k, low] = W[past] - self.x[i]
-            r_a = W[wall_contacts(W, k, -H if low else H, low)] - self.x[i] if bounce \
-                else self._wall_contacts[i, k, low]
+            # every vertex past the wall holds a body at rest (and supports it in
+            # a body contact's solve); an impact (its deepest contact moving into
+            # the wall faster than the threshold) began at the deepest ones
+            self._wall_contacts[i, k, low] = r_a = W[past_wall(W, k, -H if low else H, low)] \
+                - self.x[i]
+            u = deepest_speed(r_a, len(r_a), k, low, self.v[i], self.w[i]) if len(r_a) else 0.0
+            if bounce or (u < -self.loads.threshold if low else u > self.loads.threshold):
+                r_a = W[wall_contacts(W, k, -H if low else H, low)] - self.x[i]
             a_k = self.loads.accel[i, k]
             # a bounce acts at the instant of the crossing, tau before the step's end
-            tau = crossing_time(r_a, len(r_a), k, low, self.v[i], self.w[i], a_k, correction[k],
-                                self.h) if bounce and len(r_a) else 0.0
+            tau = crossing_time(u, a_k, correction[k], low, self.h) if bounce else 0.0
             self.x[i, k] += correction[k]                   # no interpenetration persists
             if bounce:
                 self.v[i, k] = wall_speed(self.v[i, k], a_k, correction[k])
@@ -751,15 +754,17 @@ class Simulation:
                 continue
             n = np.zeros(3)
             n[k] = 1.0 if low else -1.0
-            v_contact = self.v[i].copy()
+            v_contact, w_contact = self.v[i].copy(), self.w[i].copy()
             P = impulse.wall_impulses(r_a, n, self.inv_mass[i], I_inv, self.v[i], self.w[i],
                                       self.loads.wall_e[i], self.loads.wall_mu[i],
                                       self.loads.threshold, kernel=self.kernel)
             impulse.contact_sum_python(P, n, r_a, self.x[i],
                                        self._impulse_record(i, wall_name(k, correction[k])))
             if tau > 0.0:
-                bounce_advance(self.x[i], self.v[i], v_contact, self.lo[i], self.hi[i], k, low,
-                               a_k, tau)
+                w = self.w[i]
+                bounce_advance(self.x[i], self.v[i], v_contact, self.R[i], w,
+                               w[0] - w_contact[0], w[1] - w_contact[1], w[2] - w_contact[2],
+                               np.empty((3, 3)), self.lo[i], self.hi[i], k, low, a_k, tau)
 
     # 6. broad phase (S4 test 1)
     def _broad_phase(self) -> np.ndarray:

@@ -10,6 +10,7 @@ from refsim.dynamics.simulation import Simulation
 from refsim.dynamics.walls import (
     bounce_advance,
     crossing_time,
+    deepest_speed,
     wall_name,
     wall_response_points_inplace,
     wall_response_seed,
@@ -78,42 +79,53 @@ def test_inplace_response_needs_its_scratch_for_the_speed_at_the_wall():
 
 def test_crossing_time_of_a_fall_under_gravity():
     # a point fell from the floor (y = 0) at 3 m/s for tau = 0.6 ms under g:
-    # it is 3 tau + g tau^2 / 2 deep, moving at 3 + g tau; the deepest of
-    # two contacts (offsets from the centroid) tells
+    # it is 3 tau + g tau^2 / 2 deep, moving at 3 + g tau
     tau, h = 6e-4, 1e-3
     depth = 3.0 * tau + 0.5 * G * tau * tau
-    r_a = np.array([[0.3, -0.2, 0.0], [0.0, -0.5, 0.0]])
-    v = np.array([0.0, -(3.0 + G * tau), 0.0])
-    found = crossing_time(r_a, 2, 1, True, v, np.zeros(3), -G, depth, h)
-    assert found == pytest.approx(tau, rel=1e-12)
-    # the same depth reached by the spin alone: w x r at the deepest contact
-    w = np.array([0.0, 0.0, 4.0])                    # (w x r)_y = w_z r_x
-    r_a = np.array([[-0.75, -0.5, 0.0]])
-    assert crossing_time(r_a, 1, 1, True, np.zeros(3), w, 0.0, 3e-4, h) == \
-        pytest.approx(3e-4 / 3.0, rel=1e-12)
+    assert crossing_time(-(3.0 + G * tau), -G, depth, True, h) == pytest.approx(tau, rel=1e-12)
     # a contact moving out of the wall has not just crossed it; a shallow
     # crossing at a crawl is clamped to the step
-    assert crossing_time(r_a, 1, 1, True, -v, np.zeros(3), -G, depth, h) == 0.0
-    assert crossing_time(r_a, 1, 1, True, np.array([0.0, -1e-3, 0.0]), np.zeros(3), 0.0,
-                         1e-4, h) == h
+    assert crossing_time(3.0, -G, depth, True, h) == 0.0
+    assert crossing_time(-1e-3, 0.0, 1e-4, True, h) == h
+    # the ceiling: the normal is -e_k, a crossing moves up
+    assert crossing_time(2.0, 0.0, -1e-3, False, h) == pytest.approx(5e-4, rel=1e-12)
+
+
+def test_the_deepest_contact_and_its_normal_speed():
+    # the contact lowest along y crosses a low wall first; its speed along y
+    # is v_y + (w x r)_y = v_y + w_z r_x - w_x r_z
+    r_a = np.array([[0.3, -0.2, 0.0], [-0.75, -0.5, 0.1], [0.5, -0.5, 0.0]])
+    v, w = np.array([1.0, -2.0, 0.0]), np.array([0.5, 0.0, 4.0])
+    assert deepest_speed(r_a, 3, 1, True, v, w) == -2.0 + 4.0 * -0.75 - 0.5 * 0.1
+    assert deepest_speed(r_a, 3, 1, False, v, w) == -2.0 + 4.0 * 0.3      # the highest
+    assert deepest_speed(r_a, 1, 1, True, v, w) == -2.0 + 4.0 * 0.3       # only the first
 
 
 def test_bounce_advance_carries_the_rebound_from_the_instant_of_impact():
     # at the floor, 2 m/s up after the impulse, 0.4 ms before the step's end;
-    # the impulse also changed the lateral velocity by -0.5 m/s
+    # the impulse also changed the lateral velocity by -0.5 m/s and the spin
+    # by 3 rad/s about z
     tau = 4e-4
     x, v = np.array([1.0, -5.0, 0.0]), np.array([0.5, 2.0, 0.0])
+    R, w = np.eye(3), np.array([0.0, 1.0, 3.0])
     lo, hi = x - 0.5, x + 0.5
-    bounce_advance(x, v, np.array([1.0, -2.1, 0.0]), lo, hi, 1, True, -G, tau)
+    bounce_advance(x, v, np.array([1.0, -2.1, 0.0]), R, w, 0.0, 0.0, 3.0, np.empty((3, 3)),
+                   lo, hi, 1, True, -G, tau)
     assert x[1] == pytest.approx(-5.0 + 2.0 * tau - 0.5 * G * tau * tau, rel=1e-15)
     assert v[1] == pytest.approx(2.0 - G * tau, rel=1e-15)
     assert x[0] == pytest.approx(1.0 - 0.5 * tau, rel=1e-15)
     assert v[0] == 0.5 and x[2] == 0.0
     assert np.array_equal(hi - lo, np.ones(3)) and lo[1] == x[1] - 0.5
+    # turned by 3 tau about z, the spin with it (its z part stays)
+    a = 3.0 * tau
+    turn = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0], [0, 0, 1.0]])
+    assert np.allclose(R, turn, rtol=0.0, atol=1e-15)
+    assert np.allclose(w, turn @ [0.0, 1.0, 3.0], rtol=0.0, atol=1e-15)
     # an impact that leaves the body on the floor (e = 0): nothing moves
-    x, v = np.array([0.0, -5.0, 0.0]), np.array([0.0, 0.0, 0.0])
-    bounce_advance(x, v, np.array([0.0, -2.0, 0.0]), x.copy(), x.copy(), 1, True, -G, tau)
-    assert x[1] == -5.0 and v[1] == 0.0
+    x, v, R = np.array([0.0, -5.0, 0.0]), np.array([0.0, 0.0, 0.0]), np.eye(3)
+    bounce_advance(x, v, np.array([0.0, -2.0, 0.0]), R, np.zeros(3), 1.0, 0.0, 0.0,
+                   np.empty((3, 3)), x.copy(), x.copy(), 1, True, -G, tau)
+    assert x[1] == -5.0 and v[1] == 0.0 and np.array_equal(R, np.eye(3))
 
 
 @pytest.mark.parametrize("kernel", ["readable", "compiled"])
