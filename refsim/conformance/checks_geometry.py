@@ -209,9 +209,9 @@ def classify_triangles(a, b, distance_tolerance: float = 0.0, roundoff: float = 
     gap, the rounding bound and the tolerance (module docstring), as
     example fields. ``roundoff``: the engine's declared unit roundoff over
     float64's (:func:`_roundoff`), which scales the rounding bound."""
+    from refsim.collision.disagreement import exact_class
     from refsim.collision.sat_exact import triangles_intersect_sat
     from refsim.collision.triangle import triangles_intersect
-    from refsim.studies.triangles import exact_class
 
     t1 = tuple(map(tuple, np.asarray(a, np.float64).tolist()))
     t2 = tuple(map(tuple, np.asarray(b, np.float64).tolist()))

@@ -32,19 +32,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from refsim.collision.disagreement import exact_class
 from refsim.collision.predicates import (
-    FILTERED,
-    _orient3d_terms,
     orient2d_filtered,
     orient3d,
     orient3d_filtered,
+    orient3d_terms,
 )
-from refsim.collision.sat_exact import triangles_intersect_sat
-from refsim.collision.triangle import (
-    normal_signs,
-    triangles_intersect,
-    triangles_intersect_float,
-)
+from refsim.collision.triangle import triangles_intersect, triangles_intersect_float
 from refsim.collision.triangle_batch import certified_batch, triangles_intersect_batch
 from refsim.studies import TIMED
 from refsim.types import random_rotation, rotation_about_axis, transform_points
@@ -170,34 +165,6 @@ def near_degenerate_pairs(n: int, seed: int = 0):
 # classification of disagreements with an oracle
 # --------------------------------------------------------------------------
 
-def _points_coplanar(points) -> bool:
-    """All points on one plane, exactly (true for collinear or equal points)."""
-    m = len(points)
-    for i in range(m):
-        for j in range(i + 1, m):
-            for k in range(j + 1, m):
-                a, b, c = points[i], points[j], points[k]
-                if any(normal_signs(a, b, c, FILTERED)):
-                    return all(orient3d(a, b, c, d) == 0 for d in points)
-    return True
-
-
-def _strict_crossing(t1, t2) -> bool:
-    """Some edge of one triangle crosses the other's OPEN interior
-    transversally, decided with strict signs only (no zero involved)."""
-    for e, t in ((t1, t2), (t2, t1)):
-        a, b, c = t
-        for i in range(3):
-            p, q = e[i], e[(i + 1) % 3]
-            sp, sq = orient3d(a, b, c, p), orient3d(a, b, c, q)
-            if sp * sq >= 0:
-                continue
-            signs = {orient3d(p, q, a, b), orient3d(p, q, b, c), orient3d(p, q, c, a)}
-            if signs in ({1}, {-1}):
-                return True
-    return False
-
-
 def decision_margin(t1, t2) -> float:
     """The smallest normalized volume of the orientations the decision uses.
 
@@ -211,7 +178,7 @@ def decision_margin(t1, t2) -> float:
     is compared with).
     """
     def rel(a, b, c, d):
-        det, _ = _orient3d_terms(a, b, c, d)
+        det, _ = orient3d_terms(a, b, c, d)
         lengths = math.prod(math.dist(p, d) for p in (a, b, c))
         return abs(det) / lengths if lengths > 0 else 0.0
 
@@ -228,49 +195,10 @@ def decision_margin(t1, t2) -> float:
     return min(margins)
 
 
-#: The classes a disagreement on a triangle pair takes from exact predicates
-#: alone (:func:`exact_class`), shared by this study's classifier and the
-#: conformance kit's (:func:`refsim.conformance.checks_geometry.classify_triangles`).
-#: The two part only where no exact predicate decides: this study calls a
-#: pair "tolerance" by its dimensionless decision margin
-#: (:data:`NEAR_DEGENERATE_MARGIN`), the kit by its gap in metres against the
-#: rounding bound and the engine's declared tolerance.
-EXACT_CLASSES = ("bug", "coplanar", "touching")
-
-
-def exact_class(t1, t2, answers: tuple[bool, bool | None] | None = None) -> str | None:
-    """The class of a disagreement on the triangle pair ``(t1, t2)`` (tuples
-    of float coordinates) that exact predicates decide, or None when none
-    does and the class turns on a tolerance:
-
-    - ``"bug"``: refsim's exact answer differs from an independent exact
-      ground truth, the separating-axis test in rational arithmetic
-      (:mod:`refsim.collision.sat_exact`; not applicable, so never a bug, for
-      a degenerate triangle);
-    - ``"coplanar"``: all six vertices lie on one plane, exactly;
-    - ``"touching"``: refsim finds a common point, but no edge crosses the
-      other triangle's open interior with all signs strict: the contact
-      depends on an exact zero orientation (the exact minimum distance is 0).
-
-    ``answers``: ``(refsim, truth)`` when the caller has them already:
-    :func:`refsim.collision.triangle.triangles_intersect` and
-    :func:`refsim.collision.sat_exact.triangles_intersect_sat` on the pair.
-    """
-    refsim, truth = answers if answers is not None else (
-        triangles_intersect(t1, t2), triangles_intersect_sat(t1, t2))
-    if truth is not None and truth != refsim:
-        return "bug"
-    if _points_coplanar(t1 + t2):
-        return "coplanar"
-    if refsim and not _strict_crossing(t1, t2):
-        return "touching"
-    return None
-
-
 def classify_disagreement(a, b) -> str:
     """Why an engine's answer may differ from refsim's exact one on (a, b).
 
-    First the classes exact predicates decide (:func:`exact_class`):
+    First the classes exact predicates decide (:func:`refsim.collision.disagreement.exact_class`):
     ``"bug"`` when refsim's answer differs from the rational separating-axis
     ground truth (refsim is wrong, whatever the margins say), then
     ``"coplanar"`` and ``"touching"``. Otherwise:
