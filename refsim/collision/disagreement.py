@@ -17,6 +17,13 @@ is asked about (:func:`exact_class`):
   (:func:`strict_crossing`): the contact rests on an exact zero orientation
   and the exact minimum distance is 0.
 
+Where none of them holds, :func:`classify_triangle_pair` measures the pair's
+**gap** in metres (:mod:`refsim.collision.gaps`: distance apart, minus the
+depth of a crossing) and calls the disagreement ``"tolerance"`` when the gap
+lies within the rounding bound (float64's, scaled by the engine's unit
+roundoff) or the engine's declared distance tolerance, ``"bug"`` beyond
+both: one vocabulary (:data:`CLASSES`) and one tolerance measure.
+
 Both the studies' comparison with oracles (:mod:`refsim.studies.triangles`,
 :mod:`refsim.studies.levels`) and the conformance kit
 (:mod:`refsim.conformance.checks_geometry`) classify with these, so that one
@@ -28,12 +35,21 @@ filter cannot decide), plus one rational separating-axis test.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
+import numpy as np
+
+from refsim.collision.gaps import rounding_bound, signed_gap
 from refsim.collision.predicates import FILTERED, orient3d
 from refsim.collision.sat_exact import triangles_intersect_sat
 from refsim.collision.triangle import normal_signs, triangles_intersect
 
 #: The classes :func:`exact_class` can return.
 EXACT_CLASSES = ("bug", "coplanar", "touching")
+
+#: The classes :func:`classify_triangle_pair` can return, in the order the
+#: studies tabulate them.
+CLASSES = ("coplanar", "touching", "tolerance", "bug")
 
 
 def points_coplanar(points) -> bool:
@@ -90,3 +106,46 @@ def exact_class(t1, t2, answers: tuple[bool, bool | None] | None = None) -> str 
     if refsim and not strict_crossing(t1, t2):
         return "touching"
     return None
+
+
+@dataclass(frozen=True)
+class TriangleVerdict:
+    """A classified disagreement on a triangle pair: its class (one of
+    :data:`CLASSES`), its gap in metres (0 for "touching"), and the rounding
+    bound in metres it was compared with (already scaled by the roundoff)."""
+
+    kind: str
+    gap: float
+    bound: float
+
+
+def classify_triangle_pair(a, b, distance_tolerance: float = 0.0,
+                           roundoff: float = 1.0) -> TriangleVerdict:
+    """Why an engine's answer may differ from refsim's exact one on the
+    triangle pair ``(a, b)`` ((3, 3) arrays or nested sequences).
+
+    First the classes exact predicates decide (:func:`exact_class`): "bug"
+    when refsim's answer differs from the rational separating-axis truth,
+    then "coplanar" and "touching". Otherwise the pair's gap
+    (:func:`refsim.collision.gaps.signed_gap`, against the exact answer)
+    decides: "tolerance" when ``|gap|`` is within the rounding bound
+    (:func:`refsim.collision.gaps.rounding_bound` times ``roundoff``, the
+    engine's unit roundoff over float64's) or ``distance_tolerance`` (what
+    the engine declares, metres), else "bug": a well-conditioned pair
+    answered differently, which rounding does not explain.
+
+    Call it only for pairs where the answers differ; it does not look at
+    the engine's answer.
+    """
+    t1 = tuple(map(tuple, np.asarray(a, np.float64).tolist()))
+    t2 = tuple(map(tuple, np.asarray(b, np.float64).tolist()))
+    refsim = triangles_intersect(t1, t2)
+    truth = triangles_intersect_sat(t1, t2)
+    bound = rounding_bound(t1, t2) * roundoff
+    gap = signed_gap(t1, t2, refsim if truth is None else truth)
+    kind = exact_class(t1, t2, (refsim, truth))
+    if kind == "touching":
+        gap = 0.0
+    elif kind is None:
+        kind = "tolerance" if abs(gap) <= max(bound, distance_tolerance) else "bug"
+    return TriangleVerdict(kind, gap, bound)

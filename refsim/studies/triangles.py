@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from refsim.collision.disagreement import exact_class
+from refsim.collision.disagreement import CLASSES, classify_triangle_pair
 from refsim.collision.predicates import (
     orient2d_filtered,
     orient3d,
@@ -46,19 +46,22 @@ from refsim.types import random_rotation, rotation_about_axis, transform_points
 
 TriangleTest = Callable[[np.ndarray, np.ndarray], bool]
 
-#: A disagreement with a float engine counts as "tolerance" (not "bug") when
-#: some orientation the decision depends on is this close to degenerate. The
+#: How near-degenerate a pair is for :func:`measure_float_errors` (which
+#: reports how near degeneracy the float tests go wrong; disagreements are
+#: classified by their gap in metres, :func:`classify_disagreement`): some
+#: orientation the decision depends on is this close to degenerate. The
 #: measure is the normalized volume |det[a-d, b-d, c-d]| / (|a-d| |b-d| |c-d|)
 #: (see :func:`decision_margin`): scale and translation invariant, in [0, 1],
 #: roughly the distance of d from the plane abc over its distance from the
 #: points, or the sine of the angle between nearly parallel edges. A float
 #: engine whose arithmetic differs from ours (plane equations, projections,
 #: clipping) errs by a few thousand ulps at most on such quantities, so 1e-12
-#: (about 1e4 ulps of 1) covers any rounding; a disagreement on a better
-#: conditioned pair is not explained by floating point and is a bug.
+#: (about 1e4 ulps of 1, the relative size of the classifier's rounding bound
+#: :data:`refsim.collision.gaps.ROUNDING_ULPS`) covers any rounding.
 NEAR_DEGENERATE_MARGIN = 1e-12
 
-DISAGREEMENT_KINDS = ("coplanar", "touching", "tolerance", "bug")
+#: The classes of a disagreement (:func:`classify_disagreement`).
+DISAGREEMENT_KINDS = CLASSES
 
 
 # --------------------------------------------------------------------------
@@ -196,29 +199,17 @@ def decision_margin(t1, t2) -> float:
 
 
 def classify_disagreement(a, b) -> str:
-    """Why an engine's answer may differ from refsim's exact one on (a, b).
-
-    First the classes exact predicates decide (:func:`refsim.collision.disagreement.exact_class`):
-    ``"bug"`` when refsim's answer differs from the rational separating-axis
-    ground truth (refsim is wrong, whatever the margins say), then
-    ``"coplanar"`` and ``"touching"``. Otherwise:
-
-    - ``"tolerance"``: no exact zero decides it, but the decision is
-      near-degenerate (:func:`decision_margin` <= ``NEAR_DEGENERATE_MARGIN``):
-      within reach of a float engine's rounding and epsilons.
-    - ``"bug"``: anything else: a well-conditioned pair answered differently.
+    """Why an engine's answer may differ from refsim's exact one on (a, b):
+    the class of :func:`refsim.collision.disagreement.classify_triangle_pair`
+    (the conformance kit's too) for an engine that declares no tolerance:
+    "coplanar" and "touching" by exact predicates, "bug" where refsim's
+    answer differs from the rational ground truth, else "tolerance" when the
+    pair's gap is within the float64 rounding bound and "bug" beyond it.
 
     Call it only for pairs where the answers differ; it does not look at
     them.
     """
-    t1 = tuple(map(tuple, np.asarray(a, np.float64).tolist()))
-    t2 = tuple(map(tuple, np.asarray(b, np.float64).tolist()))
-    kind = exact_class(t1, t2)
-    if kind is not None:
-        return kind
-    if decision_margin(t1, t2) <= NEAR_DEGENERATE_MARGIN:
-        return "tolerance"
-    return "bug"
+    return classify_triangle_pair(a, b).kind
 
 
 @dataclass(frozen=True)
@@ -227,7 +218,8 @@ class Disagreement:
     refsim: bool
     oracle: bool
     kind: str
-    margin: float
+    gap: float              # metres: distance apart, minus the depth of a crossing
+    bound: float            # the rounding bound the gap was compared with, metres
 
 
 @dataclass(frozen=True)
@@ -254,10 +246,9 @@ def compare_with_oracle(A, B, oracle: TriangleTest) -> Agreement:
     theirs = np.array([bool(oracle(a, b)) for a, b in zip(A, B, strict=True)], dtype=bool)
     found = []
     for i in np.flatnonzero(ours != theirs):
-        t1 = tuple(map(tuple, A[i].tolist()))
-        t2 = tuple(map(tuple, B[i].tolist()))
-        found.append(Disagreement(int(i), bool(ours[i]), bool(theirs[i]),
-                                  classify_disagreement(A[i], B[i]), decision_margin(t1, t2)))
+        verdict = classify_triangle_pair(A[i], B[i])
+        found.append(Disagreement(int(i), bool(ours[i]), bool(theirs[i]), verdict.kind,
+                                  verdict.gap, verdict.bound))
     counts = {kind: sum(d.kind == kind for d in found) for kind in DISAGREEMENT_KINDS}
     return Agreement(n=len(A), agree=int((ours == theirs).sum()), refsim_true=int(ours.sum()),
                      oracle_true=int(theirs.sum()), counts=counts, disagreements=tuple(found))
