@@ -110,7 +110,7 @@ from refsim.dynamics.rotation_seed import axes_step_seed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "ffd30d2a57927e58"
+SOURCES_DIGEST = "df7bf20c3712e9ae"
 
 #: The kernel took every step it was asked for.
 DONE = 0
