@@ -179,9 +179,9 @@ def tree_of(mesh, kernel: str | None = None) -> TriangleTree:
     the readable :func:`build_tree` or its compiled twin (``kernel``, see
     :mod:`refsim.kernels`; the same tree either way)."""
     def build(m) -> TriangleTree:
-        if HIERARCHY_BUILD.runs_compiled(kernel):
-            return build_tree_compiled(m.vertices, m.faces, "least-area")
-        return build_tree(m.vertices, m.faces)
+        if not HIERARCHY_BUILD.runs_compiled(kernel):
+            return build_tree(m.vertices, m.faces)
+        return build_tree_compiled(m.vertices, m.faces, "least-area")
 
     return mesh.derived("triangle_tree", build)
 

@@ -311,9 +311,9 @@ def frame_topology_of(mesh, kernel: str | None = None) -> TriangleTree:
     mesh, by the readable :func:`refsim.collision.bvh.build_tree` or its
     compiled twin (``kernel``, :mod:`refsim.kernels`: the same tree)."""
     def build(m) -> TriangleTree:
-        if HIERARCHY_BUILD.runs_compiled(kernel):
-            return build_tree_compiled(m.vertices, m.faces, "least-volume")
-        return build_tree(m.vertices, m.faces, split=least_volume_split)
+        if not HIERARCHY_BUILD.runs_compiled(kernel):
+            return build_tree(m.vertices, m.faces, split=least_volume_split)
+        return build_tree_compiled(m.vertices, m.faces, "least-volume")
 
     return mesh.derived("frame_topology", build)
 
