@@ -22,9 +22,12 @@ call runs readable until the process has spent about one compile's time
 that way, so that a short script does not wait for a compile.
 ``REFSIM_TIERED_START=0`` turns that off.
 
-:data:`PAIRS` lists every kernel pair, readable and compiled, by dotted
-name; tests/test_kernels.py walks it and checks each pair bit for bit on its
-own cases. A compiled twin is the readable function itself compiled
+Each pair is a :class:`KernelPair`, defined at the end of this module and
+registered in :data:`PAIRS`: the module that runs it dispatches through it
+(``LINEAR_BOX_SCAN(kernel)`` is the function to call), and
+tests/test_kernels.py walks the registry, checks each pair bit for bit on
+its own cases and checks that those cases run through the pair. A
+compiled twin is the readable function itself compiled
 (:func:`compile_kernel`) wherever numba takes the readable source; the rest
 are written as plain loops in a module of compiled kernels, and each such
 function's docstring names the readable one it mirrors ("Mirrors: ...").
@@ -53,6 +56,7 @@ import importlib
 import os
 import time
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 from refsim.errors import OptionError, check_option
@@ -372,57 +376,162 @@ def sources_digest(module: str) -> str:
 
 
 def resolve(dotted: str):
-    """The object ``"package.module:name"`` names (for :data:`PAIRS`)."""
+    """The object ``"package.module:name"`` names (``name`` may be dotted,
+    ``Class.method``)."""
     module, name = dotted.split(":")
-    return getattr(importlib.import_module(module), name)
+    found = importlib.import_module(module)
+    for part in name.split("."):
+        found = getattr(found, part)
+    return found
 
 
 COMPILED_FROM_SOURCE = "compiled from the readable source"
 MIRRORS = "mirrors the readable kernel"
 
-#: Every kernel pair: name -> (readable, compiled, how the compiled one is
-#: made), by dotted name. tests/test_kernels.py runs each pair on its cases
-#: through the public path with ``kernel="readable"`` and ``"compiled"`` and
-#: checks the answers bit for bit, and checks that each mirror's docstring
-#: names the readable function it mirrors.
-PAIRS: dict[str, tuple[str, str, str]] = {
-    "broad-phase sweep": ("refsim.collision.broad_phase:overlapping_pairs_sweep",
-                          "refsim.collision.broad_phase:overlapping_pairs_sweep_compiled",
-                          COMPILED_FROM_SOURCE),
-    "contact impulses": ("refsim.dynamics.impulse:solve_contacts_python",
-                         "refsim.dynamics.impulse:solve_contacts_compiled",
-                         COMPILED_FROM_SOURCE),
-    "island contact impulses": ("refsim.dynamics.impulse:solve_island_python",
-                                "refsim.dynamics.impulse:solve_island_compiled",
-                                COMPILED_FROM_SOURCE),
-    "indexed ear clipping": ("refsim.models.ear_index:clip_ears",
-                             "refsim.models._numba_kernels:clip_ears",
-                             COMPILED_FROM_SOURCE),
-    "seed orientation step": ("refsim.dynamics.rotation_seed:orientation_step_seed",
-                              "refsim.dynamics.rotation_seed:orientation_step_seed_compiled",
-                              MIRRORS),
-    "batched boxes": ("refsim.dynamics.boxes:boxes_numpy",
-                      "refsim.dynamics.boxes:boxes_compiled", MIRRORS),
-    "linear box scan": ("refsim.bounds.aabb_linear:aabb_linear_kernel",
-                        "refsim.bounds._numba_kernels:aabb_linear_numba", MIRRORS),
-    "incremental box": ("refsim.bounds.aabb_incremental:IncrementalAABB",
-                        "refsim.bounds._numba_kernels:incremental_update_numba", MIRRORS),
-    "hierarchy build": ("refsim.collision.bvh:build_tree",
-                        "refsim.collision._numba_build:build_tree", MIRRORS),
-    "oriented node boxes": ("refsim.collision.bvh_exact:build_frame_tree",
-                            "refsim.collision._numba_build:frame_boxes", MIRRORS),
-    "hierarchy refit": ("refsim.collision.bvh:refit",
-                        "refsim.collision._numba_kernels:prepare", MIRRORS),
-    "hierarchy traversal": ("refsim.collision.bvh:_pairs_python",
-                            "refsim.collision._numba_kernels:traverse", MIRRORS),
-    "certified triangle filter": ("refsim.collision.triangle_batch:triangles_intersect_batch",
-                                  "refsim.collision._numba_kernels:certified", MIRRORS),
-    "exact hierarchy query": ("refsim.collision.bvh_exact:descend",
-                              "refsim.collision._numba_kernels:exact_query", MIRRORS),
-    "exact triangle stage": ("refsim.collision.triangle:_triangle_vs_triangle",
-                             "refsim.collision._numba_exact:triangle_vs_triangle", MIRRORS),
-    "fused particle steps": ("refsim.particles.system:ParticleSystem",
-                             "refsim.particles._numba_kernels:rk_steps_fused", MIRRORS),
-    "simulation loop": ("refsim.dynamics.simulation:Simulation",
-                        "refsim.dynamics._numba_kernels:advance", MIRRORS),
-}
+#: Every kernel pair by name (:class:`KernelPair` registers itself here).
+#: tests/test_kernels.py walks it: it runs each pair on its cases through the
+#: public path with ``kernel="readable"`` and ``"compiled"`` and checks the
+#: answers bit for bit, checks that each pair dispatches to its two
+#: functions, and that each mirror's docstring names the readable function
+#: it mirrors.
+PAIRS: dict[str, KernelPair] = {}
+
+
+class KernelPair:
+    """A readable kernel and its compiled twin: registered by name in
+    :data:`PAIRS` (the parity tests walk it), and the one place that
+    chooses between them.
+
+    ``readable`` and ``compiled`` are the two functions a call dispatches
+    to, with one signature, named ``"package.module:name"`` and imported on
+    first use (so that importing refsim imports no numba kernel module, and
+    this module, below every algorithm, names them without importing them).
+    ``how``: :data:`COMPILED_FROM_SOURCE` (numba compiles the readable
+    source) or :data:`MIRRORS` (a twin written as plain loops, whose
+    docstring says "Mirrors" and names the readable function). ``mirror``:
+    the ``(readable, compiled)`` functions whose docstrings tell that, where
+    the dispatched two are thin callers of them (default: the dispatched
+    two).
+
+    :meth:`choose` (also the pair called: ``pair(kernel)``) takes the
+    ``kernel=`` a user passes (None: the default of :func:`choose_kernel`,
+    with ``REFSIM_KERNELS``); :meth:`pick` takes a kernel already chosen
+    (a composition root, such as the simulation loop or a tracker, chooses
+    once and passes the choice down) and costs one comparison.
+    """
+
+    def __init__(self, name: str, readable: str, compiled: str, how: str = MIRRORS, *,
+                 mirror: tuple[str, str] | None = None):
+        if name in PAIRS:
+            raise ValueError(f"a kernel pair named {name!r} exists already")
+        self.name = name
+        self.readable_path, self.compiled_path, self.how = readable, compiled, how
+        self.mirror = mirror or (readable, compiled)
+        self._readable: Callable | None = None
+        self._compiled: Callable | None = None
+        PAIRS[name] = self
+
+    def __repr__(self) -> str:
+        return f"KernelPair({self.name!r}, {self.readable_path!r}, {self.compiled_path!r})"
+
+    @property
+    def readable(self) -> Callable:
+        """The readable function (imported on first use)."""
+        if self._readable is None:
+            self._readable = resolve(self.readable_path)
+        return self._readable
+
+    @property
+    def compiled(self) -> Callable:
+        """The compiled twin (imported on first use: numba loads then)."""
+        if self._compiled is None:
+            self._compiled = resolve(self.compiled_path)
+        return self._compiled
+
+    def pick(self, chosen: str) -> Callable:
+        """The function for a kernel already chosen by :func:`choose_kernel`
+        (``"readable"`` or ``"compiled"``; not checked again)."""
+        if chosen == "compiled":
+            found = self._compiled
+            return found if found is not None else self.compiled
+        found = self._readable
+        return found if found is not None else self.readable
+
+    def choose(self, kernel: str | None) -> Callable:
+        """The function for ``kernel=`` as a user passes it (None: the
+        default); an unknown kernel, or "compiled" without numba, raises
+        OptionError (:func:`choose_kernel`)."""
+        return self.pick(choose_kernel(kernel))
+
+    __call__ = choose
+
+    def runs_compiled(self, kernel: str | None) -> bool:
+        """Whether ``kernel=`` (None: the default) runs the compiled twin:
+        for callers whose two sides differ beyond the function called."""
+        return choose_kernel(kernel) == "compiled"
+
+
+# The pairs, by area. A module that dispatches takes its pair from here.
+
+BROAD_PHASE_SWEEP = KernelPair(
+    "broad-phase sweep", "refsim.collision.broad_phase:overlapping_pairs_sweep",
+    "refsim.collision.broad_phase:overlapping_pairs_sweep_compiled", COMPILED_FROM_SOURCE)
+HIERARCHY_BUILD = KernelPair(
+    "hierarchy build", "refsim.collision.bvh:build_tree",
+    "refsim.collision._numba_build:build_tree")
+ORIENTED_NODE_BOXES = KernelPair(
+    "oriented node boxes", "refsim.collision.bvh_exact:build_frame_tree",
+    "refsim.collision.bvh_exact:build_frame_tree_compiled",
+    mirror=("refsim.collision.bvh_exact:build_frame_tree",
+            "refsim.collision._numba_build:frame_boxes"))
+HIERARCHY_REFIT = KernelPair(
+    "hierarchy refit", "refsim.collision.bvh:refit", "refsim.collision._numba_kernels:prepare")
+HIERARCHY_TRAVERSAL = KernelPair(
+    "hierarchy traversal", "refsim.collision.bvh:_pairs_python",
+    "refsim.collision._numba_kernels:traverse")
+CERTIFIED_FILTER = KernelPair(
+    "certified triangle filter", "refsim.collision.seed_levels:intersecting_batch",
+    "refsim.collision.seed_levels:intersecting_compiled",
+    mirror=("refsim.collision.triangle_batch:triangles_intersect_batch",
+            "refsim.collision._numba_kernels:certified"))
+EXACT_HIERARCHY_QUERY = KernelPair(
+    "exact hierarchy query", "refsim.collision.bvh_exact:descend",
+    "refsim.collision._numba_kernels:exact_query")
+EXACT_TRIANGLE_STAGE = KernelPair(
+    "exact triangle stage", "refsim.collision.triangle:_triangle_vs_triangle",
+    "refsim.collision._numba_exact:triangle_vs_triangle")
+LINEAR_BOX_SCAN = KernelPair(
+    "linear box scan", "refsim.bounds.aabb_linear:aabb_linear_kernel",
+    "refsim.bounds._numba_kernels:aabb_linear_numba")
+INCREMENTAL_BOX = KernelPair(
+    "incremental box", "refsim.bounds.aabb_incremental:IncrementalAABB._update_python",
+    "refsim.bounds.aabb_incremental:IncrementalAABB._update_numba",
+    mirror=("refsim.bounds.aabb_incremental:IncrementalAABB",
+            "refsim.bounds._numba_kernels:incremental_update_numba"))
+CORNER_TREE = KernelPair(
+    "indexed corner tree", "refsim.models.ear_index:build_tree",
+    "refsim.models._numba_kernels:build_tree", COMPILED_FROM_SOURCE)
+EAR_CLIPPING = KernelPair(
+    "indexed ear clipping", "refsim.models.ear_index:clip_ears",
+    "refsim.models._numba_kernels:clip_ears", COMPILED_FROM_SOURCE)
+PARTICLE_STEPS = KernelPair(
+    "fused particle steps", "refsim.particles.system:ParticleSystem._advance_readable",
+    "refsim.particles.system:ParticleSystem._advance_fused",
+    mirror=("refsim.particles.system:ParticleSystem",
+            "refsim.particles._numba_kernels:rk_steps_fused"))
+# refsim.dynamics still chooses between these two by hand (each call site
+# compares the kernel's name); registered here for the parity tests
+CONTACT_IMPULSES = KernelPair(
+    "contact impulses", "refsim.dynamics.impulse:solve_contacts_python",
+    "refsim.dynamics.impulse:solve_contacts_compiled", COMPILED_FROM_SOURCE)
+ISLAND_IMPULSES = KernelPair(
+    "island contact impulses", "refsim.dynamics.impulse:solve_island_python",
+    "refsim.dynamics.impulse:solve_island_compiled", COMPILED_FROM_SOURCE)
+SEED_ORIENTATION_STEP = KernelPair(
+    "seed orientation step", "refsim.dynamics.rotation_seed:orientation_step_seed",
+    "refsim.dynamics.rotation_seed:orientation_step_seed_compiled")
+BATCHED_BOXES = KernelPair(
+    "batched boxes", "refsim.dynamics.boxes:boxes_numpy", "refsim.dynamics.boxes:boxes_compiled")
+SIMULATION_LOOP = KernelPair(
+    "simulation loop", "refsim.dynamics.simulation:Simulation",
+    "refsim.dynamics._numba_kernels:advance")

@@ -207,6 +207,59 @@ def test_every_package_and_module_lies_in_one_layer():
     assert len(listed) == len(set(listed)), "listed in two layers"
 
 
+#: Private names (a leading underscore) that a module takes from another
+#: package of refsim, each with the reason: (importing module, imported
+#: name) -> why. Everything else that crosses a package is public.
+PRIVATE_ALLOWANCES: dict[tuple[str, str], str] = {
+    ("refsim.dynamics._numba_kernels", "refsim.bounds._numba_kernels.incremental_update_numba"):
+        "a compiled kernel calls compiled kernels only, and numba compiles the callee into "
+        "the caller: the simulation loop's box update is the incremental box kernel "
+        "itself, which lives with its readable twin in refsim.bounds",
+}
+
+
+def private(name: str) -> bool:
+    """Whether a dotted name has a private part (``_x``; ``__x__`` is not)."""
+    return any(part.startswith("_") and not part.endswith("__") for part in name.split("."))
+
+
+def private_imports() -> tuple[list[str], set[tuple[str, str]]]:
+    """Every import of a private name or module of another package of refsim
+    (as text), not allowed, and the allowances that matched."""
+    found, used = [], set()
+    for name, path in modules().items():
+        for target, line in imports(name, path):
+            theirs = unit(target)
+            if theirs is None or theirs == unit(name) or not private(target):
+                continue
+            if (name, target) in PRIVATE_ALLOWANCES:
+                used.add((name, target))
+                continue
+            found.append(f"{path.relative_to(ROOT)}:{line}: {name} imports {target}, a private "
+                         f"name of {theirs}")
+    return found, used
+
+
+def test_no_module_imports_a_private_name_of_another_package():
+    found, _ = private_imports()
+    assert not found, "\n".join(found)
+
+
+def test_every_private_allowance_is_still_needed():
+    _, used = private_imports()
+    assert set(PRIVATE_ALLOWANCES) - used == set()
+
+
+@pytest.mark.parametrize(("name", "is_private"), [
+    ("refsim.collision.predicates.orient3d", False),
+    ("refsim.collision.predicates._orient3d_terms", True),
+    ("refsim.collision._numba_kernels.traverse", True),
+    ("refsim.__version__", False),
+])
+def test_a_private_name_has_a_leading_underscore(name, is_private):
+    assert private(name) is is_private
+
+
 def test_the_walk_sees_nested_and_relative_imports(tmp_path):
     source = tmp_path / "demo.py"
     source.write_text("import os\n\ndef f():\n    from refsim.oracles import fcl_adapter\n"

@@ -215,6 +215,7 @@ CASES = {
     "contact impulses": _impulses,
     "island contact impulses": _island_impulses,
     "indexed ear clipping": _ear_clipping,
+    "indexed corner tree": _ear_clipping,
     "seed orientation step": _seed_rotation,
     "batched boxes": _batched_boxes,
     "linear box scan": _linear_scan,
@@ -241,16 +242,84 @@ def test_readable_and_compiled_agree_bit_for_bit(name):
     assert _same(readable, compiled), name
 
 
+#: The pairs whose callers still choose by hand rather than through the
+#: pair (``pair(kernel)`` or ``pair.pick``), with the reason; every other
+#: pair's cases must run through it (:func:`test_each_pair_dispatches_its_cases`).
+CHOSEN_BY_HAND = {
+    "contact impulses": "refsim.dynamics compares the kernel's name (its own work)",
+    "island contact impulses": "refsim.dynamics compares the kernel's name (its own work)",
+    "seed orientation step": "refsim.dynamics compares the kernel's name (its own work)",
+    "batched boxes": "refsim.dynamics compares the kernel's name (its own work)",
+    "simulation loop": "refsim.dynamics compares the kernel's name (its own work)",
+    "hierarchy build": "the two builds take their split rule differently (a callable, a "
+                       "name): the pair decides (runs_compiled), the caller calls",
+    "hierarchy refit": "one step of a compiled query pipeline whose readable side is three "
+                       "calls",
+    "hierarchy traversal": "one step of a compiled query pipeline",
+    "exact hierarchy query": "one step of a compiled query pipeline",
+    "exact triangle stage": "called from inside the compiled query",
+}
+
+
+def test_every_pair_is_a_kernel_pair_under_its_name():
+    for name, pair in kernels.PAIRS.items():
+        assert isinstance(pair, kernels.KernelPair) and pair.name == name
+    assert set(CHOSEN_BY_HAND) <= set(kernels.PAIRS)
+
+
+@pytest.mark.parametrize("name", sorted(set(kernels.PAIRS) - set(CHOSEN_BY_HAND)))
+@pytest.mark.parametrize("kernel", kernels.KERNELS)
+def test_each_pair_dispatches_its_cases(name, kernel, monkeypatch):
+    """The public path of each pair's cases calls the pair's function for
+    the kernel asked, and never the other: the registry is what chooses."""
+    pair = kernels.PAIRS[name]
+    calls = {"readable": 0, "compiled": 0}
+
+    def spy(side):
+        function = getattr(pair, side)
+
+        def counted(*args, **kwargs):
+            calls[side] += 1
+            return function(*args, **kwargs)
+        return counted
+
+    for side in kernels.KERNELS:
+        monkeypatch.setattr(pair, f"_{side}", spy(side))
+    CASES[name](kernel)
+    other = "compiled" if kernel == "readable" else "readable"
+    assert calls[kernel] > 0 and calls[other] == 0, (name, calls)
+
+
+def test_a_pair_chooses_as_the_switch_does(monkeypatch):
+    pair = kernels.BROAD_PHASE_SWEEP
+    assert pair("readable") is pair.pick("readable") is pair.readable
+    assert pair("compiled") is pair.pick("compiled") is pair.compiled
+    monkeypatch.setenv(kernels.KERNELS_ENV, "readable")
+    assert pair(None) is pair.readable and not pair.runs_compiled(None)
+    monkeypatch.setenv(kernels.KERNELS_ENV, "compiled")
+    assert pair(None) is pair.compiled and pair.runs_compiled(None)
+    with pytest.raises(OptionError, match="kernel"):
+        pair("fast")
+    with pytest.raises(ValueError, match="exists already"):
+        kernels.KernelPair(pair.name, pair.readable_path, pair.compiled_path)
+
+
 @pytest.mark.parametrize("name", sorted(kernels.PAIRS))
 def test_each_pair_resolves_and_each_mirror_names_its_readable_function(name):
-    readable_path, compiled_path, how = kernels.PAIRS[name]
-    readable, compiled = kernels.resolve(readable_path), kernels.resolve(compiled_path)
+    pair = kernels.PAIRS[name]
+    readable_path, compiled_path, how = pair.readable_path, pair.compiled_path, pair.how
+    assert callable(pair.readable) and callable(pair.compiled)
     assert how in (kernels.COMPILED_FROM_SOURCE, kernels.MIRRORS)
     if how == kernels.MIRRORS:
+        readable_path, compiled_path = pair.mirror
+        compiled = kernels.resolve(compiled_path)
+        kernels.resolve(readable_path)
         doc = inspect.getdoc(getattr(compiled, "py_func", compiled)) or ""
-        readable_name = readable_path.split(":")[1]
+        readable_name = readable_path.split(":")[1].split(".")[-1]
         assert doc.startswith("Mirrors") and readable_name in doc, (name, doc[:120])
-    elif hasattr(compiled, "py_func"):
+        return
+    readable, compiled = pair.readable, pair.compiled
+    if hasattr(compiled, "py_func"):
         # compiled from the readable source: numba's dispatcher wraps that very function
         assert compiled.py_func is readable, name
     else:

@@ -87,7 +87,7 @@ import numpy as np
 
 from refsim.bounds.aabb_linear import rotated_coordinates
 from refsim.errors import ModelError
-from refsim.kernels import choose_kernel
+from refsim.kernels import INCREMENTAL_BOX, choose_kernel
 from refsim.models.mesh import Mesh, require_mesh
 from refsim.types import Pose, as_pose
 
@@ -208,6 +208,7 @@ class IncrementalAABB:
         # yet) and the counters of the last update (visits, evaluations).
         self._extremes = np.full((2, 3), -1, np.int64)
         self._counts = np.zeros(2, np.int64)
+        self._update = INCREMENTAL_BOX.pick(kernel).__get__(self)   # the bound method
         if kernel == "readable":
             # Plain lists: indexing them is several times faster than numpy
             # scalars, and the kernel reads like the algorithm.
@@ -257,9 +258,7 @@ class IncrementalAABB:
         """:meth:`update` without the pose check, for a loop whose poses are
         known to be finite float64 (3, 3) orthonormal and (3,) (the check
         costs more than the compiled update itself)."""
-        if self.kernel == "compiled":
-            return self._update_numba(rotation, translation)
-        return self._update_python(rotation, translation)
+        return self._update(rotation, translation)
 
     # -- the readable kernel -------------------------------------------------------
 

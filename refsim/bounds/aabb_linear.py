@@ -50,7 +50,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from refsim.kernels import choose_kernel
+from refsim.kernels import LINEAR_BOX_SCAN, choose_kernel
 from refsim.models.mesh import Mesh, require_mesh
 from refsim.types import Pose, as_pose, transform_points
 
@@ -118,13 +118,11 @@ def aabb_linear(mesh: Mesh, pose: Pose, *, kernel: str | None = None
         The box corners: ``lo[k] = min_v r_k(v) + t_k``, ``hi`` likewise.
     """
     require_mesh(mesh)
-    kernel = choose_kernel(kernel)
+    scan = LINEAR_BOX_SCAN(kernel)
     rotation, translation = as_pose(pose)
-    if kernel == "readable":
-        return aabb_linear_kernel(mesh.vertices.T, rotation, translation)
-    from refsim.bounds import _numba_kernels as nk
-
-    return nk.aabb_linear_numba(np.ascontiguousarray(mesh.vertices.T), rotation, translation)
+    # (the readable scan gives the same bits on a copy: elementwise, and
+    # minima and maxima do not round)
+    return scan(np.ascontiguousarray(mesh.vertices.T), rotation, translation)
 
 
 class LinearAABB:
@@ -144,10 +142,7 @@ class LinearAABB:
         n = mesh.n_vertices
         self.visits, self.evaluations = n, 3 * n  # the same for every update
         self._vertices_t = np.ascontiguousarray(mesh.vertices.T)  # (3, n), once
-        if kernel == "compiled":
-            from refsim.bounds._numba_kernels import aabb_linear_numba
-
-            self._kernel_numba = aabb_linear_numba
+        self._scan = LINEAR_BOX_SCAN.pick(kernel)
 
     def update(self, pose: Pose) -> tuple[np.ndarray, np.ndarray]:
         """The box ``(lo, hi)`` of the mesh under ``pose``, each (3,)."""
@@ -159,6 +154,4 @@ class LinearAABB:
         """:meth:`update` without the pose check, for a loop whose poses are
         known to be finite float64 (3, 3) orthonormal and (3,) (the check
         costs more than the compiled update itself)."""
-        if self.kernel == "readable":
-            return aabb_linear_kernel(self._vertices_t, rotation, translation)
-        return self._kernel_numba(self._vertices_t, rotation, translation)
+        return self._scan(self._vertices_t, rotation, translation)

@@ -73,7 +73,7 @@ from refsim.rounding import O2D_ERRBOUND_A, O3D_ERRBOUND_A
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "f4f4684f592ca82e"
+SOURCES_DIGEST = "1944e2d253670386"
 
 #: Dekker's splitter for float64: 2**ceil(53 / 2) + 1 (Shewchuk, section 2.5).
 SPLITTER = 134217729.0
@@ -385,7 +385,7 @@ def orient3d_exact(a, b, c, d):
 def orient3d(a, b, c, d):
     """Mirrors :func:`refsim.collision.predicates.orient3d_filtered_sign`:
     the float filter (same formula and evaluation order as
-    ``predicates._orient3d_terms``), then :func:`orient3d_exact`. Input in the
+    ``predicates.orient3d_terms``), then :func:`orient3d_exact`. Input in the
     filter's range."""
     adx, ady, adz = a[0] - d[0], a[1] - d[1], a[2] - d[2]
     bdx, bdy, bdz = b[0] - d[0], b[1] - d[1], b[2] - d[2]

@@ -30,7 +30,7 @@ from refsim.rounding import O2D_ERRBOUND_A, O3D_ERRBOUND_A
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "5d17816dcc8dab8e"
+SOURCES_DIGEST = "b21636d5d6852463"
 
 # -- the certified triangle-pair filter (triangle_numba's steps 1-4) -------------------
 #

@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from refsim.collision.boxes import boxes_overlap
-from refsim.kernels import choose_kernel, compile_kernel
+from refsim.kernels import BROAD_PHASE_SWEEP, compile_kernel
 
 
 def overlapping_pairs_all(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
@@ -78,6 +78,4 @@ def overlapping_pairs(lo: np.ndarray, hi: np.ndarray, *, kernel: str | None = No
                       ) -> np.ndarray:
     """Overlapping pairs of the B boxes ``lo``, ``hi`` (B, 3) by sort and
     sweep, on the chosen kernel (:mod:`refsim.kernels`)."""
-    if choose_kernel(kernel) == "compiled":
-        return overlapping_pairs_sweep_compiled(lo, hi)
-    return overlapping_pairs_sweep(lo, hi)
+    return BROAD_PHASE_SWEEP(kernel)(lo, hi)

@@ -51,7 +51,7 @@ import numpy as np
 
 from refsim.collision.boxes import triangle_boxes, world_vertices
 from refsim.errors import check_option
-from refsim.kernels import choose_kernel
+from refsim.kernels import HIERARCHY_BUILD
 from refsim.types import unit_exponent
 
 #: Triangles per leaf. Small leaves prune more; each leaf-leaf visit costs
@@ -179,7 +179,7 @@ def tree_of(mesh, kernel: str | None = None) -> TriangleTree:
     the readable :func:`build_tree` or its compiled twin (``kernel``, see
     :mod:`refsim.kernels`; the same tree either way)."""
     def build(m) -> TriangleTree:
-        if choose_kernel(kernel) == "readable":
+        if not HIERARCHY_BUILD.runs_compiled(kernel):
             return build_tree(m.vertices, m.faces)
         return build_tree_compiled(m.vertices, m.faces, "least-area")
 

@@ -131,7 +131,7 @@ from refsim.collision.seed_levels import exact_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_numba import compiled_exact_kernels
 from refsim.errors import StateError
-from refsim.kernels import choose_kernel
+from refsim.kernels import HIERARCHY_BUILD, ORIENTED_NODE_BOXES
 from refsim.types import ORTHONORMAL_TOL, as_pose, unit_exponent
 
 #: The node test's margin, relative to the scene's size S (see the module
@@ -311,7 +311,7 @@ def frame_topology_of(mesh, kernel: str | None = None) -> TriangleTree:
     mesh, by the readable :func:`refsim.collision.bvh.build_tree` or its
     compiled twin (``kernel``, :mod:`refsim.kernels`: the same tree)."""
     def build(m) -> TriangleTree:
-        if choose_kernel(kernel) == "readable":
+        if not HIERARCHY_BUILD.runs_compiled(kernel):
             return build_tree(m.vertices, m.faces, split=least_volume_split)
         return build_tree_compiled(m.vertices, m.faces, "least-volume")
 
@@ -371,9 +371,7 @@ def frame_tree_of(mesh, kernel: str | None = None) -> FrameTree:
     mesh, by :func:`build_frame_tree` or its compiled twin (``kernel``,
     :mod:`refsim.kernels`: the same tree)."""
     def build(m) -> FrameTree:
-        if choose_kernel(kernel) == "readable":
-            return build_frame_tree(m)
-        return build_frame_tree_compiled(m)
+        return ORIENTED_NODE_BOXES(kernel)(m)
 
     return mesh.derived("frame_tree", build)
 

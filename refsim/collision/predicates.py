@@ -106,8 +106,9 @@ def _scaled_integers(values: Sequence[float]) -> list[int]:
 # orient3d
 # --------------------------------------------------------------------------
 
-def _orient3d_terms(a, b, c, d):
-    """Float determinant and permanent, in Shewchuk's evaluation order."""
+def orient3d_terms(a, b, c, d):
+    """Float determinant and permanent of orient3d, in Shewchuk's evaluation
+    order (the permanent bounds the determinant's rounding error)."""
     adx, ady, adz = a[0] - d[0], a[1] - d[1], a[2] - d[2]
     bdx, bdy, bdz = b[0] - d[0], b[1] - d[1], b[2] - d[2]
     cdx, cdy, cdz = c[0] - d[0], c[1] - d[1], c[2] - d[2]
@@ -142,7 +143,7 @@ def orient3d_filtered(a, b, c, d) -> tuple[int, bool]:
 
     The points must be in the filter's range (:func:`in_filter_range`).
     """
-    det, permanent = _orient3d_terms(a, b, c, d)
+    det, permanent = orient3d_terms(a, b, c, d)
     bound = O3D_ERRBOUND_A * permanent
     if det > bound or -det > bound:
         return (1 if det > 0 else -1), True
@@ -151,7 +152,7 @@ def orient3d_filtered(a, b, c, d) -> tuple[int, bool]:
 
 def orient3d_filtered_sign(a, b, c, d) -> int:
     """Exact sign of orient3d via the filter (in-range input only)."""
-    det, permanent = _orient3d_terms(a, b, c, d)
+    det, permanent = orient3d_terms(a, b, c, d)
     bound = O3D_ERRBOUND_A * permanent
     if det > bound:
         return 1
@@ -162,7 +163,7 @@ def orient3d_filtered_sign(a, b, c, d) -> int:
 
 def orient3d_float(a, b, c, d) -> int:
     """Sign of the float determinant, unfiltered (NOT robust; for C4 only)."""
-    det, _ = _orient3d_terms(a, b, c, d)
+    det, _ = orient3d_terms(a, b, c, d)
     return _sign(det)
 
 

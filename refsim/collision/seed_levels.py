@@ -23,6 +23,7 @@ import numpy as np
 
 from refsim.collision.boxes import triangle_boxes
 from refsim.errors import StateError
+from refsim.kernels import CERTIFIED_FILTER
 
 #: Box pairs tested per vectorized block: bounds the temporary arrays to a
 #: few tens of MB (6 bool arrays of this many entries) whatever the meshes.
@@ -74,15 +75,27 @@ def exact_pairs(world_a, faces_a, world_b, faces_b, candidates: np.ndarray,
     """
     if len(candidates) == 0:
         return candidates
-    if kernel == "compiled":
-        from refsim.collision.triangle_numba import intersecting_indexed
+    return candidates[CERTIFIED_FILTER.pick(kernel)(world_a, faces_a, world_b, faces_b,
+                                                    candidates)]
 
-        if not (np.isfinite(world_a).all() and np.isfinite(world_b).all()):
-            raise StateError("a transformed vertex is not finite (pose too large?)")
-        return candidates[intersecting_indexed(world_a, faces_a, world_b, faces_b,
-                                               candidates)]
+
+def intersecting_batch(world_a, faces_a, world_b, faces_b, candidates: np.ndarray
+                       ) -> np.ndarray:
+    """(k,) bool: which candidate face pairs intersect, by the numpy batch
+    kernel (:func:`refsim.collision.triangle_batch.triangles_intersect_batch`)."""
     from refsim.collision.triangle_batch import triangles_intersect_batch
 
-    hit = triangles_intersect_batch(world_a[faces_a[candidates[:, 0]]],
-                                    world_b[faces_b[candidates[:, 1]]])
-    return candidates[hit]
+    return triangles_intersect_batch(world_a[faces_a[candidates[:, 0]]],
+                                     world_b[faces_b[candidates[:, 1]]])
+
+
+def intersecting_compiled(world_a, faces_a, world_b, faces_b, candidates: np.ndarray
+                          ) -> np.ndarray:
+    """:func:`intersecting_batch` by the compiled filter and exact stage
+    (:func:`refsim.collision.triangle_numba.intersecting_indexed`): the same
+    answers."""
+    from refsim.collision.triangle_numba import intersecting_indexed
+
+    if not (np.isfinite(world_a).all() and np.isfinite(world_b).all()):
+        raise StateError("a transformed vertex is not finite (pose too large?)")
+    return intersecting_indexed(world_a, faces_a, world_b, faces_b, candidates)

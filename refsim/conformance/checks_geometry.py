@@ -9,7 +9,7 @@ declares (:func:`refsim.engines.declarations`):
 - triangle pairs (:func:`classify_triangles`): the ground truth first
   confirmed against refsim's own exact test (a wrong truth is a "bug",
   never the engine's fault); then "coplanar" and "touching" by exact
-  predicates; otherwise the pair's gap (:mod:`refsim.conformance.gaps`:
+  predicates; otherwise the pair's gap (:mod:`refsim.collision.gaps`:
   distance apart, minus the depth of a crossing) within the rounding bound
   (float64's, scaled by the engine's declared ``unit_roundoff``) or the
   engine's ``distance_tolerance`` is "tolerance", beyond both "bug";
@@ -48,7 +48,7 @@ from fractions import Fraction
 
 import numpy as np
 
-from refsim.conformance.gaps import (
+from refsim.collision.gaps import (
     UNIT_ROUNDOFF,
     face_box_distances,
     rounding_bound,
@@ -209,24 +209,10 @@ def classify_triangles(a, b, distance_tolerance: float = 0.0, roundoff: float = 
     gap, the rounding bound and the tolerance (module docstring), as
     example fields. ``roundoff``: the engine's declared unit roundoff over
     float64's (:func:`_roundoff`), which scales the rounding bound."""
-    from refsim.collision.sat_exact import triangles_intersect_sat
-    from refsim.collision.triangle import triangles_intersect
-    from refsim.studies.triangles import exact_class
+    from refsim.collision.disagreement import classify_triangle_pair
 
-    t1 = tuple(map(tuple, np.asarray(a, np.float64).tolist()))
-    t2 = tuple(map(tuple, np.asarray(b, np.float64).tolist()))
-    refsim = triangles_intersect(t1, t2)
-    truth = triangles_intersect_sat(t1, t2)
-    bound = rounding_bound(a, b) * roundoff
-    gap = signed_gap(a, b, refsim if truth is None else truth)
-    # "bug" (the ground truth itself is wrong), "coplanar", "touching": the
-    # classes exact predicates decide, as in the studies' classifier
-    kind = exact_class(t1, t2, (refsim, truth))
-    if kind == "touching":
-        gap = 0.0
-    elif kind is None:
-        kind = "tolerance" if abs(gap) <= max(bound, distance_tolerance) else "bug"
-    return _verdict(kind, gap, bound, distance_tolerance, roundoff)
+    verdict = classify_triangle_pair(a, b, distance_tolerance, roundoff)
+    return _verdict(verdict.kind, verdict.gap, verdict.bound, distance_tolerance, roundoff)
 
 
 def _ask_triangles(prepared, pair) -> bool:

@@ -13,7 +13,7 @@ comparison with the specification hold for both. tests/models/test_ear_index.py
 checks compiled against uncompiled, bit for bit.
 
 This module imports numba at import time; import it only when the compiled
-kernel is chosen (:func:`refsim.models.ear_index.compiled_kernels`).
+kernel is chosen (:data:`refsim.kernels.CORNER_TREE`, :data:`refsim.kernels.EAR_CLIPPING`).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from refsim.models import ear_index
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "4e3f955599be26bb"
+SOURCES_DIGEST = "9aa0f0776b457612"
 
 for _helper in (ear_index.orient, ear_index.orient_error, ear_index.blocks,
                 ear_index.is_candidate, ear_index.mark_contacts,

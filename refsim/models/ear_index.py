@@ -133,13 +133,12 @@ uncompiled it is the readable version the tests compare with.
 
 from __future__ import annotations
 
-import functools
 import heapq
 from typing import NamedTuple
 
 import numpy as np
 
-from refsim.kernels import choose_kernel
+from refsim.kernels import CORNER_TREE, EAR_CLIPPING, choose_kernel
 from refsim.rounding import O2D_ERRBOUND_A
 
 #: Corners per leaf of the k-d tree. Smaller leaves prune closer to the
@@ -542,15 +541,6 @@ def clip_ears(xs, ys, marked, tree, ring, best, out, work):
 # -- running it -------------------------------------------------------------------------
 
 
-@functools.cache
-def compiled_kernels():
-    """``(build_tree, clip_ears)`` compiled by numba from this module's
-    source (:mod:`refsim.models._numba_kernels`)."""
-    from refsim.models import _numba_kernels as nk
-
-    return nk.build_tree, nk.clip_ears
-
-
 def shared_points(xs, ys) -> np.ndarray:
     """(k,) bool: whether each corner's point ``(xs, ys)`` occurs more than once
     (exact equality, as in the specification's coincidence rule; -0.0 == 0.0)."""
@@ -576,10 +566,8 @@ def clip_indexed(xs, ys, *, kernel: str | None = None, work=None) -> np.ndarray:
     xs = np.ascontiguousarray(xs, dtype=np.float64)
     ys = np.ascontiguousarray(ys, dtype=np.float64)
     k = len(xs)
-    if choose_kernel(kernel) == "compiled":
-        build, clip = compiled_kernels()
-    else:
-        build, clip = build_tree, clip_ears
+    kernel = choose_kernel(kernel)
+    build, clip = CORNER_TREE.pick(kernel), EAR_CLIPPING.pick(kernel)
     room = 2 * k
     perm = np.arange(k, dtype=np.int64)
     leaf = np.empty(k, np.int64)

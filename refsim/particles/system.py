@@ -39,7 +39,7 @@ import numpy as np
 from refsim.dynamics.forces import acceleration, acceleration_into
 from refsim.dynamics.walls import wall_response_points, wall_response_points_inplace
 from refsim.errors import DivergenceError, OptionError, StateError, as_numbers, check_count
-from refsim.kernels import Tier, choose_kernel
+from refsim.kernels import PARTICLE_STEPS, Tier, choose_kernel
 from refsim.limits import MAX_STEPS
 from refsim.particles.config import ParticleConfig
 from refsim.solvers.explicit_rk import rk_step, rk_step_into, stages_with_own_state
@@ -204,11 +204,18 @@ class ParticleSystem:
         arithmetic of :func:`refsim.solvers.explicit_rk.rk_step` term by
         term), then the walls in place. The compiled kernel: the same
         arithmetic fused into one loop over the particles
-        (:func:`refsim.particles._numba_kernels.rk_steps_fused`).
+        (:func:`refsim.particles._numba_kernels.rk_steps_fused`). The two
+        are the pair :data:`refsim.kernels.PARTICLE_STEPS`.
         """
-        if self.kernel == "compiled":
-            self._steps_fused(1)
-            return
+        PARTICLE_STEPS.pick(self.kernel)(self, 1)
+
+    def _advance_readable(self, steps: int) -> None:
+        """``steps`` readable steps (:meth:`step`); says nothing of the
+        state's finiteness (None)."""
+        for _ in range(steps):
+            self._step_readable()
+
+    def _step_readable(self) -> None:
         h = self.config.step
         rk_step_into(self.method, self._derivative_into, self.t, self.state, h, self._K,
                      self._stage, self._product)
@@ -221,6 +228,20 @@ class ParticleSystem:
         self.t += h
         self.steps += 1
         self.nfev += self.method.stages
+
+    def _advance_fused(self, steps: int) -> int | None:
+        """``steps`` steps by the fused loop in calls of at most
+        :data:`FUSED_PARTICLE_STEPS` particle-steps (a fraction of a second
+        each), each call one pass over the state. Returns the number of
+        non-finite numbers in the state after them, counted by the last
+        call (None for no steps)."""
+        non_finite = None
+        done, per_call = 0, max(1, FUSED_PARTICLE_STEPS // self.count)
+        while done < steps:
+            block = min(per_call, steps - done)
+            non_finite = self._steps_fused(block)
+            done += block
+        return non_finite
 
     def _steps_fused(self, steps: int) -> int:
         """``steps`` steps as one compiled loop (``kernel="compiled"``): each
@@ -259,16 +280,14 @@ class ParticleSystem:
         """
         steps = check_count("steps", steps, maximum=MAX_STEPS)
         done = self._run_tiered(steps)
-        if self.kernel == "compiled" and steps > done:
-            per_call = max(1, FUSED_PARTICLE_STEPS // self.count)
-            while done < steps:
-                block = min(per_call, steps - done)
-                non_finite = self._steps_fused(block)
-                done += block
-            # the last call counted the final state's non-finite numbers
+        # Overflow on the way to inf is what the check below reports, once;
+        # numpy's warnings would print it again, per operation.
+        with np.errstate(over="ignore", invalid="ignore"):
+            non_finite = PARTICLE_STEPS.pick(self.kernel)(self, steps - done)
+        if non_finite is not None:
+            # the last fused call counted the final state's non-finite numbers
             finite = non_finite == 0
         else:
-            self._steps_readable(steps - done)
             # max and min propagate NaN and see +-inf, without the (2, N, 3)
             # bool temporary of np.isfinite(state).all().
             finite = bool(np.isfinite(self.state.max()) and np.isfinite(self.state.min()))
@@ -280,8 +299,7 @@ class ParticleSystem:
         # Overflow on the way to inf is what run's check reports, once;
         # numpy's warnings would print it again, per operation.
         with np.errstate(over="ignore", invalid="ignore"):
-            for _ in range(steps):
-                self.step()
+            self._advance_readable(steps)
 
     def _run_tiered(self, steps: int) -> int:
         """The first of ``steps`` steps of a default system on a cold numba

@@ -50,10 +50,11 @@ import numpy as np
 from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
 from refsim.collision.containment import contains_point
+from refsim.collision.disagreement import strict_crossing
 from refsim.collision.spheres import bounding_sphere
 from refsim.kernels import choose_kernel
 from refsim.studies import TIMED
-from refsim.studies.triangles import DISAGREEMENT_KINDS, _strict_crossing, classify_disagreement
+from refsim.studies.triangles import DISAGREEMENT_KINDS, classify_disagreement
 from refsim.types import Pose, random_rotation, rotation_about_axis
 
 # --------------------------------------------------------------------------
@@ -495,8 +496,8 @@ def classify_body_disagreement(mesh_a, pose_a, mesh_b, pose_b, ours: bool,
     if ours:
         world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
         pairs = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel)
-        crossing = any(_strict_crossing(tuple(map(tuple, world_a[mesh_a.faces[i]].tolist())),
-                                        tuple(map(tuple, world_b[mesh_b.faces[j]].tolist())))
+        crossing = any(strict_crossing(tuple(map(tuple, world_a[mesh_a.faces[i]].tolist())),
+                                       tuple(map(tuple, world_b[mesh_b.faces[j]].tolist())))
                        for i, j in pairs)
         if not crossing:
             return "touching"

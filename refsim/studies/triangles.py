@@ -32,38 +32,36 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from refsim.collision.disagreement import CLASSES, classify_triangle_pair
 from refsim.collision.predicates import (
-    FILTERED,
-    _orient3d_terms,
     orient2d_filtered,
     orient3d,
     orient3d_filtered,
+    orient3d_terms,
 )
-from refsim.collision.sat_exact import triangles_intersect_sat
-from refsim.collision.triangle import (
-    normal_signs,
-    triangles_intersect,
-    triangles_intersect_float,
-)
+from refsim.collision.triangle import triangles_intersect, triangles_intersect_float
 from refsim.collision.triangle_batch import certified_batch, triangles_intersect_batch
 from refsim.studies import TIMED
 from refsim.types import random_rotation, rotation_about_axis, transform_points
 
 TriangleTest = Callable[[np.ndarray, np.ndarray], bool]
 
-#: A disagreement with a float engine counts as "tolerance" (not "bug") when
-#: some orientation the decision depends on is this close to degenerate. The
+#: How near-degenerate a pair is for :func:`measure_float_errors` (which
+#: reports how near degeneracy the float tests go wrong; disagreements are
+#: classified by their gap in metres, :func:`classify_disagreement`): some
+#: orientation the decision depends on is this close to degenerate. The
 #: measure is the normalized volume |det[a-d, b-d, c-d]| / (|a-d| |b-d| |c-d|)
 #: (see :func:`decision_margin`): scale and translation invariant, in [0, 1],
 #: roughly the distance of d from the plane abc over its distance from the
 #: points, or the sine of the angle between nearly parallel edges. A float
 #: engine whose arithmetic differs from ours (plane equations, projections,
 #: clipping) errs by a few thousand ulps at most on such quantities, so 1e-12
-#: (about 1e4 ulps of 1) covers any rounding; a disagreement on a better
-#: conditioned pair is not explained by floating point and is a bug.
+#: (about 1e4 ulps of 1, the relative size of the classifier's rounding bound
+#: :data:`refsim.collision.gaps.ROUNDING_ULPS`) covers any rounding.
 NEAR_DEGENERATE_MARGIN = 1e-12
 
-DISAGREEMENT_KINDS = ("coplanar", "touching", "tolerance", "bug")
+#: The classes of a disagreement (:func:`classify_disagreement`).
+DISAGREEMENT_KINDS = CLASSES
 
 
 # --------------------------------------------------------------------------
@@ -170,34 +168,6 @@ def near_degenerate_pairs(n: int, seed: int = 0):
 # classification of disagreements with an oracle
 # --------------------------------------------------------------------------
 
-def _points_coplanar(points) -> bool:
-    """All points on one plane, exactly (true for collinear or equal points)."""
-    m = len(points)
-    for i in range(m):
-        for j in range(i + 1, m):
-            for k in range(j + 1, m):
-                a, b, c = points[i], points[j], points[k]
-                if any(normal_signs(a, b, c, FILTERED)):
-                    return all(orient3d(a, b, c, d) == 0 for d in points)
-    return True
-
-
-def _strict_crossing(t1, t2) -> bool:
-    """Some edge of one triangle crosses the other's OPEN interior
-    transversally, decided with strict signs only (no zero involved)."""
-    for e, t in ((t1, t2), (t2, t1)):
-        a, b, c = t
-        for i in range(3):
-            p, q = e[i], e[(i + 1) % 3]
-            sp, sq = orient3d(a, b, c, p), orient3d(a, b, c, q)
-            if sp * sq >= 0:
-                continue
-            signs = {orient3d(p, q, a, b), orient3d(p, q, b, c), orient3d(p, q, c, a)}
-            if signs in ({1}, {-1}):
-                return True
-    return False
-
-
 def decision_margin(t1, t2) -> float:
     """The smallest normalized volume of the orientations the decision uses.
 
@@ -211,7 +181,7 @@ def decision_margin(t1, t2) -> float:
     is compared with).
     """
     def rel(a, b, c, d):
-        det, _ = _orient3d_terms(a, b, c, d)
+        det, _ = orient3d_terms(a, b, c, d)
         lengths = math.prod(math.dist(p, d) for p in (a, b, c))
         return abs(det) / lengths if lengths > 0 else 0.0
 
@@ -228,69 +198,18 @@ def decision_margin(t1, t2) -> float:
     return min(margins)
 
 
-#: The classes a disagreement on a triangle pair takes from exact predicates
-#: alone (:func:`exact_class`), shared by this study's classifier and the
-#: conformance kit's (:func:`refsim.conformance.checks_geometry.classify_triangles`).
-#: The two part only where no exact predicate decides: this study calls a
-#: pair "tolerance" by its dimensionless decision margin
-#: (:data:`NEAR_DEGENERATE_MARGIN`), the kit by its gap in metres against the
-#: rounding bound and the engine's declared tolerance.
-EXACT_CLASSES = ("bug", "coplanar", "touching")
-
-
-def exact_class(t1, t2, answers: tuple[bool, bool | None] | None = None) -> str | None:
-    """The class of a disagreement on the triangle pair ``(t1, t2)`` (tuples
-    of float coordinates) that exact predicates decide, or None when none
-    does and the class turns on a tolerance:
-
-    - ``"bug"``: refsim's exact answer differs from an independent exact
-      ground truth, the separating-axis test in rational arithmetic
-      (:mod:`refsim.collision.sat_exact`; not applicable, so never a bug, for
-      a degenerate triangle);
-    - ``"coplanar"``: all six vertices lie on one plane, exactly;
-    - ``"touching"``: refsim finds a common point, but no edge crosses the
-      other triangle's open interior with all signs strict: the contact
-      depends on an exact zero orientation (the exact minimum distance is 0).
-
-    ``answers``: ``(refsim, truth)`` when the caller has them already:
-    :func:`refsim.collision.triangle.triangles_intersect` and
-    :func:`refsim.collision.sat_exact.triangles_intersect_sat` on the pair.
-    """
-    refsim, truth = answers if answers is not None else (
-        triangles_intersect(t1, t2), triangles_intersect_sat(t1, t2))
-    if truth is not None and truth != refsim:
-        return "bug"
-    if _points_coplanar(t1 + t2):
-        return "coplanar"
-    if refsim and not _strict_crossing(t1, t2):
-        return "touching"
-    return None
-
-
 def classify_disagreement(a, b) -> str:
-    """Why an engine's answer may differ from refsim's exact one on (a, b).
-
-    First the classes exact predicates decide (:func:`exact_class`):
-    ``"bug"`` when refsim's answer differs from the rational separating-axis
-    ground truth (refsim is wrong, whatever the margins say), then
-    ``"coplanar"`` and ``"touching"``. Otherwise:
-
-    - ``"tolerance"``: no exact zero decides it, but the decision is
-      near-degenerate (:func:`decision_margin` <= ``NEAR_DEGENERATE_MARGIN``):
-      within reach of a float engine's rounding and epsilons.
-    - ``"bug"``: anything else: a well-conditioned pair answered differently.
+    """Why an engine's answer may differ from refsim's exact one on (a, b):
+    the class of :func:`refsim.collision.disagreement.classify_triangle_pair`
+    (the conformance kit's too) for an engine that declares no tolerance:
+    "coplanar" and "touching" by exact predicates, "bug" where refsim's
+    answer differs from the rational ground truth, else "tolerance" when the
+    pair's gap is within the float64 rounding bound and "bug" beyond it.
 
     Call it only for pairs where the answers differ; it does not look at
     them.
     """
-    t1 = tuple(map(tuple, np.asarray(a, np.float64).tolist()))
-    t2 = tuple(map(tuple, np.asarray(b, np.float64).tolist()))
-    kind = exact_class(t1, t2)
-    if kind is not None:
-        return kind
-    if decision_margin(t1, t2) <= NEAR_DEGENERATE_MARGIN:
-        return "tolerance"
-    return "bug"
+    return classify_triangle_pair(a, b).kind
 
 
 @dataclass(frozen=True)
@@ -299,7 +218,8 @@ class Disagreement:
     refsim: bool
     oracle: bool
     kind: str
-    margin: float
+    gap: float              # metres: distance apart, minus the depth of a crossing
+    bound: float            # the rounding bound the gap was compared with, metres
 
 
 @dataclass(frozen=True)
@@ -326,10 +246,9 @@ def compare_with_oracle(A, B, oracle: TriangleTest) -> Agreement:
     theirs = np.array([bool(oracle(a, b)) for a, b in zip(A, B, strict=True)], dtype=bool)
     found = []
     for i in np.flatnonzero(ours != theirs):
-        t1 = tuple(map(tuple, A[i].tolist()))
-        t2 = tuple(map(tuple, B[i].tolist()))
-        found.append(Disagreement(int(i), bool(ours[i]), bool(theirs[i]),
-                                  classify_disagreement(A[i], B[i]), decision_margin(t1, t2)))
+        verdict = classify_triangle_pair(A[i], B[i])
+        found.append(Disagreement(int(i), bool(ours[i]), bool(theirs[i]), verdict.kind,
+                                  verdict.gap, verdict.bound))
     counts = {kind: sum(d.kind == kind for d in found) for kind in DISAGREEMENT_KINDS}
     return Agreement(n=len(A), agree=int((ours == theirs).sum()), refsim_true=int(ours.sum()),
                      oracle_true=int(theirs.sum()), counts=counts, disagreements=tuple(found))

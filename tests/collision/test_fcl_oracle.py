@@ -3,7 +3,7 @@ classified (touching, coplanar, tolerance, bug); no bugs allowed.
 
 Measured (seeded, reproducible with these tests): on 20 000 uniform random
 pairs refsim and FCL agree on every pair; on 5 000 near-degenerate pairs FCL
-differs on a few hundred, all "tolerance" (decision margins below 5e-15), and
+differs on 623, all "tolerance" (gaps within the rounding bound), and
 on the exactly representable cases of test_triangle only on a degenerate
 point triangle at a vertex (FCL: no contact).
 """
@@ -15,6 +15,7 @@ import pytest
 from refsim.oracles.fcl_adapter import FCLOracle
 
 from refsim.claims.collision import ROUNDING_TILT
+from refsim.collision.gaps import rounding_bound
 from refsim.collision.triangle_batch import triangles_intersect_batch
 from refsim.models.mesh import Mesh
 from refsim.studies.triangles import (
@@ -57,8 +58,22 @@ def test_near_degenerate_pairs_have_no_bug_class_disagreements(fcl):
     assert result.counts["bug"] == 0
     # They do disagree, within rounding: that is what the classes are for.
     assert result.counts["tolerance"] > 0
-    assert all(d.margin <= NEAR_DEGENERATE_MARGIN for d in result.disagreements
-               if d.kind == "tolerance")
+    # Each "tolerance" is a gap within the rounding bound, a "bug" none.
+    assert all(abs(d.gap) <= d.bound for d in result.disagreements if d.kind == "tolerance")
+    assert all(d.bound == rounding_bound(A[d.index], B[d.index]) for d in result.disagreements)
+
+
+def test_the_studies_and_the_kit_classify_alike(fcl):
+    """One classifier: the study's class of every disagreement is the kit's
+    for an engine that declares no tolerance, on the same pairs."""
+    from refsim.conformance.checks_geometry import classify_triangles
+
+    A, B, _ = near_degenerate_pairs(600, seed=4)
+    result = compare_with_oracle(A, B, fcl.triangles_intersect)
+    assert result.disagreements
+    for d in result.disagreements:
+        kit = classify_triangles(A[d.index], B[d.index])
+        assert (kit["class"], kit["gap_metres"]) == (d.kind, d.gap)
 
 
 def test_exactly_representable_cases(fcl):
@@ -84,9 +99,10 @@ def test_classifier_labels():
     # bug; decision margin 0.15).
     assert classify_disagreement(T, ((0.3, 0.2, -0.7), (0.1, 0.35, 0.9), (1.3, 1.1, 0.45))) \
         == "bug"
-    # An exact zero the answer does not depend on still marks the pair as
-    # near-degenerate: here vertex (0, 0, 0) lies on the other plane, x = y.
-    assert classify_disagreement(T, CASES["piercing"][0]) == "tolerance"
+    # An exact zero the answer does not depend on (vertex (0, 0, 0) lies on
+    # the other plane, x = y) does not excuse a clean piercing: its depth is
+    # far beyond rounding.
+    assert classify_disagreement(T, CASES["piercing"][0]) == "bug"
 
 
 def _octahedron(scale=1.0):

@@ -101,10 +101,10 @@ def test_integer_scaling_gives_the_rational_answers_on_every_family():
 
 def test_both_classifiers_share_the_exact_classes():
     """The studies' classifier and the conformance kit's give the same class
-    wherever exact predicates decide (refsim.studies.triangles.exact_class)."""
+    wherever exact predicates decide (refsim.collision.disagreement.exact_class)."""
+    from refsim.collision.disagreement import EXACT_CLASSES, exact_class
     from refsim.conformance.cases_triangles import triangle_cases
     from refsim.conformance.checks_geometry import classify_triangles
-    from refsim.studies.triangles import EXACT_CLASSES, exact_class
 
     decided = 0
     for pair in triangle_cases(400, 0).pairs:

@@ -10,6 +10,7 @@ import math
 import numpy as np
 import pytest
 
+from refsim.collision.gaps import penetration_depth, triangle_distance
 from refsim.conformance.cases_boxes import BoxCase, exact_box, rounding_bound
 from refsim.conformance.cases_meshes import PoseCase, PoseCases, _exact_pairs
 from refsim.conformance.checks_geometry import (
@@ -22,7 +23,6 @@ from refsim.conformance.checks_geometry import (
     classify_pairs,
     classify_triangles,
 )
-from refsim.conformance.gaps import penetration_depth, triangle_distance
 from refsim.engines import Declarations, declarations
 from refsim.errors import OptionError
 from tests.conformance.broken_engines import BoxIgnoresRotation, GjkLikeCollide, PaddedBox

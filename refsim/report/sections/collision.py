@@ -122,8 +122,9 @@ def build(ctx) -> Section:
         rows=tuple(pair_rows),
         caption=("Every disagreement classified (refsim.studies.triangles."
                  "classify_disagreement): coplanar, touching (the contact rests on an exact "
-                 "zero), tolerance (decision margin <= "
-                 f"{measure.NEAR_DEGENERATE_MARGIN:g}), bug. For posed meshes n is the "
+                 "zero), tolerance (the pair's gap, distance apart or depth of the crossing, "
+                 "within the rounding bound of refsim.collision.gaps, as in the conformance "
+                 "kit), bug. For posed meshes n is the "
                  "number of distinct face pairs either engine reports. Reproduce: "
                  f"{TRIANGLES_COMMAND} and {BODY_ORACLES_COMMAND}" if triangle_rows
                  or agreement.pairs

@@ -1,7 +1,8 @@
 """How far a wrong geometric answer is from being right, in metres.
 
 When an engine's answer on two triangles differs from the exact one, the
-kit measures the **gap** of the pair: the distance between the closed
+conformance kit and the studies measure the **gap** of the pair
+(:func:`refsim.collision.disagreement.classify_triangle_pair`): the distance between the closed
 triangles when they are apart, minus the penetration depth when they cross
 (the shortest translation that separates them), 0 when they touch. A
 mesh-pair or collide answer is measured by the gaps of the face pairs it
