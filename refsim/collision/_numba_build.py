@@ -78,7 +78,7 @@ TINY_ROTATION = 2.0 ** -27
 #: eight interleaved partial sums.
 PAIRWISE_BLOCK = 128
 
-#: Rows of the explicit stacks of :func:`pairwise_sum` (its splits halve a
+#: Rows of the explicit stacks of :func:`pairwise_sums` (its splits halve a
 #: range: 2 log2(n / 64) + 1 frames for n terms).
 PAIRWISE_STACK = 130
 
@@ -134,59 +134,149 @@ def unit_exponent(largest):
 
 
 @numba.njit(cache=True)
-def block_sum(u, v, lo, n, mu, mv):
+def block_sums(x, y, z, f, lo, n, m0, m1, m2):
     """numpy's pairwise sum of at most PAIRWISE_BLOCK terms (module
-    docstring), of the products ``(u[r] - mu) (v[r] - mv)`` for r in
-    ``lo..lo+n``: fewer than 8 one after another; else eight partial sums
-    over the multiples of 8, added as ``((r0 + r1) + (r2 + r3)) + ((r4 + r5)
-    + (r6 + r7))``, then the rest."""
+    docstring) of each of the six products ``d_i d_j`` a covariance needs,
+    d = (x[r] f - m0, y[r] f - m1, z[r] f - m2) for r in ``lo..lo+n`` (f the
+    points' scale, a power of two), in one pass: fewer than 8 terms one
+    after another; else eight partial sums over the multiples of 8, added
+    as ``((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))``, then the rest.
+    Returns (xx, yy, zz, xy, xz, yz). Each sum takes numpy's operations in
+    numpy's order (the same bits as six separate sums); the differences are
+    formed once a point instead of four times."""
     if n < 8:
-        total = 0.0
+        xx = yy = zz = xy = xz = yz = 0.0
         for r in range(lo, lo + n):
-            total += (u[r] - mu) * (v[r] - mv)
-        return total
-    r0 = (u[lo] - mu) * (v[lo] - mv)
-    r1 = (u[lo + 1] - mu) * (v[lo + 1] - mv)
-    r2 = (u[lo + 2] - mu) * (v[lo + 2] - mv)
-    r3 = (u[lo + 3] - mu) * (v[lo + 3] - mv)
-    r4 = (u[lo + 4] - mu) * (v[lo + 4] - mv)
-    r5 = (u[lo + 5] - mu) * (v[lo + 5] - mv)
-    r6 = (u[lo + 6] - mu) * (v[lo + 6] - mv)
-    r7 = (u[lo + 7] - mu) * (v[lo + 7] - mv)
+            d0, d1, d2 = x[r] * f - m0, y[r] * f - m1, z[r] * f - m2
+            xx += d0 * d0
+            yy += d1 * d1
+            zz += d2 * d2
+            xy += d0 * d1
+            xz += d0 * d2
+            yz += d1 * d2
+        return xx, yy, zz, xy, xz, yz
+    d0, d1, d2 = x[lo + 0] * f - m0, y[lo + 0] * f - m1, z[lo + 0] * f - m2
+    xx0, yy0, zz0 = d0 * d0, d1 * d1, d2 * d2
+    xy0, xz0, yz0 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 1] * f - m0, y[lo + 1] * f - m1, z[lo + 1] * f - m2
+    xx1, yy1, zz1 = d0 * d0, d1 * d1, d2 * d2
+    xy1, xz1, yz1 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 2] * f - m0, y[lo + 2] * f - m1, z[lo + 2] * f - m2
+    xx2, yy2, zz2 = d0 * d0, d1 * d1, d2 * d2
+    xy2, xz2, yz2 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 3] * f - m0, y[lo + 3] * f - m1, z[lo + 3] * f - m2
+    xx3, yy3, zz3 = d0 * d0, d1 * d1, d2 * d2
+    xy3, xz3, yz3 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 4] * f - m0, y[lo + 4] * f - m1, z[lo + 4] * f - m2
+    xx4, yy4, zz4 = d0 * d0, d1 * d1, d2 * d2
+    xy4, xz4, yz4 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 5] * f - m0, y[lo + 5] * f - m1, z[lo + 5] * f - m2
+    xx5, yy5, zz5 = d0 * d0, d1 * d1, d2 * d2
+    xy5, xz5, yz5 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 6] * f - m0, y[lo + 6] * f - m1, z[lo + 6] * f - m2
+    xx6, yy6, zz6 = d0 * d0, d1 * d1, d2 * d2
+    xy6, xz6, yz6 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 7] * f - m0, y[lo + 7] * f - m1, z[lo + 7] * f - m2
+    xx7, yy7, zz7 = d0 * d0, d1 * d1, d2 * d2
+    xy7, xz7, yz7 = d0 * d1, d0 * d2, d1 * d2
     end = lo + n - n % 8
     for i in range(lo + 8, end, 8):
-        r0 += (u[i] - mu) * (v[i] - mv)
-        r1 += (u[i + 1] - mu) * (v[i + 1] - mv)
-        r2 += (u[i + 2] - mu) * (v[i + 2] - mv)
-        r3 += (u[i + 3] - mu) * (v[i + 3] - mv)
-        r4 += (u[i + 4] - mu) * (v[i + 4] - mv)
-        r5 += (u[i + 5] - mu) * (v[i + 5] - mv)
-        r6 += (u[i + 6] - mu) * (v[i + 6] - mv)
-        r7 += (u[i + 7] - mu) * (v[i + 7] - mv)
-    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+        d0, d1, d2 = x[i + 0] * f - m0, y[i + 0] * f - m1, z[i + 0] * f - m2
+        xx0 += d0 * d0
+        yy0 += d1 * d1
+        zz0 += d2 * d2
+        xy0 += d0 * d1
+        xz0 += d0 * d2
+        yz0 += d1 * d2
+        d0, d1, d2 = x[i + 1] * f - m0, y[i + 1] * f - m1, z[i + 1] * f - m2
+        xx1 += d0 * d0
+        yy1 += d1 * d1
+        zz1 += d2 * d2
+        xy1 += d0 * d1
+        xz1 += d0 * d2
+        yz1 += d1 * d2
+        d0, d1, d2 = x[i + 2] * f - m0, y[i + 2] * f - m1, z[i + 2] * f - m2
+        xx2 += d0 * d0
+        yy2 += d1 * d1
+        zz2 += d2 * d2
+        xy2 += d0 * d1
+        xz2 += d0 * d2
+        yz2 += d1 * d2
+        d0, d1, d2 = x[i + 3] * f - m0, y[i + 3] * f - m1, z[i + 3] * f - m2
+        xx3 += d0 * d0
+        yy3 += d1 * d1
+        zz3 += d2 * d2
+        xy3 += d0 * d1
+        xz3 += d0 * d2
+        yz3 += d1 * d2
+        d0, d1, d2 = x[i + 4] * f - m0, y[i + 4] * f - m1, z[i + 4] * f - m2
+        xx4 += d0 * d0
+        yy4 += d1 * d1
+        zz4 += d2 * d2
+        xy4 += d0 * d1
+        xz4 += d0 * d2
+        yz4 += d1 * d2
+        d0, d1, d2 = x[i + 5] * f - m0, y[i + 5] * f - m1, z[i + 5] * f - m2
+        xx5 += d0 * d0
+        yy5 += d1 * d1
+        zz5 += d2 * d2
+        xy5 += d0 * d1
+        xz5 += d0 * d2
+        yz5 += d1 * d2
+        d0, d1, d2 = x[i + 6] * f - m0, y[i + 6] * f - m1, z[i + 6] * f - m2
+        xx6 += d0 * d0
+        yy6 += d1 * d1
+        zz6 += d2 * d2
+        xy6 += d0 * d1
+        xz6 += d0 * d2
+        yz6 += d1 * d2
+        d0, d1, d2 = x[i + 7] * f - m0, y[i + 7] * f - m1, z[i + 7] * f - m2
+        xx7 += d0 * d0
+        yy7 += d1 * d1
+        zz7 += d2 * d2
+        xy7 += d0 * d1
+        xz7 += d0 * d2
+        yz7 += d1 * d2
+    xx = ((xx0 + xx1) + (xx2 + xx3)) + ((xx4 + xx5) + (xx6 + xx7))
+    yy = ((yy0 + yy1) + (yy2 + yy3)) + ((yy4 + yy5) + (yy6 + yy7))
+    zz = ((zz0 + zz1) + (zz2 + zz3)) + ((zz4 + zz5) + (zz6 + zz7))
+    xy = ((xy0 + xy1) + (xy2 + xy3)) + ((xy4 + xy5) + (xy6 + xy7))
+    xz = ((xz0 + xz1) + (xz2 + xz3)) + ((xz4 + xz5) + (xz6 + xz7))
+    yz = ((yz0 + yz1) + (yz2 + yz3)) + ((yz4 + yz5) + (yz6 + yz7))
     for r in range(end, lo + n):
-        total += (u[r] - mu) * (v[r] - mv)
-    return total
+        d0, d1, d2 = x[r] * f - m0, y[r] * f - m1, z[r] * f - m2
+        xx += d0 * d0
+        yy += d1 * d1
+        zz += d2 * d2
+        xy += d0 * d1
+        xz += d0 * d2
+        yz += d1 * d2
+    return xx, yy, zz, xy, xz, yz
+
 
 
 @numba.njit(cache=True)
-def pairwise_sum(u, v, n, mu, mv):
-    """``np.sum((u[:n] - mu) * (v[:n] - mv))``'s pairwise sum (module
-    docstring), before numpy adds it to 0.0: a range longer than
-    PAIRWISE_BLOCK is split at a multiple of 8 below its half and the
-    halves' sums added. Written with explicit stacks (``frames`` of (start,
+def pairwise_sums(x, y, z, f, n, m0, m1, m2):
+    """numpy's pairwise sums (module docstring) of the six products of
+    :func:`block_sums` over the first n points, before numpy adds each to
+    0.0: a range longer than PAIRWISE_BLOCK is split at a multiple of 8 below
+    its half and the halves' sums added; the six sums share the splits (they
+    have the same n). Written with explicit stacks (``frames`` of (start,
     length, halves done), ``values`` of sums), not by recursion: numba's
-    cache reloads recursive functions wrongly (numba bug report 6061, github.com/numba/numba)."""
+    cache reloads recursive functions wrongly (numba bug report 6061,
+    github.com/numba/numba)."""
     if n <= PAIRWISE_BLOCK:
-        return block_sum(u, v, 0, n, mu, mv)
+        return block_sums(x, y, z, f, 0, n, m0, m1, m2)
     frames = np.empty((PAIRWISE_STACK, 3), dtype=np.int64)
-    values = np.empty(PAIRWISE_STACK)
+    values = np.empty((PAIRWISE_STACK, 6))
     frames[0, 0], frames[0, 1], frames[0, 2] = 0, n, 0
     top, stored = 1, 0
     while top > 0:
         lo, length, split = frames[top - 1, 0], frames[top - 1, 1], frames[top - 1, 2]
         if length <= PAIRWISE_BLOCK:
-            values[stored] = block_sum(u, v, lo, length, mu, mv)
+            sums = block_sums(x, y, z, f, lo, length, m0, m1, m2)
+            for j in range(6):
+                values[stored, j] = sums[j]
             stored += 1
             top -= 1
         elif split == 0:
@@ -197,10 +287,12 @@ def pairwise_sum(u, v, n, mu, mv):
             frames[top + 1, 0], frames[top + 1, 1], frames[top + 1, 2] = lo, half, 0
             top += 2                            # the first half on top: summed first
         else:
-            values[stored - 2] = values[stored - 2] + values[stored - 1]   # first + second
+            for j in range(6):                  # first + second
+                values[stored - 2, j] = values[stored - 2, j] + values[stored - 1, j]
             stored -= 1
             top -= 1
-    return values[0]
+    return (values[0, 0], values[0, 1], values[0, 2], values[0, 3], values[0, 4],
+            values[0, 5])
 
 
 @numba.njit(cache=True)
@@ -213,35 +305,33 @@ def covariance(x, y, z, n, largest, a, scaled):
     if n < 2:
         a[:, :] = 0.0
         return
-    # np.ldexp(points, -e): the points themselves when e = 0 (coordinates
-    # already in [0.5, 1), as build_tree leaves many sets), a product by
-    # 2**-e when that is a normal float (both round the exact value once),
-    # else ldexp itself
+    # np.ldexp(points, -e): a product by f = 2**-e when that is a normal
+    # float (both round the exact value once; 1.0 when e = 0, coordinates
+    # already in [0.5, 1), as build_tree leaves many sets), formed where each
+    # point is read; else ldexp itself, into ``scaled``
     k = -unit_exponent(largest)
-    if k != 0:
-        factor = math.ldexp(1.0, k)
-        normal = -1022 <= k <= 1023
+    f = 1.0
+    if -1022 <= k <= 1023:
+        f = math.ldexp(1.0, k)
+    else:
         for r in range(n):
-            if normal:
-                scaled[0, r], scaled[1, r], scaled[2, r] = x[r] * factor, y[r] * factor, \
-                    z[r] * factor
-            else:
-                scaled[0, r], scaled[1, r], scaled[2, r] = math.ldexp(x[r], k), \
-                    math.ldexp(y[r], k), math.ldexp(z[r], k)
+            scaled[0, r], scaled[1, r], scaled[2, r] = math.ldexp(x[r], k), \
+                math.ldexp(y[r], k), math.ldexp(z[r], k)
         x, y, z = scaled[0], scaled[1], scaled[2]
     m0 = m1 = m2 = 0.0                    # points.mean(axis=0): rows in turn, from 0.0
     for r in range(n):
-        m0 += x[r]
-        m1 += y[r]
-        m2 += z[r]
+        m0 += x[r] * f
+        m1 += y[r] * f
+        m2 += z[r] * f
     m0, m1, m2 = m0 / n, m1 / n, m2 / n
     # np.sum adds the pairwise sum to 0.0 (which turns a -0.0 into 0.0)
-    a[0, 0] = 0.0 + pairwise_sum(x, x, n, m0, m0)
-    a[1, 1] = 0.0 + pairwise_sum(y, y, n, m1, m1)
-    a[2, 2] = 0.0 + pairwise_sum(z, z, n, m2, m2)
-    a[0, 1] = a[1, 0] = 0.0 + pairwise_sum(x, y, n, m0, m1)
-    a[0, 2] = a[2, 0] = 0.0 + pairwise_sum(x, z, n, m0, m2)
-    a[1, 2] = a[2, 1] = 0.0 + pairwise_sum(y, z, n, m1, m2)
+    xx, yy, zz, xy, xz, yz = pairwise_sums(x, y, z, f, n, m0, m1, m2)
+    a[0, 0] = 0.0 + xx
+    a[1, 1] = 0.0 + yy
+    a[2, 2] = 0.0 + zz
+    a[0, 1] = a[1, 0] = 0.0 + xy
+    a[0, 2] = a[2, 0] = 0.0 + xz
+    a[1, 2] = a[2, 1] = 0.0 + yz
 
 
 @numba.njit(cache=True)
