@@ -32,8 +32,10 @@ called, so the tree is the same on every machine, as the readable one.
 
 How it is made cheaper than the readable build without changing a bit:
 the six candidate halves of a node have their covariances formed first and
-their eigenvectors found together (:func:`symmetric_eigenvectors`: the
-processor overlaps six chains of dependent divisions and square roots); a
+their eigenvectors found two at a time, each matrix's entries in locals
+(:func:`eigenvectors_of_pair`: the processor overlaps the two chains of
+dependent divisions and square roots); a covariance's six sums take one
+pass (:func:`block_sums`); a
 node's own principal axes are those of the half its parent chose (the same
 triangles in the same order), so each node's eigenproblem is solved once;
 keys are ranked by buckets and insertion instead of a general sort
@@ -105,12 +107,11 @@ def split_scratch(m):
     along each, ``bucket`` (m,) and ``counts``
     (m + 1,) int64, and for the six candidate halves (the first and second
     of each axis, and the node itself last) their covariance matrices
-    ``a``, rotations ``v``, ``done`` flags and principal ``axes`` (7, 3, 3)."""
+    ``a`` and principal ``axes`` (7, 3, 3)."""
     m = max(m, 1)
     return (np.empty(9 * m), np.empty(9 * m), np.empty(9 * m), np.empty((3, m)),
             np.empty((3, m), dtype=np.int64), np.empty(m, dtype=np.int64),
-            np.empty(m + 1, dtype=np.int64), np.empty((7, 3, 3)), np.empty((7, 3, 3)),
-            np.empty(7, dtype=np.bool_), np.empty((7, 3, 3)))
+            np.empty(m + 1, dtype=np.int64), np.empty((7, 3, 3)), np.empty((7, 3, 3)))
 
 
 # -- the principal axes ---------------------------------------------------------------
@@ -335,67 +336,180 @@ def covariance(x, y, z, n, largest, a, scaled):
 
 
 @numba.njit(cache=True)
-def symmetric_eigenvectors(a, v, axes, count, done):
-    """Mirrors: bvh_exact.symmetric_eigenvectors, of ``count`` matrices at
-    once: ``a`` (count, 3, 3) is overwritten, ``v`` (count, 3, 3) and
-    ``done`` (count,) are scratch, the eigenvectors (columns) go to ``axes``
-    (count, 3, 3).
+def symmetric_eigenvectors(a, axes, count):
+    """Mirrors: bvh_exact.symmetric_eigenvectors, of ``count`` matrices
+    ``a`` (count, 3, 3), left unchanged; the eigenvectors (columns) go to
+    ``axes`` (count, 3, 3). Two at a time (:func:`eigenvectors_of_pair`),
+    the last of an odd count with itself."""
+    for m in range(0, count, 2):
+        eigenvectors_of_pair(a, axes, m, min(m + 1, count - 1))
 
-    Each matrix takes the readable function's steps, in its order; the
-    matrices take them in turns (rotation (p, q) of a sweep for each, then
-    the next), so that the processor overlaps their chains of dependent
-    divisions and square roots, which a single 3 x 3 problem waits on."""
-    for m in range(count):
-        done[m] = False
-        for i in range(3):
-            for j in range(3):
-                v[m, i, j] = 1.0 if i == j else 0.0
+
+@numba.njit(cache=True)
+def eigenvectors_of_pair(a, axes, first, second):
+    """Mirrors: bvh_exact.symmetric_eigenvectors, of matrices ``a[first]``
+    and ``a[second]`` (each (3, 3), left unchanged) into ``axes[first]`` and
+    ``axes[second]``: each matrix's rotations in the readable order, on its
+    entries held in locals, the two matrices in turns so that the processor
+    overlaps their chains of divisions and square roots. A matrix whose
+    off-diagonal entries are all zero takes no rotation (each is skipped
+    when its entry is zero), so sweeping it on while the other converges
+    changes nothing: the same bits as one matrix alone."""
+    a00_0, a01_0, a02_0 = a[first, 0, 0], a[first, 0, 1], a[first, 0, 2]
+    a10_0, a11_0, a12_0 = a[first, 1, 0], a[first, 1, 1], a[first, 1, 2]
+    a20_0, a21_0, a22_0 = a[first, 2, 0], a[first, 2, 1], a[first, 2, 2]
+    v00_0, v01_0, v02_0 = 1.0, 0.0, 0.0
+    v10_0, v11_0, v12_0 = 0.0, 1.0, 0.0
+    v20_0, v21_0, v22_0 = 0.0, 0.0, 1.0
+    a00_1, a01_1, a02_1 = a[second, 0, 0], a[second, 0, 1], a[second, 0, 2]
+    a10_1, a11_1, a12_1 = a[second, 1, 0], a[second, 1, 1], a[second, 1, 2]
+    a20_1, a21_1, a22_1 = a[second, 2, 0], a[second, 2, 1], a[second, 2, 2]
+    v00_1, v01_1, v02_1 = 1.0, 0.0, 0.0
+    v10_1, v11_1, v12_1 = 0.0, 1.0, 0.0
+    v20_1, v21_1, v22_1 = 0.0, 0.0, 1.0
     for _ in range(JACOBI_SWEEPS):
-        remaining = 0
-        for m in range(count):
-            if not done[m]:
-                done[m] = abs(a[m, 0, 1]) + abs(a[m, 0, 2]) + abs(a[m, 1, 2]) == 0.0
-                remaining += not done[m]
-        if remaining == 0:
+        if (abs(a01_0) + abs(a02_0) + abs(a12_0) == 0.0
+                and abs(a01_1) + abs(a02_1) + abs(a12_1) == 0.0):
             break
-        for p, q in ((0, 1), (0, 2), (1, 2)):
-            for m in range(count):
-                if done[m] or a[m, p, q] == 0.0:
-                    continue
-                tau = (a[m, q, q] - a[m, p, p]) / (2.0 * a[m, p, q])
-                t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
-                if abs(t) <= TINY_ROTATION:
-                    c, s = 1.0, t                 # what the next two lines give then
-                else:
-                    c = 1.0 / math.sqrt(1.0 + t * t)
-                    s = t * c
-                for r in range(3):                # a <- a J (columns p, q)
-                    arp, arq = a[m, r, p], a[m, r, q]
-                    a[m, r, p], a[m, r, q] = c * arp - s * arq, s * arp + c * arq
-                for r in range(3):                # a <- J^T a (rows p, q)
-                    apr, aqr = a[m, p, r], a[m, q, r]
-                    a[m, p, r], a[m, q, r] = c * apr - s * aqr, s * apr + c * aqr
-                a[m, p, q] = a[m, q, p] = 0.0
-                for r in range(3):                # v <- v J
-                    vrp, vrq = v[m, r, p], v[m, r, q]
-                    v[m, r, p], v[m, r, q] = c * vrp - s * vrq, s * vrp + c * vrq
-    for m in range(count):
-        # columns by increasing eigenvalue, ties by index (a stable sort of three)
-        o0, o1, o2 = 0, 1, 2
-        if a[m, o1, o1] < a[m, o0, o0]:
-            o0, o1 = o1, o0
-        if a[m, o2, o2] < a[m, o1, o1]:
-            o1, o2 = o2, o1
-            if a[m, o1, o1] < a[m, o0, o0]:
-                o0, o1 = o1, o0
-        for column, i in enumerate((o0, o1, o2)):
-            big = 0                                   # np.argmax: the first largest
-            for r in range(1, 3):
-                if abs(v[m, r, i]) > abs(v[m, big, i]):
-                    big = r
-            flip = v[m, big, i] < 0.0
-            for r in range(3):
-                axes[m, r, column] = -v[m, r, i] if flip else v[m, r, i]
+        if a01_0 != 0.0:
+            tau = (a11_0 - a00_0) / (2.0 * a01_0)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a00_0, a01_0 = c * a00_0 - s * a01_0, s * a00_0 + c * a01_0
+            a10_0, a11_0 = c * a10_0 - s * a11_0, s * a10_0 + c * a11_0
+            a20_0, a21_0 = c * a20_0 - s * a21_0, s * a20_0 + c * a21_0
+            a00_0, a10_0 = c * a00_0 - s * a10_0, s * a00_0 + c * a10_0
+            a01_0, a11_0 = c * a01_0 - s * a11_0, s * a01_0 + c * a11_0
+            a02_0, a12_0 = c * a02_0 - s * a12_0, s * a02_0 + c * a12_0
+            a01_0 = a10_0 = 0.0
+            v00_0, v01_0 = c * v00_0 - s * v01_0, s * v00_0 + c * v01_0
+            v10_0, v11_0 = c * v10_0 - s * v11_0, s * v10_0 + c * v11_0
+            v20_0, v21_0 = c * v20_0 - s * v21_0, s * v20_0 + c * v21_0
+        if a01_1 != 0.0:
+            tau = (a11_1 - a00_1) / (2.0 * a01_1)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a00_1, a01_1 = c * a00_1 - s * a01_1, s * a00_1 + c * a01_1
+            a10_1, a11_1 = c * a10_1 - s * a11_1, s * a10_1 + c * a11_1
+            a20_1, a21_1 = c * a20_1 - s * a21_1, s * a20_1 + c * a21_1
+            a00_1, a10_1 = c * a00_1 - s * a10_1, s * a00_1 + c * a10_1
+            a01_1, a11_1 = c * a01_1 - s * a11_1, s * a01_1 + c * a11_1
+            a02_1, a12_1 = c * a02_1 - s * a12_1, s * a02_1 + c * a12_1
+            a01_1 = a10_1 = 0.0
+            v00_1, v01_1 = c * v00_1 - s * v01_1, s * v00_1 + c * v01_1
+            v10_1, v11_1 = c * v10_1 - s * v11_1, s * v10_1 + c * v11_1
+            v20_1, v21_1 = c * v20_1 - s * v21_1, s * v20_1 + c * v21_1
+        if a02_0 != 0.0:
+            tau = (a22_0 - a00_0) / (2.0 * a02_0)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a00_0, a02_0 = c * a00_0 - s * a02_0, s * a00_0 + c * a02_0
+            a10_0, a12_0 = c * a10_0 - s * a12_0, s * a10_0 + c * a12_0
+            a20_0, a22_0 = c * a20_0 - s * a22_0, s * a20_0 + c * a22_0
+            a00_0, a20_0 = c * a00_0 - s * a20_0, s * a00_0 + c * a20_0
+            a01_0, a21_0 = c * a01_0 - s * a21_0, s * a01_0 + c * a21_0
+            a02_0, a22_0 = c * a02_0 - s * a22_0, s * a02_0 + c * a22_0
+            a02_0 = a20_0 = 0.0
+            v00_0, v02_0 = c * v00_0 - s * v02_0, s * v00_0 + c * v02_0
+            v10_0, v12_0 = c * v10_0 - s * v12_0, s * v10_0 + c * v12_0
+            v20_0, v22_0 = c * v20_0 - s * v22_0, s * v20_0 + c * v22_0
+        if a02_1 != 0.0:
+            tau = (a22_1 - a00_1) / (2.0 * a02_1)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a00_1, a02_1 = c * a00_1 - s * a02_1, s * a00_1 + c * a02_1
+            a10_1, a12_1 = c * a10_1 - s * a12_1, s * a10_1 + c * a12_1
+            a20_1, a22_1 = c * a20_1 - s * a22_1, s * a20_1 + c * a22_1
+            a00_1, a20_1 = c * a00_1 - s * a20_1, s * a00_1 + c * a20_1
+            a01_1, a21_1 = c * a01_1 - s * a21_1, s * a01_1 + c * a21_1
+            a02_1, a22_1 = c * a02_1 - s * a22_1, s * a02_1 + c * a22_1
+            a02_1 = a20_1 = 0.0
+            v00_1, v02_1 = c * v00_1 - s * v02_1, s * v00_1 + c * v02_1
+            v10_1, v12_1 = c * v10_1 - s * v12_1, s * v10_1 + c * v12_1
+            v20_1, v22_1 = c * v20_1 - s * v22_1, s * v20_1 + c * v22_1
+        if a12_0 != 0.0:
+            tau = (a22_0 - a11_0) / (2.0 * a12_0)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a01_0, a02_0 = c * a01_0 - s * a02_0, s * a01_0 + c * a02_0
+            a11_0, a12_0 = c * a11_0 - s * a12_0, s * a11_0 + c * a12_0
+            a21_0, a22_0 = c * a21_0 - s * a22_0, s * a21_0 + c * a22_0
+            a10_0, a20_0 = c * a10_0 - s * a20_0, s * a10_0 + c * a20_0
+            a11_0, a21_0 = c * a11_0 - s * a21_0, s * a11_0 + c * a21_0
+            a12_0, a22_0 = c * a12_0 - s * a22_0, s * a12_0 + c * a22_0
+            a12_0 = a21_0 = 0.0
+            v01_0, v02_0 = c * v01_0 - s * v02_0, s * v01_0 + c * v02_0
+            v11_0, v12_0 = c * v11_0 - s * v12_0, s * v11_0 + c * v12_0
+            v21_0, v22_0 = c * v21_0 - s * v22_0, s * v21_0 + c * v22_0
+        if a12_1 != 0.0:
+            tau = (a22_1 - a11_1) / (2.0 * a12_1)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a01_1, a02_1 = c * a01_1 - s * a02_1, s * a01_1 + c * a02_1
+            a11_1, a12_1 = c * a11_1 - s * a12_1, s * a11_1 + c * a12_1
+            a21_1, a22_1 = c * a21_1 - s * a22_1, s * a21_1 + c * a22_1
+            a10_1, a20_1 = c * a10_1 - s * a20_1, s * a10_1 + c * a20_1
+            a11_1, a21_1 = c * a11_1 - s * a21_1, s * a11_1 + c * a21_1
+            a12_1, a22_1 = c * a12_1 - s * a22_1, s * a12_1 + c * a22_1
+            a12_1 = a21_1 = 0.0
+            v01_1, v02_1 = c * v01_1 - s * v02_1, s * v01_1 + c * v02_1
+            v11_1, v12_1 = c * v11_1 - s * v12_1, s * v11_1 + c * v12_1
+            v21_1, v22_1 = c * v21_1 - s * v22_1, s * v21_1 + c * v22_1
+    sorted_columns(a00_0, a11_0, a22_0, ((v00_0, v10_0, v20_0), (v01_0, v11_0, v21_0),
+                                         (v02_0, v12_0, v22_0)), axes[first])
+    sorted_columns(a00_1, a11_1, a22_1, ((v00_1, v10_1, v20_1), (v01_1, v11_1, v21_1),
+                                         (v02_1, v12_1, v22_1)), axes[second])
+
+
+@numba.njit(cache=True, inline="always")
+def sorted_columns(d0, d1, d2, columns, axes):
+    """The eigenvectors ``columns`` (eigenvalues d0, d1, d2) into ``axes``
+    (3, 3) as bvh_exact.symmetric_eigenvectors orders and signs them: by
+    increasing eigenvalue, ties by index (a stable sort of three), each
+    column's first largest component made positive."""
+    o0, o1, o2 = 0, 1, 2
+    e0, e1, e2 = d0, d1, d2
+    if e1 < e0:
+        o0, o1, e0, e1 = o1, o0, e1, e0
+    if e2 < e1:
+        o1, o2, e1, e2 = o2, o1, e2, e1
+        if e1 < e0:
+            o0, o1, e0, e1 = o1, o0, e1, e0
+    for column, i in enumerate((o0, o1, o2)):
+        c0, c1, c2 = columns[i]
+        big, largest = c0, abs(c0)            # np.argmax: the first largest
+        if abs(c1) > largest:
+            big, largest = c1, abs(c1)
+        if abs(c2) > largest:
+            big = c2
+        if big < 0.0:
+            c0, c1, c2 = -c0, -c1, -c2
+        axes[0, column], axes[1, column], axes[2, column] = c0, c1, c2
+
 
 
 @numba.njit(cache=True, inline="always")
@@ -568,13 +682,13 @@ def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
     ``known``, else (at the root) computed. The six halves' covariances are
     formed first and their eigenvectors found together
     (:func:`symmetric_eigenvectors`), then their volumes compared."""
-    x, y, z, keys, ranked, bucket, counts, a, v, done, axes = work
+    x, y, z, keys, ranked, bucket, counts, a, axes = work
     if not known:
         for i in range(k):
             ranked[0, i] = i
         n, largest = gather(tx, ty, tz, members, ranked[0], 0, k, x, y, z)
         covariance(x, y, z, n, largest, a[NODE], axes_work)
-        symmetric_eigenvectors(a[NODE:], v[NODE:], axes[NODE:], 1, done[NODE:])
+        symmetric_eigenvectors(a[NODE:], axes[NODE:], 1)
     node = axes[NODE]
     a00, a01, a02 = node[0, 0], node[0, 1], node[0, 2]
     a10, a11, a12 = node[1, 0], node[1, 1], node[1, 2]
@@ -594,7 +708,7 @@ def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
             n, largest = gather(tx, ty, tz, members, ranked[axis], lo, hi, x[at:], y[at:],
                                 z[at:])
             covariance(x[at:], y[at:], z[at:], n, largest, a[2 * axis + half], axes_work)
-    symmetric_eigenvectors(a, v, axes, 6, done)
+    symmetric_eigenvectors(a, axes, 6)
     volumes = np.empty(3)
     for axis in range(3):
         for half, (lo, hi) in enumerate(((0, mid), (mid, k))):
@@ -625,7 +739,7 @@ def surface_area(tri_lo, tri_hi, ranked, lo, hi):
 def least_area_split(tx, ty, tz, members, k, mid, work):
     """Mirrors: bvh.least_area_split, of ``members[:k]``: returns the chosen
     axis; its order (positions in members) is ``ranked[axis]``."""
-    x, y, _, keys, ranked, bucket, counts, _, _, _, _ = work
+    x, y, _, keys, ranked, bucket, counts, _, _ = work
     tri_lo = x[:3 * k].reshape((3, k))       # scratch: (3, k) each
     tri_hi = y[:3 * k].reshape((3, k))
     for r in range(k):
@@ -665,7 +779,7 @@ def build_tree(tx, ty, tz, leaf_size, rule):
     order = np.arange(m, dtype=np.int64)
     members = np.empty(max(m, 1), dtype=np.int64)
     work, axes_work = split_scratch(m), axes_scratch(3 * max(m, 1))
-    ranked, axes = work[4], work[10]
+    ranked, axes = work[4], work[8]
     count[0] = m
     nodes = 1
     # pending nodes, (node, lo, hi, axes known), each with its principal axes
@@ -828,13 +942,12 @@ def frame_boxes(vx, vy, vz, faces, left, right, start, count, order):
     eigenvectors found BOX_BATCH nodes at a time, then each box formed."""
     n_nodes = len(left)
     a, axes = np.empty((n_nodes, 3, 3)), np.empty((n_nodes, 3, 3))
-    v, done = np.empty((BOX_BATCH, 3, 3)), np.empty(BOX_BATCH, dtype=np.bool_)
     boxes = np.empty((n_nodes, 15))
     visit_nodes(vx, vy, vz, faces, left, right, start, count, order, False, a, axes, boxes)
     worst = 0.0
     for first in range(0, n_nodes, BOX_BATCH):
         last = min(first + BOX_BATCH, n_nodes)
-        symmetric_eigenvectors(a[first:last], v, axes[first:last], last - first, done)
+        symmetric_eigenvectors(a[first:last], axes[first:last], last - first)
         for node in range(first, last):
             off = axes_deviation(axes[node])
             if not (off <= worst):            # max(worst, off), a NaN counted as inf
