@@ -66,6 +66,10 @@ import numpy as np
 #: ``bvh.least_area_split``, ``bvh_exact.least_volume_split``).
 LEAST_AREA, LEAST_VOLUME = 0, 1
 
+#: bvh_exact.VOLUME_TIE: volumes within this fraction of the least tie, and
+#: the area breaks the tie (:func:`chosen_axis`).
+VOLUME_TIE = 0.1
+
 #: Most sweeps of :func:`symmetric_eigenvectors` (bvh_exact.JACOBI_SWEEPS).
 JACOBI_SWEEPS = 50
 
@@ -681,7 +685,8 @@ def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
     (the same triangles in the same order): given in ``axes[NODE]`` when
     ``known``, else (at the root) computed. The six halves' covariances are
     formed first and their eigenvectors found together
-    (:func:`symmetric_eigenvectors`), then their volumes compared."""
+    (:func:`symmetric_eigenvectors`), then their volumes and areas compared
+    (:func:`chosen_axis`)."""
     x, y, z, keys, ranked, bucket, counts, a, axes = work
     if not known:
         for i in range(k):
@@ -709,14 +714,41 @@ def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
                                 z[at:])
             covariance(x[at:], y[at:], z[at:], n, largest, a[2 * axis + half], axes_work)
     symmetric_eigenvectors(a, axes, 6)
-    volumes = np.empty(3)
+    v0 = v1 = v2 = s0 = s1 = s2 = 0.0
     for axis in range(3):
+        volume = area = 0.0
         for half, (lo, hi) in enumerate(((0, mid), (mid, k))):
             at, n = 3 * (axis * k + lo), 3 * (hi - lo)
             low, high = extents(x[at:], y[at:], z[at:], n, axes[2 * axis + half])
-            part = ((high[0] - low[0]) * (high[1] - low[1])) * (high[2] - low[2])
-            volumes[axis] = part if half == 0 else volumes[axis] + part   # box_volume + ...
-    return least_axis(volumes)
+            d0, d1, d2 = high[0] - low[0], high[1] - low[1], high[2] - low[2]
+            part, face = (d0 * d1) * d2, (d0 * d1 + d1 * d2) + d2 * d0
+            volume, area = (part, face) if half == 0 else (volume + part, area + face)
+        if axis == 0:
+            v0, s0 = volume, area
+        elif axis == 1:
+            v1, s1 = volume, area
+        else:
+            v2, s2 = volume, area
+    return chosen_axis(v0, v1, v2, s0, s1, s2)
+
+
+@numba.njit(cache=True)
+def chosen_axis(v0, v1, v2, s0, s1, s2):
+    """Mirrors the choice of bvh_exact.least_volume_split among three axes
+    of total volumes v and areas s: the least area among the volumes within
+    VOLUME_TIE of the least volume (``min``: the first least), area ties
+    keeping the lower axis."""
+    least = v0
+    if v1 < least:
+        least = v1
+    if v2 < least:
+        least = v2
+    bound = least * (1.0 + VOLUME_TIE)
+    best, best_area = -1, 0.0
+    for axis, volume, area in ((0, v0, s0), (1, v1, s1), (2, v2, s2)):
+        if volume <= bound and (best < 0 or area < best_area):
+            best, best_area = axis, area
+    return best
 
 
 @numba.njit(cache=True)
