@@ -12,14 +12,15 @@ Interference Detection", SIGGRAPH 1996):
 1. Node volumes are oriented boxes in body space, computed once per mesh
    (:class:`FrameTree`: a tree of :func:`refsim.collision.bvh.build_tree`
    split across the one of each node's principal axes whose halves have
-   the least total box volume, :func:`least_volume_split`; each node's box
+   the least total box volume, the area breaking near ties,
+   :func:`least_volume_split`; each node's box
    along the principal axes of its vertices, :func:`oriented_box`,
    :func:`principal_axes`). On a curved surface such a box is about as thin
    as the patch is bent, where the axis-aligned box of a tilted patch is as
    thick as the patch is wide: on the separated sphere benchmark the query
    visited 117 node pairs against 751 with axis-aligned node boxes, 2185
    against 4025 on the deep one (both over the least-area tree of
-   :mod:`refsim.collision.bvh`; the least-volume split visits 151 and 2307
+   :mod:`refsim.collision.bvh`; the least-volume split visits 127 and 2251
    there, and 25 instead of 247 on two linked tori).
 2. A query expresses body b in a's frame, ``x_a = M x_b + u`` with
    ``M = Ra^T Rb`` and ``u = Ra^T (tb - ta)``, and a pair of nodes in the
