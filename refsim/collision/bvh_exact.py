@@ -330,12 +330,9 @@ def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int) -> 
         volumes.append(float(np.prod(first)) + float(np.prod(second)))
         areas.append(box_area(first) + box_area(second))
         rankings.append(ranked)
-    least = min(volumes)
-    best = None
-    for axis in range(3):                     # area ties keep the lower axis
-        if volumes[axis] <= least * (1.0 + VOLUME_TIE) and (best is None
-                                                            or areas[axis] < areas[best]):
-            best = axis
+    bound = min(volumes) * (1.0 + VOLUME_TIE)
+    tied = [axis for axis in range(3) if volumes[axis] <= bound]
+    best = min(tied, key=lambda axis: areas[axis])    # area ties keep the lower axis
     return members[rankings[best]]
 
 
