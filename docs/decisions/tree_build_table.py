@@ -4,7 +4,8 @@
         --benchmark-only -p no:randomly --benchmark-json=tree.json
     .venv/bin/python docs/decisions/tree_build_table.py tree.json
 
-prints two markdown tables, one row per mesh: the median milliseconds of a
+prints two markdown tables (a run of some of the benchmarks, ``-k``,
+leaves the others' cells or rows out), one row per mesh: the median milliseconds of a
 new mesh's tree build (refsim's compiled and readable builds for the exact
 level, the compiled one for the triangle-aabb level, FCL's BVHModel) with
 the compiled builds' ratios to FCL; and of its first boolean query, trees
@@ -41,6 +42,10 @@ def _ms(value: float | None) -> str:
     return f"{value:.3g}" if value < 100 else f"{value:.0f}"
 
 
+def _ratio(value: float | None, reference: float) -> str:
+    return "" if value is None else f"{value / reference:.2f}"
+
+
 def tables(path: str) -> list[str]:
     builds, queries, faces = _medians(path)
     order = sorted(builds, key=lambda name: (not name.endswith(".ac"), faces[name], name))
@@ -50,13 +55,13 @@ def tables(path: str) -> list[str]:
     for name in order:
         ms = builds[name]
         fcl = ms["fcl exact"]
-        exact, aabb = ms["refsim-compiled exact"], ms["refsim-compiled aabb"]
+        exact, aabb = ms["refsim-compiled exact"], ms.get("refsim-compiled aabb")
         lines.append(f"| {name} | {faces[name]} | {_ms(fcl)} | {_ms(exact)} | {exact / fcl:.2f} "
-                     f"| {_ms(aabb)} | {aabb / fcl:.2f} "
+                     f"| {_ms(aabb)} | {_ratio(aabb, fcl)} "
                      f"| {_ms(ms.get('refsim-readable exact'))} |")
     lines += ["", "| mesh | faces | FCL build + collide | refsim first bodies_collide | ratio |",
               "| --- | ---: | ---: | ---: | ---: |"]
-    for name in order:
+    for name in (n for n in order if n in queries):
         ms = queries[name]
         lines.append(f"| {name} | {faces[name]} | {_ms(ms['fcl'])} | {_ms(ms['refsim'])} "
                      f"| {ms['refsim'] / ms['fcl']:.2f} |")

@@ -32,8 +32,10 @@ called, so the tree is the same on every machine, as the readable one.
 
 How it is made cheaper than the readable build without changing a bit:
 the six candidate halves of a node have their covariances formed first and
-their eigenvectors found together (:func:`symmetric_eigenvectors`: the
-processor overlaps six chains of dependent divisions and square roots); a
+their eigenvectors found two at a time, each matrix's entries in locals
+(:func:`eigenvectors_of_pair`: the processor overlaps the two chains of
+dependent divisions and square roots); a covariance's six sums take one
+pass (:func:`block_sums`); a
 node's own principal axes are those of the half its parent chose (the same
 triangles in the same order), so each node's eigenproblem is solved once;
 keys are ranked by buckets and insertion instead of a general sort
@@ -64,6 +66,10 @@ import numpy as np
 #: ``bvh.least_area_split``, ``bvh_exact.least_volume_split``).
 LEAST_AREA, LEAST_VOLUME = 0, 1
 
+#: bvh_exact.VOLUME_TIE: volumes within this fraction of the least tie, and
+#: the area breaks the tie (:func:`chosen_axis`).
+VOLUME_TIE = 0.1
+
 #: Most sweeps of :func:`symmetric_eigenvectors` (bvh_exact.JACOBI_SWEEPS).
 JACOBI_SWEEPS = 50
 
@@ -78,7 +84,7 @@ TINY_ROTATION = 2.0 ** -27
 #: eight interleaved partial sums.
 PAIRWISE_BLOCK = 128
 
-#: Rows of the explicit stacks of :func:`pairwise_sum` (its splits halve a
+#: Rows of the explicit stacks of :func:`pairwise_sums` (its splits halve a
 #: range: 2 log2(n / 64) + 1 frames for n terms).
 PAIRWISE_STACK = 130
 
@@ -105,12 +111,11 @@ def split_scratch(m):
     along each, ``bucket`` (m,) and ``counts``
     (m + 1,) int64, and for the six candidate halves (the first and second
     of each axis, and the node itself last) their covariance matrices
-    ``a``, rotations ``v``, ``done`` flags and principal ``axes`` (7, 3, 3)."""
+    ``a`` and principal ``axes`` (7, 3, 3)."""
     m = max(m, 1)
     return (np.empty(9 * m), np.empty(9 * m), np.empty(9 * m), np.empty((3, m)),
             np.empty((3, m), dtype=np.int64), np.empty(m, dtype=np.int64),
-            np.empty(m + 1, dtype=np.int64), np.empty((7, 3, 3)), np.empty((7, 3, 3)),
-            np.empty(7, dtype=np.bool_), np.empty((7, 3, 3)))
+            np.empty(m + 1, dtype=np.int64), np.empty((7, 3, 3)), np.empty((7, 3, 3)))
 
 
 # -- the principal axes ---------------------------------------------------------------
@@ -134,59 +139,149 @@ def unit_exponent(largest):
 
 
 @numba.njit(cache=True)
-def block_sum(u, v, lo, n, mu, mv):
+def block_sums(x, y, z, f, lo, n, m0, m1, m2):
     """numpy's pairwise sum of at most PAIRWISE_BLOCK terms (module
-    docstring), of the products ``(u[r] - mu) (v[r] - mv)`` for r in
-    ``lo..lo+n``: fewer than 8 one after another; else eight partial sums
-    over the multiples of 8, added as ``((r0 + r1) + (r2 + r3)) + ((r4 + r5)
-    + (r6 + r7))``, then the rest."""
+    docstring) of each of the six products ``d_i d_j`` a covariance needs,
+    d = (x[r] f - m0, y[r] f - m1, z[r] f - m2) for r in ``lo..lo+n`` (f the
+    points' scale, a power of two), in one pass: fewer than 8 terms one
+    after another; else eight partial sums over the multiples of 8, added
+    as ``((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))``, then the rest.
+    Returns (xx, yy, zz, xy, xz, yz). Each sum takes numpy's operations in
+    numpy's order (the same bits as six separate sums); the differences are
+    formed once a point instead of four times."""
     if n < 8:
-        total = 0.0
+        xx = yy = zz = xy = xz = yz = 0.0
         for r in range(lo, lo + n):
-            total += (u[r] - mu) * (v[r] - mv)
-        return total
-    r0 = (u[lo] - mu) * (v[lo] - mv)
-    r1 = (u[lo + 1] - mu) * (v[lo + 1] - mv)
-    r2 = (u[lo + 2] - mu) * (v[lo + 2] - mv)
-    r3 = (u[lo + 3] - mu) * (v[lo + 3] - mv)
-    r4 = (u[lo + 4] - mu) * (v[lo + 4] - mv)
-    r5 = (u[lo + 5] - mu) * (v[lo + 5] - mv)
-    r6 = (u[lo + 6] - mu) * (v[lo + 6] - mv)
-    r7 = (u[lo + 7] - mu) * (v[lo + 7] - mv)
+            d0, d1, d2 = x[r] * f - m0, y[r] * f - m1, z[r] * f - m2
+            xx += d0 * d0
+            yy += d1 * d1
+            zz += d2 * d2
+            xy += d0 * d1
+            xz += d0 * d2
+            yz += d1 * d2
+        return xx, yy, zz, xy, xz, yz
+    d0, d1, d2 = x[lo + 0] * f - m0, y[lo + 0] * f - m1, z[lo + 0] * f - m2
+    xx0, yy0, zz0 = d0 * d0, d1 * d1, d2 * d2
+    xy0, xz0, yz0 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 1] * f - m0, y[lo + 1] * f - m1, z[lo + 1] * f - m2
+    xx1, yy1, zz1 = d0 * d0, d1 * d1, d2 * d2
+    xy1, xz1, yz1 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 2] * f - m0, y[lo + 2] * f - m1, z[lo + 2] * f - m2
+    xx2, yy2, zz2 = d0 * d0, d1 * d1, d2 * d2
+    xy2, xz2, yz2 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 3] * f - m0, y[lo + 3] * f - m1, z[lo + 3] * f - m2
+    xx3, yy3, zz3 = d0 * d0, d1 * d1, d2 * d2
+    xy3, xz3, yz3 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 4] * f - m0, y[lo + 4] * f - m1, z[lo + 4] * f - m2
+    xx4, yy4, zz4 = d0 * d0, d1 * d1, d2 * d2
+    xy4, xz4, yz4 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 5] * f - m0, y[lo + 5] * f - m1, z[lo + 5] * f - m2
+    xx5, yy5, zz5 = d0 * d0, d1 * d1, d2 * d2
+    xy5, xz5, yz5 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 6] * f - m0, y[lo + 6] * f - m1, z[lo + 6] * f - m2
+    xx6, yy6, zz6 = d0 * d0, d1 * d1, d2 * d2
+    xy6, xz6, yz6 = d0 * d1, d0 * d2, d1 * d2
+    d0, d1, d2 = x[lo + 7] * f - m0, y[lo + 7] * f - m1, z[lo + 7] * f - m2
+    xx7, yy7, zz7 = d0 * d0, d1 * d1, d2 * d2
+    xy7, xz7, yz7 = d0 * d1, d0 * d2, d1 * d2
     end = lo + n - n % 8
     for i in range(lo + 8, end, 8):
-        r0 += (u[i] - mu) * (v[i] - mv)
-        r1 += (u[i + 1] - mu) * (v[i + 1] - mv)
-        r2 += (u[i + 2] - mu) * (v[i + 2] - mv)
-        r3 += (u[i + 3] - mu) * (v[i + 3] - mv)
-        r4 += (u[i + 4] - mu) * (v[i + 4] - mv)
-        r5 += (u[i + 5] - mu) * (v[i + 5] - mv)
-        r6 += (u[i + 6] - mu) * (v[i + 6] - mv)
-        r7 += (u[i + 7] - mu) * (v[i + 7] - mv)
-    total = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+        d0, d1, d2 = x[i + 0] * f - m0, y[i + 0] * f - m1, z[i + 0] * f - m2
+        xx0 += d0 * d0
+        yy0 += d1 * d1
+        zz0 += d2 * d2
+        xy0 += d0 * d1
+        xz0 += d0 * d2
+        yz0 += d1 * d2
+        d0, d1, d2 = x[i + 1] * f - m0, y[i + 1] * f - m1, z[i + 1] * f - m2
+        xx1 += d0 * d0
+        yy1 += d1 * d1
+        zz1 += d2 * d2
+        xy1 += d0 * d1
+        xz1 += d0 * d2
+        yz1 += d1 * d2
+        d0, d1, d2 = x[i + 2] * f - m0, y[i + 2] * f - m1, z[i + 2] * f - m2
+        xx2 += d0 * d0
+        yy2 += d1 * d1
+        zz2 += d2 * d2
+        xy2 += d0 * d1
+        xz2 += d0 * d2
+        yz2 += d1 * d2
+        d0, d1, d2 = x[i + 3] * f - m0, y[i + 3] * f - m1, z[i + 3] * f - m2
+        xx3 += d0 * d0
+        yy3 += d1 * d1
+        zz3 += d2 * d2
+        xy3 += d0 * d1
+        xz3 += d0 * d2
+        yz3 += d1 * d2
+        d0, d1, d2 = x[i + 4] * f - m0, y[i + 4] * f - m1, z[i + 4] * f - m2
+        xx4 += d0 * d0
+        yy4 += d1 * d1
+        zz4 += d2 * d2
+        xy4 += d0 * d1
+        xz4 += d0 * d2
+        yz4 += d1 * d2
+        d0, d1, d2 = x[i + 5] * f - m0, y[i + 5] * f - m1, z[i + 5] * f - m2
+        xx5 += d0 * d0
+        yy5 += d1 * d1
+        zz5 += d2 * d2
+        xy5 += d0 * d1
+        xz5 += d0 * d2
+        yz5 += d1 * d2
+        d0, d1, d2 = x[i + 6] * f - m0, y[i + 6] * f - m1, z[i + 6] * f - m2
+        xx6 += d0 * d0
+        yy6 += d1 * d1
+        zz6 += d2 * d2
+        xy6 += d0 * d1
+        xz6 += d0 * d2
+        yz6 += d1 * d2
+        d0, d1, d2 = x[i + 7] * f - m0, y[i + 7] * f - m1, z[i + 7] * f - m2
+        xx7 += d0 * d0
+        yy7 += d1 * d1
+        zz7 += d2 * d2
+        xy7 += d0 * d1
+        xz7 += d0 * d2
+        yz7 += d1 * d2
+    xx = ((xx0 + xx1) + (xx2 + xx3)) + ((xx4 + xx5) + (xx6 + xx7))
+    yy = ((yy0 + yy1) + (yy2 + yy3)) + ((yy4 + yy5) + (yy6 + yy7))
+    zz = ((zz0 + zz1) + (zz2 + zz3)) + ((zz4 + zz5) + (zz6 + zz7))
+    xy = ((xy0 + xy1) + (xy2 + xy3)) + ((xy4 + xy5) + (xy6 + xy7))
+    xz = ((xz0 + xz1) + (xz2 + xz3)) + ((xz4 + xz5) + (xz6 + xz7))
+    yz = ((yz0 + yz1) + (yz2 + yz3)) + ((yz4 + yz5) + (yz6 + yz7))
     for r in range(end, lo + n):
-        total += (u[r] - mu) * (v[r] - mv)
-    return total
+        d0, d1, d2 = x[r] * f - m0, y[r] * f - m1, z[r] * f - m2
+        xx += d0 * d0
+        yy += d1 * d1
+        zz += d2 * d2
+        xy += d0 * d1
+        xz += d0 * d2
+        yz += d1 * d2
+    return xx, yy, zz, xy, xz, yz
+
 
 
 @numba.njit(cache=True)
-def pairwise_sum(u, v, n, mu, mv):
-    """``np.sum((u[:n] - mu) * (v[:n] - mv))``'s pairwise sum (module
-    docstring), before numpy adds it to 0.0: a range longer than
-    PAIRWISE_BLOCK is split at a multiple of 8 below its half and the
-    halves' sums added. Written with explicit stacks (``frames`` of (start,
+def pairwise_sums(x, y, z, f, n, m0, m1, m2):
+    """numpy's pairwise sums (module docstring) of the six products of
+    :func:`block_sums` over the first n points, before numpy adds each to
+    0.0: a range longer than PAIRWISE_BLOCK is split at a multiple of 8 below
+    its half and the halves' sums added; the six sums share the splits (they
+    have the same n). Written with explicit stacks (``frames`` of (start,
     length, halves done), ``values`` of sums), not by recursion: numba's
-    cache reloads recursive functions wrongly (numba bug report 6061, github.com/numba/numba)."""
+    cache reloads recursive functions wrongly (numba bug report 6061,
+    github.com/numba/numba)."""
     if n <= PAIRWISE_BLOCK:
-        return block_sum(u, v, 0, n, mu, mv)
+        return block_sums(x, y, z, f, 0, n, m0, m1, m2)
     frames = np.empty((PAIRWISE_STACK, 3), dtype=np.int64)
-    values = np.empty(PAIRWISE_STACK)
+    values = np.empty((PAIRWISE_STACK, 6))
     frames[0, 0], frames[0, 1], frames[0, 2] = 0, n, 0
     top, stored = 1, 0
     while top > 0:
         lo, length, split = frames[top - 1, 0], frames[top - 1, 1], frames[top - 1, 2]
         if length <= PAIRWISE_BLOCK:
-            values[stored] = block_sum(u, v, lo, length, mu, mv)
+            sums = block_sums(x, y, z, f, lo, length, m0, m1, m2)
+            for j in range(6):
+                values[stored, j] = sums[j]
             stored += 1
             top -= 1
         elif split == 0:
@@ -197,10 +292,12 @@ def pairwise_sum(u, v, n, mu, mv):
             frames[top + 1, 0], frames[top + 1, 1], frames[top + 1, 2] = lo, half, 0
             top += 2                            # the first half on top: summed first
         else:
-            values[stored - 2] = values[stored - 2] + values[stored - 1]   # first + second
+            for j in range(6):                  # first + second
+                values[stored - 2, j] = values[stored - 2, j] + values[stored - 1, j]
             stored -= 1
             top -= 1
-    return values[0]
+    return (values[0, 0], values[0, 1], values[0, 2], values[0, 3], values[0, 4],
+            values[0, 5])
 
 
 @numba.njit(cache=True)
@@ -213,99 +310,210 @@ def covariance(x, y, z, n, largest, a, scaled):
     if n < 2:
         a[:, :] = 0.0
         return
-    # np.ldexp(points, -e): the points themselves when e = 0 (coordinates
-    # already in [0.5, 1), as build_tree leaves many sets), a product by
-    # 2**-e when that is a normal float (both round the exact value once),
-    # else ldexp itself
+    # np.ldexp(points, -e): a product by f = 2**-e when that is a normal
+    # float (both round the exact value once; 1.0 when e = 0, coordinates
+    # already in [0.5, 1), as build_tree leaves many sets), formed where each
+    # point is read; else ldexp itself, into ``scaled``
     k = -unit_exponent(largest)
-    if k != 0:
-        factor = math.ldexp(1.0, k)
-        normal = -1022 <= k <= 1023
+    f = 1.0
+    if -1022 <= k <= 1023:
+        f = math.ldexp(1.0, k)
+    else:
         for r in range(n):
-            if normal:
-                scaled[0, r], scaled[1, r], scaled[2, r] = x[r] * factor, y[r] * factor, \
-                    z[r] * factor
-            else:
-                scaled[0, r], scaled[1, r], scaled[2, r] = math.ldexp(x[r], k), \
-                    math.ldexp(y[r], k), math.ldexp(z[r], k)
+            scaled[0, r], scaled[1, r], scaled[2, r] = math.ldexp(x[r], k), \
+                math.ldexp(y[r], k), math.ldexp(z[r], k)
         x, y, z = scaled[0], scaled[1], scaled[2]
     m0 = m1 = m2 = 0.0                    # points.mean(axis=0): rows in turn, from 0.0
     for r in range(n):
-        m0 += x[r]
-        m1 += y[r]
-        m2 += z[r]
+        m0 += x[r] * f
+        m1 += y[r] * f
+        m2 += z[r] * f
     m0, m1, m2 = m0 / n, m1 / n, m2 / n
     # np.sum adds the pairwise sum to 0.0 (which turns a -0.0 into 0.0)
-    a[0, 0] = 0.0 + pairwise_sum(x, x, n, m0, m0)
-    a[1, 1] = 0.0 + pairwise_sum(y, y, n, m1, m1)
-    a[2, 2] = 0.0 + pairwise_sum(z, z, n, m2, m2)
-    a[0, 1] = a[1, 0] = 0.0 + pairwise_sum(x, y, n, m0, m1)
-    a[0, 2] = a[2, 0] = 0.0 + pairwise_sum(x, z, n, m0, m2)
-    a[1, 2] = a[2, 1] = 0.0 + pairwise_sum(y, z, n, m1, m2)
+    xx, yy, zz, xy, xz, yz = pairwise_sums(x, y, z, f, n, m0, m1, m2)
+    a[0, 0] = 0.0 + xx
+    a[1, 1] = 0.0 + yy
+    a[2, 2] = 0.0 + zz
+    a[0, 1] = a[1, 0] = 0.0 + xy
+    a[0, 2] = a[2, 0] = 0.0 + xz
+    a[1, 2] = a[2, 1] = 0.0 + yz
 
 
 @numba.njit(cache=True)
-def symmetric_eigenvectors(a, v, axes, count, done):
-    """Mirrors: bvh_exact.symmetric_eigenvectors, of ``count`` matrices at
-    once: ``a`` (count, 3, 3) is overwritten, ``v`` (count, 3, 3) and
-    ``done`` (count,) are scratch, the eigenvectors (columns) go to ``axes``
-    (count, 3, 3).
+def symmetric_eigenvectors(a, axes, count):
+    """Mirrors: bvh_exact.symmetric_eigenvectors, of ``count`` matrices
+    ``a`` (count, 3, 3), left unchanged; the eigenvectors (columns) go to
+    ``axes`` (count, 3, 3). Two at a time (:func:`eigenvectors_of_pair`),
+    the last of an odd count with itself."""
+    for m in range(0, count, 2):
+        eigenvectors_of_pair(a, axes, m, min(m + 1, count - 1))
 
-    Each matrix takes the readable function's steps, in its order; the
-    matrices take them in turns (rotation (p, q) of a sweep for each, then
-    the next), so that the processor overlaps their chains of dependent
-    divisions and square roots, which a single 3 x 3 problem waits on."""
-    for m in range(count):
-        done[m] = False
-        for i in range(3):
-            for j in range(3):
-                v[m, i, j] = 1.0 if i == j else 0.0
+
+@numba.njit(cache=True)
+def eigenvectors_of_pair(a, axes, first, second):
+    """Mirrors: bvh_exact.symmetric_eigenvectors, of matrices ``a[first]``
+    and ``a[second]`` (each (3, 3), left unchanged) into ``axes[first]`` and
+    ``axes[second]``: each matrix's rotations in the readable order, on its
+    entries held in locals, the two matrices in turns so that the processor
+    overlaps their chains of divisions and square roots. A matrix whose
+    off-diagonal entries are all zero takes no rotation (each is skipped
+    when its entry is zero), so sweeping it on while the other converges
+    changes nothing: the same bits as one matrix alone."""
+    a00_0, a01_0, a02_0 = a[first, 0, 0], a[first, 0, 1], a[first, 0, 2]
+    a10_0, a11_0, a12_0 = a[first, 1, 0], a[first, 1, 1], a[first, 1, 2]
+    a20_0, a21_0, a22_0 = a[first, 2, 0], a[first, 2, 1], a[first, 2, 2]
+    v00_0, v01_0, v02_0 = 1.0, 0.0, 0.0
+    v10_0, v11_0, v12_0 = 0.0, 1.0, 0.0
+    v20_0, v21_0, v22_0 = 0.0, 0.0, 1.0
+    a00_1, a01_1, a02_1 = a[second, 0, 0], a[second, 0, 1], a[second, 0, 2]
+    a10_1, a11_1, a12_1 = a[second, 1, 0], a[second, 1, 1], a[second, 1, 2]
+    a20_1, a21_1, a22_1 = a[second, 2, 0], a[second, 2, 1], a[second, 2, 2]
+    v00_1, v01_1, v02_1 = 1.0, 0.0, 0.0
+    v10_1, v11_1, v12_1 = 0.0, 1.0, 0.0
+    v20_1, v21_1, v22_1 = 0.0, 0.0, 1.0
     for _ in range(JACOBI_SWEEPS):
-        remaining = 0
-        for m in range(count):
-            if not done[m]:
-                done[m] = abs(a[m, 0, 1]) + abs(a[m, 0, 2]) + abs(a[m, 1, 2]) == 0.0
-                remaining += not done[m]
-        if remaining == 0:
+        if (abs(a01_0) + abs(a02_0) + abs(a12_0) == 0.0
+                and abs(a01_1) + abs(a02_1) + abs(a12_1) == 0.0):
             break
-        for p, q in ((0, 1), (0, 2), (1, 2)):
-            for m in range(count):
-                if done[m] or a[m, p, q] == 0.0:
-                    continue
-                tau = (a[m, q, q] - a[m, p, p]) / (2.0 * a[m, p, q])
-                t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
-                if abs(t) <= TINY_ROTATION:
-                    c, s = 1.0, t                 # what the next two lines give then
-                else:
-                    c = 1.0 / math.sqrt(1.0 + t * t)
-                    s = t * c
-                for r in range(3):                # a <- a J (columns p, q)
-                    arp, arq = a[m, r, p], a[m, r, q]
-                    a[m, r, p], a[m, r, q] = c * arp - s * arq, s * arp + c * arq
-                for r in range(3):                # a <- J^T a (rows p, q)
-                    apr, aqr = a[m, p, r], a[m, q, r]
-                    a[m, p, r], a[m, q, r] = c * apr - s * aqr, s * apr + c * aqr
-                a[m, p, q] = a[m, q, p] = 0.0
-                for r in range(3):                # v <- v J
-                    vrp, vrq = v[m, r, p], v[m, r, q]
-                    v[m, r, p], v[m, r, q] = c * vrp - s * vrq, s * vrp + c * vrq
-    for m in range(count):
-        # columns by increasing eigenvalue, ties by index (a stable sort of three)
-        o0, o1, o2 = 0, 1, 2
-        if a[m, o1, o1] < a[m, o0, o0]:
-            o0, o1 = o1, o0
-        if a[m, o2, o2] < a[m, o1, o1]:
-            o1, o2 = o2, o1
-            if a[m, o1, o1] < a[m, o0, o0]:
-                o0, o1 = o1, o0
-        for column, i in enumerate((o0, o1, o2)):
-            big = 0                                   # np.argmax: the first largest
-            for r in range(1, 3):
-                if abs(v[m, r, i]) > abs(v[m, big, i]):
-                    big = r
-            flip = v[m, big, i] < 0.0
-            for r in range(3):
-                axes[m, r, column] = -v[m, r, i] if flip else v[m, r, i]
+        if a01_0 != 0.0:
+            tau = (a11_0 - a00_0) / (2.0 * a01_0)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a00_0, a01_0 = c * a00_0 - s * a01_0, s * a00_0 + c * a01_0
+            a10_0, a11_0 = c * a10_0 - s * a11_0, s * a10_0 + c * a11_0
+            a20_0, a21_0 = c * a20_0 - s * a21_0, s * a20_0 + c * a21_0
+            a00_0, a10_0 = c * a00_0 - s * a10_0, s * a00_0 + c * a10_0
+            a01_0, a11_0 = c * a01_0 - s * a11_0, s * a01_0 + c * a11_0
+            a02_0, a12_0 = c * a02_0 - s * a12_0, s * a02_0 + c * a12_0
+            a01_0 = a10_0 = 0.0
+            v00_0, v01_0 = c * v00_0 - s * v01_0, s * v00_0 + c * v01_0
+            v10_0, v11_0 = c * v10_0 - s * v11_0, s * v10_0 + c * v11_0
+            v20_0, v21_0 = c * v20_0 - s * v21_0, s * v20_0 + c * v21_0
+        if a01_1 != 0.0:
+            tau = (a11_1 - a00_1) / (2.0 * a01_1)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a00_1, a01_1 = c * a00_1 - s * a01_1, s * a00_1 + c * a01_1
+            a10_1, a11_1 = c * a10_1 - s * a11_1, s * a10_1 + c * a11_1
+            a20_1, a21_1 = c * a20_1 - s * a21_1, s * a20_1 + c * a21_1
+            a00_1, a10_1 = c * a00_1 - s * a10_1, s * a00_1 + c * a10_1
+            a01_1, a11_1 = c * a01_1 - s * a11_1, s * a01_1 + c * a11_1
+            a02_1, a12_1 = c * a02_1 - s * a12_1, s * a02_1 + c * a12_1
+            a01_1 = a10_1 = 0.0
+            v00_1, v01_1 = c * v00_1 - s * v01_1, s * v00_1 + c * v01_1
+            v10_1, v11_1 = c * v10_1 - s * v11_1, s * v10_1 + c * v11_1
+            v20_1, v21_1 = c * v20_1 - s * v21_1, s * v20_1 + c * v21_1
+        if a02_0 != 0.0:
+            tau = (a22_0 - a00_0) / (2.0 * a02_0)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a00_0, a02_0 = c * a00_0 - s * a02_0, s * a00_0 + c * a02_0
+            a10_0, a12_0 = c * a10_0 - s * a12_0, s * a10_0 + c * a12_0
+            a20_0, a22_0 = c * a20_0 - s * a22_0, s * a20_0 + c * a22_0
+            a00_0, a20_0 = c * a00_0 - s * a20_0, s * a00_0 + c * a20_0
+            a01_0, a21_0 = c * a01_0 - s * a21_0, s * a01_0 + c * a21_0
+            a02_0, a22_0 = c * a02_0 - s * a22_0, s * a02_0 + c * a22_0
+            a02_0 = a20_0 = 0.0
+            v00_0, v02_0 = c * v00_0 - s * v02_0, s * v00_0 + c * v02_0
+            v10_0, v12_0 = c * v10_0 - s * v12_0, s * v10_0 + c * v12_0
+            v20_0, v22_0 = c * v20_0 - s * v22_0, s * v20_0 + c * v22_0
+        if a02_1 != 0.0:
+            tau = (a22_1 - a00_1) / (2.0 * a02_1)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a00_1, a02_1 = c * a00_1 - s * a02_1, s * a00_1 + c * a02_1
+            a10_1, a12_1 = c * a10_1 - s * a12_1, s * a10_1 + c * a12_1
+            a20_1, a22_1 = c * a20_1 - s * a22_1, s * a20_1 + c * a22_1
+            a00_1, a20_1 = c * a00_1 - s * a20_1, s * a00_1 + c * a20_1
+            a01_1, a21_1 = c * a01_1 - s * a21_1, s * a01_1 + c * a21_1
+            a02_1, a22_1 = c * a02_1 - s * a22_1, s * a02_1 + c * a22_1
+            a02_1 = a20_1 = 0.0
+            v00_1, v02_1 = c * v00_1 - s * v02_1, s * v00_1 + c * v02_1
+            v10_1, v12_1 = c * v10_1 - s * v12_1, s * v10_1 + c * v12_1
+            v20_1, v22_1 = c * v20_1 - s * v22_1, s * v20_1 + c * v22_1
+        if a12_0 != 0.0:
+            tau = (a22_0 - a11_0) / (2.0 * a12_0)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a01_0, a02_0 = c * a01_0 - s * a02_0, s * a01_0 + c * a02_0
+            a11_0, a12_0 = c * a11_0 - s * a12_0, s * a11_0 + c * a12_0
+            a21_0, a22_0 = c * a21_0 - s * a22_0, s * a21_0 + c * a22_0
+            a10_0, a20_0 = c * a10_0 - s * a20_0, s * a10_0 + c * a20_0
+            a11_0, a21_0 = c * a11_0 - s * a21_0, s * a11_0 + c * a21_0
+            a12_0, a22_0 = c * a12_0 - s * a22_0, s * a12_0 + c * a22_0
+            a12_0 = a21_0 = 0.0
+            v01_0, v02_0 = c * v01_0 - s * v02_0, s * v01_0 + c * v02_0
+            v11_0, v12_0 = c * v11_0 - s * v12_0, s * v11_0 + c * v12_0
+            v21_0, v22_0 = c * v21_0 - s * v22_0, s * v21_0 + c * v22_0
+        if a12_1 != 0.0:
+            tau = (a22_1 - a11_1) / (2.0 * a12_1)
+            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+            if abs(t) <= TINY_ROTATION:
+                c, s = 1.0, t
+            else:
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = t * c
+            a01_1, a02_1 = c * a01_1 - s * a02_1, s * a01_1 + c * a02_1
+            a11_1, a12_1 = c * a11_1 - s * a12_1, s * a11_1 + c * a12_1
+            a21_1, a22_1 = c * a21_1 - s * a22_1, s * a21_1 + c * a22_1
+            a10_1, a20_1 = c * a10_1 - s * a20_1, s * a10_1 + c * a20_1
+            a11_1, a21_1 = c * a11_1 - s * a21_1, s * a11_1 + c * a21_1
+            a12_1, a22_1 = c * a12_1 - s * a22_1, s * a12_1 + c * a22_1
+            a12_1 = a21_1 = 0.0
+            v01_1, v02_1 = c * v01_1 - s * v02_1, s * v01_1 + c * v02_1
+            v11_1, v12_1 = c * v11_1 - s * v12_1, s * v11_1 + c * v12_1
+            v21_1, v22_1 = c * v21_1 - s * v22_1, s * v21_1 + c * v22_1
+    sorted_columns(a00_0, a11_0, a22_0, ((v00_0, v10_0, v20_0), (v01_0, v11_0, v21_0),
+                                         (v02_0, v12_0, v22_0)), axes[first])
+    sorted_columns(a00_1, a11_1, a22_1, ((v00_1, v10_1, v20_1), (v01_1, v11_1, v21_1),
+                                         (v02_1, v12_1, v22_1)), axes[second])
+
+
+@numba.njit(cache=True, inline="always")
+def sorted_columns(d0, d1, d2, columns, axes):
+    """The eigenvectors ``columns`` (eigenvalues d0, d1, d2) into ``axes``
+    (3, 3) as bvh_exact.symmetric_eigenvectors orders and signs them: by
+    increasing eigenvalue, ties by index (a stable sort of three), each
+    column's first largest component made positive."""
+    o0, o1, o2 = 0, 1, 2
+    e0, e1, e2 = d0, d1, d2
+    if e1 < e0:
+        o0, o1, e0, e1 = o1, o0, e1, e0
+    if e2 < e1:
+        o1, o2, e1, e2 = o2, o1, e2, e1
+        if e1 < e0:
+            o0, o1, e0, e1 = o1, o0, e1, e0
+    for column, i in enumerate((o0, o1, o2)):
+        c0, c1, c2 = columns[i]
+        big, largest = c0, abs(c0)            # np.argmax: the first largest
+        if abs(c1) > largest:
+            big, largest = c1, abs(c1)
+        if abs(c2) > largest:
+            big = c2
+        if big < 0.0:
+            c0, c1, c2 = -c0, -c1, -c2
+        axes[0, column], axes[1, column], axes[2, column] = c0, c1, c2
+
 
 
 @numba.njit(cache=True, inline="always")
@@ -477,14 +685,15 @@ def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
     (the same triangles in the same order): given in ``axes[NODE]`` when
     ``known``, else (at the root) computed. The six halves' covariances are
     formed first and their eigenvectors found together
-    (:func:`symmetric_eigenvectors`), then their volumes compared."""
-    x, y, z, keys, ranked, bucket, counts, a, v, done, axes = work
+    (:func:`symmetric_eigenvectors`), then their volumes and areas compared
+    (:func:`chosen_axis`)."""
+    x, y, z, keys, ranked, bucket, counts, a, axes = work
     if not known:
         for i in range(k):
             ranked[0, i] = i
         n, largest = gather(tx, ty, tz, members, ranked[0], 0, k, x, y, z)
         covariance(x, y, z, n, largest, a[NODE], axes_work)
-        symmetric_eigenvectors(a[NODE:], v[NODE:], axes[NODE:], 1, done[NODE:])
+        symmetric_eigenvectors(a[NODE:], axes[NODE:], 1)
     node = axes[NODE]
     a00, a01, a02 = node[0, 0], node[0, 1], node[0, 2]
     a10, a11, a12 = node[1, 0], node[1, 1], node[1, 2]
@@ -504,15 +713,42 @@ def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
             n, largest = gather(tx, ty, tz, members, ranked[axis], lo, hi, x[at:], y[at:],
                                 z[at:])
             covariance(x[at:], y[at:], z[at:], n, largest, a[2 * axis + half], axes_work)
-    symmetric_eigenvectors(a, v, axes, 6, done)
-    volumes = np.empty(3)
+    symmetric_eigenvectors(a, axes, 6)
+    v0 = v1 = v2 = s0 = s1 = s2 = 0.0
     for axis in range(3):
+        volume = area = 0.0
         for half, (lo, hi) in enumerate(((0, mid), (mid, k))):
             at, n = 3 * (axis * k + lo), 3 * (hi - lo)
             low, high = extents(x[at:], y[at:], z[at:], n, axes[2 * axis + half])
-            part = ((high[0] - low[0]) * (high[1] - low[1])) * (high[2] - low[2])
-            volumes[axis] = part if half == 0 else volumes[axis] + part   # box_volume + ...
-    return least_axis(volumes)
+            d0, d1, d2 = high[0] - low[0], high[1] - low[1], high[2] - low[2]
+            part, face = (d0 * d1) * d2, (d0 * d1 + d1 * d2) + d2 * d0
+            volume, area = (part, face) if half == 0 else (volume + part, area + face)
+        if axis == 0:
+            v0, s0 = volume, area
+        elif axis == 1:
+            v1, s1 = volume, area
+        else:
+            v2, s2 = volume, area
+    return chosen_axis(v0, v1, v2, s0, s1, s2)
+
+
+@numba.njit(cache=True)
+def chosen_axis(v0, v1, v2, s0, s1, s2):
+    """Mirrors the choice of bvh_exact.least_volume_split among three axes
+    of total volumes v and areas s: the least area among the volumes within
+    VOLUME_TIE of the least volume (``min``: the first least), area ties
+    keeping the lower axis."""
+    least = v0
+    if v1 < least:
+        least = v1
+    if v2 < least:
+        least = v2
+    bound = least * (1.0 + VOLUME_TIE)
+    best, best_area = -1, 0.0
+    for axis, volume, area in ((0, v0, s0), (1, v1, s1), (2, v2, s2)):
+        if volume <= bound and (best < 0 or area < best_area):
+            best, best_area = axis, area
+    return best
 
 
 @numba.njit(cache=True)
@@ -535,7 +771,7 @@ def surface_area(tri_lo, tri_hi, ranked, lo, hi):
 def least_area_split(tx, ty, tz, members, k, mid, work):
     """Mirrors: bvh.least_area_split, of ``members[:k]``: returns the chosen
     axis; its order (positions in members) is ``ranked[axis]``."""
-    x, y, _, keys, ranked, bucket, counts, _, _, _, _ = work
+    x, y, _, keys, ranked, bucket, counts, _, _ = work
     tri_lo = x[:3 * k].reshape((3, k))       # scratch: (3, k) each
     tri_hi = y[:3 * k].reshape((3, k))
     for r in range(k):
@@ -575,7 +811,7 @@ def build_tree(tx, ty, tz, leaf_size, rule):
     order = np.arange(m, dtype=np.int64)
     members = np.empty(max(m, 1), dtype=np.int64)
     work, axes_work = split_scratch(m), axes_scratch(3 * max(m, 1))
-    ranked, axes = work[4], work[10]
+    ranked, axes = work[4], work[8]
     count[0] = m
     nodes = 1
     # pending nodes, (node, lo, hi, axes known), each with its principal axes
@@ -738,13 +974,12 @@ def frame_boxes(vx, vy, vz, faces, left, right, start, count, order):
     eigenvectors found BOX_BATCH nodes at a time, then each box formed."""
     n_nodes = len(left)
     a, axes = np.empty((n_nodes, 3, 3)), np.empty((n_nodes, 3, 3))
-    v, done = np.empty((BOX_BATCH, 3, 3)), np.empty(BOX_BATCH, dtype=np.bool_)
     boxes = np.empty((n_nodes, 15))
     visit_nodes(vx, vy, vz, faces, left, right, start, count, order, False, a, axes, boxes)
     worst = 0.0
     for first in range(0, n_nodes, BOX_BATCH):
         last = min(first + BOX_BATCH, n_nodes)
-        symmetric_eigenvectors(a[first:last], v, axes[first:last], last - first, done)
+        symmetric_eigenvectors(a[first:last], axes[first:last], last - first)
         for node in range(first, last):
             off = axes_deviation(axes[node])
             if not (off <= worst):            # max(worst, off), a NaN counted as inf

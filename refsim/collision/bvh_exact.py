@@ -12,14 +12,15 @@ Interference Detection", SIGGRAPH 1996):
 1. Node volumes are oriented boxes in body space, computed once per mesh
    (:class:`FrameTree`: a tree of :func:`refsim.collision.bvh.build_tree`
    split across the one of each node's principal axes whose halves have
-   the least total box volume, :func:`least_volume_split`; each node's box
+   the least total box volume, the area breaking near ties,
+   :func:`least_volume_split`; each node's box
    along the principal axes of its vertices, :func:`oriented_box`,
    :func:`principal_axes`). On a curved surface such a box is about as thin
    as the patch is bent, where the axis-aligned box of a tilted patch is as
    thick as the patch is wide: on the separated sphere benchmark the query
    visited 117 node pairs against 751 with axis-aligned node boxes, 2185
    against 4025 on the deep one (both over the least-area tree of
-   :mod:`refsim.collision.bvh`; the least-volume split visits 151 and 2307
+   :mod:`refsim.collision.bvh`; the least-volume split visits 127 and 2251
    there, and 25 instead of 247 on two linked tori).
 2. A query expresses body b in a's frame, ``x_a = M x_b + u`` with
    ``M = Ra^T Rb`` and ``u = Ra^T (tb - ta)``, and a pair of nodes in the
@@ -277,33 +278,62 @@ def oriented_box(points: np.ndarray, axes: np.ndarray | None = None):
 
 def box_volume(points: np.ndarray) -> float:
     """Volume of the box about ``points`` (k, 3) along their principal axes."""
+    return float(np.prod(box_sides(points)))
+
+
+def box_sides(points: np.ndarray) -> np.ndarray:
+    """(3,): the side lengths of the box about ``points`` (k, 3) along their
+    principal axes."""
     projected = project(points, principal_axes(points))
-    return float(np.prod(projected.max(axis=0) - projected.min(axis=0)))
+    return projected.max(axis=0) - projected.min(axis=0)
+
+
+def box_area(sides: np.ndarray) -> float:
+    """Half the surface area of a box with these side lengths,
+    ``(d0 d1 + d1 d2) + d2 d0``."""
+    return float((sides[0] * sides[1] + sides[1] * sides[2]) + sides[2] * sides[0])
+
+
+#: :func:`least_volume_split` counts two splits' volumes as a tie when the
+#: larger is within this fraction of the least, and breaks the tie by area
+#: (docs/decisions/tree-build.md, the trials of the split rule).
+VOLUME_TIE = 0.1
 
 
 def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int) -> np.ndarray:
-    """``members`` ranked by centroid along the one of the node's three
-    principal axes whose halves ``[:mid]`` and ``[mid:]`` have the least
-    total oriented-box volume (a split rule for
-    :func:`refsim.collision.bvh.build_tree`; the triangles' vertices stand
-    for the points, shared ones counted once per triangle).
+    """``members`` ranked by centroid along one of the node's three principal
+    axes, chosen by the oriented boxes of its halves ``[:mid]`` and
+    ``[mid:]``: among the axes whose halves' total box volume is within
+    VOLUME_TIE of the least, the one whose halves' total box area is least
+    (a split rule for :func:`refsim.collision.bvh.build_tree`; the
+    triangles' vertices stand for the points, shared ones counted once per
+    triangle).
 
     Splitting across the longest principal axis (OBBTree's rule) keeps a
     tube's segments short, which the least-area split of axis-aligned boxes
     does not, but it cuts a sphere's caps badly; choosing among the three
     axes by the children's volumes does well on both
-    (docs/decisions/query-fixed-cost.md)."""
+    (docs/decisions/query-fixed-cost.md). Volume alone is blind where two
+    splits give boxes of the same total volume: a ring about its axis cut
+    into two flat rings (each as wide as the whole) or into two arcs (each
+    half as wide). The area tells them apart; without it the tree of a
+    torus about z was a stack of flat rings, and two such tori linked cost
+    20 times the node pairs (docs/decisions/tree-build.md)."""
     points = triangles[members]
     centroids = project(points.mean(axis=1), principal_axes(points.reshape(-1, 3)))
-    best_volume = np.inf
+    volumes, areas, rankings = [], [], []
     for axis in range(3):
         # stable tie-break by index, so the same mesh always gives the same tree
         ranked = np.lexsort((members, centroids[:, axis]))
-        volume = (box_volume(points[ranked[:mid]].reshape(-1, 3))
-                  + box_volume(points[ranked[mid:]].reshape(-1, 3)))
-        if volume < best_volume:              # ties keep the lower axis
-            best_volume, best = volume, ranked
-    return members[best]
+        first = box_sides(points[ranked[:mid]].reshape(-1, 3))
+        second = box_sides(points[ranked[mid:]].reshape(-1, 3))
+        volumes.append(float(np.prod(first)) + float(np.prod(second)))
+        areas.append(box_area(first) + box_area(second))
+        rankings.append(ranked)
+    bound = min(volumes) * (1.0 + VOLUME_TIE)
+    tied = [axis for axis in range(3) if volumes[axis] <= bound]
+    best = min(tied, key=lambda axis: areas[axis])    # area ties keep the lower axis
+    return members[rankings[best]]
 
 
 def frame_topology_of(mesh, kernel: str | None = None) -> TriangleTree:

@@ -143,3 +143,30 @@ def test_an_unknown_split_rule_is_refused():
     vertices, faces = GENERATED["box"]
     with pytest.raises(OptionError, match="split must be one of"):
         bvh.build_tree_compiled(vertices, faces, "longest-axis")
+
+
+def test_the_compiled_split_ties_volumes_as_the_readable_one():
+    assert bvh.build_kernels().VOLUME_TIE == bvh_exact.VOLUME_TIE
+
+
+def test_a_ring_is_cut_into_arcs_not_into_flat_rings():
+    """A torus about z: cut across z (two flat rings, each as wide as the
+    whole) or across x (two arcs) gives boxes of about the same total
+    volume, and the area breaks the tie (bvh_exact.least_volume_split): the
+    root's children are arcs, each holding triangles above and below the
+    torus's mid-plane and lying on one side of the axis (the mean of the
+    centroids' unit directions about z is about 2/pi long for a half ring,
+    about 0 for a whole one)."""
+    torus = trimesh.creation.torus(major_radius=1.0, minor_radius=0.3, major_sections=32,
+                                   minor_sections=16)
+    mesh = Mesh(np.asarray(torus.vertices), np.asarray(torus.faces))
+    for kernel in ("readable", "compiled"):
+        tree = bvh_exact.frame_topology_of(Mesh(mesh.vertices, mesh.faces), kernel)
+        centroids = mesh.vertices[mesh.faces].mean(axis=1)
+        for child in (tree.left[0], tree.right[0]):
+            members = tree.order[tree.start[child]:tree.start[child] + tree.count[child]]
+            z = centroids[members, 2]
+            assert z.min() < -0.2 and z.max() > 0.2, kernel     # the tube's whole section
+            xy = centroids[members, :2]
+            directions = xy / np.linalg.norm(xy, axis=1)[:, None]
+            assert np.linalg.norm(directions.mean(axis=0)) > 0.5, kernel
