@@ -819,8 +819,24 @@ class Simulation:
         self._solve_island(contacts)
         for a, b, _, geometry in contacts:
             dx_a, dx_b = separate_bodies(geometry, self.inv_mass[a], self.inv_mass[b])
-            self.x[a] += dx_a
-            self.x[b] += dx_b
+            for i, dx in ((a, dx_a), (b, dx_b)):
+                self.x[i] += dx
+                if self.rotation == "impulse" and dx.any():
+                    self._keep_angular_momentum(i, dx)
+
+    def _keep_angular_momentum(self, i: int, dx: np.ndarray) -> None:
+        """Body i was moved by ``dx`` to end an overlap: its momentum ``p``
+        then has the moment ``dx x p`` more about every fixed point, which no
+        force supplied. Its spin takes that much less angular momentum,
+        ``w -= I^-1 (dx x p)`` (world inverse inertia), so that the total
+        about any fixed point is what the impulses left. The rotational
+        energy changes by ``-w . (dx x p)`` to first order, with ``dx`` a
+        fraction of a step's travel."""
+        p = self.v[i] / self.inv_mass[i]
+        moment = np.array([dx[1] * p[2] - dx[2] * p[1], dx[2] * p[0] - dx[0] * p[2],
+                           dx[0] * p[1] - dx[1] * p[0]])
+        I_inv = world_inertia(self.R[i:i + 1], self.I_body_inv[i:i + 1])[0]
+        self.w[i] -= matvec(I_inv, moment)
 
     def _solve_island(self, contacts) -> None:
         """One impulse solve (:func:`refsim.dynamics.impulse.solve_island`)
