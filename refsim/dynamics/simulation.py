@@ -776,7 +776,8 @@ class Simulation:
                     self.x[a], self.x[b], self.v[a], self.v[b])
                 continue
             geometry = contact_geometry(self.world_vertices(a), self.world_vertices(b),
-                                        self.x[a], self.x[b], self.R[a], self.R[b])
+                                        self.x[a], self.x[b], self.R[a], self.R[b],
+                                        kernel=self.kernel)
             if geometry.depth < 0.0:
                 continue                  # a separating axis: coarse-level false contact
             # the impulses act over the corners of the region where the
