@@ -32,12 +32,21 @@ import math
 import numba
 import numpy as np
 
+from refsim.collision._numba_kernels import (
+    APART,
+    BAD_POSE_A,
+    BAD_POSE_B,
+    FIRST_HIT,
+    HIT,
+    UNDECIDED,
+    exact_query,
+)
 from refsim.collision.contact import CROSSING_SLACK, DEEPEST_FRACTION, ON_SURFACE
 
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "dab7b136bd5dbeab"
+SOURCES_DIGEST = "f618506a3feaaa8e"
 
 _JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 
@@ -292,3 +301,29 @@ def contact_region_numba(world_a, faces_a, world_b, faces_b, pairs, n):
             points[kept] = points[i]
             kept += 1
     return contact_polygon_numba(points[:kept], n[0], n[1], n[2])
+
+
+@numba.njit(cache=True, nogil=True)
+def collide_pairs_numba(floats, float_start, ints, int_start, mesh_of, rotation, origin, pairs,
+                        tol, margin_rounding, margin_per_deviation, codes):
+    """The exact level's answer for each body pair of ``pairs`` (P, 2), as
+    :func:`refsim.collision._numba_kernels.exact_collide` gives it for one
+    pair (APART, HIT, UNDECIDED, BAD_POSE_A, BAD_POSE_B), into ``codes``
+    (P,): the same query, one call for a step's pairs instead of one per
+    pair. Mesh m's packed arrays (:func:`refsim.collision.bvh_exact.pack_frame_tree`)
+    are ``floats[float_start[m]:float_start[m + 1]]`` and likewise ``ints``;
+    body i has mesh ``mesh_of[i]`` and pose ``(rotation[i], origin[i])``."""
+    for p in range(pairs.shape[0]):
+        a, b = pairs[p, 0], pairs[p, 1]
+        ma, mb = mesh_of[a], mesh_of[b]
+        status, found, uncertain = exact_query(
+            floats[float_start[ma]:float_start[ma + 1]], ints[int_start[ma]:int_start[ma + 1]],
+            rotation[a], origin[a],
+            floats[float_start[mb]:float_start[mb + 1]], ints[int_start[mb]:int_start[mb + 1]],
+            rotation[b], origin[b], FIRST_HIT, tol, margin_rounding, margin_per_deviation)
+        if status:
+            codes[p] = BAD_POSE_A if status == 1 else BAD_POSE_B
+        elif found.shape[0]:
+            codes[p] = HIT
+        else:
+            codes[p] = UNDECIDED if uncertain.shape[0] else APART
