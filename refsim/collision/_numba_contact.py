@@ -48,20 +48,19 @@ from refsim.collision.contact import CROSSING_SLACK, DEEPEST_FRACTION, ON_SURFAC
 #: this module (tests/test_kernels.py checks it).
 SOURCES_DIGEST = "f618506a3feaaa8e"
 
-_JIT = {"cache": True, "nogil": True, "error_model": "numpy"}
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _dot(a0, a1, a2, b0, b1, b2):
     return a0 * b0 + a1 * b1 + a2 * b2
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _edge_crossings(edge_world, edge_faces, tri_world, tri_faces, pairs, edge_col, tri_col,
                     out, k):
     """Mirrors refsim.collision.contact.edge_crossings: the edges of the
@@ -102,7 +101,7 @@ def _edge_crossings(edge_world, edge_faces, tri_world, tri_faces, pairs, edge_co
     return k
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def winding_number_numba(x0, x1, x2, world, faces):
     """Mirrors refsim.collision.contact.winding_numbers for one point
     ``(x0, x1, x2)`` about the closed mesh ``world[faces]``: the signed
@@ -125,7 +124,7 @@ def winding_number_numba(x0, x1, x2, world, faces):
     return 2.0 * total / (4.0 * math.pi)
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _vertices_within(world, other, other_faces, out, k):
     """Mirrors refsim.collision.contact._vertices_within: ``world``'s vertices
     in ``other``'s box whose winding number about it exceeds ON_SURFACE,
@@ -147,7 +146,7 @@ def _vertices_within(world, other, other_faces, out, k):
     return k
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _exit_distance(x0, x1, x2, d0, d1, d2, world, faces):
     """Mirrors refsim.collision.contact.exit_distances for one point: the
     nearest crossing, along the unit ``d``, of a face facing along ``d``
@@ -176,7 +175,7 @@ def _exit_distance(x0, x1, x2, d0, d1, d2, world, faces):
     return best
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _deepest(points, k, d0, d1, d2, world_a, faces_a, world_b, faces_b):
     """Mirrors refsim.collision.contact.deepest_points over ``points[:k]``:
     a mask of the points kept."""
@@ -204,12 +203,12 @@ def _deepest(points, k, d0, d1, d2, world_a, faces_a, world_b, faces_b):
     return keep
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _turn(u, v, o, a, b):
     return (u[a] - u[o]) * (v[b] - v[o]) - (v[a] - v[o]) * (u[b] - u[o])
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _chain(u, v, order, tol, span, kept):
     """Andrew's chain over ``order`` into ``kept``; returns its length."""
     m = 0
@@ -223,7 +222,7 @@ def _chain(u, v, order, tol, span, kept):
     return m
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def contact_polygon_numba(points, n0, n1, n2):
     """Mirrors refsim.collision.contact.contact_polygon: the corners of the
     convex hull of ``points``' projection across ``n``, in the hull's order
@@ -280,7 +279,7 @@ def contact_polygon_numba(points, n0, n1, n2):
     return out
 
 
-@numba.njit(**_JIT)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def contact_region_numba(world_a, faces_a, world_b, faces_b, pairs, n):
     """Mirrors refsim.collision.contact.contact_points from its triangle
     pairs on: the region's points (crossings of A's edges, of B's edges,
@@ -303,7 +302,7 @@ def contact_region_numba(world_a, faces_a, world_b, faces_b, pairs, n):
     return contact_polygon_numba(points[:kept], n[0], n[1], n[2])
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def collide_pairs_numba(floats, float_start, ints, int_start, mesh_of, rotation, origin, pairs,
                         tol, margin_rounding, margin_per_deviation, codes):
     """The exact level's answer for each body pair of ``pairs`` (P, 2), as

@@ -777,11 +777,12 @@ class Simulation:
         from refsim.collision import _numba_contact, _numba_kernels
         from refsim.collision.bvh_exact import MARGIN_PER_DEVIATION, MARGIN_ROUNDING
 
-        packed = self._packed_meshes()
+        floats, float_start, ints, int_start, mesh_of = self._packed_meshes()
         rows = np.ascontiguousarray(pairs, dtype=np.int64)
         origin = self.x - matvec(self.R, self.center)        # pose(i)'s, all at once
         codes = np.empty(len(rows), dtype=np.int64)
-        _numba_contact.collide_pairs_numba(*packed, self.R, origin, rows, ORTHONORMAL_TOL,
+        _numba_contact.collide_pairs_numba(floats, float_start, ints, int_start, mesh_of,
+                                           self.R, origin, rows, ORTHONORMAL_TOL,
                                            MARGIN_ROUNDING, MARGIN_PER_DEVIATION, codes)
         hits = []
         for (a, b), code in zip(rows.tolist(), codes.tolist(), strict=True):
@@ -799,7 +800,7 @@ class Simulation:
             from refsim.collision.bvh_exact import pack_frame_tree
 
             meshes: dict[int, int] = {}
-            arrays = []
+            arrays: list[tuple[np.ndarray, np.ndarray]] = []
             mesh_of = np.empty(len(self.bodies), dtype=np.int64)
             for i, body in enumerate(self.bodies):
                 if id(body.mesh) not in meshes:
