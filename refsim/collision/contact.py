@@ -116,8 +116,8 @@ def winding_numbers(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """(k,) winding numbers of ``points`` (k, 3) about the closed surface of
     ``triangles`` (m, 3, 3): 1 inside, 0 outside (module docstring)."""
     points = np.asarray(points, dtype=np.float64)
-    if not len(points):
-        return np.zeros(0)
+    if not len(points) or not len(triangles):
+        return np.zeros(len(points))             # no surface: outside
     if len(points) * len(triangles) > PAIRS_PER_BLOCK:
         return np.concatenate([winding_numbers(points[s], triangles)
                                for s in _blocks(points, len(triangles))])
