@@ -56,10 +56,13 @@ triangles.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from refsim.collision.bodies import intersecting_pairs
 from refsim.collision.boxes import world_vertices
+from refsim.kernels import choose_kernel
 
 #: A point whose winding number exceeds this is inside the mesh or on its
 #: surface. Outside, the winding number is 0 up to rounding: about 1e-15,
@@ -104,12 +107,17 @@ def _blocks(points: np.ndarray, triangles: int):
     return [slice(i, i + step) for i in range(0, len(points), step)]
 
 
+#: ``math.atan2`` element by element: the C library's, which the compiled
+#: twin (:mod:`refsim.collision._numba_contact`) calls too.
+_atan2 = np.frompyfunc(math.atan2, 2, 1)
+
+
 def winding_numbers(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     """(k,) winding numbers of ``points`` (k, 3) about the closed surface of
     ``triangles`` (m, 3, 3): 1 inside, 0 outside (module docstring)."""
     points = np.asarray(points, dtype=np.float64)
-    if not len(points):
-        return np.zeros(0)
+    if not len(points) or not len(triangles):
+        return np.zeros(len(points))             # no surface: outside
     if len(points) * len(triangles) > PAIRS_PER_BLOCK:
         return np.concatenate([winding_numbers(points[s], triangles)
                                for s in _blocks(points, len(triangles))])
@@ -118,7 +126,11 @@ def winding_numbers(points: np.ndarray, triangles: np.ndarray) -> np.ndarray:
     la, lb, lc = (np.sqrt(_dot(x, x)) for x in (a, b, c))
     numerator = _dot(a, _cross(b, c))
     denominator = la * lb * lc + _dot(a, b) * lc + _dot(b, c) * la + _dot(c, a) * lb
-    return 2.0 * np.arctan2(numerator, denominator).sum(axis=1) / (4.0 * np.pi)
+    # the C library's atan2 (numpy's own loops differ from it in the last bit
+    # on some processors) and the angles summed triangle by triangle
+    # (cumsum: one order everywhere), as the compiled twin does
+    angles = _atan2(numerator, denominator).astype(np.float64)
+    return 2.0 * np.cumsum(angles, axis=1)[:, -1] / (4.0 * np.pi)
 
 
 def edge_crossings(edge_triangles: np.ndarray, triangles: np.ndarray) -> np.ndarray:
@@ -293,7 +305,19 @@ def contact_points(mesh_a, pose_a, mesh_b, pose_b, n, kernel: str | None = None
     """Where a contact's impulses act, ``n`` the normal from B into A: the
     corners (:func:`contact_polygon`) of the thickest part
     (:func:`deepest_points`) of the meshes' intersection region
-    (:func:`intersection_points`); empty when the meshes do not meet."""
+    (:func:`intersection_points`); empty when the meshes do not meet.
+
+    ``kernel`` (:mod:`refsim.kernels`): "compiled" runs the steps after the
+    triangle pairs as one compiled call
+    (:func:`refsim.collision._numba_contact.contact_region_numba`), the same
+    points bit for bit."""
+    if choose_kernel(kernel) == "compiled":
+        from refsim.collision._numba_contact import contact_region_numba
+
+        world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
+        pairs = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level="exact", kernel=kernel)
+        return contact_region_numba(world_a, mesh_a.faces, world_b, mesh_b.faces, pairs,
+                                    np.asarray(n, dtype=np.float64))
     points, tri_a, tri_b = _region(mesh_a, pose_a, mesh_b, pose_b, kernel)
     if not len(points):
         return points

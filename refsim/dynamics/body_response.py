@@ -60,6 +60,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.dynamics.products import dot, norm
+from refsim.kernels import choose_kernel
 
 #: Extra separation after the positional correction, relative to the bodies'
 #: size (the sum of their projection extents along n): the exact collision
@@ -106,8 +107,8 @@ class ContactGeometry:
     extent: float
 
 
-def contact_geometry(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a, axes_b
-                     ) -> ContactGeometry:
+def contact_geometry(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a, axes_b,
+                     kernel: str | None = None) -> ContactGeometry:
     """Normal, depth and point of two overlapping bodies' vertex sets.
 
     A negative depth means the normal separates the bodies (no contact).
@@ -123,7 +124,24 @@ def contact_geometry(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a,
 
     Raises ValueError when no candidate has a direction: coincident
     centroids and zero orientation axes on both bodies.
+
+    ``kernel`` (:mod:`refsim.kernels`): "compiled" runs
+    :func:`refsim.dynamics._numba_contact.contact_geometry_numba`, the same
+    bits.
     """
+    if choose_kernel(kernel) == "compiled":
+        from refsim.dynamics._numba_contact import contact_geometry_numba
+
+        out = np.empty(8)
+        if contact_geometry_numba(np.ascontiguousarray(world_a, dtype=np.float64),
+                                  np.ascontiguousarray(world_b, dtype=np.float64),
+                                  np.asarray(c_a, dtype=np.float64),
+                                  np.asarray(c_b, dtype=np.float64),
+                                  np.asarray(axes_a, dtype=np.float64),
+                                  np.asarray(axes_b, dtype=np.float64), out):
+            return ContactGeometry(n=out[0:3], depth=float(out[3]), point=out[4:7],
+                                   extent=float(out[7]))
+        raise ValueError(_NO_AXIS)
     d = np.asarray(c_a, dtype=np.float64) - c_b
     candidates = [d] + [axes_a[:, k] for k in range(3)] + [axes_b[:, k] for k in range(3)]
     best = None
@@ -143,8 +161,7 @@ def contact_geometry(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a,
     if best is None:
         # Only when the centroids coincide and both bodies' axes are zero
         # vectors (a degenerate orientation): no direction to separate along.
-        raise ValueError("contact_geometry: every candidate axis has zero length (coincident "
-                         "centroids and zero orientation axes); no contact normal")
+        raise ValueError(_NO_AXIS)
     n, depth, pa, pb = best
     if depth < 0.0:
         # a separating axis: the bodies do not touch (their boxes, or spheres,
@@ -152,10 +169,19 @@ def contact_geometry(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a,
         point = 0.5 * (world_a[pa.argmin()] + world_b[pb.argmax()])
     else:
         slab_lo, slab_hi = pa.min(), pb.max()
-        point = 0.5 * (world_a[pa <= slab_hi].mean(axis=0)
-                       + world_b[pb >= slab_lo].mean(axis=0))
+        point = 0.5 * (_centroid(world_a[pa <= slab_hi]) + _centroid(world_b[pb >= slab_lo]))
     extent = float((pa.max() - pa.min()) + (pb.max() - pb.min()))
     return ContactGeometry(n=n, depth=float(depth), point=point, extent=extent)
+
+
+_NO_AXIS = ("contact_geometry: every candidate axis has zero length (coincident centroids "
+            "and zero orientation axes); no contact normal")
+
+
+def _centroid(points: np.ndarray) -> np.ndarray:
+    """The mean of ``points`` (k >= 1, 3), summed row by row in index order
+    (cumsum: one order on every machine, which the compiled twin repeats)."""
+    return np.cumsum(points, axis=0)[-1] / len(points)
 
 
 def separate_bodies(geometry: ContactGeometry, m_inv_a: float, m_inv_b: float

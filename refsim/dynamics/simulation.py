@@ -126,6 +126,7 @@ from refsim.signals import SignalHold, held_signals
 from refsim.solvers.explicit_rk import rk_step
 from refsim.solvers.integrate import resolve_method, whole_steps
 from refsim.storage.frames import FrameSink, MemorySink, frame_count
+from refsim.types import ORTHONORMAL_TOL
 
 #: At most about this many frames by default (``every`` is chosen so).
 MAX_FRAMES = 1000
@@ -390,6 +391,7 @@ class Simulation:
         # The compiled loop (many steps per call), when the kernel is compiled
         # and the loop does this scene's choices (loop_support).
         self.loop_seconds = 0.0
+        self._packed: tuple | None = None       # the meshes for the compiled narrow phase
         self._loop: CompiledLoop | None = None
         if self.kernel == "compiled" and loop_support(self) is None:
             self._loop = CompiledLoop(self)
@@ -783,12 +785,60 @@ class Simulation:
 
     # 7. narrow phase (S4 at the scene's level)
     def _narrow_phase(self, pairs: np.ndarray) -> list:
+        if self.kernel == "compiled" and self.level == "exact" and len(pairs):
+            return self._narrow_phase_compiled(pairs)
         hits = []
         for a, b in pairs:
             if bodies_collide(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
                               self.pose(b), level=self.level, kernel=self.kernel):
                 hits.append((a, b))
         return hits
+
+    def _narrow_phase_compiled(self, pairs: np.ndarray) -> list:
+        """The exact level's pairs in one compiled call
+        (:func:`refsim.collision._numba_contact.collide_pairs_numba`: the
+        hierarchy query of :func:`~refsim.collision.bodies.bodies_collide`
+        for every pair); a pair it leaves undecided, or whose pose it
+        rejects, goes to :func:`~refsim.collision.bodies.bodies_collide`,
+        which decides it or raises. The same pairs as the readable kernel."""
+        from refsim.collision import _numba_contact, _numba_kernels
+        from refsim.collision.bvh_exact import MARGIN_PER_DEVIATION, MARGIN_ROUNDING
+
+        floats, float_start, ints, int_start, mesh_of = self._packed_meshes()
+        rows = np.ascontiguousarray(pairs, dtype=np.int64)
+        origin = self.x - matvec(self.R, self.center)        # pose(i)'s, all at once
+        codes = np.empty(len(rows), dtype=np.int64)
+        _numba_contact.collide_pairs_numba(floats, float_start, ints, int_start, mesh_of,
+                                           self.R, origin, rows, ORTHONORMAL_TOL,
+                                           MARGIN_ROUNDING, MARGIN_PER_DEVIATION, codes)
+        hits = []
+        for (a, b), code in zip(rows.tolist(), codes.tolist(), strict=True):
+            if code == _numba_kernels.HIT or (
+                    code != _numba_kernels.APART
+                    and bodies_collide(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
+                                       self.pose(b), level=self.level, kernel=self.kernel)):
+                hits.append((a, b))
+        return hits
+
+    def _packed_meshes(self) -> tuple:
+        """The bodies' meshes packed for :func:`_narrow_phase_compiled`
+        (``floats, float_start, ints, int_start, mesh_of``), built once."""
+        if self._packed is None:
+            from refsim.collision.bvh_exact import pack_frame_tree
+
+            meshes: dict[int, int] = {}
+            arrays: list[tuple[np.ndarray, np.ndarray]] = []
+            mesh_of = np.empty(len(self.bodies), dtype=np.int64)
+            for i, body in enumerate(self.bodies):
+                if id(body.mesh) not in meshes:
+                    meshes[id(body.mesh)] = len(arrays)
+                    arrays.append(pack_frame_tree(body.mesh))
+                mesh_of[i] = meshes[id(body.mesh)]
+            float_start = np.cumsum([0] + [len(f) for f, _ in arrays]).astype(np.int64)
+            int_start = np.cumsum([0] + [len(k) for _, k in arrays]).astype(np.int64)
+            self._packed = (np.concatenate([f for f, _ in arrays]), float_start,
+                            np.concatenate([k for _, k in arrays]), int_start, mesh_of)
+        return self._packed
 
     # 8. body-body response (S8, or corrected)
     def _body_response(self, pairs, touching: set) -> None:
@@ -803,7 +853,8 @@ class Simulation:
                     self.x[a], self.x[b], self.v[a], self.v[b])
                 continue
             geometry = contact_geometry(self.world_vertices(a), self.world_vertices(b),
-                                        self.x[a], self.x[b], self.R[a], self.R[b])
+                                        self.x[a], self.x[b], self.R[a], self.R[b],
+                                        kernel=self.kernel)
             if geometry.depth < 0.0:
                 continue                  # a separating axis: coarse-level false contact
             # the impulses act over the corners of the region where the
