@@ -187,3 +187,32 @@ def _any_exact(world_a, mesh_a, world_b, mesh_b, candidates, kernel) -> bool:
         if len(exact_pairs(world_a, mesh_a.faces, world_b, mesh_b.faces, batch, kernel)):
             return True
     return False
+
+
+#: :func:`exact_answers`' codes: the meshes touch, are apart, or the
+#: compiled query left the pair to :func:`bodies_collide`.
+TOUCH, APART, UNDECIDED = 1, 0, -1
+
+
+def exact_answers(packed: tuple, R: np.ndarray, origin: np.ndarray,
+                  rows: np.ndarray) -> np.ndarray:
+    """The exact level's answer for many body pairs in one compiled call:
+    ``packed`` the bodies' frame trees laid end to end (``floats,
+    float_start, ints, int_start, mesh_of``, each body's from
+    :func:`refsim.collision.bvh_exact.pack_frame_tree`), ``R`` (B, 3, 3) and
+    ``origin`` (B, 3) the bodies' poses, ``rows`` (P, 2) int64 the pairs.
+    Returns (P,) int64 codes: :data:`TOUCH`, :data:`APART`, or
+    :data:`UNDECIDED` for a pair the query leaves to :func:`bodies_collide`
+    (which decides it, or raises on a pose it rejects). The query is
+    :func:`bodies_collide`'s at level "exact", so the same pairs touch."""
+    from refsim.collision import _numba_contact, _numba_kernels
+    from refsim.collision.bvh_exact import MARGIN_PER_DEVIATION, MARGIN_ROUNDING
+    from refsim.types import ORTHONORMAL_TOL
+
+    floats, float_start, ints, int_start, mesh_of = packed
+    codes = np.empty(len(rows), dtype=np.int64)
+    _numba_contact.collide_pairs_numba(floats, float_start, ints, int_start, mesh_of, R,
+                                       origin, rows, ORTHONORMAL_TOL, MARGIN_ROUNDING,
+                                       MARGIN_PER_DEVIATION, codes)
+    return np.where(codes == _numba_kernels.HIT, TOUCH,
+                    np.where(codes == _numba_kernels.APART, APART, UNDECIDED))

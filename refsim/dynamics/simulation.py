@@ -126,7 +126,6 @@ from refsim.signals import SignalHold, held_signals
 from refsim.solvers.explicit_rk import rk_step
 from refsim.solvers.integrate import resolve_method, whole_steps
 from refsim.storage.frames import FrameSink, MemorySink, frame_count
-from refsim.types import ORTHONORMAL_TOL
 
 #: At most about this many frames by default (``every`` is chosen so).
 MAX_FRAMES = 1000
@@ -796,25 +795,20 @@ class Simulation:
 
     def _narrow_phase_compiled(self, pairs: np.ndarray) -> list:
         """The exact level's pairs in one compiled call
-        (:func:`refsim.collision._numba_contact.collide_pairs_numba`: the
+        (:func:`refsim.collision.bodies.exact_answers`: the
         hierarchy query of :func:`~refsim.collision.bodies.bodies_collide`
         for every pair); a pair it leaves undecided, or whose pose it
         rejects, goes to :func:`~refsim.collision.bodies.bodies_collide`,
         which decides it or raises. The same pairs as the readable kernel."""
-        from refsim.collision import _numba_contact, _numba_kernels
-        from refsim.collision.bvh_exact import MARGIN_PER_DEVIATION, MARGIN_ROUNDING
+        from refsim.collision.bodies import APART, TOUCH, exact_answers
 
-        floats, float_start, ints, int_start, mesh_of = self._packed_meshes()
         rows = np.ascontiguousarray(pairs, dtype=np.int64)
         origin = self.x - matvec(self.R, self.center)        # pose(i)'s, all at once
-        codes = np.empty(len(rows), dtype=np.int64)
-        _numba_contact.collide_pairs_numba(floats, float_start, ints, int_start, mesh_of,
-                                           self.R, origin, rows, ORTHONORMAL_TOL,
-                                           MARGIN_ROUNDING, MARGIN_PER_DEVIATION, codes)
+        codes = exact_answers(self._packed_meshes(), self.R, origin, rows)
         hits = []
         for (a, b), code in zip(rows.tolist(), codes.tolist(), strict=True):
-            if code == _numba_kernels.HIT or (
-                    code != _numba_kernels.APART
+            if code == TOUCH or (
+                    code != APART
                     and bodies_collide(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
                                        self.pose(b), level=self.level, kernel=self.kernel)):
                 hits.append((a, b))
