@@ -169,10 +169,10 @@ A failure within twice its tolerance is "tolerance"; beyond, "bug" (unless
 recognised as above). An engine that declares a contact law other than a
 restitution coefficient (``contact_law``, :func:`refsim.engines.declarations`)
 is not held to the answers that assume one: its misses of
-``rigid.apex_ratio`` and ``rigid.oblique_bounce`` are "law", naming it. An
-apex ratio that cannot be read (fewer bounces than it needs) is
-"unmeasurable", with the reason; so are bounce times, and a miss of
-``rigid.elastic_tumble`` or ``rigid.bounce_times`` by such an engine is "law". A scene whose ``simulate`` raises, or
+``rigid.apex_ratio``, ``rigid.oblique_bounce``, ``rigid.cradle``,
+``rigid.elastic_tumble`` and ``rigid.bounce_times`` are "law", naming it.
+An apex ratio or bounce times that cannot be read (fewer bounces than they
+need) are "unmeasurable", with the reason. A scene whose ``simulate`` raises, or
 returns arrays of other shapes than the contract's, is that scene's
 "crash" in every check that reads it.
 
@@ -1088,6 +1088,7 @@ def check_rigid_bounce_times(engine, cases) -> CheckResult:
                                 "largest_miss": worst, "tolerance": tol}
         example = {"bounce_times": got, "closed_form": closed.tolist(),
                    "misses_in_steps": [m / h for m in misses], "tolerance": tol}
+        outcome: str | None
         if len(got) < R.BOUNCES:
             outcome = "unmeasurable"
             example["reason"] = (f"{len(got)} flights after a bounce, {R.BOUNCES} needed "
