@@ -67,6 +67,19 @@ cradle-e1, cradle-e0.5 Newton's cradle: a row along x of equal balls (the
                        at e = 1 leave the last at 1 m/s and the others at
                        rest; two at e = 0.5 leave at 0.25 and 0.75 m/s
                        (:func:`cradle_answer`)
+slide-ball, slide-box   a body set sliding on the floor at 3 m/s without
+                       spin, Coulomb's mu 0.3, e = 0 (it stays on the floor):
+                       friction decelerates the centre at mu g while the
+                       contact slips; the sphere rolls from ``t* = v0 / (mu g
+                       (1 + d^2 / k^2))`` on at ``v0 / (1 + k^2 / d^2)`` (2 v0
+                       / (7 mu g) and 5/7 v0 for a smooth solid ball), the
+                       cube stops at ``v0 / (mu g)`` after ``v0^2 / (2 mu
+                       g)`` (:func:`slide_answer`)
+tumble-brick           the brick dropped spinning at (1, 3, 2) rad/s, its
+                       lowest vertex 2.7 m above the floor, e = 1, no
+                       friction, 5 s: every impact is elastic and no force
+                       but gravity's does work, so the mechanical energy
+                       stays
 =====================  =====================================================
 
 Two choices keep the answers exact for every reasonable engine:
@@ -98,9 +111,10 @@ seed model) that cannot pose them refuses the scene
 (:class:`refsim.errors.UnposableKey`) and the check reports it as not
 posed, with the key.
 
-Cost: about 30,940 steps per engine in all (the drops are 1.8 to 3.0 s of
-simulated time, the free brick 12 s, the cradles 20 ms), and 1,700 more for
-the determinism check's reruns.
+Cost: about 37,540 steps per engine in all (the drops are 1.8 to 3.0 s of
+simulated time, the free brick 12 s, the tumbling brick 5 s, the slides 0.4
+and 1.2 s, the cradles 20 ms), and 1,700 more for the determinism check's
+reruns.
 """
 
 from __future__ import annotations
@@ -210,11 +224,27 @@ CRADLE_GAP = 0.0027
 CRADLE_SPEED = 1.0
 CRADLE_DURATION = 0.02
 
+#: The slides (module docstring, :func:`slide_answer`): name, model, speed
+#: (m/s, along +x), mu, e, run (s: the ball's slip ends at 0.29 s, the cube
+#: stops at 1.02 s; each run goes on a little past that).
+SLIDES = (("slide-ball", SPHERE, 3.0, 0.3, 0.0, 0.4),
+          ("slide-box", CUBE, 3.0, 0.3, 0.0, 1.2))
+
+#: The elastic tumble (module docstring): the brick's start (its lowest
+#: vertex's height, m; its centre 3 m above the floor), its spin (rad/s, world
+#: axes) and the run (s). Five seconds hold six to eight floor impacts in
+#: refsim, Bullet and MuJoCo; ten double the run for every engine and change
+#: one verdict only (docs/decisions/textbook-checks.md).
+TUMBLE_HEIGHT = 2.7
+TUMBLE_SPIN = (1.0, 3.0, 2.0)
+TUMBLE_DURATION = 5.0
+
 
 @dataclass(frozen=True)
 class RigidScene:
     """One scene of the set: its name, kind ("drop", "oblique", "spin",
-    "rest", "free", "strike", "stack", "incline", "cradle"), the scene, and the
+    "rest", "free", "strike", "stack", "incline", "cradle", "slide",
+    "tumble"), the scene, and the
     parameters its answer needs (``angle``: an incline's, degrees)."""
 
     name: str
@@ -328,7 +358,51 @@ def rigid_scenes() -> tuple[RigidScene, ...]:
                                  angle=angle))
     for name, balls, e in CRADLES:
         scenes.append(RigidScene(name, "cradle", _cradle_scene(balls, e), e))
+    for name, model, speed, mu, e, duration in SLIDES:
+        scenes.append(RigidScene(name, "slide",
+                                 _scene(model, e, mu, 0.0, duration, velocity=(speed, 0.0, 0.0)),
+                                 e, mu))
+    scenes.append(RigidScene("tumble-brick", "tumble",
+                             _scene(BRICK, 1.0, 0.0, TUMBLE_HEIGHT, TUMBLE_DURATION,
+                                    angular_velocity=TUMBLE_SPIN),
+                             1.0, 0.0, TUMBLE_HEIGHT))
     return tuple(scenes)
+
+
+def slide_answer(scene: RigidScene) -> dict[str, float]:
+    """The slide's closed form: the body moves along x at ``v0`` without
+    spin, its lowest point on the floor, under Coulomb's kinetic friction
+    ``mu m g`` against the slip of its contact point (Kleppner & Kolenkow,
+    *An Introduction to Mechanics*, the bowling ball that slides into
+    rolling; Goldstein, *Classical Mechanics*, rigid-body motion).
+
+    - The centre decelerates at ``mu g`` while the contact slips.
+    - The sphere: the friction's moment ``mu m g d`` about the centre (``d``
+      the depth of the contact below it) spins it up at ``mu g d / k^2``
+      (``I = m k^2``), so the slip ``v + w d`` falls at ``mu g (1 + d^2 /
+      k^2)``: it ends at ``t* = v0 / (mu g (1 + d^2 / k^2))``, and the ball
+      rolls on at ``v0 / (1 + k^2 / d^2)``. With ``k^2 = 2/5 d^2`` (a smooth
+      solid ball) that is ``2 v0 / (7 mu g)`` and ``5/7 v0``; here ``k`` is
+      the sphere mesh's own (its uniform solid's moment about z) and ``d``
+      its lowest vertex's depth below the centre of mass, as in
+      :func:`oblique_answer`.
+    - The cube slides on its face, which cannot roll: it stops at ``t* = v0
+      / (mu g)`` after ``v0^2 / (2 mu g)`` and stays.
+
+    Keys: ``deceleration``, ``slip_end_time``, ``speed_after`` (the
+    centre's speed once the slip has ended), ``depth`` (``d``) and, for the
+    cube, ``distance``."""
+    vertices, center, inertia = _body(_model(scene))
+    body = scene.scene.bodies[0]
+    v0 = float(body.velocity[0])
+    a = scene.friction * GRAVITY
+    depth = float(center[1] - vertices[:, 1].min())
+    if _model(scene) == SPHERE:
+        ratio = depth * depth / float(inertia[2, 2])           # d^2 / k^2
+        return {"deceleration": a, "slip_end_time": v0 / (a * (1.0 + ratio)),
+                "speed_after": v0 / (1.0 + 1.0 / ratio), "depth": depth}
+    return {"deceleration": a, "slip_end_time": v0 / a, "speed_after": 0.0, "depth": depth,
+            "distance": v0 * v0 / (2.0 * a)}
 
 
 def _cradle_scene(balls: int, e: float):

@@ -115,13 +115,64 @@ meet them within these bounds.
   an engine that declares a contact law other than restitution is "law":
   the answer is Newton's impact law's.
 
+- ``rigid.slide_to_roll`` (the sphere and the cube set sliding on the floor at
+  3 m/s without spin, mu 0.3, e = 0): by Coulomb's kinetic friction
+  (:func:`refsim.conformance.cases_rigid.slide_answer`) the centre
+  decelerates at ``mu g`` while the contact slips; the slip ends at ``v0 /
+  (mu g (1 + d^2 / k^2))`` for the sphere (2 v0 / (7 mu g) for a smooth
+  solid ball; here with the mesh's own ``k`` and contact depth ``d``), at
+  ``v0 / (mu g)`` for the cube, which stops after ``v0^2 / (2 mu g)``.
+  The deceleration is the least-squares slope of the centre's speed over
+  the frames from ``CONTACT_STEPS h`` to :data:`SLIDE_WINDOW` of the closed
+  form's slip time, within :func:`slide_tolerance` of ``mu g``: what the
+  facets do to it (:func:`slide_facet_shift`: 0.85 % for the sphere-2k
+  model over its window, 0 for the cube's face) plus ``2 CONTACT_STEPS h /
+  T`` (friction up to ``CONTACT_STEPS`` steps late at either end of a
+  window of ``T``, each moving the speed by ``CONTACT_STEPS mu g h``): 2.4
+  % for the ball, 0.44 % for the cube at h = 1e-3. The slip ends (the
+  first frame whose slip is below what ``CONTACT_STEPS`` steps of the
+  closed form's slip rate take) within that fraction of the closed form's
+  time plus ``CONTACT_STEPS h``; the cube's travel is within that fraction
+  of ``v0^2 / (2 mu g)`` plus ``v0 CONTACT_STEPS h`` (friction found that
+  late at the start). The ball's speed after the slip is recorded, not
+  judged: the faceted ball rocks over a facet every 0.12 rad it turns and
+  each landing takes about 1 % of its energy (measured in every engine:
+  2.09 m/s 0.3 s after the slip where a smooth ball keeps 2.15), which the
+  closed form of a smooth ball does not have.
+- ``rigid.elastic_tumble`` (the brick dropped spinning, e = 1, no friction,
+  5 s): exact impacts and an exact integrator keep the mechanical energy
+  exactly (an impulse at one point with e = 1 and no friction returns the
+  normal speed and so the kinetic energy: Stronge, *Impact Mechanics*, ch.
+  2; between impacts only gravity does work). A step method finds each
+  impact at a step and may leave the body up to ``CONTACT_STEPS v h`` off
+  where it struck, which is the energy check's ``CONTACT_STEPS m g v_max h``
+  (:func:`energy_tolerance`) per impact: the largest relative change of the
+  energy over the run is held to that times the impacts read from the
+  trajectory (runs of frames whose vertical velocity changes by more than
+  gravity's, :data:`FLIGHT_TOL`; a contact over several steps once):
+  :func:`tumble_tolerance`, 0.62 % of the energy per impact here.
+- ``rigid.bounce_times`` (the drops of ``rigid.apex_ratio``): the first
+  ``BOUNCES`` bounces happen at ``t1 = sqrt(2 H / g)``, ``t_{k+1} = t_k + 2
+  e^k v1 / g`` (:func:`refsim.dynamics.analytic.bounce_times`), each read
+  from the trajectory by fitting the free flight after it with the closed
+  form's gravity and extrapolating it back to the floor
+  (:func:`bounce_times`). RK4 is exact for a constant force, so an engine
+  that integrates the flight with the scene's RK4 and places each impact at
+  its time within the step meets the closed form to rounding; the fit is
+  exact for such a flight. The tolerance is :data:`BOUNCE_TIME_STEPS` of a
+  step: a time of impact interpolated linearly within the step stays
+  inside it, a bounce resolved at the end of its step (up to a step late,
+  accumulating over the bounces) or a semi-implicit Euler fall (it lands
+  half a step early) does not.
+
 A failure within twice its tolerance is "tolerance"; beyond, "bug" (unless
 recognised as above). An engine that declares a contact law other than a
 restitution coefficient (``contact_law``, :func:`refsim.engines.declarations`)
 is not held to the answers that assume one: its misses of
-``rigid.apex_ratio`` and ``rigid.oblique_bounce`` are "law", naming it. An
-apex ratio that cannot be read (fewer bounces than it needs) is
-"unmeasurable", with the reason. A scene whose ``simulate`` raises, or
+``rigid.apex_ratio``, ``rigid.oblique_bounce``, ``rigid.cradle``,
+``rigid.elastic_tumble`` and ``rigid.bounce_times`` are "law", naming it.
+An apex ratio or bounce times that cannot be read (fewer bounces than they
+need) are "unmeasurable", with the reason. A scene whose ``simulate`` raises, or
 returns arrays of other shapes than the contract's, is that scene's
 "crash" in every check that reads it.
 
@@ -133,7 +184,9 @@ mean distance of a square's points from its centre, ``s (sqrt 2 + ln(1 +
 sqrt 2)) / 6``.
 
 Cost: the runs of :mod:`refsim.conformance.cases_rigid` (shared between the
-checks) plus two reruns for ``rigid.determinism``.
+checks) plus two reruns for ``rigid.determinism``; ``rigid.bounce_times``
+reads the drops' runs, and :func:`slide_facet_shift` turns the sphere mesh's
+vertices (1,002) through 2,001 angles per slide scene.
 """
 
 from __future__ import annotations
@@ -784,6 +837,272 @@ def check_rigid_incline(engine, cases) -> CheckResult:
                  seconds=time.perf_counter() - start)
 
 
+
+# -- sliding, elastic tumbling, bounce times ------------------------------------------
+
+
+#: The slide's deceleration is fitted over the frames from CONTACT_STEPS
+#: steps after the start (friction may act that late) to this fraction of
+#: the closed-form slip time: near its end a facet landing of the ball can
+#: stop the slip early (its friction impulse, ``mu (1 + e)`` times the
+#: landing's vertical speed of at most 0.12 m/s, times ``1 + d^2 / k^2`` on
+#: the slip, is up to 0.13 m/s; a tenth of the slip is 0.3 m/s).
+SLIDE_WINDOW = 0.9
+
+
+def _slide_spin_up(scene, t: np.ndarray) -> np.ndarray:
+    """The angle (rad, about z) the slide's body has turned at times ``t``
+    by the closed form: the sphere spins up at ``mu g d / k^2`` (negative
+    about z for a slide along +x); the cube does not turn."""
+    if R._model(scene) != R.SPHERE:
+        return np.zeros_like(t)
+    _, _, inertia = R._body(R._model(scene))
+    depth = R.slide_answer(scene)["depth"]
+    return -0.5 * scene.friction * R.GRAVITY * depth / float(inertia[2, 2]) * t * t
+
+
+def slide_facet_shift(scene, start: float, stop: float) -> float:
+    """How far, relative to ``mu g``, the facets of the slide's mesh move the
+    deceleration fitted over ``[start, stop]`` (module docstring).
+
+    A smooth ball's centre stays at one height; the faceted one's rests on
+    its lowest vertex, so as it turns its centre rises and falls (by 1.9 mm
+    for the sphere-2k model) at ``dy/dt`` up to 0.12 m/s. The floor's
+    normal force is ``m (g + d^2y/dt^2)``, and Coulomb's friction ``mu``
+    times it, so the centre's speed along the floor is ``v0 - mu g t - mu
+    (dy/dt - dy/dt(0))``: this returns the least-squares slope of the last
+    term over the window, over ``mu g``, with the height read from the
+    mesh's vertices turned by :func:`_slide_spin_up` (the body kept on the
+    floor). Geometry only: no dynamics of any engine."""
+    vertices, center, _ = R._body(R._model(scene))
+    local = vertices - center
+    t = np.linspace(start, stop, 2001)
+    angle = _slide_spin_up(scene, t)
+    height = -(np.sin(angle)[:, None] * local[None, :, 0]
+               + np.cos(angle)[:, None] * local[None, :, 1]).min(axis=1)
+    rise = np.gradient(height, t)
+    slope = np.polyfit(t, -(rise - rise[0]), 1)[0]        # per mu
+    return float(abs(slope) / R.GRAVITY)
+
+
+def slide_window(scene) -> tuple[float, float]:
+    """The fit window (s) of the slide's deceleration."""
+    h = scene.scene.integration.step
+    return CONTACT_STEPS * h, SLIDE_WINDOW * R.slide_answer(scene)["slip_end_time"]
+
+
+def slide_tolerance(scene) -> float:
+    """The slide's deceleration tolerance, relative to ``mu g`` (module
+    docstring): the facets' share (:func:`slide_facet_shift`) plus ``2
+    CONTACT_STEPS h / T`` over a window of ``T``."""
+    start, stop = slide_window(scene)
+    h = scene.scene.integration.step
+    return slide_facet_shift(scene, start, stop) + 2.0 * CONTACT_STEPS * h / (stop - start)
+
+
+def check_rigid_slide_to_roll(engine, cases) -> CheckResult:
+    """``rigid.slide_to_roll``: a body set sliding on the floor decelerates
+    at mu g until its contact stops slipping, at the closed form's time: a
+    ball then rolls, a cube stops after v0^2 / (2 mu g) (module docstring)."""
+    start = time.perf_counter()
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("slide",), outcomes, examples):
+        answer = R.slide_answer(scene)
+        h = scene.scene.integration.step
+        t = np.asarray(trajectory.t)
+        v = np.asarray(trajectory.velocity)[:, 0]
+        w = np.asarray(trajectory.angular_velocity)[:, 0]
+        slip = v[:, 0] + w[:, 2] * answer["depth"]
+        a, b = slide_window(scene)
+        window = (t >= a) & (t <= b)
+        ratio = math.nan
+        if window.sum() >= 3 and np.isfinite(v[window, 0]).all():
+            ratio = float(-np.polyfit(t[window], v[window, 0], 1)[0] / answer["deceleration"])
+        tol = slide_tolerance(scene)
+        v0 = float(scene.scene.bodies[0].velocity[0])
+        t_star = answer["slip_end_time"]
+        # the slip has ended once it is below what CONTACT_STEPS steps of
+        # the closed form's slip rate take
+        stopped = np.flatnonzero(slip <= CONTACT_STEPS * h * v0 / t_star)
+        t_end = float(t[stopped[0]]) if len(stopped) else math.nan
+        time_tol = t_star * tol + CONTACT_STEPS * h
+        got = {"deceleration_over_mu_g": ratio, "deceleration_tolerance": tol,
+               "slip_end_time": t_end, "closed_form_slip_end_time": t_star,
+               "slip_end_tolerance": time_tol,
+               "speed_at_slip_end": float(v[stopped[0], 0]) if len(stopped) else math.nan,
+               "closed_form_speed_after": answer["speed_after"],
+               "speed_at_end_of_run": float(v[-1, 0])}
+        parts = [classify_miss(abs(ratio - 1.0), tol) if math.isfinite(ratio) else "bug",
+                 classify_miss(abs(t_end - t_star), time_tol) if math.isfinite(t_end)
+                 else "bug"]
+        if "distance" in answer:
+            x = np.asarray(trajectory.position)[:, 0, 0]
+            travel = float(x[-1] - x[0])
+            distance_tol = answer["distance"] * tol + v0 * CONTACT_STEPS * h
+            got.update({"distance": travel, "closed_form_distance": answer["distance"],
+                        "distance_tolerance": distance_tol})
+            parts.append(classify_miss(abs(travel - answer["distance"]), distance_tol)
+                         if math.isfinite(travel) else "bug")
+        measured[scene.name] = got
+        outcome = "bug" if "bug" in parts else next((p for p in parts if p), None)
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, **got, **scene.to_dict()})
+    return tally("rigid", "slide_to_roll", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
+#: A frame-to-frame change of the centre's vertical velocity within this
+#: fraction of gravity's ``g dt`` is free flight (a contact in the step
+#: changes it by its share of the body's weight at least, ``g dt`` for a
+#: resting contact; rounding in RK4 or Euler is below 1e-12 of it).
+FLIGHT_TOL = 1e-3
+
+
+def _flights(trajectory) -> list[tuple[int, int]]:
+    """The free flights of body 0: ``(first, last)`` frames of each run of
+    frames between which the vertical velocity changes by gravity alone
+    (:data:`FLIGHT_TOL`), in order."""
+    t = np.asarray(trajectory.t)
+    dv = np.diff(np.asarray(trajectory.velocity)[:, 0, 1])
+    dt = np.diff(t)
+    free = np.abs(dv + R.GRAVITY * dt) <= FLIGHT_TOL * R.GRAVITY * dt
+    flights = []
+    i = 0
+    while i < len(free):
+        if free[i]:
+            j = i
+            while j + 1 < len(free) and free[j + 1]:
+                j += 1
+            flights.append((i, j + 1))
+            i = j + 1
+        else:
+            i += 1
+    return flights
+
+
+def _contacts(trajectory) -> int:
+    """How many times body 0 met a wall: the runs of frames that are not
+    free flight (:func:`_flights`), a contact over several steps once."""
+    frames = len(np.asarray(trajectory.t))
+    flights = _flights(trajectory)
+    gaps = sum(1 for (_, last), (first, _) in zip(flights[:-1], flights[1:], strict=True)
+               if first > last)
+    ends = (flights[0][0] > 0) + (flights[-1][1] < frames - 1) if flights else 1
+    return gaps + int(ends)
+
+
+def tumble_tolerance(scene, contacts: int) -> float:
+    """Relative energy change the elastic tumble allows after ``contacts``
+    impacts (module docstring): :func:`energy_tolerance` for each, over the
+    energy at the start."""
+    body = scene.scene.bodies[0]
+    _, center, inertia = R._body(R._model(scene))
+    w = np.asarray(body.angular_velocity)
+    start = (body.mass * R.GRAVITY * (body.position[1] + center[1] + R.HALF_SIZE)
+             + 0.5 * body.mass * float(w @ inertia @ w)
+             + 0.5 * body.mass * float(np.dot(body.velocity, body.velocity)))
+    return max(contacts, 1) * energy_tolerance(scene) / start
+
+
+def check_rigid_elastic_tumble(engine, cases) -> CheckResult:
+    """``rigid.elastic_tumble``: a brick tumbling in the world cube with
+    e = 1 and no friction keeps its mechanical energy (module docstring)."""
+    start = time.perf_counter()
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("tumble",), outcomes, examples):
+        energy = R.energy(scene, trajectory)
+        change = (energy - energy[0]) / energy[0]
+        drift = float(np.abs(change).max()) if np.isfinite(change).all() else math.inf
+        contacts = _contacts(trajectory)
+        tol = tumble_tolerance(scene, contacts)
+        got = {"largest_energy_change": drift, "final_energy_change": float(change[-1]),
+               "impacts": contacts, "tolerance": tol}
+        measured[scene.name] = got
+        outcome = classify_miss(drift, tol) if math.isfinite(drift) else "bug"
+        example = dict(got)
+        outcome = _law(engine, outcome, example)
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, **example, **scene.to_dict()})
+    return tally("rigid", "elastic_tumble", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
+#: The bounce times' tolerance, in steps (module docstring): far above what
+#: an exact time of impact and RK4's exact parabola leave (rounding, 1e-12
+#: s), above a time of impact found by interpolating the depth linearly
+#: within the step (at most ``g h^2 / (8 v)`` a bounce: 2.3e-3 steps by the
+#: third bounce at the slowest impact here, 1.57 m/s), and far below the
+#: half step by which a semi-implicit Euler fall lands early or a bounce
+#: found at the end of its step lands late.
+BOUNCE_TIME_STEPS = 0.01
+
+#: A flight shorter than this many frames is not read as a bounce's arc.
+ARC_FRAMES = 5
+
+
+def bounce_times(scene, trajectory) -> list[float]:
+    """The times of the bounces (s), each read from the free flight after it
+    (:func:`_flights`, after the fall): the lowest vertex's height over the
+    flight's frames, fitted by least squares with ``y + g t^2 / 2 = a + b
+    t`` (the closed form's gravity), extrapolated back to the floor (the
+    earlier root of ``a + b t - g t^2 / 2``)."""
+    t = np.asarray(trajectory.t)
+    heights = R.lowest_height(scene, trajectory)
+    times = []
+    for first, last in _flights(trajectory):
+        if first == 0 or last - first + 1 < ARC_FRAMES:
+            continue                                  # the fall, or a contact's gap
+        s = t[first:last + 1] - t[first]
+        b, a = np.polyfit(s, heights[first:last + 1] + 0.5 * R.GRAVITY * s * s, 1)
+        root = b * b + 2.0 * R.GRAVITY * a
+        if not (math.isfinite(root) and root >= 0.0):
+            times.append(math.nan)
+            continue
+        times.append(float(t[first] - 2.0 * a / (b + math.sqrt(root))))
+    return times
+
+
+def check_rigid_bounce_times(engine, cases) -> CheckResult:
+    """``rigid.bounce_times``: the drops bounce at t1 = sqrt(2 H / g) and
+    t_{k+1} = t_k + 2 e^k v1 / g (module docstring)."""
+    start = time.perf_counter()
+    outcomes: list[str | None] = []
+    examples: list[dict] = []
+    measured: dict = {}
+    for scene, trajectory in _runs(engine, cases, ("drop",), outcomes, examples):
+        closed = analytic.bounce_times(scene.height, R.GRAVITY, scene.e, R.BOUNCES)
+        got = bounce_times(scene, trajectory)[:R.BOUNCES]
+        h = scene.scene.integration.step
+        tol = BOUNCE_TIME_STEPS * h
+        misses = [g - c for g, c in zip(got, closed, strict=False)]
+        worst = (max(abs(m) for m in misses) if len(got) == R.BOUNCES
+                 and all(math.isfinite(m) for m in misses) else math.nan)
+        measured[scene.name] = {"bounce_times": got, "closed_form": closed.tolist(),
+                                "misses_in_steps": [m / h for m in misses],
+                                "largest_miss": worst, "tolerance": tol}
+        example = {"bounce_times": got, "closed_form": closed.tolist(),
+                   "misses_in_steps": [m / h for m in misses], "tolerance": tol}
+        outcome: str | None
+        if len(got) < R.BOUNCES:
+            outcome = "unmeasurable"
+            example["reason"] = (f"{len(got)} flights after a bounce, {R.BOUNCES} needed "
+                                 f"(the body bounced fewer times in {float(trajectory.t[-1]):g} s)")
+        else:
+            outcome = classify_miss(worst, tol) if math.isfinite(worst) else "bug"
+        outcome = _law(engine, outcome, example)
+        outcomes.append(outcome)
+        if outcome is not None:
+            examples.append({"class": outcome, **example, **scene.to_dict()})
+    return tally("rigid", "bounce_times", outcomes, examples=examples, measured=measured,
+                 seconds=time.perf_counter() - start)
+
+
 # -- the textbook problems, as the report shows them ----------------------------------
 
 
@@ -840,6 +1159,15 @@ def _cradle_ratio(m: dict) -> float:
                m["energy_error"] / (2.0 * CRADLE_TOL), m["momentum_drift"] / MOMENTUM_TOL)
 
 
+def _slide_ratio(m: dict) -> float:
+    ratios = [abs(m["deceleration_over_mu_g"] - 1.0) / m["deceleration_tolerance"],
+              abs(m["slip_end_time"] - m["closed_form_slip_end_time"])
+              / m["slip_end_tolerance"]]
+    if "distance" in m:
+        ratios.append(abs(m["distance"] - m["closed_form_distance"]) / m["distance_tolerance"])
+    return math.nan if any(math.isnan(r) for r in ratios) else max(ratios)
+
+
 def _off_centre_ratio(m: dict) -> float:
     return max(m["largest_miss_of_closing_speed"] / OFF_CENTRE_TOL,
                m["momentum_drift"] / MOMENTUM_TOL)
@@ -889,4 +1217,18 @@ TEXTBOOK_PROBLEMS = (
                     "largest miss / first ball's speed",
                     lambda m: _worst(m, lambda s: s["largest_miss_of_speed"]),
                     lambda m: _worst(m, _cradle_ratio)),
+    TextbookProblem("rigid.slide_to_roll",
+                    "a ball sliding into rolling, a box sliding to rest: deceleration mu g",
+                    "deceleration error / mu g",
+                    lambda m: _worst(m, lambda s: abs(s["deceleration_over_mu_g"] - 1.0)),
+                    lambda m: _worst(m, _slide_ratio)),
+    TextbookProblem("rigid.elastic_tumble", "a brick tumbling at e = 1: energy kept",
+                    "relative energy change",
+                    lambda m: _worst(m, lambda s: s["largest_energy_change"]),
+                    lambda m: _worst(m, lambda s: s["largest_energy_change"]
+                                     / s["tolerance"])),
+    TextbookProblem("rigid.bounce_times", "drops: the times of the first three bounces",
+                    "largest bounce-time miss, s",
+                    lambda m: _worst(m, lambda s: s["largest_miss"]),
+                    lambda m: _worst(m, lambda s: s["largest_miss"] / s["tolerance"])),
 )

@@ -34,6 +34,11 @@ rigid.incline          rigid       Coulomb's incline: slide or stick
 rigid.stack            rigid       stable stacks stay where they are
 rigid.cradle           rigid       Newton's cradle: binary impacts hand
                                    the velocity down the row
+rigid.slide_to_roll    rigid       a sliding body decelerates at mu g
+                                   until it rolls (ball) or stops (cube)
+rigid.elastic_tumble   rigid       a brick tumbling at e = 1 keeps its
+                                   energy
+rigid.bounce_times     rigid       bounces at the closed form's times
 =====================  ==========  =========================================
 
 ``--cases N`` sizes the generated sets (triangles, poses, boxes); the ODE
@@ -41,7 +46,7 @@ problems and the rigid scenes are fixed sets.
 
 Cost: building a case set is the cost its module states (the exact answers
 dominate it; measured times in docs/decisions/conformance.md); the rigid set
-is about 30,000 steps per engine; the registry itself is O(checks).
+is about 37,500 steps per engine; the registry itself is O(checks).
 """
 
 from __future__ import annotations
@@ -106,6 +111,9 @@ CHECKS: tuple[Check, ...] = (
     Check("rigid", "incline", "rigid", RB.check_rigid_incline, miss_unit="metres"),
     Check("rigid", "stack", "rigid", RB.check_rigid_stack, miss_unit="metres"),
     Check("rigid", "cradle", "rigid", RB.check_rigid_cradle),
+    Check("rigid", "slide_to_roll", "rigid", RB.check_rigid_slide_to_roll),
+    Check("rigid", "elastic_tumble", "rigid", RB.check_rigid_elastic_tumble),
+    Check("rigid", "bounce_times", "rigid", RB.check_rigid_bounce_times),
 )
 
 CHECK_KEYS = tuple(c.key for c in CHECKS)

@@ -166,7 +166,7 @@ def test_rigid_scenes_and_their_tolerances():
                      "oblique-spin-e1", "oblique-backspin", "oblique-e0", "spin-cube", "rest-cube",
                      "free-brick", "strike-e1", "strike-e0.5", "offset-stack", "cantilever",
                      "board", "incline-slide", "incline-stick", "incline-mu1.5", "cradle-e1",
-                     "cradle-e0.5"]
+                     "cradle-e0.5", "slide-ball", "slide-box", "tumble-brick"]
     for scene in cases.of_kind("drop"):
         body = scene.scene.bodies[0]
         vertices = R._body(body.model.name)[0]

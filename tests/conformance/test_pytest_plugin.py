@@ -32,14 +32,14 @@ def test_plugin_runs_one_test_per_check_of_a_shipped_engine(pytester):
     expected = shipped_expected_failures("refsim-seed")
     result = pytester.runpytest(f"--refsim-engine={SEED_ENGINE}", "--refsim-cases=10",
                                 f"--refsim-expected-failures={expected}", "-v", "-rx")
-    # the user's own test, and the seed engine's 21 checks: its eight declared
-    # divergences (S9 three times, S5/S7, C12, S8 three times) are xfails with
-    # their reasons; the incline it cannot pose (world.mu) is skipped
-    result.assert_outcomes(passed=13, xfailed=8, skipped=1)
+    # the user's own test, and the seed engine's 24 checks: its eleven declared
+    # divergences (S9 five times, S5/S7 twice, C12, S8 three times) are xfails
+    # with their reasons; the incline it cannot pose (world.mu) is skipped
+    result.assert_outcomes(passed=13, xfailed=11, skipped=1)
     result.stdout.fnmatch_lines([
-        "*collected 22 items",
-        "refsim conformance: 21 checks of refsim-seed (refsim.engines.refsim_engines:seed): "
-        "triangles.reference, triangles.agreement, *, rigid.cradle",
+        "*collected 25 items",
+        "refsim conformance: 24 checks of refsim-seed (refsim.engines.refsim_engines:seed): "
+        "triangles.reference, triangles.agreement, *, rigid.bounce_times",
         "*refsim-conformance*triangles.agreement PASSED*",
         "*refsim-conformance*rigid.spin_to_rest XFAIL*",
         "*refsim conformance: refsim.engines.refsim_engines:seed*",

@@ -81,7 +81,9 @@ def build(ctx) -> Section:
     intro = ("Problems whose answer mechanics gives in closed form: drops and their apex "
              "ratios, oblique impacts with Coulomb friction in every regime, a spin stopped "
              "by friction, a torque-free body flipping about its middle axis, a ball "
-             "striking a free rod off its centre, and stacks that must not move. Every "
+             "striking a free rod off its centre, stacks that must not move, a ball "
+             "sliding into rolling and a box sliding to rest, a brick tumbling with "
+             "elastic impacts, and the times of a drop's bounces. Every "
              "rigid-body engine runs them through the conformance kit; the first table "
              "shows each engine's misses against the kit's tolerances, the second how "
              "refsim's own error changes with the step.")
