@@ -721,9 +721,8 @@ class Simulation:
     def _wall_impulse(self, i: int, correction: np.ndarray) -> None:
         """Corrected wall contact: push back, speed at the wall, impulses at
         the vertices past the wall (the deepest of them for an impact), and a
-        bounce carried on from the
-        instant of the crossing to the end of the step
-        (:func:`~refsim.dynamics.walls.crossing_time`,
+        bounce carried on from the instant of the crossing to the end of the
+        step (:func:`~refsim.dynamics.walls.crossing_time`,
         :func:`~refsim.dynamics.walls.bounce_advance`)."""
         world = self.scene.world
         H = world.half_size
