@@ -97,6 +97,20 @@ def _running(processes) -> list[psutil.Process]:
     return left
 
 
+def _scheduler_address(scheduler, scheduler_file, log) -> str:
+    """The address the scheduler writes to its file, once the file holds
+    all of it: the scheduler creates the file before it has written it, so
+    a file that exists may still be empty (seen on a loaded machine)."""
+    deadline = time.monotonic() + START_SECONDS
+    while True:
+        assert scheduler.poll() is None, log.read_text()
+        assert time.monotonic() < deadline, "the scheduler did not start"
+        try:
+            return json.loads(scheduler_file.read_text())["address"]
+        except (FileNotFoundError, json.JSONDecodeError, KeyError):
+            time.sleep(POLL_SECONDS)
+
+
 @pytest.fixture(scope="session")
 def dask_scheduler(tmp_path_factory):
     """The address of a scheduler with two single-thread workers."""
@@ -111,12 +125,7 @@ def dask_scheduler(tmp_path_factory):
     workers = None
     started = []
     try:
-        deadline = time.monotonic() + START_SECONDS
-        while not scheduler_file.exists():
-            assert scheduler.poll() is None, (folder / "scheduler.log").read_text()
-            assert time.monotonic() < deadline, "the scheduler did not start"
-            time.sleep(POLL_SECONDS)
-        address = json.loads(scheduler_file.read_text())["address"]
+        address = _scheduler_address(scheduler, scheduler_file, folder / "scheduler.log")
         workers = _dask("worker", "--scheduler-file", str(scheduler_file), "--nworkers", "2",
                         "--nthreads", "1", "--host", "127.0.0.1", "--no-dashboard",
                         "--local-directory", str(folder), "--death-timeout", "60",
