@@ -215,11 +215,6 @@ PRIVATE_ALLOWANCES: dict[tuple[str, str], str] = {
         "a compiled kernel calls compiled kernels only, and numba compiles the callee into "
         "the caller: the simulation loop's box update is the incremental box kernel "
         "itself, which lives with its readable twin in refsim.bounds",
-    ("refsim.dynamics._numba_kernels", "refsim.collision._numba_kernels.exact_query"):
-        "the same reason: the loop certifies overlapping boxes apart by running the exact "
-        "query, compiled into the loop",
-    ("refsim.dynamics._numba_kernels", "refsim.collision._numba_kernels.FIRST_HIT"):
-        "the exact query's mode argument, a compile-time constant of that kernel",
 }
 
 

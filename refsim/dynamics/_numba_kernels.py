@@ -42,10 +42,6 @@ What it runs (one step, the stages of the readable outline, same order):
                 compiled from its own source, the wall static);
 6. broad-phase  every pair of boxes, in the sorted order of
                 :func:`refsim.collision.broad_phase.overlapping_pairs_sweep`;
-7. narrow-phase at level "exact", the exact query of each pair
-                (:func:`_all_apart`); the step stays in the loop only
-                when it certifies every pair apart (the readable step then
-                finds no body contact either);
 8. response     at level "aabb", the seed's exchange,
                 :func:`refsim.dynamics.body_response.exchange_velocities_seed`.
 
@@ -59,8 +55,7 @@ step, when
 
 - ``STOP_READABLE``: a step needs what the kernel does not do (a pair of
   boxes overlaps and the scene's level or body response is not the seed's
-  exchange at level "aabb", except at level "exact" when the exact query
-  certifies every such pair apart; or the energy bound is above half the
+  exchange at level "aabb"; or the energy bound is above half the
   divergence limit, or not finite). The state is restored to the start of
   that step, and the caller takes it with the readable step, which decides
   (and raises DivergenceError where it must);
@@ -107,19 +102,16 @@ from numba.core import types
 from numba.extending import intrinsic
 
 from refsim.bounds._numba_kernels import incremental_update_numba
-from refsim.collision._numba_kernels import FIRST_HIT, exact_query
-from refsim.collision.bvh_exact import MARGIN_PER_DEVIATION, MARGIN_ROUNDING
 from refsim.dynamics import loop_layout as slot
 from refsim.dynamics.impulse import contact_sum_python, solve_contacts_python
 from refsim.dynamics.rotation_impulse import WALL_DEEPEST_FRACTION, free_rotation_step
 from refsim.dynamics.rotation_seed import axes_step_seed
 from refsim.dynamics.walls import bounce_advance, crossing_time, deepest_speed
-from refsim.types import ORTHONORMAL_TOL
 
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "80264ca6e3e3eb07"
+SOURCES_DIGEST = "3cc4237acc7208c7"
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -132,8 +124,6 @@ STOP_EVENTS = 2
 BODY_NONE = 0           # no body-body stage (one body, level "none", response "off")
 BODY_EXCHANGE = 1       # level "aabb", the seed's exchange (S8): done in the loop
 BODY_HAND_BACK = 2      # any other: a step with an overlapping pair of boxes goes back
-BODY_QUERY = 3          # level "exact": a step goes back when the exact query finds a
-                        # pair of overlapping boxes whose meshes it cannot tell apart
 
 #: Rotation models of the loop (the scene's ``dynamics.rotation``).
 ROTATION_OFF = 0
@@ -197,10 +187,7 @@ def advance(n_steps, floats, ints, flags):
         _view1(ints, ints, slot.PAST), _view2(floats, ints, slot.R_A),
         _view2(floats, ints, slot.P), _view1(floats, ints, slot.N),
         _view2(floats, ints, slot.ORIGIN), _view2(flags, ints, slot.NOW_WALLS),
-        _view2(ints, ints, slot.PAIRS),
-        # the meshes of the exact query
-        _view1(floats, ints, slot.MESH_FLOATS), _view1(ints, ints, slot.MESH_INTS),
-        _view2(ints, ints, slot.MESH_SPANS))
+        _view2(ints, ints, slot.PAIRS))
     counters[slot.C_STEPS] += done
     counters[slot.C_LOOP_STEPS] += done
     counters[slot.C_PENDING] = n_events
@@ -254,7 +241,7 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
            x, v, w, R, lo, hi, walls, bodies, events, tracked, tracker_rows, trackers_f,
            trackers_i, impulse_now, event_data,
            y, y_i, K, x0, v0, w0, R0, A, E, L, corr, past, r_a, P, n, origin, now_walls,
-           pairs, mesh_floats, mesh_ints, mesh_spans):
+           pairs):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation.step`, up to
     ``n_steps`` times, in place; returns ``(steps, events, stop)`` (module
     docstring: the readable function of each stage, and the hand-back),
@@ -312,8 +299,6 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
         ``r_a`` (M, 3), impulses ``P`` (M, 4) and normal ``n`` (3,), M the
         most vertices of a body; ``origin`` (B, 3); ``now_walls`` (B, 6)
         bool; ``pairs`` (max(B (B - 1) / 2, 1), 2) int64
-    mesh_floats, mesh_ints, mesh_spans : with ``BODY_QUERY``, the bodies'
-        meshes as the exact query takes them (:func:`_all_apart`)
     """
     B = x.shape[0]
     s = hb.shape[0]
@@ -474,12 +459,6 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
             if n_pairs and body_mode == BODY_HAND_BACK:
                 _restore(x, v, w, R, x0, v0, w0, R0)        # the readable step redoes this one
                 return step, n_events, STOP_READABLE
-            if n_pairs and body_mode == BODY_QUERY:
-                if not _all_apart(n_pairs, pairs, x, R, center, mesh_floats, mesh_ints,
-                                  mesh_spans):
-                    _restore(x, v, w, R, x0, v0, w0, R0)    # the readable step redoes this one
-                    return step, n_events, STOP_READABLE
-                n_pairs = 0          # no pair touches: the step has no body contact
         # the wall contacts that began (committed only now: a hand-back above
         # leaves the previous step's flags)
         for b in range(B):
@@ -549,35 +528,6 @@ def _tracker_update(row, trackers_f, trackers_i, rotation, translation, lo, hi):
         i[row[T_GENERATION]:row[T_GENERATION] + 2],
         i[row[T_COUNTS]:row[T_COUNTS] + 2],
         lo, hi)
-
-
-@numba.njit(cache=True, nogil=True)
-def _all_apart(n_pairs, pairs, x, R, center, mesh_floats, mesh_ints, spans):
-    """Mirrors refsim.dynamics.simulation.Simulation._narrow_phase at level
-    "exact" where it finds nothing: whether the exact query
-    (:func:`refsim.collision._numba_kernels.exact_query`, FIRST_HIT, as
-    :func:`refsim.collision.bodies.bodies_collide` asks it) certifies every
-    pair of ``pairs[:n_pairs]`` apart. Any hit, undecided pair or rejected
-    pose answers False: the readable step then decides. Each body's pose is
-    :meth:`Simulation.pose`'s, ``(R, x - R c)``, ``R c`` summed left to
-    right; body b's mesh is ``mesh_floats[spans[b, 0]:spans[b, 1]]`` and
-    ``mesh_ints[spans[b, 2]:spans[b, 3]]``
-    (:func:`refsim.collision.bvh_exact.pack_frame_tree`)."""
-    t = np.empty((2, 3))
-    for p in range(n_pairs):
-        a, b = pairs[p, 0], pairs[p, 1]
-        for k in range(3):
-            t[0, k] = x[a, k] - ((R[a, k, 0] * center[a, 0] + R[a, k, 1] * center[a, 1])
-                                 + R[a, k, 2] * center[a, 2])
-            t[1, k] = x[b, k] - ((R[b, k, 0] * center[b, 0] + R[b, k, 1] * center[b, 1])
-                                 + R[b, k, 2] * center[b, 2])
-        status, found, uncertain = exact_query(
-            mesh_floats[spans[a, 0]:spans[a, 1]], mesh_ints[spans[a, 2]:spans[a, 3]], R[a], t[0],
-            mesh_floats[spans[b, 0]:spans[b, 1]], mesh_ints[spans[b, 2]:spans[b, 3]], R[b], t[1],
-            FIRST_HIT, ORTHONORMAL_TOL, MARGIN_ROUNDING, MARGIN_PER_DEVIATION)
-        if status or found.shape[0] or uncertain.shape[0]:
-            return False
-    return True
 
 
 @numba.njit(cache=True, nogil=True)

@@ -55,10 +55,8 @@ def loop_support(sim: Simulation) -> str | None:
     responses (the seed's, with either wall speed, and the corrected
     impulses), any solver, linear or quadratic drag, ``world.mu`` and the
     restitution threshold, and body-body contacts at every level but
-    "sphere" (the seed's exchange at level "aabb" in the loop; at level
-    "exact", the steps whose overlapping boxes the exact query certifies
-    apart in the loop; any other step with overlapping boxes is handed
-    back). The
+    "sphere" (the seed's exchange at level "aabb" in the loop; any other
+    level or response hands the steps with overlapping boxes back). The
     loads of :mod:`refsim.dynamics.loads` beyond these (a tilted gravity,
     forces, torques, fixed bodies, missing walls, coefficients per body)
     run on the readable step.
@@ -180,16 +178,8 @@ class CompiledLoop:
             body_mode = kernels.BODY_NONE
         elif sim.level == "aabb" and sim.body_response == "seed":
             body_mode = kernels.BODY_EXCHANGE
-        elif sim.level == "exact":
-            body_mode = kernels.BODY_QUERY
         else:
             body_mode = kernels.BODY_HAND_BACK
-        mesh_floats, mesh_ints = np.zeros(1), np.zeros(1, np.int64)
-        mesh_spans = np.zeros((B, 4), np.int64)
-        if body_mode == kernels.BODY_QUERY:
-            mesh_floats, float_start, mesh_ints, int_start, mesh_of = sim._packed_meshes()
-            mesh_spans[:] = np.stack([float_start[mesh_of], float_start[mesh_of + 1],
-                                      int_start[mesh_of], int_start[mesh_of + 1]], axis=1)
         capacity = max(EVENT_ROWS, 4 * (6 * B + B * (B - 1) // 2))
         most = max(1, max(len(vs) for vs in vertices))     # vertices of a body, at most
         s = len(method.b_)
@@ -239,9 +229,7 @@ class CompiledLoop:
                 (slot.PAST, np.zeros(most), i),
                 (slot.PAIRS, np.zeros((max(B * (B - 1) // 2, 1), 2)), i),
                 (slot.WALLS, np.zeros((B, 6)), b), (slot.BODIES, np.zeros((B, B)), b),
-                (slot.NOW_WALLS, np.zeros((B, 6)), b),
-                (slot.MESH_FLOATS, mesh_floats, f), (slot.MESH_INTS, mesh_ints, i),
-                (slot.MESH_SPANS, mesh_spans, i)):
+                (slot.NOW_WALLS, np.zeros((B, 6)), b)):
             packing.put(k, array, dtype)
         self.floats, self.ints, self.flags = packing.pack()
         self._placed = packing.placed

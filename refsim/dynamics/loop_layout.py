@@ -41,10 +41,8 @@ from __future__ import annotations
  PAST, PAIRS) = range(37, 49)                                     # the last two: scratch
 # -- bool arrays (``flags``) ----------------------------------------------------------------
 WALLS, BODIES, NOW_WALLS = range(49, 52)                         # the last: scratch
-# -- the meshes for the exact query of ``BODY_QUERY`` (float64, int64, int64)
-MESH_FLOATS, MESH_INTS, MESH_SPANS = range(52, 55)
 #: How many arrays the header describes.
-ARRAYS = 55
+ARRAYS = 52
 
 #: Entries of ``SCALARS`` (float64).
 S_H, S_GRAVITY, S_RESTITUTION, S_FRICTION, S_THRESHOLD, S_HALF_SIZE, S_ENERGY_LIMIT = range(7)

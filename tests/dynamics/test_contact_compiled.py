@@ -96,34 +96,3 @@ def test_body_contacts_on_the_compiled_kernel_bit_for_bit(name):
     # the compiled kernel took both roads: its loop, and readable steps with
     # the compiled contact stages
     assert 0 < compiled.loop_steps < steps
-
-
-def test_boxes_that_overlap_around_meshes_apart_stay_in_the_loop():
-    # two cubes turned 45 degrees about z, 1 m apart along x and along y: in
-    # their own frame 1.414 m apart along a face normal (a gap of 0.414 m),
-    # while their world boxes (half width 0.707) overlap. Moving alike, in a
-    # world without gravity, they never touch: the exact query certifies the
-    # pair apart at every step, the loop takes every step, and the readable
-    # step, which asks the same query, gives the same bits.
-    c = s = np.sqrt(0.5)
-    turned = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
-    scene = scene_from_dict({
-        "world": {"half_size": 5.0, "gravity": 0.0, "restitution": 0.5, "friction": 0.1},
-        "integration": {"solver": "euler", "step": 1e-3, "duration": 1.0},
-        "collision": {"level": "exact"},
-        "dynamics": {"rotation": "impulse", "body_response": "impulse",
-                     "wall_response": "impulse"},
-        "body": [{"name": name, "model": "cube.ac", "position": position,
-                  "orientation": turned, "velocity": [0.5, 0.2, -0.3]}
-                 for name, position in (("a", [0.0, 0.0, 0.0]), ("b", [1.0, 1.0, 0.0]))]})
-    readable = Simulation(scene, kernel="readable")
-    compiled = Simulation(scene, kernel="compiled")
-    (lo_a, hi_a), (lo_b, hi_b) = ((w.min(axis=0), w.max(axis=0))
-                                  for w in (compiled.world_vertices(0), compiled.world_vertices(1)))
-    assert (lo_a <= hi_b).all() and (lo_b <= hi_a).all()        # the boxes overlap
-    for sim in (readable, compiled):
-        sim.advance(300)
-    assert compiled.loop_steps == 300
-    for name in ("x", "v", "w", "R"):
-        assert getattr(readable, name).tobytes() == getattr(compiled, name).tobytes(), name
-    assert readable.events == compiled.events == []
