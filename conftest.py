@@ -21,7 +21,8 @@ same reason the command line's notice of numba compiling
 numba's cache, not on the command. So is the tiered start
 (``REFSIM_TIERED_START``, :class:`refsim.kernels.Tier`): a default call
 takes the compiled kernels as it did, whatever the cache holds; the tier's
-own tests turn it on.
+own tests turn it on. On an empty numba cache the long compiles run once,
+before the workers start (:func:`pytest_sessionstart`).
 """
 
 from __future__ import annotations
@@ -43,6 +44,22 @@ def pytest_configure(config) -> None:
         if signal.getsignal(signum) is signal.SIG_IGN:
             signal.signal(signum, signal.default_int_handler if signum == signal.SIGINT
                           else signal.SIG_DFL)
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_sessionstart(session) -> None:
+    """Before pytest-xdist starts its workers, the kernel families whose
+    first compile takes tens of seconds (:func:`refsim.warm.tiers`) are
+    compiled into numba's cache, side by side, if it lacks them: otherwise
+    every worker compiles each of them for itself on an empty cache (a
+    fresh clone). A warm cache costs a look at its index."""
+    config = session.config
+    workers = getattr(config.option, "numprocesses", None)
+    if hasattr(config, "workerinput") or not isinstance(workers, int) or workers < 2:
+        return
+    from refsim.warm import compile_side_by_side
+
+    compile_side_by_side()
+
 
 #: pytester runs a small suite in a temporary directory (tests/test_no_skips_in_ci.py).
 pytest_plugins = ["pytester"]

@@ -271,13 +271,17 @@ class Tier:
         if self.settled:
             return False
         if (_environment(TIERED_ENV) == "0" or not numba_usable()
-                or self.spent >= self.compile_seconds
-                or all(compiled_here(resolve(name)) for name in self.dispatchers)):
+                or self.spent >= self.compile_seconds or self.cached()):
             # settled: from now on one attribute answers, not the environment
             # (a compiled query takes a few microseconds)
             self.settled = True
             return False
         return _environment_kernel() is None      # REFSIM_KERNELS chooses, call by call
+
+    def cached(self) -> bool:
+        """Whether numba holds every kernel of the family for this processor,
+        in memory or in its disk cache, whatever the tier's settings."""
+        return all(compiled_here(resolve(name)) for name in self.dispatchers)
 
     def remaining(self) -> float:
         """The readable seconds left before the family compiles."""

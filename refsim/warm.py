@@ -16,7 +16,9 @@ command that ends before the compile does leaves no half-written entry;
 the background process goes on to finish the cache for the next run.
 
 ``python -m refsim.warm`` compiles every cold family and prints one line
-per family.
+per family; ``python -m refsim.warm NAME`` compiles the family ``NAME``
+(a key of :data:`COMPILERS`). :func:`compile_side_by_side` compiles the
+cold families in processes side by side.
 """
 
 from __future__ import annotations
@@ -25,6 +27,8 @@ import subprocess
 import sys
 
 import numpy as np
+
+from refsim.kernels import numba_usable
 
 
 def tiers():
@@ -87,6 +91,25 @@ def warm(stream=sys.stdout) -> list[str]:
     return names
 
 
+def compile_side_by_side(stream=sys.stdout) -> list[str]:
+    """Compiles every family numba's cache lacks, each in a process of its
+    own, all at once, and waits for them; one line on ``stream`` first.
+    Whatever the tiered start's setting: for a test session about to
+    start several worker processes, each of which would otherwise compile
+    the same families for itself. Returns their names."""
+    names = [tier.name for tier in tiers() if numba_usable() and not tier.cached()]
+    if not names:
+        return []
+    print(f"refsim: compiling {', '.join(names)} for this machine first "
+          "(numba keeps the machine code)", file=stream, flush=True)
+    children = [subprocess.Popen([sys.executable, "-m", "refsim.warm", name],
+                                 stdin=subprocess.DEVNULL) for name in names]
+    failed = [name for name, child in zip(names, children, strict=True) if child.wait() != 0]
+    if failed:
+        raise RuntimeError(f"refsim.warm: compiling {', '.join(failed)} failed")
+    return names
+
+
 def start_in_background(stream) -> subprocess.Popen | None:
     """Starts ``python -m refsim.warm`` in a process of its own when some
     family is cold, saying so on ``stream``; else None. Its output is
@@ -104,4 +127,7 @@ def start_in_background(stream) -> subprocess.Popen | None:
 
 
 if __name__ == "__main__":
-    warm()
+    if len(sys.argv) > 1:                      # one family, by name (compile_side_by_side)
+        COMPILERS[" ".join(sys.argv[1:])]()
+    else:
+        warm()

@@ -2,8 +2,21 @@
 
 from __future__ import annotations
 
+import fcntl
+import pickle
+from pathlib import Path
+
 import pytest
 from refsim.oracles import OracleUnavailable
+
+from refsim.report.entries.conformance import MATRIX_CASES as QUICK_REPORT_CASES
+from refsim.report.run import REPORT_SEED
+
+#: The conformance matrix every test of the session reads (the kit's tests
+#: and the quick report's page): the quick report's cases and seed, so that
+#: the report and the kit's tests share one run of the shipped engines.
+MATRIX_CASES = QUICK_REPORT_CASES[0]
+MATRIX_SEED = REPORT_SEED
 
 
 @pytest.fixture
@@ -18,3 +31,43 @@ def oracle():
             pytest.skip(str(exc))
 
     return build
+
+
+def shared_directory(tmp_path_factory, worker_id) -> Path:
+    """The session's temporary directory that every pytest-xdist worker
+    sees (each worker's own basetemp is below it; without xdist, the
+    session's basetemp)."""
+    shared = tmp_path_factory.getbasetemp()
+    return shared if worker_id == "master" else shared.parent
+
+
+def once_per_session(shared: Path, name: str, build):
+    """``build(directory)``'s value, computed by the first worker of the
+    session to ask (under a file lock, the others waiting) and read back
+    from a pickle by the rest: a session fixture of pytest-xdist is
+    otherwise made again by every worker. ``directory`` (``shared/name``)
+    holds whatever files ``build`` writes."""
+    directory = shared / name
+    value_file = shared / f"{name}.pickle"
+    with open(shared / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not value_file.exists():            # written last: the build finished
+            directory.mkdir(exist_ok=True)
+            value = build(directory)
+            value_file.write_bytes(pickle.dumps(value))
+    return pickle.loads(value_file.read_bytes())
+
+
+@pytest.fixture(scope="session")
+def shipped_matrix(tmp_path_factory, worker_id):
+    """``(matrix, results, pages)``: every shipped engine through the
+    conformance kit, ``MATRIX_CASES`` cases per set from ``MATRIX_SEED``,
+    its pages written to the directory ``pages``; once per session."""
+    from refsim.conformance.matrix import run_matrix
+
+    def build(directory):
+        return run_matrix(cases=MATRIX_CASES, seed=MATRIX_SEED, out_dir=directory)
+
+    shared = shared_directory(tmp_path_factory, worker_id)
+    matrix, results = once_per_session(shared, "shipped-matrix", build)
+    return matrix, results, shared / "shipped-matrix"

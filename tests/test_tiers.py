@@ -194,3 +194,48 @@ def test_a_long_command_starts_the_compile_in_the_background_only_when_cold(cold
     err = io.StringIO()
     assert warm.start_in_background(err) is None and err.getvalue() == ""
     assert len(started) == 1
+
+
+def test_a_test_session_compiles_the_cold_families_side_by_side_first(cold, monkeypatch):
+    """``compile_side_by_side`` (the suite's first step under pytest-xdist):
+    a process per cold family, all started before any is waited for,
+    whatever the tiered start's setting; a failed compile is an error, and
+    a warm cache starts nothing."""
+    from refsim import warm
+
+    monkeypatch.setenv("REFSIM_TIERED_START", "0")
+    events = []
+
+    class Child:
+        def __init__(self, args, **kwargs):
+            self.name = args[-1]
+            events.append(("start", args))
+
+        def wait(self):
+            events.append(("wait", self.name))
+            return 1 if self.name == "fused particle steps" else 0
+
+    monkeypatch.setattr(warm.subprocess, "Popen", Child)
+    out = io.StringIO()
+    with pytest.raises(RuntimeError, match=r"^refsim.warm: compiling fused particle steps "
+                                           r"failed$"):
+        warm.compile_side_by_side(out)
+    names = [tier.name for tier in warm.tiers()]
+    assert events == ([("start", [sys.executable, "-m", "refsim.warm", n]) for n in names]
+                      + [("wait", n) for n in names])
+    assert out.getvalue() == (f"refsim: compiling {', '.join(names)} for this machine first "
+                              "(numba keeps the machine code)\n")
+    monkeypatch.setattr("refsim.kernels.compiled_here", lambda dispatcher: True)
+    events.clear()
+    assert warm.compile_side_by_side(out) == [] and events == []
+
+
+def test_one_family_compiles_by_name_in_a_process_of_its_own(tmp_path):
+    """``python -m refsim.warm NAME`` compiles that family into numba's cache."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+    done = subprocess.run([sys.executable, "-m", "refsim.warm", "fused particle steps"],
+                          env=env, capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    indexes = {p.name.split("-")[0] for p in (tmp_path / "numba").rglob("*.nbi")}
+    assert "_numba_kernels.rk_steps_fused" in indexes
+    assert "_numba_kernels.advance" not in indexes

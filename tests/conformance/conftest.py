@@ -5,19 +5,17 @@ from __future__ import annotations
 
 import pytest
 
-#: Cases per generated set in these tests: enough for the float engines'
-#: touching and near-degenerate failures to appear (a few per cent of the
-#: near-degenerate families), small enough to keep tests/conformance
-#: under a minute.
-CASES = 40
-SEED = 0
+from tests.conftest import MATRIX_CASES, MATRIX_SEED
+
+#: Cases per generated set in these tests: the session's shared matrix
+#: (tests/conftest.py), which the quick report's page reads too; enough for
+#: the float engines' touching and near-degenerate failures to appear (a few
+#: per cent of the near-degenerate families).
+CASES = MATRIX_CASES
+SEED = MATRIX_SEED
 
 
 @pytest.fixture(scope="session")
-def shipped_run(tmp_path_factory):
+def shipped_run(shipped_matrix):
     """The shipped engines side by side, pages written: (matrix, results, dir)."""
-    from refsim.conformance.matrix import run_matrix
-
-    out = tmp_path_factory.mktemp("matrix")
-    matrix, results = run_matrix(cases=CASES, seed=SEED, out_dir=out)
-    return matrix, results, out
+    return shipped_matrix

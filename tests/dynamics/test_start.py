@@ -168,3 +168,33 @@ def test_large_meshes_that_can_meet_are_not_timed(cold, tmp_path, monkeypatch):
 
     monkeypatch.setattr(Simulation, "advance", no_steps)
     assert start.start_kernel(scene, scene.integration.n_steps) is None
+
+
+CACHED_LOOP_CHILD = r"""
+import json
+from refsim.dynamics.simulation import Simulation
+from refsim.studies.bounce import cubes_scene
+Simulation(cubes_scene(10, "seed"), kernel="compiled").advance(2)
+from refsim.dynamics._numba_kernels import advance
+print(json.dumps({"hits": sum(advance.stats.cache_hits.values()),
+                  "misses": sum(advance.stats.cache_misses.values())}))
+"""
+
+
+def test_a_second_process_loads_the_loop_from_numbas_cache():
+    """The loop has one signature for every scene, and its machine code
+    survives the process: once this process has run it (compiling it into
+    numba's cache, or loading it from there), a fresh process loads it
+    without compiling. (Its cold compile is timed by
+    docs/decisions/loop_compile_cost.py, not here.)"""
+    from refsim.dynamics._numba_kernels import advance
+    from refsim.studies.bounce import cubes_scene
+
+    Simulation(cubes_scene(3, "impulse"), kernel="compiled").advance(2)
+    assert len(advance.signatures) == 1
+    env = dict(os.environ)
+    env.pop("NUMBA_DISABLE_JIT", None)
+    done = subprocess.run([sys.executable, "-c", CACHED_LOOP_CHILD], env=env,
+                          capture_output=True, text=True, timeout=600)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == '{"hits": 1, "misses": 0}'

@@ -2,7 +2,8 @@
 
 Under pytest-xdist every worker would build its own copy of a session
 fixture; the first worker to get here builds the report into the session's
-shared temporary directory (under a file lock), and the others read it.
+shared temporary directory (``once_per_session``, tests/conftest.py), and
+the others read it.
 Beside it, ``entry-records.json`` keeps the records of every entry the
 report's run measured, timings left out (:func:`records_without_timings`),
 for the test that measures them again on workers.
@@ -10,14 +11,15 @@ for the test that measures them again on workers.
 
 from __future__ import annotations
 
-import fcntl
 import io
 import json
+import shutil
 
 import pytest
 
 from refsim.report import build
 from refsim.report.section import EVERY_ITEM, to_json
+from tests.conftest import MATRIX_CASES, MATRIX_SEED, once_per_session, shared_directory
 
 #: Where the quick report's entries' records are kept, beside its page.
 ENTRY_RECORDS = "entry-records.json"
@@ -54,28 +56,45 @@ def without_timings(value, patterns, path=()):
 
 
 @pytest.fixture(scope="session")
-def quick_report(tmp_path_factory, worker_id):
-    """``(out_dir, html, results)`` of ``refsim report --quick``."""
-    # xdist's workers each have a basetemp below the session's; without
-    # xdist ("master") the session's own basetemp is the shared one.
-    shared = tmp_path_factory.getbasetemp()
-    if worker_id != "master":
-        shared = shared.parent
-    out = shared / "quick-report"
-    with open(shared / "quick-report.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        if not (out / "index.html").exists():    # written last: the build finished
-            runs = []
+def quick_report(tmp_path_factory, worker_id, shipped_matrix):
+    """``(out_dir, html, results)`` of ``refsim report --quick``.
 
-            class Kept(build.Run):                # the report's run, kept for its records
-                def __init__(self, **kwargs):
-                    super().__init__(**kwargs)
-                    runs.append(self)
+    Its conformance matrix is the session's shared one
+    (``shipped_matrix``, tests/conftest.py: the quick report's cases and
+    seed, pages copied into the report's folder), not a second run of
+    every engine. The report measures it through an in-process sweep
+    (``Run.sweep_options``), which gives the same cells as the direct run,
+    timings aside: tests/report/test_report_sweeps.py and
+    tests/conformance/test_shards.py hold the two equal."""
+    from refsim.conformance import matrix as conformance_matrix
 
-            with pytest.MonkeyPatch.context() as patch:
-                patch.setattr(build, "Run", Kept)
-                build.build_report(out, quick=True, stream=io.StringIO())
-            (run,) = runs
-            kept = {name: records_without_timings(run.get(name)) for name in run._records}
-            (out / ENTRY_RECORDS).write_text(json.dumps(kept, sort_keys=True))
+    run_matrix = conformance_matrix.run_matrix
+
+    def shared_matrix(specs=None, *, cases, seed=0, out_dir=None, only=None, **options):
+        kept, results, pages = shipped_matrix
+        if specs is not None or only is not None or (cases, seed) != (MATRIX_CASES, MATRIX_SEED):
+            return run_matrix(specs, cases=cases, seed=seed, out_dir=out_dir, only=only,
+                              **options)
+        if out_dir is not None:
+            shutil.copytree(pages, out_dir, dirs_exist_ok=True)
+        return kept, results
+
+    def build_quick(out):
+        runs = []
+
+        class Kept(build.Run):                # the report's run, kept for its records
+            def __init__(self, **kwargs):
+                super().__init__(**kwargs)
+                runs.append(self)
+
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(build, "Run", Kept)
+            patch.setattr(conformance_matrix, "run_matrix", shared_matrix)
+            build.build_report(out, quick=True, stream=io.StringIO())
+        (run,) = runs
+        kept = {name: records_without_timings(run.get(name)) for name in run._records}
+        (out / ENTRY_RECORDS).write_text(json.dumps(kept, sort_keys=True))
+
+    out = shared_directory(tmp_path_factory, worker_id) / "quick-report"
+    once_per_session(out.parent, out.name, build_quick)
     return out, (out / "index.html").read_text(), json.loads((out / "results.json").read_text())

@@ -222,15 +222,3 @@ def test_refsim_time_to_rest_matches_the_analytic_settling(simulate):
                                                   abs=2 * row.analytic_bounces * STEP)
         assert row.refsim_settle < row.zeno
     assert GRAVITY == G
-
-
-def test_loop_compile_cost_is_measured_and_the_second_process_hits_the_cache():
-    from refsim.studies.bounce import measure_loop_compile_cost
-
-    cost = measure_loop_compile_cost()
-    print(cost)
-    # the first process compiles the loop (a cache miss), the second loads it
-    assert cost.cold_misses >= 1
-    assert cost.cached_hits >= 1 and cost.cached_misses == 0
-    for phase in (cost.cold_first_call, cost.cached_first_call, cost.steady_step):
-        assert 0.0 < phase < 600.0
