@@ -714,9 +714,12 @@ def exact_collide(floats_a, ints_a, rotation_a, translation_a,
     """:func:`exact_query` in mode FIRST_HIT, answered as one code (APART,
     HIT, UNDECIDED, BAD_POSE_A, BAD_POSE_B): returning a number instead of
     two arrays spares the caller numba's boxing of the arrays."""
+    # the mode as an int64, not the literal a global constant is typed as:
+    # exact_query then reuses the machine code of its calls from Python
+    # instead of compiling a second specialization for the literal
     status, found, uncertain = exact_query(
         floats_a, ints_a, rotation_a, translation_a, floats_b, ints_b, rotation_b,
-        translation_b, FIRST_HIT, tol, margin_rounding, margin_per_deviation)
+        translation_b, np.int64(FIRST_HIT), tol, margin_rounding, margin_per_deviation)
     if status:
         return BAD_POSE_A if status == 1 else BAD_POSE_B
     if found.shape[0]:
