@@ -42,7 +42,7 @@ from refsim.kernels import Tier
 #: About the loop's first compile on a two-core machine, rounded down
 #: (docs/decisions/cold-start.md): a run whose readable steps take less
 #: starts readable.
-LOOP_COMPILE_SECONDS = 12.0
+LOOP_COMPILE_SECONDS = 25.0
 
 #: The simulation loop as a family of compiled kernels: the process's
 #: readable budget before it compiles (:class:`refsim.kernels.Tier`).
