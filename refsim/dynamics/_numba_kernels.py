@@ -111,7 +111,7 @@ from refsim.dynamics.walls import bounce_advance, crossing_time, deepest_speed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "3cc4237acc7208c7"
+SOURCES_DIGEST = "b3468e533a1c063b"
 
 #: The kernel took every step it was asked for.
 DONE = 0

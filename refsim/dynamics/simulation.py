@@ -78,12 +78,12 @@ from refsim.dynamics.forces import field_rhs, translational_rhs
 from refsim.dynamics.loads import apply_torques, scene_loads
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
 from refsim.dynamics.products import inverse, matvec
-from refsim.dynamics.rotation_impulse import free_rotation_steps, principal_frame
+from refsim.dynamics.rotation_impulse import principal_frame
 from refsim.dynamics.rotation_seed import orientation_step_seed_kernel
 from refsim.dynamics.trajectory import FRAME_ENTRIES, Contact, Event, Trajectory
 from refsim.dynamics.walls import SPEEDS
 from refsim.errors import ArgumentTypeError, StateError, check_count, check_option
-from refsim.kernels import choose_kernel, compile_kernel
+from refsim.kernels import FREE_ROTATION_STEPS, choose_kernel
 from refsim.limits import MAX_STEPS
 from refsim.models.mesh import Mesh
 from refsim.scenes.schema import Scene
@@ -283,8 +283,7 @@ class Simulation:
         if self.rotation == "impulse":
             for i, b in enumerate(bodies):
                 self.Q[i], self.moments[i] = principal_frame(b.inertia)
-        self._free_steps = (compile_kernel(free_rotation_steps) if self.kernel == "compiled"
-                            else free_rotation_steps)
+        self._free_steps = FREE_ROTATION_STEPS.pick(self.kernel)
 
         # Bodies whose boxes come from the batched scan, one group per mesh;
         # the others call their own tracker (see ``boxes``).
