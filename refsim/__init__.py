@@ -50,7 +50,7 @@ _EXPORTS = {
     "FixedStepResult": "refsim.solvers.integrate",
     "ParticleConfig": "refsim.particles.config",
     "ParticleSystem": "refsim.particles.system",
-    "simulate": "refsim.dynamics.simulation",
+    "simulate": "refsim.dynamics.simulate",
     "Simulation": "refsim.dynamics.simulation",
     "Trajectory": "refsim.dynamics.trajectory",
     "view": "refsim.viewer.live",

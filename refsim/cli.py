@@ -217,7 +217,7 @@ def _run_bodies(scene, text: str, out: Path, every: int | None) -> int:
     does not grow with the steps), then written as a Trajectory (.npz) whose
     settings record the scene: its file and its ``text``, from which
     ``refsim replay`` rebuilds the meshes."""
-    from refsim.dynamics.simulation import default_every, simulate
+    from refsim.dynamics.simulate import default_every, simulate
     from refsim.dynamics.start import start_kernel
     from refsim.storage.frames import SpillSink, check_disk_space
     from refsim.storage.writing import output_target

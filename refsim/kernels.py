@@ -523,19 +523,25 @@ PARTICLE_STEPS = KernelPair(
     "refsim.particles.system:ParticleSystem._advance_fused",
     mirror=("refsim.particles.system:ParticleSystem",
             "refsim.particles._numba_kernels:rk_steps_fused"))
-# refsim.dynamics still chooses between these two by hand (each call site
-# compares the kernel's name); registered here for the parity tests
 CONTACT_IMPULSES = KernelPair(
     "contact impulses", "refsim.dynamics.impulse:solve_contacts_python",
     "refsim.dynamics.impulse:solve_contacts_compiled", COMPILED_FROM_SOURCE)
 ISLAND_IMPULSES = KernelPair(
     "island contact impulses", "refsim.dynamics.impulse:solve_island_python",
     "refsim.dynamics.impulse:solve_island_compiled", COMPILED_FROM_SOURCE)
+FREE_ROTATION_STEPS = KernelPair(
+    "free rotation steps", "refsim.dynamics.rotation_impulse:free_rotation_steps",
+    "refsim.dynamics.rotation_impulse:free_rotation_steps_compiled", COMPILED_FROM_SOURCE)
 SEED_ORIENTATION_STEP = KernelPair(
     "seed orientation step", "refsim.dynamics.rotation_seed:orientation_step_seed",
     "refsim.dynamics.rotation_seed:orientation_step_seed_compiled")
 BATCHED_BOXES = KernelPair(
     "batched boxes", "refsim.dynamics.boxes:boxes_numpy", "refsim.dynamics.boxes:boxes_compiled")
+CONTACT_GEOMETRY = KernelPair(
+    "contact geometry", "refsim.dynamics.body_response:contact_geometry_readable",
+    "refsim.dynamics.body_response:contact_geometry_compiled",
+    mirror=("refsim.dynamics.body_response:contact_geometry",
+            "refsim.dynamics._numba_contact:contact_geometry_numba"))
 SIMULATION_LOOP = KernelPair(
     "simulation loop", "refsim.dynamics.simulation:Simulation",
     "refsim.dynamics._numba_kernels:advance")

@@ -59,7 +59,7 @@ def _compile_exact_query() -> None:
 
 
 def _compile_loop() -> None:
-    from refsim.dynamics.simulation import simulate
+    from refsim.dynamics.simulate import simulate
     from refsim.scenes.loader import load_scene
 
     scene = load_scene("spinning-cube.toml")

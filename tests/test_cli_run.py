@@ -191,11 +191,11 @@ def test_a_rigid_body_scene_writes_its_trajectory(tmp_path, capsys):
 
 
 def test_a_diverging_rigid_run_keeps_its_frames(tmp_path, capsys, monkeypatch):
-    import refsim.dynamics.simulation as simulation
+    import refsim.dynamics.simulate as runs
     from refsim.dynamics.trajectory import Trajectory
     from refsim.errors import DivergenceError
 
-    real = simulation.simulate
+    real = runs.simulate
 
     def diverging(scene, every=None, **kwargs):
         # kwargs: the sink the command line streams the frames to
@@ -203,7 +203,7 @@ def test_a_diverging_rigid_run_keeps_its_frames(tmp_path, capsys, monkeypatch):
         raise DivergenceError("energy grew without bound", step=51, time=0.102, body="b",
                               partial=partial)
 
-    monkeypatch.setattr(simulation, "simulate", diverging)
+    monkeypatch.setattr(runs, "simulate", diverging)
     scene = write(tmp_path, RIGID)
     out = tmp_path / "out.npz"
     assert main(["run", str(scene), "-o", str(out), "--every", "10"]) == EXIT_DIVERGED
@@ -351,7 +351,7 @@ def test_a_frame_too_large_for_the_disk_names_the_count(tmp_path, capsys, monkey
 
 
 def test_streamed_rigid_frames_are_the_librarys(tmp_path):
-    from refsim.dynamics.simulation import simulate
+    from refsim.dynamics.simulate import simulate
     from refsim.dynamics.trajectory import Trajectory
     from refsim.scenes.loader import load_scene
 

@@ -18,6 +18,7 @@ from refsim import kernels
 from refsim.collision.broad_phase import overlapping_pairs
 from refsim.collision.seed_levels import exact_pairs, triangle_box_pairs
 from refsim.dynamics import impulse
+from refsim.dynamics.body_response import contact_geometry
 from refsim.dynamics.boxes import boxes_kernel
 from refsim.dynamics.rotation_seed import orientation_step_seed_kernel
 from refsim.errors import OptionError
@@ -113,6 +114,43 @@ def _batched_boxes(kernel):
     R = np.stack([random_rotation(rng) for _ in range(9)])
     origin = rng.normal(size=(9, 3))
     return boxes_kernel(np.ascontiguousarray(CUBE.vertices.T), R, origin, kernel=kernel)
+
+
+def _contact_geometry(kernel):
+    """Two cubes turned at random, their centres 0.8 to 1.6 apart: touching,
+    overlapping and apart (a negative depth)."""
+    rng = np.random.default_rng(RNG_SEED)
+    out = []
+    for _ in range(30):
+        R_a, R_b = random_rotation(rng), random_rotation(rng)
+        c_a = rng.normal(size=3)
+        c_a *= rng.uniform(0.8, 1.6) / np.linalg.norm(c_a)
+        c_b = np.zeros(3)
+        world_a = CUBE.vertices @ R_a.T + c_a
+        world_b = CUBE.vertices @ R_b.T + c_b
+        g = contact_geometry(world_a, world_b, c_a, c_b, R_a, R_b, kernel=kernel)
+        out.append((g.n, g.depth, g.point, g.extent))
+    return out
+
+
+def _free_rotation(kernel):
+    """The spinning cube's scene with a brick (three distinct moments) under
+    the corrected rotation, 300 steps of the readable step (its rotation
+    stage calls the pair the simulation chose), landing on the floor."""
+    import tomllib
+    from pathlib import Path
+
+    from refsim.dynamics.simulation import Simulation
+    from refsim.scenes.loader import scene_from_dict
+
+    path = Path(__file__).parents[1] / "scenes" / "spinning-cube.toml"
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    data["dynamics"]["rotation"] = "impulse"
+    data["body"][0].update(model="brick.ac", position=[0.0, -4.2, 0.0])   # lands in the run
+    sim = Simulation(scene_from_dict(data), kernel=kernel)
+    for _ in range(300):
+        sim.step()
+    return sim.R.copy(), sim.w.copy(), sim.x.copy()
 
 
 def _linear_scan(kernel):
@@ -218,6 +256,8 @@ CASES = {
     "indexed corner tree": _ear_clipping,
     "seed orientation step": _seed_rotation,
     "batched boxes": _batched_boxes,
+    "contact geometry": _contact_geometry,
+    "free rotation steps": _free_rotation,
     "linear box scan": _linear_scan,
     "incremental box": _incremental,
     "hierarchy build": _hierarchy_build,
@@ -246,11 +286,9 @@ def test_readable_and_compiled_agree_bit_for_bit(name):
 #: pair (``pair(kernel)`` or ``pair.pick``), with the reason; every other
 #: pair's cases must run through it (:func:`test_each_pair_dispatches_its_cases`).
 CHOSEN_BY_HAND = {
-    "contact impulses": "refsim.dynamics compares the kernel's name (its own work)",
-    "island contact impulses": "refsim.dynamics compares the kernel's name (its own work)",
-    "seed orientation step": "refsim.dynamics compares the kernel's name (its own work)",
-    "batched boxes": "refsim.dynamics compares the kernel's name (its own work)",
-    "simulation loop": "refsim.dynamics compares the kernel's name (its own work)",
+    "simulation loop": "the simulation runs the compiled loop only where it does the "
+                       "scene's choices (loop_support): a choice of the scene as much as of "
+                       "the kernel",
     "hierarchy build": "the two builds take their split rule differently (a callable, a "
                        "name): the pair decides (runs_compiled), the caller calls",
     "hierarchy refit": "one step of a compiled query pipeline whose readable side is three "

@@ -47,7 +47,8 @@ import numpy as np
 from refsim.advisor.metrics import REST_SPEED
 from refsim.advisor.records import Fidelity
 from refsim.advisor.runs import with_fidelity
-from refsim.dynamics.simulation import Simulation, simulate
+from refsim.dynamics.simulate import simulate
+from refsim.dynamics.simulation import Simulation
 
 #: Impacts at least this fast must have a twin (twice the resting speed, as
 #: the advisor excuses unpaired events below it).

@@ -21,10 +21,13 @@ Three ways to run it, one engine at a time or side by side:
 
 The pieces: case sets with exact answers (``cases_triangles``,
 ``cases_meshes``, ``cases_boxes``, ``cases_ode``, ``cases_rigid``), the
-checks (``checks_geometry``, ``checks_ode``, ``checks_rigid``; listed in
-``registry``), the records (``results``), declared divergences
-(``expected``), the run (``runner``), the page (``page``), the matrix of
-engines (``matrix``) and the engines refsim ships (``shipped``).
+checks (``checks_geometry``, ``checks_ode``, and the rigid checks in
+``checks_bounces``, ``checks_contact``, ``checks_rotation`` and
+``checks_strikes``, sharing ``rigid_runs``, re-exported by ``checks_rigid``;
+listed in ``registry``), the textbook problems (``textbook_problems``), the
+records (``results``), declared divergences (``expected``), the run
+(``runner``), the page (``page``), the matrix of engines (``matrix``) and the
+engines refsim ships (``shipped``).
 
 Names are imported on first use, so that loading the pytest plugin (on every
 pytest run where refsim is installed) costs nothing.

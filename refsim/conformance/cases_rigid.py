@@ -154,7 +154,7 @@ OBLIQUE_E = 0.8
 #: The spinning ones start one step's fall up and spin slowly: the mesh
 #: turns little before its lowest vertex lands, whose lever off the vertical
 #: (and the spin's share of its normal speed, ``|w|`` times that lever) the
-#: check allows for (:mod:`refsim.conformance.checks_rigid`).
+#: check allows for (:mod:`refsim.conformance.checks_bounces`).
 OBLIQUE_IMPACTS = (
     ("oblique-sphere", OBLIQUE_VELOCITY, 0.0, OBLIQUE_HEIGHT, OBLIQUE_FRICTION, OBLIQUE_E),
     ("oblique-rolling", (2.0, -2.0, 0.0), 0.0, OBLIQUE_HEIGHT, 0.3, 0.8),

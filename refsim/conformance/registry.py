@@ -54,9 +54,12 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from refsim.conformance import checks_bounces as RB
+from refsim.conformance import checks_contact as RC
 from refsim.conformance import checks_geometry as G
 from refsim.conformance import checks_ode as O
-from refsim.conformance import checks_rigid as RB
+from refsim.conformance import checks_rotation as RR
+from refsim.conformance import checks_strikes as RS
 
 CASE_SETS = ("triangles", "poses", "boxes", "ode", "rigid")
 
@@ -102,17 +105,17 @@ CHECKS: tuple[Check, ...] = (
     Check("rigid", "apex_ratio", "rigid", RB.check_rigid_apex_ratio),
     Check("rigid", "no_spin", "rigid", RB.check_rigid_no_spin),
     Check("rigid", "oblique_bounce", "rigid", RB.check_rigid_oblique_bounce),
-    Check("rigid", "spin_to_rest", "rigid", RB.check_rigid_spin_to_rest),
+    Check("rigid", "spin_to_rest", "rigid", RC.check_rigid_spin_to_rest),
     Check("rigid", "energy", "rigid", RB.check_rigid_energy),
-    Check("rigid", "resting_contact", "rigid", RB.check_rigid_resting_contact),
+    Check("rigid", "resting_contact", "rigid", RC.check_rigid_resting_contact),
     Check("rigid", "determinism", "rigid", RB.check_rigid_determinism),
-    Check("rigid", "free_rotation", "rigid", RB.check_rigid_free_rotation),
-    Check("rigid", "off_centre", "rigid", RB.check_rigid_off_centre),
-    Check("rigid", "incline", "rigid", RB.check_rigid_incline, miss_unit="metres"),
-    Check("rigid", "stack", "rigid", RB.check_rigid_stack, miss_unit="metres"),
-    Check("rigid", "cradle", "rigid", RB.check_rigid_cradle),
-    Check("rigid", "slide_to_roll", "rigid", RB.check_rigid_slide_to_roll),
-    Check("rigid", "elastic_tumble", "rigid", RB.check_rigid_elastic_tumble),
+    Check("rigid", "free_rotation", "rigid", RR.check_rigid_free_rotation),
+    Check("rigid", "off_centre", "rigid", RS.check_rigid_off_centre),
+    Check("rigid", "incline", "rigid", RC.check_rigid_incline, miss_unit="metres"),
+    Check("rigid", "stack", "rigid", RC.check_rigid_stack, miss_unit="metres"),
+    Check("rigid", "cradle", "rigid", RS.check_rigid_cradle),
+    Check("rigid", "slide_to_roll", "rigid", RC.check_rigid_slide_to_roll),
+    Check("rigid", "elastic_tumble", "rigid", RR.check_rigid_elastic_tumble),
     Check("rigid", "bounce_times", "rigid", RB.check_rigid_bounce_times),
 )
 

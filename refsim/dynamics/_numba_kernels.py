@@ -111,7 +111,7 @@ from refsim.dynamics.walls import bounce_advance, crossing_time, deepest_speed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "8dcacf9b71ca3d0c"
+SOURCES_DIGEST = "f3da3ba0dab86aeb"
 
 #: The kernel took every step it was asked for.
 DONE = 0

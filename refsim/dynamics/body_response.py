@@ -60,7 +60,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.dynamics.products import dot, norm
-from refsim.kernels import choose_kernel
+from refsim.kernels import CONTACT_GEOMETRY
 
 #: Extra separation after the positional correction, relative to the bodies'
 #: size (the sum of their projection extents along n): the exact collision
@@ -127,21 +127,34 @@ def contact_geometry(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a,
 
     ``kernel`` (:mod:`refsim.kernels`): "compiled" runs
     :func:`refsim.dynamics._numba_contact.contact_geometry_numba`, the same
-    bits.
+    bits (:func:`contact_geometry_compiled`); "readable",
+    :func:`contact_geometry_readable`.
     """
-    if choose_kernel(kernel) == "compiled":
-        from refsim.dynamics._numba_contact import contact_geometry_numba
+    return CONTACT_GEOMETRY(kernel)(world_a, world_b, c_a, c_b, axes_a, axes_b)
 
-        out = np.empty(8)
-        if contact_geometry_numba(np.ascontiguousarray(world_a, dtype=np.float64),
-                                  np.ascontiguousarray(world_b, dtype=np.float64),
-                                  np.asarray(c_a, dtype=np.float64),
-                                  np.asarray(c_b, dtype=np.float64),
-                                  np.asarray(axes_a, dtype=np.float64),
-                                  np.asarray(axes_b, dtype=np.float64), out):
-            return ContactGeometry(n=out[0:3], depth=float(out[3]), point=out[4:7],
-                                   extent=float(out[7]))
-        raise ValueError(_NO_AXIS)
+
+def contact_geometry_compiled(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a,
+                              axes_b) -> ContactGeometry:
+    """:func:`contact_geometry` by its compiled twin,
+    :func:`refsim.dynamics._numba_contact.contact_geometry_numba`."""
+    from refsim.dynamics._numba_contact import contact_geometry_numba
+
+    out = np.empty(8)
+    if contact_geometry_numba(np.ascontiguousarray(world_a, dtype=np.float64),
+                              np.ascontiguousarray(world_b, dtype=np.float64),
+                              np.asarray(c_a, dtype=np.float64),
+                              np.asarray(c_b, dtype=np.float64),
+                              np.asarray(axes_a, dtype=np.float64),
+                              np.asarray(axes_b, dtype=np.float64), out):
+        return ContactGeometry(n=out[0:3], depth=float(out[3]), point=out[4:7],
+                               extent=float(out[7]))
+    raise ValueError(_NO_AXIS)
+
+
+def contact_geometry_readable(world_a: np.ndarray, world_b: np.ndarray, c_a, c_b, axes_a,
+                              axes_b) -> ContactGeometry:
+    """The readable kernel of :func:`contact_geometry` (its docstring says
+    what it computes)."""
     d = np.asarray(c_a, dtype=np.float64) - c_b
     candidates = [d] + [axes_a[:, k] for k in range(3)] + [axes_b[:, k] for k in range(3)]
     best = None

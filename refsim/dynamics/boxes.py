@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from refsim.kernels import choose_kernel, compile_kernel
+from refsim.kernels import BATCHED_BOXES, compile_kernel
 
 
 def boxes_numpy(vertices_t: np.ndarray, R: np.ndarray, origin: np.ndarray
@@ -66,6 +66,4 @@ def boxes_kernel(vertices_t, R, origin, *, kernel: str | None = None
                  ) -> tuple[np.ndarray, np.ndarray]:
     """The boxes of all bodies of one mesh on the chosen kernel
     (:mod:`refsim.kernels`)."""
-    if choose_kernel(kernel) == "compiled":
-        return boxes_compiled(vertices_t, R, origin)
-    return boxes_numpy(vertices_t, R, origin)
+    return BATCHED_BOXES(kernel)(vertices_t, R, origin)

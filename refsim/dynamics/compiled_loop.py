@@ -35,7 +35,7 @@ import numpy as np
 from refsim.bounds.aabb_incremental import IncrementalAABB
 from refsim.dynamics import impulse
 from refsim.dynamics import loop_layout as slot
-from refsim.dynamics.trajectory import Event
+from refsim.dynamics.trajectory import Contact, Event
 
 if TYPE_CHECKING:
     from refsim.dynamics.simulation import Simulation
@@ -262,7 +262,7 @@ class CompiledLoop:
         walks keep their own extremes and stamps: a walk from any start
         finds the same box."""
         sim, k = self.sim, self.kernels
-        self.tracked = np.full(len(sim.bodies), -1, np.int64)
+        self.tracked: np.ndarray = np.full(len(sim.bodies), -1, np.int64)
         rows: list[list[int]] = []
         floats: list[np.ndarray] = []
         ints: list[np.ndarray] = []
@@ -301,9 +301,9 @@ class CompiledLoop:
                 n_i = put(ints, np.zeros(size, np.int64), size, n_i)
             self.tracked[b] = len(rows)
             rows.append(row)
-        self.tracker_rows = np.array(rows, np.int64).reshape(-1, 14)
-        self.trackers_f = np.concatenate(floats) if floats else np.zeros(1)
-        self.trackers_i = np.concatenate(ints) if ints else np.zeros(1, np.int64)
+        self.tracker_rows: np.ndarray = np.array(rows, np.int64).reshape(-1, 14)
+        self.trackers_f: np.ndarray = np.concatenate(floats) if floats else np.zeros(1)
+        self.trackers_i: np.ndarray = np.concatenate(ints) if ints else np.zeros(1, np.int64)
 
     def _lay_out_leaves(self, vertices: list[np.ndarray]) -> None:
         """Every body's :func:`vertex_leaves`, concatenated: body b's leaves
@@ -314,7 +314,7 @@ class CompiledLoop:
         made: dict[int, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
         orders, starts = [np.zeros(0, np.int64)], [np.zeros(1, np.int64)]
         spheres = [np.zeros((0, 5))]
-        self.first_leaf = np.zeros(len(self.sim.bodies) + 1, np.int64)
+        self.first_leaf: np.ndarray = np.zeros(len(self.sim.bodies) + 1, np.int64)
         n_leaves = 0
         for b, vs in enumerate(vertices):
             key = id(self.sim.bodies[b].mesh)
@@ -326,9 +326,9 @@ class CompiledLoop:
             spheres.append(sphere)
             n_leaves += len(sphere)
             self.first_leaf[b + 1] = n_leaves
-        self.leaf_order = np.concatenate(orders)
-        self.leaf_start = np.concatenate(starts)
-        self.leaf_spheres = np.ascontiguousarray(np.concatenate(spheres))
+        self.leaf_order: np.ndarray = np.concatenate(orders)
+        self.leaf_start: np.ndarray = np.concatenate(starts)
+        self.leaf_spheres: np.ndarray = np.ascontiguousarray(np.concatenate(spheres))
 
     # -- contacts: the set of the readable step <-> the loop's flags -----------------------
 
@@ -341,8 +341,6 @@ class CompiledLoop:
         """Bring ``sim._touching`` up to date with the flags (before a readable step)."""
         if not self._set_stale:
             return
-        from refsim.dynamics.simulation import Contact
-
         names = self.sim.names
         touching = set()
         for i, k in zip(*np.nonzero(self.walls), strict=True):

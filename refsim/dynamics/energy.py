@@ -24,8 +24,14 @@ Cost: O(B) per state; O(F B) for a trajectory of F frames.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+from refsim.dynamics.loads import field_potential
+
+if TYPE_CHECKING:
+    from refsim.dynamics.simulation import Simulation
 
 
 @dataclass(frozen=True)
@@ -75,6 +81,22 @@ def mechanical_energy(mass, inertia, gravity: float, floor: float, center_of_mas
                        potential=mass * gravity * height)
 
 
+def body_energy(sim: Simulation, center_of_mass, orientation, velocity,
+                angular_velocity) -> EnergyParts:
+    """The energy parts of ``sim``'s bodies in states of any leading shape
+    (..., B, ...): :func:`refsim.dynamics.energy.mechanical_energy` with the
+    seed's gravity, else with each body's field (:mod:`refsim.dynamics.loads`)."""
+    world = sim.scene.world
+    if sim.loads.uniform:
+        return mechanical_energy(sim.mass, sim.I_body, world.gravity, -world.half_size,
+                                 center_of_mass, orientation, velocity, angular_velocity)
+    parts = mechanical_energy(sim.mass, sim.I_body, 0.0, -world.half_size, center_of_mass,
+                              orientation, velocity, angular_velocity)
+    return EnergyParts(kinetic=parts.kinetic, rotational=parts.rotational,
+                       potential=field_potential(sim.mass, sim.loads.accel, center_of_mass,
+                                                 world.half_size))
+
+
 def trajectory_energy(scene, trajectory) -> EnergyParts:
     """The energy of every frame and body of ``trajectory``, a run of
     ``scene`` (refsim's or another engine's, in refsim's frame layout), each
@@ -86,7 +108,7 @@ def trajectory_energy(scene, trajectory) -> EnergyParts:
     the recorded velocity is the centre of mass's, as
     :meth:`refsim.Simulation.record` writes it.
     """
-    from refsim.dynamics.simulation import Simulation, body_energy  # it imports this module
+    from refsim.dynamics.simulation import Simulation  # it imports this module
 
     sim = Simulation(scene)
     R = np.asarray(trajectory.orientation, dtype=np.float64)

@@ -73,7 +73,7 @@ import math
 import numpy as np
 
 from refsim.dynamics.products import jitable
-from refsim.kernels import choose_kernel, compile_kernel
+from refsim.kernels import CONTACT_IMPULSES, ISLAND_IMPULSES, compile_kernel
 
 #: Sweeps of phase 1. Gauss-Seidel over the four corners of a face landing
 #: flat converges linearly: the cube's bounce speed is off by 2e-3 (relative)
@@ -453,9 +453,7 @@ def solve_island_compiled(*args):
 
 def solve_island(*args, kernel: str | None = None):
     """:func:`solve_island_python` on the chosen kernel (:mod:`refsim.kernels`)."""
-    if choose_kernel(kernel) == "compiled":
-        return solve_island_compiled(*args)
-    return solve_island_python(*args)
+    return ISLAND_IMPULSES(kernel)(*args)
 
 
 def solve_contacts_compiled(*args):
@@ -466,9 +464,7 @@ def solve_contacts_compiled(*args):
 
 def solve_contacts(*args, kernel: str | None = None):
     """:func:`solve_contacts_python` on the chosen kernel (:mod:`refsim.kernels`)."""
-    if choose_kernel(kernel) == "compiled":
-        return solve_contacts_compiled(*args)
-    return solve_contacts_python(*args)
+    return CONTACT_IMPULSES(kernel)(*args)
 
 
 #: Entries of a contact's impulse record (:func:`contact_sum_python`): the

@@ -85,6 +85,7 @@ import math
 import numpy as np
 
 from refsim.dynamics.products import jitable, matmul, orthonormalize_columns
+from refsim.kernels import compile_kernel
 
 #: Below this ``|theta|^2`` (``|theta| < 1e-4``) :func:`rotation_exp_into`
 #: uses the series of ``sin(a)/a`` and ``(1 - cos(a))/a^2``, whose truncation
@@ -232,6 +233,12 @@ def free_rotation_steps(R, w, Q, moments, h):
     L = np.empty(3)
     for b in range(R.shape[0]):
         free_rotation_step(R[b], w[b], Q[b], moments[b], h, P, L, E)
+
+
+def free_rotation_steps_compiled(R, w, Q, moments, h):
+    """:func:`free_rotation_steps` compiled by numba as it stands (the same
+    source; compiled on first use, then cached on disk)."""
+    compile_kernel(free_rotation_steps)(R, w, Q, moments, h)
 
 
 def world_inertia(R: np.ndarray, I_body: np.ndarray) -> np.ndarray:

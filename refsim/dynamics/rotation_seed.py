@@ -77,7 +77,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.dynamics.products import jitable, orthonormalize_columns
-from refsim.kernels import choose_kernel, compile_kernel
+from refsim.kernels import SEED_ORIENTATION_STEP, compile_kernel
 
 
 def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -174,9 +174,7 @@ def orientation_step_seed_compiled(R: np.ndarray, w: np.ndarray, h: float) -> np
 def orientation_step_seed_kernel(R: np.ndarray, w: np.ndarray, h: float, *,
                                  kernel: str | None = None) -> np.ndarray:
     """:func:`orientation_step_seed` on the chosen kernel (:mod:`refsim.kernels`)."""
-    if choose_kernel(kernel) == "compiled":
-        return orientation_step_seed_compiled(R, w, h)
-    return orientation_step_seed(R, w, h)
+    return SEED_ORIENTATION_STEP(kernel)(R, w, h)
 
 
 @dataclass(frozen=True)

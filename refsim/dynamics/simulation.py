@@ -39,14 +39,16 @@ angular velocities in rad/s (world frame), ``R`` (B, 3, 3) orientations
 (columns: the body's axes). The reported position is the body's reference
 point, its mesh's origin, ``x - R c`` for the body-space centroid ``c``.
 
-Divergence: the step stops with :class:`~refsim.errors.DivergenceError`
-when the state is not finite, or when the mechanical energy ``E`` (kinetic,
-potential above the floor, and rotational, bounded above by
-``lambda_max |w|^2 / 2`` with the body's largest principal moment, so that
-the check costs O(B)) exceeds ``DIVERGENCE_FACTOR * (E_0 + E_scale)``, with ``E_scale = sum_b m_b
-(g 2H + (2H / 1 s)^2 / 2)`` (every body raised across the cube, and moving
-across it in one second), so that a scene starting at rest has a sensible
-scale. The frames recorded so far are in the error's ``partial``.
+Divergence (stage 3): the step stops with
+:class:`~refsim.errors.DivergenceError` when the state is not finite or its
+energy grows beyond all bounds (:mod:`refsim.dynamics.divergence`).
+
+Where the stages live: this module holds the state, the outline and the
+short stages (1, 2, 4); the divergence check, the wall stage and the
+body-body stages are base classes of :class:`Simulation`, each in its own
+module (:mod:`refsim.dynamics.divergence`, :mod:`refsim.dynamics.wall_stage`,
+:mod:`refsim.dynamics.body_stage`), whose methods are the simulation's own.
+:func:`refsim.dynamics.simulate.simulate` runs a scene whole.
 
 Seed sections: S5-S9; the choices where the seed is silent or wrong are
 listed in :mod:`refsim.dynamics.choices`.
@@ -58,82 +60,37 @@ for the broad phase and the narrow-phase cost of the k candidate pairs.
 
 from __future__ import annotations
 
-import contextlib
-import math
 import time
-from dataclasses import dataclass, replace
-from typing import NamedTuple, cast
+from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 
 from refsim.bounds.aabb_linear import transform_vertices
 from refsim.bounds.tracker import AABBTracker, make_aabb_tracker
-from refsim.bounds.world_cube import world_cube_test
-from refsim.collision.bodies import bodies_collide
-from refsim.collision.broad_phase import overlapping_pairs
-from refsim.collision.contact import contact_points
-from refsim.dynamics import impulse
+from refsim.dynamics import body_stage, divergence, impulse, wall_stage
 from refsim.dynamics import loop_layout as slot
-from refsim.dynamics.body_response import (
-    WALL_TOUCH,
-    contact_geometry,
-    exchange_velocities_seed,
-    separate_bodies,
-)
 from refsim.dynamics.boxes import boxes_kernel
 from refsim.dynamics.compiled_loop import CompiledLoop, loop_support
-from refsim.dynamics.energy import EnergyParts, mechanical_energy
+from refsim.dynamics.divergence import DIVERGENCE_FACTOR
+from refsim.dynamics.energy import EnergyParts, body_energy
 from refsim.dynamics.forces import field_rhs, translational_rhs
-from refsim.dynamics.loads import apply_torques, field_potential, keep_walls, scene_loads
+from refsim.dynamics.loads import apply_torques, scene_loads
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
 from refsim.dynamics.products import inverse, matvec
-from refsim.dynamics.rotation_impulse import (
-    free_rotation_steps,
-    past_wall,
-    principal_frame,
-    wall_contacts,
-    world_inertia,
-)
-from refsim.dynamics.rotation_seed import (
-    contact_spin_seed,
-    contact_vertex_seed,
-    orientation_step_seed_kernel,
-)
-from refsim.dynamics.start import LOOP, start_kernel
-from refsim.dynamics.trajectory import FRAME_ENTRIES, Event, Trajectory
-from refsim.dynamics.walls import (
-    SPEEDS,
-    bounce_advance,
-    crossing_time,
-    deepest_speed,
-    wall_name,
-    wall_response_seed,
-    wall_speed,
-)
-from refsim.errors import (
-    ArgumentTypeError,
-    DivergenceError,
-    StateError,
-    check_count,
-    check_number,
-    check_option,
-)
-from refsim.kernels import choose_kernel, compile_kernel
+from refsim.dynamics.rotation_impulse import principal_frame
+from refsim.dynamics.rotation_seed import orientation_step_seed_kernel
+from refsim.dynamics.trajectory import FRAME_ENTRIES, Contact, Event, Trajectory
+from refsim.dynamics.walls import SPEEDS
+from refsim.errors import ArgumentTypeError, StateError, check_count, check_option
+from refsim.kernels import FREE_ROTATION_STEPS, choose_kernel
 from refsim.limits import MAX_STEPS
 from refsim.models.mesh import Mesh
 from refsim.scenes.schema import Scene
 from refsim.signals import SignalHold, held_signals
 from refsim.solvers.explicit_rk import rk_step
-from refsim.solvers.integrate import resolve_method, whole_steps
-from refsim.storage.frames import FrameSink, MemorySink, frame_count
-
-#: At most about this many frames by default (``every`` is chosen so).
-MAX_FRAMES = 1000
-
-#: Energy growth that counts as divergence (see the module docstring): far
-#: beyond anything a bounded scene with restitution <= 1 reaches (the seed's
-#: rotation model pumps energy, but by factors of a few), far below overflow.
-DIVERGENCE_FACTOR = 1e6
+from refsim.solvers.integrate import resolve_method
+from refsim.storage.frames import FrameSink, MemorySink
 
 #: Meshes with at most this many vertices get their boxes from one batched
 #: linear scan over all their bodies under ``boxes="auto"``: for a cube (8
@@ -166,15 +123,6 @@ def _quiet_overflow() -> np.errstate:
     return np.errstate(over="ignore", invalid="ignore", divide="ignore")
 
 
-class Contact(NamedTuple):
-    """A contact found in a step: ``kind`` "wall" (``other`` names the wall,
-    "x-" .. "z+") or "body" (``other`` is the other body's name)."""
-
-    kind: str
-    body: str
-    other: str
-
-
 class StageTimer:
     """Wall time per stage of the step: :meth:`lap` adds the time since the
     last lap (or :meth:`start`) to a stage's total, in ``seconds``."""
@@ -190,6 +138,13 @@ class StageTimer:
         now = time.perf_counter()
         self.seconds[stage] += now - self._last
         self._last = now
+
+
+def check_scene(scene) -> None:
+    """Raises ArgumentTypeError unless ``scene`` is a :class:`refsim.Scene`."""
+    if not isinstance(scene, Scene):
+        raise ArgumentTypeError(f"scene must be a refsim.Scene (refsim.load_scene(path)), "
+                                f"got {type(scene).__name__}")
 
 
 def resolve_wall_response(dynamics) -> str:
@@ -263,9 +218,7 @@ class Simulation:
 
     def __init__(self, scene, *, wall_speed: str | None = None, boxes: str = "auto",
                  kernel: str | None = None, sink: FrameSink | None = None):
-        if not isinstance(scene, Scene):
-            raise ArgumentTypeError(f"scene must be a refsim.Scene (refsim.load_scene(path)), "
-                                    f"got {type(scene).__name__}")
+        check_scene(scene)
         world, dyn, col = scene.world, scene.dynamics, scene.collision
         self.wall_speed = check_option("wall_speed",
                                        world.wall_speed if wall_speed is None else wall_speed,
@@ -330,8 +283,7 @@ class Simulation:
         if self.rotation == "impulse":
             for i, b in enumerate(bodies):
                 self.Q[i], self.moments[i] = principal_frame(b.inertia)
-        self._free_steps = (compile_kernel(free_rotation_steps) if self.kernel == "compiled"
-                            else free_rotation_steps)
+        self._free_steps = FREE_ROTATION_STEPS.pick(self.kernel)
 
         # Bodies whose boxes come from the batched scan, one group per mesh;
         # the others call their own tracker (see ``boxes``).
@@ -479,24 +431,6 @@ class Simulation:
         """The (B,) kinetic, rotational and potential parts of :meth:`energy`
         (the potential of each body's field, :mod:`refsim.dynamics.loads`)."""
         return body_energy(self, self.x, self.R, self.v, self.w)
-
-    def _energy_bound(self) -> np.ndarray:
-        """(B,) the energy with the rotational part bounded by
-        ``lambda_max |w|^2 / 2``: a cheap upper bound of :meth:`energy` for
-        the divergence check (O(B) without (B, 3, 3) products)."""
-        world = self.scene.world
-        kinetic = 0.5 * (self.mass * np.einsum("bi,bi->b", self.v, self.v)
-                         + self._lambda_max * np.einsum("bi,bi->b", self.w, self.w))
-        if self.loads.uniform:
-            return kinetic + self.mass * world.gravity * (self.x[:, 1] + world.half_size)
-        return kinetic + field_potential(self.mass, self.loads.accel, self.x, world.half_size)
-
-    def _energy_scale(self) -> float:
-        world = self.scene.world
-        span = 2.0 * world.half_size
-        field = (world.gravity if self.loads.uniform
-                 else np.sqrt(np.einsum("bi,bi->b", self.loads.accel, self.loads.accel)))
-        return float((self.mass * (field * span + 0.5 * span * span)).sum())
 
     # -- the step ---------------------------------------------------------------------
 
@@ -679,265 +613,27 @@ class Simulation:
             # check stage), so the tracker's per-call validation is skipped.
             self.lo[i], self.hi[i] = tracker.update_unchecked(self.R[i], origin[i])
 
-    # 5. walls (S3, S7, S9 or corrected)
-    def _walls(self, touching: set) -> None:
-        H = self.scene.world.half_size
-        loads = self.loads
-        beyond = np.flatnonzero(((self.lo < -H) | (self.hi > H)).any(axis=1))
-        for i in beyond.tolist():
-            correction = world_cube_test(self.lo[i], self.hi[i], H).correction
-            if not loads.all_walls:
-                correction = keep_walls(correction, loads.low, loads.high)
-            if loads.fixed[i] or not correction.any():
-                continue                  # a fixed body stays; a missing wall does not push
-            self._wall(i, correction)
-            self.lo[i] += correction
-            self.hi[i] += correction
-            for k in np.flatnonzero(correction).tolist():
-                touching.add(Contact("wall", self.names[i], wall_name(k, correction[k])))
+    # 3. divergence (refsim.dynamics.divergence)
+    _check = divergence.check
+    _diverged = divergence.diverged
+    _energy_bound = divergence.energy_bound
+    _energy_scale = divergence.energy_scale
 
-    def _wall_seed(self, i: int, correction: np.ndarray) -> None:
-        """The seed's per-axis response (S7), after S9's change of w at the
-        contact vertex when the rotation model is the seed's."""
-        if self.rotation == "seed":
-            self._wall_spin_seed(i, correction)
-        world = self.scene.world
-        self.x[i], self.v[i] = wall_response_seed(
-            self.x[i], self.v[i], correction, world.restitution, world.friction,
-            world.gravity, self.wall_speed)
+    # 5. walls (S3, S7, S9 or corrected: refsim.dynamics.wall_stage)
+    _walls = wall_stage.walls
+    _wall_seed = wall_stage.wall_seed
+    _wall_spin_seed = wall_stage.wall_spin_seed
+    _wall_impulse = wall_stage.wall_impulse
 
-    def _wall_spin_seed(self, i: int, correction: np.ndarray) -> None:
-        """S9 at each crossed wall: the contact vertex, then w += Pi x I."""
-        world = self.scene.world
-        W = self.world_vertices(i)
-        for k in np.flatnonzero(correction).tolist():
-            low = correction[k] > 0.0
-            N = np.zeros(3)
-            N[k] = 1.0 if low else -1.0                     # into the body
-            Pi = W[contact_vertex_seed(W, k, low)] - self.x[i]   # R (p_i - c)
-            self.w[i] = contact_spin_seed(self.w[i], self.v[i], Pi, N,
-                                          world.restitution, world.friction).w
-
-    def _wall_impulse(self, i: int, correction: np.ndarray) -> None:
-        """Corrected wall contact: push back, speed at the wall, impulses at
-        the vertices past the wall (the deepest of them for an impact), and a
-        bounce carried on from the instant of the crossing to the end of the
-        step (:func:`~refsim.dynamics.walls.crossing_time`,
-        :func:`~refsim.dynamics.walls.bounce_advance`)."""
-        world = self.scene.world
-        H = world.half_size
-        I_inv = world_inertia(self.R[i:i + 1], self.I_body_inv[i:i + 1])[0]
-        for k in np.flatnonzero(correction).tolist():
-            low = correction[k] > 0.0
-            W = self.world_vertices(i)
-            # DEVIATION (D6): the speed at the wall (energy of the push-back, as in S7), but
-            # only for a real bounce: in resting contact this torque-free change
-            # at the centroid would cancel gravity by itself and leave the
-            # contact impulses (and with them friction and the torque that
-            # topples a body balanced on an edge) with nothing to do.
-            bounce = self.v[i, k] * correction[k] < -self.loads.threshold * abs(correction[k])
-            # every vertex past the wall holds a body at rest (and supports it in
-            # a body contact's solve); an impact (its deepest contact moving into
-            # the wall faster than the threshold) began at the deepest ones
-            self._wall_contacts[i, k, low] = r_a = W[past_wall(W, k, -H if low else H, low)] \
-                - self.x[i]
-            u = deepest_speed(r_a, len(r_a), k, low, self.v[i], self.w[i]) if len(r_a) else 0.0
-            if bounce or (u < -self.loads.threshold if low else u > self.loads.threshold):
-                r_a = W[wall_contacts(W, k, -H if low else H, low)] - self.x[i]
-            a_k = self.loads.accel[i, k]
-            # a bounce acts at the instant of the crossing, tau before the step's end
-            tau = crossing_time(u, a_k, correction[k], low, self.h) if bounce else 0.0
-            self.x[i, k] += correction[k]                   # no interpenetration persists
-            if bounce:
-                self.v[i, k] = wall_speed(self.v[i, k], a_k, correction[k])
-            if not len(r_a):
-                continue
-            n = np.zeros(3)
-            n[k] = 1.0 if low else -1.0
-            v_contact, w_contact = self.v[i].copy(), self.w[i].copy()
-            P = impulse.wall_impulses(r_a, n, self.inv_mass[i], I_inv, self.v[i], self.w[i],
-                                      self.loads.wall_e[i], self.loads.wall_mu[i],
-                                      self.loads.threshold, kernel=self.kernel)
-            impulse.contact_sum_python(P, n, r_a, self.x[i],
-                                       self._impulse_record(i, wall_name(k, correction[k])))
-            if tau > 0.0:
-                w = self.w[i]
-                bounce_advance(self.x[i], self.v[i], v_contact, self.R[i], w,
-                               w[0] - w_contact[0], w[1] - w_contact[1], w[2] - w_contact[2],
-                               np.empty((3, 3)), self.lo[i], self.hi[i], k, low, a_k, tau)
-
-    # 6. broad phase (S4 test 1)
-    def _broad_phase(self) -> np.ndarray:
-        if self.level == "sphere":
-            from refsim.collision.spheres import bounding_sphere
-
-            centres = np.empty((len(self.bodies), 3))
-            radii = np.empty(len(self.bodies))
-            for i, b in enumerate(self.bodies):
-                c, radii[i] = bounding_sphere(b.mesh)
-                R, origin = self.pose(i)
-                centres[i] = matvec(R, c) + origin
-            return overlapping_pairs(centres - radii[:, None], centres + radii[:, None],
-                                     kernel=self.kernel)
-        return overlapping_pairs(self.lo, self.hi, kernel=self.kernel)
-
-    # 7. narrow phase (S4 at the scene's level)
-    def _narrow_phase(self, pairs: np.ndarray) -> list:
-        if self.kernel == "compiled" and self.level == "exact" and len(pairs):
-            return self._narrow_phase_compiled(pairs)
-        hits = []
-        for a, b in pairs:
-            if bodies_collide(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
-                              self.pose(b), level=self.level, kernel=self.kernel):
-                hits.append((a, b))
-        return hits
-
-    def _narrow_phase_compiled(self, pairs: np.ndarray) -> list:
-        """The exact level's pairs in one compiled call
-        (:func:`refsim.collision.bodies.exact_answers`: the
-        hierarchy query of :func:`~refsim.collision.bodies.bodies_collide`
-        for every pair); a pair it leaves undecided, or whose pose it
-        rejects, goes to :func:`~refsim.collision.bodies.bodies_collide`,
-        which decides it or raises. The same pairs as the readable kernel."""
-        from refsim.collision.bodies import APART, TOUCH, exact_answers
-
-        rows = np.ascontiguousarray(pairs, dtype=np.int64)
-        origin = self.x - matvec(self.R, self.center)        # pose(i)'s, all at once
-        codes = exact_answers(self._packed_meshes(), self.R, origin, rows)
-        hits = []
-        for (a, b), code in zip(rows.tolist(), codes.tolist(), strict=True):
-            if code == TOUCH or (
-                    code != APART
-                    and bodies_collide(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
-                                       self.pose(b), level=self.level, kernel=self.kernel)):
-                hits.append((a, b))
-        return hits
-
-    def _packed_meshes(self) -> tuple:
-        """The bodies' meshes packed for :func:`_narrow_phase_compiled`
-        (``floats, float_start, ints, int_start, mesh_of``), built once."""
-        if self._packed is None:
-            from refsim.collision.bvh_exact import pack_frame_tree
-
-            meshes: dict[int, int] = {}
-            arrays: list[tuple[np.ndarray, np.ndarray]] = []
-            mesh_of = np.empty(len(self.bodies), dtype=np.int64)
-            for i, body in enumerate(self.bodies):
-                if id(body.mesh) not in meshes:
-                    meshes[id(body.mesh)] = len(arrays)
-                    arrays.append(pack_frame_tree(body.mesh))
-                mesh_of[i] = meshes[id(body.mesh)]
-            float_start = np.cumsum([0] + [len(f) for f, _ in arrays]).astype(np.int64)
-            int_start = np.cumsum([0] + [len(k) for _, k in arrays]).astype(np.int64)
-            self._packed = (np.concatenate([f for f, _ in arrays]), float_start,
-                            np.concatenate([k for _, k in arrays]), int_start, mesh_of)
-        return self._packed
-
-    # 8. body-body response (S8, or corrected)
-    def _body_response(self, pairs, touching: set) -> None:
-        contacts = []
-        for a, b in pairs:
-            a, b = int(a), int(b)
-            if self.loads.fixed[a] and self.loads.fixed[b]:
-                continue                  # two fixed bodies: nothing can move
-            touching.add(Contact("body", self.names[a], self.names[b]))
-            if self.body_response == "seed":
-                self.v[a], self.v[b], _ = exchange_velocities_seed(
-                    self.x[a], self.x[b], self.v[a], self.v[b])
-                continue
-            geometry = contact_geometry(self.world_vertices(a), self.world_vertices(b),
-                                        self.x[a], self.x[b], self.R[a], self.R[b],
-                                        kernel=self.kernel)
-            if geometry.depth < 0.0:
-                continue                  # a separating axis: coarse-level false contact
-            # the impulses act over the corners of the region where the
-            # meshes overlap (an offset stack is held along its whole strip);
-            # at a coarse level the meshes may not meet: the normal's point
-            points = contact_points(self.bodies[a].mesh, self.pose(a), self.bodies[b].mesh,
-                                    self.pose(b), geometry.n, kernel=self.kernel)
-            if not len(points):
-                points = geometry.point[None, :]
-            contacts.append((a, b, points, geometry))
-        if not contacts:
-            return
-        self._solve_island(contacts)
-        for a, b, _, geometry in contacts:
-            dx_a, dx_b = separate_bodies(geometry, self.inv_mass[a], self.inv_mass[b])
-            for i, dx in ((a, dx_a), (b, dx_b)):
-                self.x[i] += dx
-                if self.rotation == "impulse" and dx.any():
-                    self._keep_angular_momentum(i, dx)
-
-    def _keep_angular_momentum(self, i: int, dx: np.ndarray) -> None:
-        """Body i was moved by ``dx`` to end an overlap: its momentum ``p``
-        then has the moment ``dx x p`` more about every fixed point, which no
-        force supplied. Its spin takes that much less angular momentum,
-        ``w -= I^-1 (dx x p)`` (world inverse inertia), so that the total
-        about any fixed point is what the impulses left. The rotational
-        energy changes by ``-w . (dx x p)`` to first order, with ``dx`` a
-        fraction of a step's travel."""
-        p = self.v[i] / self.inv_mass[i]
-        moment = np.array([dx[1] * p[2] - dx[2] * p[1], dx[2] * p[0] - dx[0] * p[2],
-                           dx[0] * p[1] - dx[1] * p[0]])
-        I_inv = world_inertia(self.R[i:i + 1], self.I_body_inv[i:i + 1])[0]
-        self.w[i] -= matvec(I_inv, moment)
-
-    def _solve_island(self, contacts) -> None:
-        """One impulse solve (:func:`refsim.dynamics.impulse.solve_island`)
-        over all of the step's body contacts and, with the corrected wall
-        response, the walls the bodies in them touch: the vertices the wall
-        stage found past a wall in this step (a body resting on the floor
-        sinks into it by ``g h^2`` each step, all its supporting vertices at
-        once), else those the wall stage left on it. With the seed's wall
-        response the walls keep the seed's law and are not in the solve."""
-        world = self.scene.world
-        H = world.half_size
-        B = len(self.bodies)
-        loads = self.loads
-        sets = []                                  # (a, b, r_a, r_b, n, e, mu)
-        touched = sorted({c[0] for c in contacts} | {c[1] for c in contacts})
-        for i in touched if self.wall_response == "impulse" else ():
-            if loads.fixed[i]:
-                continue                  # no wall impulse can move it
-            W = self.world_vertices(i)
-            for k in range(3):
-                for low in (True, False):
-                    if not (loads.low[k] if low else loads.high[k]):
-                        continue                              # a missing wall
-                    r = self._wall_contacts.get((i, k, low))
-                    if r is None or not len(r):
-                        column = W[:, k]
-                        on = (column <= -H + WALL_TOUCH * H if low
-                              else column >= H - WALL_TOUCH * H)
-                        r = W[on] - self.x[i]
-                    if len(r):
-                        n = np.zeros(3)
-                        n[k] = 1.0 if low else -1.0
-                        sets.append((i, B, r, np.zeros_like(r), n, loads.wall_e[i],
-                                     loads.wall_mu[i]))
-        for a, b, points, geometry in contacts:
-            sets.append((a, b, points - self.x[a], points - self.x[b], geometry.n,
-                         loads.pair_e[a, b], loads.pair_mu[a, b]))
-        starts = np.cumsum([0] + [len(s[2]) for s in sets]).astype(np.int64)
-        static = np.zeros((1, 3))
-        v, w = np.concatenate([self.v, static]), np.concatenate([self.w, static])
-        I_inv = np.zeros((B + 1, 3, 3))
-        if self.rotation != "off":
-            I_inv[:B] = world_inertia(self.R, self.I_body_inv)     # 0 for a fixed body
-        P = np.empty((int(starts[-1]), 4))
-        impulse.solve_island(
-            starts, np.array([s[0] for s in sets], dtype=np.int64),
-            np.array([s[1] for s in sets], dtype=np.int64),
-            np.concatenate([s[2] for s in sets]), np.concatenate([s[3] for s in sets]),
-            np.array([s[4] for s in sets]), np.concatenate([self.inv_mass, [0.0]]), I_inv, v, w,
-            np.array([s[5] for s in sets]), np.array([s[6] for s in sets]), loads.threshold,
-            impulse.ITERATIONS, P, kernel=self.kernel)
-        self.v[...] = v[:B]
-        self.w[...] = w[:B]
-        for s, (a, b, r_a, _, n, _, _) in enumerate(sets):
-            other = self.names[b] if b < B else wall_name(int(np.flatnonzero(n)[0]), n.sum())
-            impulse.contact_sum_python(P[starts[s]:starts[s + 1]], n, r_a, self.x[a],
-                                       self._impulse_record(a, other))
+    # 6-8. broad phase, narrow phase, body-body response (S4, S8 or
+    # corrected: refsim.dynamics.body_stage)
+    _broad_phase = body_stage.broad_phase
+    _narrow_phase = body_stage.narrow_phase
+    _narrow_phase_compiled = body_stage.narrow_phase_compiled
+    _packed_meshes = body_stage.packed_meshes
+    _body_response = body_stage.body_response
+    _keep_angular_momentum = body_stage.keep_angular_momentum
+    _solve_island = body_stage.solve_island
 
     def _impulse_record(self, i: int, other: str) -> np.ndarray:
         """The step's impulse record of body ``i``'s contact with ``other``."""
@@ -945,29 +641,6 @@ class Simulation:
         if key not in self._impulses:
             self._impulses[key] = np.zeros(impulse.IMPULSE_RECORD)
         return self._impulses[key]
-
-    # 3. divergence
-    def _check(self) -> None:
-        # One O(B) sum answers both questions: a non-finite x, v or w makes
-        # the energy NaN or inf, and "not (E <= limit)" is then true (R stays
-        # finite while w is: it is built from w by finite operations).
-        energy = self._energy_bound()
-        total = energy.sum()
-        if total <= self._energy_limit:
-            return
-        bad = ~(np.isfinite(self.x).all(axis=1) & np.isfinite(self.v).all(axis=1)
-                & np.isfinite(self.w).all(axis=1) & np.isfinite(self.R).all(axis=(1, 2)))
-        if bad.any():
-            self._diverged("state is not finite", int(np.flatnonzero(bad)[0]))
-        # finite state whose energy is beyond the limit (or overflows)
-        self._diverged(f"energy {total:.6g} exceeds {DIVERGENCE_FACTOR:.0e} times its "
-                       f"initial value plus scale ({self._energy_limit:.6g})",
-                       int(np.argmax(energy)))
-
-    def _diverged(self, message: str, i: int):
-        # raised within the step being taken: step self.steps + 1
-        raise DivergenceError(message, step=self.steps + 1, time=(self.steps + 1) * self.h,
-                              body=self.names[i], partial=self.trajectory())
 
     def _note_events(self, touching: set[Contact]) -> None:
         """An event for each contact that began in this step (in the order of
@@ -1024,90 +697,3 @@ class Simulation:
                 "wall_response": self.wall_response, "collision_level": self.level,
                 "aabb": s.collision.aabb, "wall_speed": self.wall_speed, "boxes": self.boxes,
                 "kernel": self.kernel, "steps": self.steps}
-
-
-def body_energy(sim: Simulation, center_of_mass, orientation, velocity,
-                angular_velocity) -> EnergyParts:
-    """The energy parts of ``sim``'s bodies in states of any leading shape
-    (..., B, ...): :func:`refsim.dynamics.energy.mechanical_energy` with the
-    seed's gravity, else with each body's field (:mod:`refsim.dynamics.loads`)."""
-    world = sim.scene.world
-    if sim.loads.uniform:
-        return mechanical_energy(sim.mass, sim.I_body, world.gravity, -world.half_size,
-                                 center_of_mass, orientation, velocity, angular_velocity)
-    parts = mechanical_energy(sim.mass, sim.I_body, 0.0, -world.half_size, center_of_mass,
-                              orientation, velocity, angular_velocity)
-    return EnergyParts(kinetic=parts.kinetic, rotational=parts.rotational,
-                       potential=field_potential(sim.mass, sim.loads.accel, center_of_mass,
-                                                 world.half_size))
-
-
-def default_every(n_steps: int) -> int:
-    """The frame stride that keeps at most about ``MAX_FRAMES`` frames."""
-    return max(1, math.ceil(n_steps / MAX_FRAMES))
-
-
-def simulate(scene, *, every: int | None = None, duration: float | None = None,
-             wall_speed: str | None = None, boxes: str = "auto",
-             sink: FrameSink | None = None, kernel: str | None = None) -> Trajectory:
-    """Run ``scene`` and return its trajectory.
-
-    Parameters
-    ----------
-    scene : refsim.Scene
-    every : int, optional
-        Record a frame every ``every`` steps (and the initial state); default
-        :func:`default_every` (at most about 1000 frames).
-    duration : float, optional
-        Override ``integration.duration`` (seconds).
-    wall_speed, boxes : str, optional
-        See :class:`Simulation` (``wall_speed``: default the scene's
-        ``world.wall_speed``).
-    sink : refsim.storage.frames.FrameSink, optional
-        Where the frames go as they are computed. Default: a
-        :class:`refsim.storage.frames.MemorySink` sized for the run's frames, and the
-        trajectory holds numpy arrays. ``refsim run`` passes a
-        :class:`refsim.storage.frames.SpillSink`, so that memory does not grow with
-        the steps; the trajectory's frames are then views of its files, to be
-        saved before the sink closes. Both give the same frames, bit for bit.
-    kernel : {"readable", "compiled"}, optional
-        See :class:`Simulation`. The default runs the compiled loop, or the
-        readable step when numba's cache does not hold the loop yet and the
-        run is short (:func:`refsim.dynamics.start.start_kernel`): the same
-        frames either way.
-
-    Raises
-    ------
-    DivergenceError
-        With the frames so far in ``partial``.
-    StateError, ArgumentTypeError
-        A ``duration`` that is not a whole number (>= 1) of steps; an
-        ``every`` that is not an integer >= 1.
-    """
-    if not isinstance(scene, Scene):
-        raise ArgumentTypeError(f"scene must be a refsim.Scene (refsim.load_scene(path)), "
-                                f"got {type(scene).__name__}")
-    if duration is not None:
-        duration = check_number("duration", duration)
-        whole_steps(duration, scene.integration.step)          # refuse before any work
-        scene = replace(scene, integration=replace(scene.integration, duration=duration))
-    n_steps = scene.integration.n_steps
-    every = default_every(n_steps) if every is None else check_count("every", every, 1)
-    if sink is None:
-        # the initial state, every every-th step, and the last step
-        sink = MemorySink(capacity=frame_count(n_steps, every))
-    charge: contextlib.AbstractContextManager = contextlib.nullcontext()
-    if kernel is None:
-        # a short run on a cold numba cache runs readable (the same frames)
-        kernel = start_kernel(scene, n_steps, wall_speed=wall_speed, boxes=boxes)
-        if kernel == "readable":
-            charge = LOOP.charged()
-    sim = Simulation(scene, wall_speed=wall_speed, boxes=boxes, sink=sink, kernel=kernel)
-    with charge:
-        sim.record()
-        sim.run(n_steps, every=every)
-        if sim.steps % every:
-            sim.record()                              # always end on the last state
-    traj = sim.trajectory()
-    traj.settings["every"] = every
-    return traj

@@ -41,7 +41,7 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -52,6 +52,17 @@ from refsim.storage.writing import write_npz_atomic
 #: The .npz entries of a trajectory, in the order they are written.
 FRAME_ENTRIES = ("t", "position", "velocity", "angular_velocity", "orientation")
 ENTRIES = (*FRAME_ENTRIES, "names", "events", "stages", "stage_seconds", "settings")
+
+
+class Contact(NamedTuple):
+    """A contact found in a step: ``kind`` "wall" (``other`` names the wall,
+    "x-" .. "z+") or "body" (``other`` is the other body's name). The step
+    keeps the set of its contacts; an :class:`Event` marks the step one
+    began in."""
+
+    kind: str
+    body: str
+    other: str
 
 
 @dataclass(frozen=True)

@@ -37,7 +37,7 @@ import numpy as np
 from refsim.bounds.aabb_linear import aabb_linear_kernel
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 from refsim.collision.triangle import triangles_intersect
-from refsim.dynamics.simulation import simulate
+from refsim.dynamics.simulate import simulate
 from refsim.engines.cache import MeshCache
 from refsim.errors import StateError, check_option
 from refsim.models.mesh import Mesh

@@ -44,7 +44,7 @@ DEMO_ENGINES = {"c12-spin": None, "c11-interpenetration": None,
 
 def _mujoco_trajectory(scene):
     """The scene run by MuJoCo (raises OracleUnavailable without it)."""
-    from refsim.dynamics.simulation import default_every
+    from refsim.dynamics.simulate import default_every
     from refsim.oracles.mujoco_adapter import MujocoOracle
 
     return MujocoOracle().simulate(scene, every=default_every(scene.integration.n_steps))

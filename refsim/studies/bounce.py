@@ -140,7 +140,7 @@ def run_refsim(scene, wall_speed: str = "wall"):
     ``wall_speed``: "wall" (refsim's default: the normal speed the body had at
     the wall, energy-consistent) or "seed" (the seed's literal speed at the
     penetrated position); see :mod:`refsim.dynamics.walls`."""
-    from refsim.dynamics.simulation import simulate
+    from refsim.dynamics.simulate import simulate
 
     start = time.perf_counter()
     trajectory = simulate(scene, every=1, wall_speed=wall_speed)

@@ -27,7 +27,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from refsim.dynamics.energy import trajectory_energy
-from refsim.dynamics.simulation import Simulation, simulate
+from refsim.dynamics.simulate import simulate
+from refsim.dynamics.simulation import Simulation
 from refsim.dynamics.trajectory import Trajectory
 
 #: Below these, a body counts as at rest (the corrected model's resting

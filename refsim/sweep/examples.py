@@ -30,7 +30,7 @@ def bounce(*, seed: int, scene: str = "bounce.toml", duration: float = 0.2,
         body reached in a frame; ``wall_hits``: the number of wall events;
         ``lift``: the draws.
     """
-    from refsim.dynamics.simulation import simulate
+    from refsim.dynamics.simulate import simulate
     from refsim.scenes.loader import load_scene
 
     loaded = load_scene(scene)

@@ -60,7 +60,7 @@ def demo_c12(path, *, scene=None, duration: float | None = None,
              max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
     """C12: the seed's rotation model beside the corrected one (side by side);
     ``duration`` (s) shortens the scene's."""
-    from refsim.dynamics.simulation import simulate
+    from refsim.dynamics.simulate import simulate
 
     scene = _for(scene or _bundled("spinning-cube.toml"), duration)
     runs = []
@@ -76,7 +76,7 @@ def demo_c12(path, *, scene=None, duration: float | None = None,
 def demo_c11(path, *, case: str = C11_CASE, duration: float = C11_SECONDS,
              max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
     """C11: the seed's velocity exchange beside the corrected impulse (side by side)."""
-    from refsim.dynamics.simulation import simulate
+    from refsim.dynamics.simulate import simulate
     from refsim.studies.dynamics import c11_scene
 
     runs = []
@@ -94,7 +94,7 @@ def demo_c11(path, *, case: str = C11_CASE, duration: float = C11_SECONDS,
 def pybullet_trajectory(scene):
     """The scene run by pybullet (raises refsim.oracles.OracleUnavailable
     when pybullet is not installed)."""
-    from refsim.dynamics.simulation import default_every
+    from refsim.dynamics.simulate import default_every
     from refsim.oracles.pybullet_adapter import PybulletOracle
 
     with PybulletOracle() as engine:
@@ -106,7 +106,7 @@ def demo_wall_bounce(path, *, external=pybullet_trajectory, label: str = "pybull
                      max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
     """One wall bounce by refsim beside another engine's run of the same
     scene (``external(scene) -> Trajectory``; default pybullet)."""
-    from refsim.dynamics.simulation import simulate
+    from refsim.dynamics.simulate import simulate
 
     scene = _for(scene or _bundled("bounce.toml"), duration)
     runs = [run_from_scene("refsim", scene, simulate(scene)),

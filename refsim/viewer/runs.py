@@ -20,7 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from refsim.dynamics.simulation import Simulation, default_every
+from refsim.dynamics.simulate import default_every
+from refsim.dynamics.simulation import Simulation
 from refsim.dynamics.start import start_kernel
 from refsim.dynamics.trajectory import Trajectory
 

@@ -26,13 +26,10 @@ from refsim.conformance.cases_ode import (
     time_dependent,
 )
 from refsim.conformance.cases_triangles import FAMILIES, triangle_cases
-from refsim.conformance.checks_rigid import (
-    apex_tolerance,
-    energy_tolerance,
-    incline_tolerance,
-    spin_rest_time,
-)
+from refsim.conformance.checks_bounces import apex_tolerance
+from refsim.conformance.checks_contact import incline_tolerance, spin_rest_time
 from refsim.conformance.draw import signed_permutations
+from refsim.conformance.rigid_runs import energy_tolerance
 from refsim.types import transform_points
 
 
@@ -272,7 +269,7 @@ def test_free_brick_and_its_closed_form():
 
 
 def test_free_rotation_check_passes_the_corrected_model_and_fails_a_still_body():
-    from refsim.conformance.checks_rigid import check_rigid_free_rotation
+    from refsim.conformance.checks_rotation import check_rigid_free_rotation
     from refsim.engines.refsim_engines import corrected
 
     cases = R.RigidCases(scenes=tuple(R.rigid_cases().of_kind("free")))

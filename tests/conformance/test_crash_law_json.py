@@ -17,7 +17,7 @@ import pytest
 
 from refsim.cli import main
 from refsim.conformance import cases_rigid as R
-from refsim.conformance.checks_rigid import check_rigid_apex_ratio, check_rigid_no_spin
+from refsim.conformance.checks_bounces import check_rigid_apex_ratio, check_rigid_no_spin
 from refsim.conformance.results import ConformanceResult, conformance_schema
 from refsim.dynamics import analytic
 from tests.conformance.broken_engines import RigidStub

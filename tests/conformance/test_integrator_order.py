@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from refsim.conformance.cases_rigid import RigidCases, rigid_scenes
-from refsim.conformance.checks_rigid import check_rigid_free_rotation
+from refsim.conformance.checks_rotation import check_rigid_free_rotation
 from refsim.engines import declarations
 from refsim.engines.refsim_engines import corrected
 from refsim.errors import OptionError

@@ -11,21 +11,24 @@ import numpy as np
 import pytest
 
 from refsim.conformance import cases_rigid as R
-from refsim.conformance.checks_rigid import (
+from refsim.conformance.checks_bounces import (
     BOUNCE_TIME_STEPS,
-    CONTACT_STEPS,
-    SLIDE_WINDOW,
-    _contacts,
     bounce_times,
     check_rigid_bounce_times,
-    check_rigid_elastic_tumble,
+)
+from refsim.conformance.checks_contact import (
+    SLIDE_WINDOW,
     check_rigid_slide_to_roll,
-    energy_tolerance,
     slide_facet_shift,
     slide_tolerance,
     slide_window,
+)
+from refsim.conformance.checks_rotation import (
+    _contacts,
+    check_rigid_elastic_tumble,
     tumble_tolerance,
 )
+from refsim.conformance.rigid_runs import CONTACT_STEPS, energy_tolerance
 from refsim.dynamics import analytic
 from tests.conformance.broken_engines import RigidStub
 from tests.conformance.test_crash_law_json import bouncer, bouncing

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import refsim
-from refsim.conformance.checks_rigid import STACK_TRAVEL
+from refsim.conformance.checks_contact import STACK_TRAVEL
 from refsim.dynamics import impulse
 from refsim.scenes.loader import scene_from_dict
 

@@ -18,7 +18,8 @@ from scipy.integrate import solve_ivp
 
 from refsim.conformance import cases_rigid as R
 from refsim.dynamics.free_body import FreeBody
-from refsim.dynamics.simulation import Simulation, simulate
+from refsim.dynamics.simulate import simulate
+from refsim.dynamics.simulation import Simulation
 
 MOMENTS = ((0.36 + 0.09) / 12, (1.0 + 0.09) / 12, (1.0 + 0.36) / 12)
 

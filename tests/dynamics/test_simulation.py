@@ -10,7 +10,8 @@ import pytest
 
 import refsim
 from refsim.bundled import scenes_dir
-from refsim.dynamics.simulation import MAX_FRAMES, Simulation, default_every, simulate
+from refsim.dynamics.simulate import MAX_FRAMES, default_every, simulate
+from refsim.dynamics.simulation import Simulation
 from refsim.errors import DivergenceError, StateError
 from refsim.scenes.loader import scene_from_dict
 from refsim.studies.dynamics import REST_SPEED, REST_SPIN

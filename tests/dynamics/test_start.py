@@ -16,7 +16,8 @@ from refsim import load_scene
 from refsim.bundled import scenes_dir
 from refsim.dynamics import start
 from refsim.dynamics.compiled_loop import loop_support
-from refsim.dynamics.simulation import Simulation, simulate
+from refsim.dynamics.simulate import simulate
+from refsim.dynamics.simulation import Simulation
 
 SPIN = scenes_dir() / "spinning-cube.toml"
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import refsim
-from refsim.dynamics.simulation import simulate
+from refsim.dynamics.simulate import simulate
 from refsim.dynamics.trajectory import ENTRIES, FRAME_ENTRIES
 from refsim.errors import DivergenceError, NpzFileError, RefsimError
 from refsim.scenes.loader import scene_from_dict

@@ -20,7 +20,7 @@ from refsim.oracles.drake_adapter import (
 )
 
 from refsim.conformance import cases_rigid as R
-from refsim.conformance.checks_rigid import REST_PENETRATION_STEPS
+from refsim.conformance.checks_contact import REST_PENETRATION_STEPS
 from refsim.errors import OptionError
 from refsim.scenes.loader import scene_from_dict
 

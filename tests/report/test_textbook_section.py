@@ -6,13 +6,10 @@ from __future__ import annotations
 import math
 from types import SimpleNamespace
 
-from refsim.conformance.checks_rigid import (
-    MOMENTUM_TOL,
-    OFF_CENTRE_TOL,
-    STACK_TRAVEL,
-    TEXTBOOK_PROBLEMS,
-)
+from refsim.conformance.checks_contact import STACK_TRAVEL
+from refsim.conformance.checks_strikes import MOMENTUM_TOL, OFF_CENTRE_TOL
 from refsim.conformance.matrix import Cell, Matrix
+from refsim.conformance.textbook_problems import TEXTBOOK_PROBLEMS
 from refsim.report.entries.conformance import TextbookConvergence
 from refsim.report.sections.textbook import build
 

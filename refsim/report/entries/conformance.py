@@ -53,7 +53,7 @@ def conformance_matrix(run: Run):
 TEXTBOOK_STEPS = ((2e-3, 1e-3), (2e-3, 1e-3, 5e-4))
 
 #: The problems a quick run follows in h (a full run: every one of
-#: refsim.conformance.checks_rigid.TEXTBOOK_PROBLEMS): the cheap ones.
+#: refsim.conformance.textbook_problems.TEXTBOOK_PROBLEMS): the cheap ones.
 TEXTBOOK_QUICK = ("rigid.oblique_bounce", "rigid.free_rotation", "rigid.off_centre",
                   "rigid.cradle")
 
@@ -72,8 +72,8 @@ class TextbookConvergence:
 
 def textbook_convergence(run: Run):
     from refsim.conformance import cases_rigid as R
-    from refsim.conformance.checks_rigid import TEXTBOOK_PROBLEMS
     from refsim.conformance.registry import check_by_key
+    from refsim.conformance.textbook_problems import TEXTBOOK_PROBLEMS
     from refsim.engines import load_engine
 
     engine = load_engine("refsim.engines.refsim_engines:corrected")

@@ -97,7 +97,7 @@ def dynamics_spin(run: Run):
     pybullet runs the same scene in a client of its own (a second engine
     from the plan's factory, not the run's shared one)."""
     from refsim.bundled import scenes_dir
-    from refsim.dynamics.simulation import default_every
+    from refsim.dynamics.simulate import default_every
     from refsim.report.plan import ENGINES
     from refsim.scenes.loader import load_scene
     from refsim.studies import dynamics

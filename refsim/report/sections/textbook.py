@@ -4,13 +4,14 @@ Arranges two records.
 
 - From the plan's ``conformance-matrix``: each rigid-body engine's largest
   miss over its tolerance on each of the kit's problems that have a
-  closed-form answer (:data:`refsim.conformance.checks_rigid.TEXTBOOK_PROBLEMS`,
+  closed-form answer (:data:`refsim.conformance.textbook_problems.TEXTBOOK_PROBLEMS`,
   worst over the problem's scenes), in the colour of the check's status.
 - From ``textbook-convergence``: refsim's corrected model on the same
   problems at several steps.
 
 The errors, the tolerances and the statuses are the kit's
-(:mod:`refsim.conformance.checks_rigid`); this module only arranges them.
+(:mod:`refsim.conformance.checks_rigid` lists the modules of the rigid
+checks); this module only arranges them.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from __future__ import annotations
 import math
 
 from refsim.conformance import cases_rigid as R
-from refsim.conformance.checks_rigid import TEXTBOOK_PROBLEMS
+from refsim.conformance.textbook_problems import TEXTBOOK_PROBLEMS
 from refsim.report.plan import command
 from refsim.report.section import Cell, Section, Table
 from refsim.report.sections.conformance import CELL_COLOURS, ENGINE_TITLES, LEGEND
@@ -62,7 +63,7 @@ def build(ctx) -> Section:
                 "at most 1 passes), at the kit's step of "
                 f"{R.STEP:g} s, in the colour of the kit's verdict. The closed forms, the "
                 "scenes and the reason for each tolerance are in the kit's documentation "
-                "(refsim/conformance/checks_rigid.py). Reproduce: "
+                "(refsim/conformance/checks_rigid.py lists its modules). Reproduce: "
                 f"{command('conformance-matrix')}")
     steps = convergence.steps
     steps_rows = tuple(
