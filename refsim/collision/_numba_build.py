@@ -986,3 +986,72 @@ def frame_boxes(vx, vy, vz, faces, left, right, start, count, order):
                 worst = off if off < np.inf else np.inf
     visit_nodes(vx, vy, vz, faces, left, right, start, count, order, True, a, axes, boxes)
     return boxes, worst
+
+
+# -- one call from a mesh's arrays ------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def scaled_columns(vertices, faces):
+    """Mirrors: bvh.scaled_triangles, one array per coordinate:
+    ``np.ldexp(vertices, -unit_exponent(vertices))[faces]`` as the (3m,)
+    columns :func:`build_tree` takes, and the vertices' largest magnitude
+    (``np.abs(vertices).max()``, 0.0 for none; coordinates finite, as a
+    Mesh's are). vertices (n, 3) float64, faces (m, 3) int64."""
+    largest = 0.0
+    for i in range(vertices.shape[0]):
+        largest = largest_of(largest, vertices[i, 0], vertices[i, 1], vertices[i, 2])
+    k = -unit_exponent(largest)
+    m = faces.shape[0]
+    tx, ty, tz = np.empty(3 * m), np.empty(3 * m), np.empty(3 * m)
+    for t in range(m):
+        for v in range(3):
+            i = faces[t, v]
+            tx[3 * t + v] = math.ldexp(vertices[i, 0], k)
+            ty[3 * t + v] = math.ldexp(vertices[i, 1], k)
+            tz[3 * t + v] = math.ldexp(vertices[i, 2], k)
+    return tx, ty, tz, largest
+
+
+@numba.njit(cache=True)
+def build_tree_of(vertices, faces, leaf_size, rule):
+    """:func:`build_tree` of a mesh's arrays (:func:`scaled_columns`): one
+    call, no copies made in Python."""
+    tx, ty, tz, _ = scaled_columns(vertices, faces)
+    return build_tree(tx, ty, tz, leaf_size, rule)
+
+
+@numba.njit(cache=True)
+def frame_tree_arrays(vertices, faces, leaf_size):
+    """Mirrors: bvh_exact.build_frame_tree (default axes) and
+    bvh_exact.pack_frame_tree, from a mesh's vertices (n, 3) float64 and
+    faces (m, 3) int64, in one call: the least-volume tree
+    (:func:`build_tree`), its boxes (:func:`frame_boxes`), the links and
+    the packed arrays.
+
+    Returns ``(left, right, start, count, order, links, boxes,
+    axes_deviation, reach, floats, ints)``: the TriangleTree's arrays, the
+    FrameTree's, and pack_frame_tree's two arrays, each laid out as those
+    functions lay them out."""
+    tx, ty, tz, reach = scaled_columns(vertices, faces)
+    left, right, start, count, order = build_tree(tx, ty, tz, leaf_size, LEAST_VOLUME)
+    n, m, nodes = vertices.shape[0], faces.shape[0], len(left)
+    vx, vy, vz = np.empty(n), np.empty(n), np.empty(n)
+    for i in range(n):
+        vx[i], vy[i], vz[i] = vertices[i, 0], vertices[i, 1], vertices[i, 2]
+    writable_faces = faces.copy()
+    boxes, deviation = frame_boxes(vx, vy, vz, writable_faces, left, right, start, count, order)
+    links = np.empty((nodes, 4), dtype=np.int64)
+    for node in range(nodes):
+        links[node, 0], links[node, 1] = left[node], right[node]
+        links[node, 2], links[node, 3] = start[node], count[node]
+    floats = np.empty(2 + 3 * n + 15 * nodes)
+    floats[0], floats[1] = reach, deviation
+    floats[2:2 + 3 * n] = vertices.ravel()
+    floats[2 + 3 * n:] = boxes.ravel()
+    ints = np.empty(3 + 3 * m + 4 * nodes + m, dtype=np.int64)
+    ints[0], ints[1], ints[2] = n, m, nodes
+    ints[3:3 + 3 * m] = faces.ravel()
+    ints[3 + 3 * m:3 + 3 * m + 4 * nodes] = links.ravel()
+    ints[3 + 3 * m + 4 * nodes:] = order
+    return left, right, start, count, order, links, boxes, deviation, reach, floats, ints
