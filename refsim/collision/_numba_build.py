@@ -42,7 +42,9 @@ keys are ranked by buckets and insertion instead of a general sort
 (:func:`rank`); a node box's vertex list is filtered from its parent's
 instead of sorted (:func:`visit_nodes`); hot loops call no helper that
 takes an array (such calls, even inlined, measured more than the loops'
-work). Measured against FCL: docs/decisions/tree-build.md.
+work); a mesh's whole FrameTree and its packed arrays come from one call
+(:func:`frame_tree_arrays`), not from numpy copies around several calls.
+Measured against FCL: docs/decisions/tree-build.md.
 
 Cost: the least-volume split forms, at each node of k triangles, the
 covariances of its six candidate halves (a few passes over 9k points) and
