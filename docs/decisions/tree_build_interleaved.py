@@ -1,5 +1,5 @@
 """A new mesh's exact-level build (what tests/benchmarks/test_bench_tree_build.py
-times: ``frame_tree_of`` and ``pack_frame_tree``, compiled) against
+times: ``frame_tree_of`` and the packed arrays the query keeps, compiled) against
 python-fcl's ``BVHModel`` build, the two alternating in one process: on a
 shared, loaded machine this reads both under the same load.
 

@@ -42,7 +42,9 @@ keys are ranked by buckets and insertion instead of a general sort
 (:func:`rank`); a node box's vertex list is filtered from its parent's
 instead of sorted (:func:`visit_nodes`); hot loops call no helper that
 takes an array (such calls, even inlined, measured more than the loops'
-work). Measured against FCL: docs/decisions/tree-build.md.
+work); a mesh's whole FrameTree and its packed arrays come from one call
+(:func:`frame_tree_arrays`), not from numpy copies around several calls.
+Measured against FCL: docs/decisions/tree-build.md.
 
 Cost: the least-volume split forms, at each node of k triangles, the
 covariances of its six candidate halves (a few passes over 9k points) and
@@ -349,6 +351,34 @@ def symmetric_eigenvectors(a, axes, count):
         eigenvectors_of_pair(a, axes, m, min(m + 1, count - 1))
 
 
+@numba.njit(cache=True, inline="always")
+def jacobi_rotation(app, apq, apr, aqp, aqq, aqr, arp, arq, v0p, v0q, v1p, v1q, v2p, v2q):
+    """One rotation of bvh_exact.symmetric_eigenvectors, the one that zeroes
+    entry (p, q) of a 3 x 3 matrix (r the third index), on the entries it
+    changes, given and returned in the order (p, p), (p, q), (p, r), (q, p),
+    (q, q), (q, r), (r, p), (r, q), then the rotations' columns p and q row
+    by row: ``A <- J^T (A J)`` and ``V <- V J``, each entry formed by the
+    readable code's operations in its order, then ``a_pq = a_qp = 0``."""
+    tau = (aqq - app) / (2.0 * apq)
+    t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
+    if abs(t) <= TINY_ROTATION:
+        c, s = 1.0, t
+    else:
+        c = 1.0 / math.sqrt(1.0 + t * t)
+        s = t * c
+    app, apq = c * app - s * apq, s * app + c * apq          # A J: columns p, q
+    aqp, aqq = c * aqp - s * aqq, s * aqp + c * aqq
+    arp, arq = c * arp - s * arq, s * arp + c * arq
+    app, aqp = c * app - s * aqp, s * app + c * aqp          # J^T (A J): rows p, q
+    apq, aqq = c * apq - s * aqq, s * apq + c * aqq
+    apr, aqr = c * apr - s * aqr, s * apr + c * aqr
+    apq = aqp = 0.0
+    v0p, v0q = c * v0p - s * v0q, s * v0p + c * v0q
+    v1p, v1q = c * v1p - s * v1q, s * v1p + c * v1q
+    v2p, v2q = c * v2p - s * v2q, s * v2p + c * v2q
+    return app, apq, apr, aqp, aqq, aqr, arp, arq, v0p, v0q, v1p, v1q, v2p, v2q
+
+
 @numba.njit(cache=True)
 def eigenvectors_of_pair(a, axes, first, second):
     """Mirrors: bvh_exact.symmetric_eigenvectors, of matrices ``a[first]``
@@ -376,113 +406,35 @@ def eigenvectors_of_pair(a, axes, first, second):
                 and abs(a01_1) + abs(a02_1) + abs(a12_1) == 0.0):
             break
         if a01_0 != 0.0:
-            tau = (a11_0 - a00_0) / (2.0 * a01_0)
-            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
-            if abs(t) <= TINY_ROTATION:
-                c, s = 1.0, t
-            else:
-                c = 1.0 / math.sqrt(1.0 + t * t)
-                s = t * c
-            a00_0, a01_0 = c * a00_0 - s * a01_0, s * a00_0 + c * a01_0
-            a10_0, a11_0 = c * a10_0 - s * a11_0, s * a10_0 + c * a11_0
-            a20_0, a21_0 = c * a20_0 - s * a21_0, s * a20_0 + c * a21_0
-            a00_0, a10_0 = c * a00_0 - s * a10_0, s * a00_0 + c * a10_0
-            a01_0, a11_0 = c * a01_0 - s * a11_0, s * a01_0 + c * a11_0
-            a02_0, a12_0 = c * a02_0 - s * a12_0, s * a02_0 + c * a12_0
-            a01_0 = a10_0 = 0.0
-            v00_0, v01_0 = c * v00_0 - s * v01_0, s * v00_0 + c * v01_0
-            v10_0, v11_0 = c * v10_0 - s * v11_0, s * v10_0 + c * v11_0
-            v20_0, v21_0 = c * v20_0 - s * v21_0, s * v20_0 + c * v21_0
+            a00_0, a01_0, a02_0, a10_0, a11_0, a12_0, a20_0, a21_0, \
+                v00_0, v01_0, v10_0, v11_0, v20_0, v21_0 = jacobi_rotation(
+                    a00_0, a01_0, a02_0, a10_0, a11_0, a12_0, a20_0, a21_0,
+                    v00_0, v01_0, v10_0, v11_0, v20_0, v21_0)
         if a01_1 != 0.0:
-            tau = (a11_1 - a00_1) / (2.0 * a01_1)
-            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
-            if abs(t) <= TINY_ROTATION:
-                c, s = 1.0, t
-            else:
-                c = 1.0 / math.sqrt(1.0 + t * t)
-                s = t * c
-            a00_1, a01_1 = c * a00_1 - s * a01_1, s * a00_1 + c * a01_1
-            a10_1, a11_1 = c * a10_1 - s * a11_1, s * a10_1 + c * a11_1
-            a20_1, a21_1 = c * a20_1 - s * a21_1, s * a20_1 + c * a21_1
-            a00_1, a10_1 = c * a00_1 - s * a10_1, s * a00_1 + c * a10_1
-            a01_1, a11_1 = c * a01_1 - s * a11_1, s * a01_1 + c * a11_1
-            a02_1, a12_1 = c * a02_1 - s * a12_1, s * a02_1 + c * a12_1
-            a01_1 = a10_1 = 0.0
-            v00_1, v01_1 = c * v00_1 - s * v01_1, s * v00_1 + c * v01_1
-            v10_1, v11_1 = c * v10_1 - s * v11_1, s * v10_1 + c * v11_1
-            v20_1, v21_1 = c * v20_1 - s * v21_1, s * v20_1 + c * v21_1
+            a00_1, a01_1, a02_1, a10_1, a11_1, a12_1, a20_1, a21_1, \
+                v00_1, v01_1, v10_1, v11_1, v20_1, v21_1 = jacobi_rotation(
+                    a00_1, a01_1, a02_1, a10_1, a11_1, a12_1, a20_1, a21_1,
+                    v00_1, v01_1, v10_1, v11_1, v20_1, v21_1)
         if a02_0 != 0.0:
-            tau = (a22_0 - a00_0) / (2.0 * a02_0)
-            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
-            if abs(t) <= TINY_ROTATION:
-                c, s = 1.0, t
-            else:
-                c = 1.0 / math.sqrt(1.0 + t * t)
-                s = t * c
-            a00_0, a02_0 = c * a00_0 - s * a02_0, s * a00_0 + c * a02_0
-            a10_0, a12_0 = c * a10_0 - s * a12_0, s * a10_0 + c * a12_0
-            a20_0, a22_0 = c * a20_0 - s * a22_0, s * a20_0 + c * a22_0
-            a00_0, a20_0 = c * a00_0 - s * a20_0, s * a00_0 + c * a20_0
-            a01_0, a21_0 = c * a01_0 - s * a21_0, s * a01_0 + c * a21_0
-            a02_0, a22_0 = c * a02_0 - s * a22_0, s * a02_0 + c * a22_0
-            a02_0 = a20_0 = 0.0
-            v00_0, v02_0 = c * v00_0 - s * v02_0, s * v00_0 + c * v02_0
-            v10_0, v12_0 = c * v10_0 - s * v12_0, s * v10_0 + c * v12_0
-            v20_0, v22_0 = c * v20_0 - s * v22_0, s * v20_0 + c * v22_0
+            a00_0, a02_0, a01_0, a20_0, a22_0, a21_0, a10_0, a12_0, \
+                v00_0, v02_0, v10_0, v12_0, v20_0, v22_0 = jacobi_rotation(
+                    a00_0, a02_0, a01_0, a20_0, a22_0, a21_0, a10_0, a12_0,
+                    v00_0, v02_0, v10_0, v12_0, v20_0, v22_0)
         if a02_1 != 0.0:
-            tau = (a22_1 - a00_1) / (2.0 * a02_1)
-            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
-            if abs(t) <= TINY_ROTATION:
-                c, s = 1.0, t
-            else:
-                c = 1.0 / math.sqrt(1.0 + t * t)
-                s = t * c
-            a00_1, a02_1 = c * a00_1 - s * a02_1, s * a00_1 + c * a02_1
-            a10_1, a12_1 = c * a10_1 - s * a12_1, s * a10_1 + c * a12_1
-            a20_1, a22_1 = c * a20_1 - s * a22_1, s * a20_1 + c * a22_1
-            a00_1, a20_1 = c * a00_1 - s * a20_1, s * a00_1 + c * a20_1
-            a01_1, a21_1 = c * a01_1 - s * a21_1, s * a01_1 + c * a21_1
-            a02_1, a22_1 = c * a02_1 - s * a22_1, s * a02_1 + c * a22_1
-            a02_1 = a20_1 = 0.0
-            v00_1, v02_1 = c * v00_1 - s * v02_1, s * v00_1 + c * v02_1
-            v10_1, v12_1 = c * v10_1 - s * v12_1, s * v10_1 + c * v12_1
-            v20_1, v22_1 = c * v20_1 - s * v22_1, s * v20_1 + c * v22_1
+            a00_1, a02_1, a01_1, a20_1, a22_1, a21_1, a10_1, a12_1, \
+                v00_1, v02_1, v10_1, v12_1, v20_1, v22_1 = jacobi_rotation(
+                    a00_1, a02_1, a01_1, a20_1, a22_1, a21_1, a10_1, a12_1,
+                    v00_1, v02_1, v10_1, v12_1, v20_1, v22_1)
         if a12_0 != 0.0:
-            tau = (a22_0 - a11_0) / (2.0 * a12_0)
-            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
-            if abs(t) <= TINY_ROTATION:
-                c, s = 1.0, t
-            else:
-                c = 1.0 / math.sqrt(1.0 + t * t)
-                s = t * c
-            a01_0, a02_0 = c * a01_0 - s * a02_0, s * a01_0 + c * a02_0
-            a11_0, a12_0 = c * a11_0 - s * a12_0, s * a11_0 + c * a12_0
-            a21_0, a22_0 = c * a21_0 - s * a22_0, s * a21_0 + c * a22_0
-            a10_0, a20_0 = c * a10_0 - s * a20_0, s * a10_0 + c * a20_0
-            a11_0, a21_0 = c * a11_0 - s * a21_0, s * a11_0 + c * a21_0
-            a12_0, a22_0 = c * a12_0 - s * a22_0, s * a12_0 + c * a22_0
-            a12_0 = a21_0 = 0.0
-            v01_0, v02_0 = c * v01_0 - s * v02_0, s * v01_0 + c * v02_0
-            v11_0, v12_0 = c * v11_0 - s * v12_0, s * v11_0 + c * v12_0
-            v21_0, v22_0 = c * v21_0 - s * v22_0, s * v21_0 + c * v22_0
+            a11_0, a12_0, a10_0, a21_0, a22_0, a20_0, a01_0, a02_0, \
+                v01_0, v02_0, v11_0, v12_0, v21_0, v22_0 = jacobi_rotation(
+                    a11_0, a12_0, a10_0, a21_0, a22_0, a20_0, a01_0, a02_0,
+                    v01_0, v02_0, v11_0, v12_0, v21_0, v22_0)
         if a12_1 != 0.0:
-            tau = (a22_1 - a11_1) / (2.0 * a12_1)
-            t = (1.0 if tau >= 0.0 else -1.0) / (abs(tau) + math.sqrt(1.0 + tau * tau))
-            if abs(t) <= TINY_ROTATION:
-                c, s = 1.0, t
-            else:
-                c = 1.0 / math.sqrt(1.0 + t * t)
-                s = t * c
-            a01_1, a02_1 = c * a01_1 - s * a02_1, s * a01_1 + c * a02_1
-            a11_1, a12_1 = c * a11_1 - s * a12_1, s * a11_1 + c * a12_1
-            a21_1, a22_1 = c * a21_1 - s * a22_1, s * a21_1 + c * a22_1
-            a10_1, a20_1 = c * a10_1 - s * a20_1, s * a10_1 + c * a20_1
-            a11_1, a21_1 = c * a11_1 - s * a21_1, s * a11_1 + c * a21_1
-            a12_1, a22_1 = c * a12_1 - s * a22_1, s * a12_1 + c * a22_1
-            a12_1 = a21_1 = 0.0
-            v01_1, v02_1 = c * v01_1 - s * v02_1, s * v01_1 + c * v02_1
-            v11_1, v12_1 = c * v11_1 - s * v12_1, s * v11_1 + c * v12_1
-            v21_1, v22_1 = c * v21_1 - s * v22_1, s * v21_1 + c * v22_1
+            a11_1, a12_1, a10_1, a21_1, a22_1, a20_1, a01_1, a02_1, \
+                v01_1, v02_1, v11_1, v12_1, v21_1, v22_1 = jacobi_rotation(
+                    a11_1, a12_1, a10_1, a21_1, a22_1, a20_1, a01_1, a02_1,
+                    v01_1, v02_1, v11_1, v12_1, v21_1, v22_1)
     sorted_columns(a00_0, a11_0, a22_0, ((v00_0, v10_0, v20_0), (v01_0, v11_0, v21_0),
                                          (v02_0, v12_0, v22_0)), axes[first])
     sorted_columns(a00_1, a11_1, a22_1, ((v00_1, v10_1, v20_1), (v01_1, v11_1, v21_1),
@@ -986,3 +938,72 @@ def frame_boxes(vx, vy, vz, faces, left, right, start, count, order):
                 worst = off if off < np.inf else np.inf
     visit_nodes(vx, vy, vz, faces, left, right, start, count, order, True, a, axes, boxes)
     return boxes, worst
+
+
+# -- one call from a mesh's arrays ------------------------------------------------------
+
+
+@numba.njit(cache=True)
+def scaled_columns(vertices, faces):
+    """Mirrors: bvh.scaled_triangles, one array per coordinate:
+    ``np.ldexp(vertices, -unit_exponent(vertices))[faces]`` as the (3m,)
+    columns :func:`build_tree` takes, and the vertices' largest magnitude
+    (``np.abs(vertices).max()``, 0.0 for none; coordinates finite, as a
+    Mesh's are). vertices (n, 3) float64, faces (m, 3) int64."""
+    largest = 0.0
+    for i in range(vertices.shape[0]):
+        largest = largest_of(largest, vertices[i, 0], vertices[i, 1], vertices[i, 2])
+    k = -unit_exponent(largest)
+    m = faces.shape[0]
+    tx, ty, tz = np.empty(3 * m), np.empty(3 * m), np.empty(3 * m)
+    for t in range(m):
+        for v in range(3):
+            i = faces[t, v]
+            tx[3 * t + v] = math.ldexp(vertices[i, 0], k)
+            ty[3 * t + v] = math.ldexp(vertices[i, 1], k)
+            tz[3 * t + v] = math.ldexp(vertices[i, 2], k)
+    return tx, ty, tz, largest
+
+
+@numba.njit(cache=True)
+def build_tree_of(vertices, faces, leaf_size, rule):
+    """:func:`build_tree` of a mesh's arrays (:func:`scaled_columns`): one
+    call, no copies made in Python."""
+    tx, ty, tz, _ = scaled_columns(vertices, faces)
+    return build_tree(tx, ty, tz, leaf_size, rule)
+
+
+@numba.njit(cache=True)
+def frame_tree_arrays(vertices, faces, leaf_size):
+    """Mirrors: bvh_exact.build_frame_tree (default axes) and
+    bvh_exact.pack_frame_tree, from a mesh's vertices (n, 3) float64 and
+    faces (m, 3) int64, in one call: the least-volume tree
+    (:func:`build_tree`), its boxes (:func:`frame_boxes`), the links and
+    the packed arrays.
+
+    Returns ``(left, right, start, count, order, links, boxes,
+    axes_deviation, reach, floats, ints)``: the TriangleTree's arrays, the
+    FrameTree's, and pack_frame_tree's two arrays, each laid out as those
+    functions lay them out."""
+    tx, ty, tz, reach = scaled_columns(vertices, faces)
+    left, right, start, count, order = build_tree(tx, ty, tz, leaf_size, LEAST_VOLUME)
+    n, m, nodes = vertices.shape[0], faces.shape[0], len(left)
+    vx, vy, vz = np.empty(n), np.empty(n), np.empty(n)
+    for i in range(n):
+        vx[i], vy[i], vz[i] = vertices[i, 0], vertices[i, 1], vertices[i, 2]
+    writable_faces = faces.copy()
+    boxes, deviation = frame_boxes(vx, vy, vz, writable_faces, left, right, start, count, order)
+    links = np.empty((nodes, 4), dtype=np.int64)
+    for node in range(nodes):
+        links[node, 0], links[node, 1] = left[node], right[node]
+        links[node, 2], links[node, 3] = start[node], count[node]
+    floats = np.empty(2 + 3 * n + 15 * nodes)
+    floats[0], floats[1] = reach, deviation
+    floats[2:2 + 3 * n] = vertices.ravel()
+    floats[2 + 3 * n:] = boxes.ravel()
+    ints = np.empty(3 + 3 * m + 4 * nodes + m, dtype=np.int64)
+    ints[0], ints[1], ints[2] = n, m, nodes
+    ints[3:3 + 3 * m] = faces.ravel()
+    ints[3 + 3 * m:3 + 3 * m + 4 * nodes] = links.ravel()
+    ints[3 + 3 * m + 4 * nodes:] = order
+    return left, right, start, count, order, links, boxes, deviation, reach, floats, ints

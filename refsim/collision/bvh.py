@@ -168,10 +168,21 @@ def build_tree_compiled(vertices: np.ndarray, faces: np.ndarray, split: str = "l
     ``split`` (:data:`SPLIT_RULES`)."""
     check_option("split", split, SPLIT_RULES)
     nb = build_kernels()
-    triangles = scaled_triangles(vertices, faces)
-    columns = [np.ascontiguousarray(triangles[:, :, j]).ravel() for j in range(3)]
     rule = nb.LEAST_AREA if split == "least-area" else nb.LEAST_VOLUME
-    return TriangleTree(*nb.build_tree(*columns, leaf_size, rule))
+    return TriangleTree(*nb.build_tree_of(kernel_array(vertices, np.float64),
+                                          kernel_array(faces, np.int64), leaf_size, rule))
+
+
+def kernel_array(array: np.ndarray, dtype) -> np.ndarray:
+    """``array`` as the compiled build takes a mesh's arrays: C-contiguous,
+    of ``dtype``, read-only (a Mesh's arrays already are, and pass as they
+    are). One layout, so that numba compiles each build kernel for one
+    signature (a read-only array is another type than a writable one)."""
+    if array.dtype == dtype and array.flags.c_contiguous and not array.flags.writeable:
+        return array
+    array = np.array(array, dtype=dtype, order="C")
+    array.flags.writeable = False
+    return array
 
 
 def tree_of(mesh, kernel: str | None = None) -> TriangleTree:

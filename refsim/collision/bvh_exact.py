@@ -127,7 +127,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from refsim.collision.boxes import triangle_boxes, world_vertices
-from refsim.collision.bvh import TriangleTree, build_kernels, build_tree, build_tree_compiled
+from refsim.collision.bvh import (
+    LEAF_SIZE,
+    TriangleTree,
+    build_kernels,
+    build_tree,
+    build_tree_compiled,
+    kernel_array,
+)
 from refsim.collision.seed_levels import exact_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_numba import compiled_exact_kernels
@@ -384,16 +391,18 @@ def _frame_tree(mesh, tree: TriangleTree, boxes: np.ndarray, largest_deviation: 
 
 def build_frame_tree_compiled(mesh) -> FrameTree:
     """:func:`build_frame_tree` (with its default axes) compiled
-    (:func:`refsim.collision._numba_build.frame_boxes` over the compiled
-    :func:`frame_topology_of`): the same FrameTree, every array bit for bit."""
-    tree = frame_topology_of(mesh, "compiled")
-    # writable copies: numba compiles a read-only array argument (a Mesh's
-    # faces are read-only) as another type, a second compile of the kernel
-    columns = [np.array(mesh.vertices[:, j], dtype=np.float64) for j in range(3)]
-    faces = np.array(mesh.faces, dtype=np.int64, order="C")
-    boxes, largest_deviation = build_kernels().frame_boxes(
-        *columns, faces, tree.left, tree.right, tree.start, tree.count, tree.order)
-    return _frame_tree(mesh, tree, boxes, float(largest_deviation))
+    (:func:`refsim.collision._numba_build.frame_tree_arrays`): the same
+    FrameTree, every array bit for bit. The one compiled call also gives
+    the tree's topology and :func:`pack_frame_tree`'s arrays, which are
+    kept with the mesh (as :func:`frame_topology_of` and the query keep
+    them) unless already there: a new mesh's first query then makes no
+    other build call."""
+    (left, right, start, count, order, links, boxes, deviation, reach, floats,
+     ints) = build_kernels().frame_tree_arrays(kernel_array(mesh.vertices, np.float64),
+                                                kernel_array(mesh.faces, np.int64), LEAF_SIZE)
+    tree = mesh.derived("frame_topology", lambda m: TriangleTree(left, right, start, count, order))
+    mesh.derived("frame_tree_packed", lambda m: (floats, ints))
+    return FrameTree(tree, links, boxes, float(reach), float(deviation))
 
 
 def frame_tree_of(mesh, kernel: str | None = None) -> FrameTree:

@@ -4,7 +4,8 @@ answer, by refsim and by python-fcl in the same run.
 - ``test_tree_build``: the trees a query needs, built for a new mesh. For
   refsim's default level, "exact", that is the exact level's FrameTree
   (least-volume split and oriented node boxes) and its packed arrays
-  (``bvh_exact.pack_frame_tree``); level "triangle-aabb" needs the
+  (``bvh_exact.pack_frame_tree``, as the query keeps them:
+  ``bvh_exact._kernel_arrays``); level "triangle-aabb" needs the
   least-area tree instead (``bvh.tree_of``, ``-k aabb``). FCL: a
   ``BVHModel`` (OBBRSS) built from the arrays (beginModel, addSubModel,
   endModel). The readable build runs on the meshes of at most 2048 faces.
@@ -91,7 +92,7 @@ def _refsim_build(level: str, kernel: str):
     if level == "exact":
         def build(mesh):
             frame = bvh_exact.frame_tree_of(mesh, kernel)
-            bvh_exact.pack_frame_tree(mesh)
+            bvh_exact._kernel_arrays(mesh)          # what the query takes, kept
             return frame.tree
     else:
         def build(mesh):

@@ -103,11 +103,17 @@ def test_compiled_build_equals_readable_build_bit_for_bit(name):
         _assert_same_bits(_arrays(tree_of(readable_mesh, "readable")),
                           _arrays(tree_of(compiled_mesh, "compiled")), (name, tree_of.__name__))
     readable = bvh_exact.frame_tree_of(readable_mesh, "readable")
-    compiled = bvh_exact.frame_tree_of(compiled_mesh, "compiled")
-    _assert_same_bits([*_arrays(readable.tree), readable.links, readable.boxes,
-                       readable.reach, readable.axes_deviation],
-                      [*_arrays(compiled.tree), compiled.links, compiled.boxes,
-                       compiled.reach, compiled.axes_deviation], name)
+    # on a mesh whose topology is built (above), and on a new one, where the
+    # one compiled call builds topology, boxes and the packed arrays
+    fresh_mesh = _mesh(name)
+    for mesh in (compiled_mesh, fresh_mesh):
+        compiled = bvh_exact.frame_tree_of(mesh, "compiled")
+        _assert_same_bits([*_arrays(readable.tree), readable.links, readable.boxes,
+                           readable.reach, readable.axes_deviation],
+                          [*_arrays(compiled.tree), compiled.links, compiled.boxes,
+                           compiled.reach, compiled.axes_deviation], name)
+    _assert_same_bits(bvh_exact.pack_frame_tree(readable_mesh),
+                      bvh_exact._kernel_arrays(fresh_mesh), (name, "packed"))
 
 
 def test_the_cases_reach_what_they_are_there_for():
@@ -143,6 +149,18 @@ def test_an_unknown_split_rule_is_refused():
     vertices, faces = GENERATED["box"]
     with pytest.raises(OptionError, match="split must be one of"):
         bvh.build_tree_compiled(vertices, faces, "longest-axis")
+
+
+def test_any_array_layout_builds_the_same_tree_by_one_compiled_signature():
+    """build_tree_compiled takes arrays of any layout, dtype and writability
+    (converted to a Mesh's: C-contiguous, float64 and int64, read-only), so
+    numba compiles the build for one signature."""
+    vertices, faces = GENERATED["hull-60"]
+    expected = _arrays(bvh.build_tree(vertices, faces))
+    for v, f in ((vertices, faces), (np.asfortranarray(vertices), faces.astype(np.int32)),
+                 (vertices[::-1][::-1], faces[:, ::-1][:, ::-1])):
+        _assert_same_bits(expected, _arrays(bvh.build_tree_compiled(v, f)), v.flags)
+    assert len(bvh.build_kernels().build_tree_of.signatures) == 1
 
 
 def test_the_compiled_split_ties_volumes_as_the_readable_one():
