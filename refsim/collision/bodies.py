@@ -57,6 +57,7 @@ BOOLEAN_BATCH = 256
 EXACT_QUERY = Tier("exact collision query",
                    ("refsim.collision._numba_kernels:exact_query",
                     "refsim.collision._numba_kernels:exact_collide",
+                    "refsim.collision._numba_build:frame_tree_arrays",
                     "refsim.collision._numba_build:build_tree",
                     "refsim.collision._numba_build:frame_boxes"), compile_seconds=60.0)
 
