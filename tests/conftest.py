@@ -58,16 +58,21 @@ def once_per_session(shared: Path, name: str, build):
     return pickle.loads(value_file.read_bytes())
 
 
-@pytest.fixture(scope="session")
-def shipped_matrix(tmp_path_factory, worker_id):
+def shipped_matrix_in(shared: Path):
     """``(matrix, results, pages)``: every shipped engine through the
     conformance kit, ``MATRIX_CASES`` cases per set from ``MATRIX_SEED``,
-    its pages written to the directory ``pages``; once per session."""
+    its pages written to the directory ``pages``; made once per session
+    in the shared directory ``shared`` (:func:`once_per_session`)."""
     from refsim.conformance.matrix import run_matrix
 
     def build(directory):
         return run_matrix(cases=MATRIX_CASES, seed=MATRIX_SEED, out_dir=directory)
 
-    shared = shared_directory(tmp_path_factory, worker_id)
     matrix, results = once_per_session(shared, "shipped-matrix", build)
     return matrix, results, shared / "shipped-matrix"
+
+
+@pytest.fixture(scope="session")
+def shipped_matrix(tmp_path_factory, worker_id):
+    """:func:`shipped_matrix_in` the session's shared directory."""
+    return shipped_matrix_in(shared_directory(tmp_path_factory, worker_id))

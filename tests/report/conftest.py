@@ -19,7 +19,13 @@ import pytest
 
 from refsim.report import build
 from refsim.report.section import EVERY_ITEM, to_json
-from tests.conftest import MATRIX_CASES, MATRIX_SEED, once_per_session, shared_directory
+from tests.conftest import (
+    MATRIX_CASES,
+    MATRIX_SEED,
+    once_per_session,
+    shared_directory,
+    shipped_matrix_in,
+)
 
 #: Where the quick report's entries' records are kept, beside its page.
 ENTRY_RECORDS = "entry-records.json"
@@ -56,13 +62,15 @@ def without_timings(value, patterns, path=()):
 
 
 @pytest.fixture(scope="session")
-def quick_report(tmp_path_factory, worker_id, shipped_matrix):
+def quick_report(tmp_path_factory, worker_id):
     """``(out_dir, html, results)`` of ``refsim report --quick``.
 
     Its conformance matrix is the session's shared one
-    (``shipped_matrix``, tests/conftest.py: the quick report's cases and
+    (``shipped_matrix_in``, tests/conftest.py: the quick report's cases and
     seed, pages copied into the report's folder), not a second run of
-    every engine. The report measures it through an in-process sweep
+    every engine; asked for only when the report reaches it, so that a
+    worker making the report does not wait from its start for the worker
+    making the matrix. The report measures it through an in-process sweep
     (``Run.sweep_options``), which gives the same cells as the direct run,
     timings aside: tests/report/test_report_sweeps.py and
     tests/conformance/test_shards.py hold the two equal."""
@@ -71,7 +79,7 @@ def quick_report(tmp_path_factory, worker_id, shipped_matrix):
     run_matrix = conformance_matrix.run_matrix
 
     def shared_matrix(specs=None, *, cases, seed=0, out_dir=None, only=None, **options):
-        kept, results, pages = shipped_matrix
+        kept, results, pages = shipped_matrix_in(shared)
         if specs is not None or only is not None or (cases, seed) != (MATRIX_CASES, MATRIX_SEED):
             return run_matrix(specs, cases=cases, seed=seed, out_dir=out_dir, only=only,
                               **options)
@@ -95,6 +103,7 @@ def quick_report(tmp_path_factory, worker_id, shipped_matrix):
         kept = {name: records_without_timings(run.get(name)) for name in run._records}
         (out / ENTRY_RECORDS).write_text(json.dumps(kept, sort_keys=True))
 
-    out = shared_directory(tmp_path_factory, worker_id) / "quick-report"
-    once_per_session(out.parent, out.name, build_quick)
+    shared = shared_directory(tmp_path_factory, worker_id)
+    out = shared / "quick-report"
+    once_per_session(shared, out.name, build_quick)
     return out, (out / "index.html").read_text(), json.loads((out / "results.json").read_text())
