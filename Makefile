@@ -29,7 +29,7 @@ docs: $(STAMP)
 	$(SPHINX) -b doctest docs/_build/doctest
 	$(SPHINX) -b html docs/_build/html
 
-# The quick report (about a minute and a half); report-full measures everything, its
+# The quick report (about two minutes); report-full measures everything, its
 # sweeps on two processes (about twelve minutes on two cores).
 report: $(STAMP)
 	$(BIN)/refsim report
