@@ -23,7 +23,8 @@ GEOMETRY = {"fcl": ("triangles", "pairs", "collide"),
             "drake-hydroelastic": ("rigid",)}
 
 #: The expected failures each engine's declarations turn into xfails at
-#: 40 cases, seed 0 (measured; each reason is in refsim/conformance/expected/).
+#: the shared matrix's 20 cases, seed 0 (tests/conftest.py; measured, the
+#: same as at 40; each reason is in refsim/conformance/expected/).
 XFAILED = {
     "refsim-seed": {"rigid.apex_ratio", "rigid.no_spin", "rigid.oblique_bounce",
                     "rigid.spin_to_rest", "rigid.free_rotation", "rigid.off_centre",
@@ -51,8 +52,8 @@ XFAILED = {
 NOT_POSED = {"refsim-seed": {"rigid.incline"}}
 
 
-def test_matrix_has_the_shipped_engines_and_every_check(shipped_run):
-    matrix, results, _ = shipped_run
+def test_matrix_has_the_shipped_engines_and_every_check(shipped_matrix):
+    matrix, results, _ = shipped_matrix
     assert tuple(SHIPPED_ENGINES) == SHIPPED
     assert matrix.engines == SHIPPED
     assert matrix.checks == CHECK_KEYS
@@ -66,8 +67,8 @@ def test_matrix_has_the_shipped_engines_and_every_check(shipped_run):
             assert (cell is None) == (check.split(".")[0] not in caps), (engine, check)
 
 
-def test_each_engine_fails_only_what_it_declares(shipped_run):
-    matrix, _, _ = shipped_run
+def test_each_engine_fails_only_what_it_declares(shipped_matrix):
+    matrix, _, _ = shipped_matrix
     for engine in SHIPPED:
         statuses = {check: matrix.cell(check, engine).status for check in CHECK_KEYS
                     if matrix.cell(check, engine) is not None}
@@ -79,8 +80,8 @@ def test_each_engine_fails_only_what_it_declares(shipped_run):
     assert reason.startswith("cannot pose: ") and "world.mu" in reason
 
 
-def test_refsim_engines_pass_everything_but_documented_divergences(shipped_run):
-    _, results, _ = shipped_run
+def test_refsim_engines_pass_everything_but_documented_divergences(shipped_matrix):
+    _, results, _ = shipped_matrix
     corrected = results["refsim-corrected"]
     seed = results["refsim-seed"]
     for result in (corrected, seed):
@@ -131,8 +132,8 @@ def test_refsim_engines_pass_everything_but_documented_divergences(shipped_run):
     assert all(abs(p - 4.0) < 0.15 for p in orders.values()), orders
 
 
-def test_float_engines_fail_only_on_degenerate_input(shipped_run):
-    _, results, _ = shipped_run
+def test_float_engines_fail_only_on_degenerate_input(shipped_matrix):
+    _, results, _ = shipped_matrix
     for engine, key in (("fcl", "triangles.agreement"), ("fcl", "pairs.agreement"),
                         ("fcl", "collide.agreement"), ("trimesh", "collide.agreement"),
                         ("trimesh", "aabb.encloses")):
@@ -140,8 +141,8 @@ def test_float_engines_fail_only_on_degenerate_input(shipped_run):
         assert check.failed > 0 and "bug" not in check.classes, (engine, key, check.classes)
 
 
-def test_rigid_oracles_measured_against_the_analytic_answers(shipped_run):
-    _, results, _ = shipped_run
+def test_rigid_oracles_measured_against_the_analytic_answers(shipped_matrix):
+    _, results, _ = shipped_matrix
     mujoco, pybullet = results["mujoco"], results["pybullet"]
     for result in (mujoco, pybullet):
         for scene, m in result.check("rigid.apex_ratio").measured.items():
@@ -171,8 +172,8 @@ def test_rigid_oracles_measured_against_the_analytic_answers(shipped_run):
         assert 0.015 < free["momentum_drift"] < 0.04, result.engine
 
 
-def test_divergences_are_the_xfails_with_their_reasons(shipped_run):
-    matrix, _, _ = shipped_run
+def test_divergences_are_the_xfails_with_their_reasons(shipped_matrix):
+    matrix, _, _ = shipped_matrix
     found = {(d.engine, d.check) for d in matrix.divergences}
     assert found == {(e, c) for e, checks in XFAILED.items() for c in checks}
     for d in matrix.divergences:
@@ -184,8 +185,8 @@ def _not_strict(token):
     raise AssertionError(f"{token} in a JSON record: not strict JSON")
 
 
-def test_pages_and_json_are_written_and_self_contained(shipped_run):
-    matrix, results, out = shipped_run
+def test_pages_and_json_are_written_and_self_contained(shipped_matrix):
+    matrix, results, out = shipped_matrix
     schema = conformance_schema()
     data = json.loads((out / "matrix.json").read_text())
     assert data["engines"] == list(SHIPPED) and data["checks"] == list(CHECK_KEYS)
