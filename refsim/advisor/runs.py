@@ -37,15 +37,24 @@ A divergence (:class:`refsim.errors.DivergenceError`) is a result, not a
 failure: the record keeps the samples before it and says where it happened.
 
 The counts and the response speeds come from :class:`CountingSimulation`,
-a subclass that counts in two of the loop's stage methods (the narrow phase
+a subclass that counts in two of the step's stage methods (the narrow phase
 and the box update) and copies the velocities in a third (the divergence
 check, after the motion and before the contacts), and otherwise leaves the
-step untouched, so the trajectory is the loop's own, bit for bit (a test
-checks it against :func:`refsim.simulate`).
+step untouched, so the trajectory is the simulation's own, bit for bit (a
+test checks it against :func:`refsim.simulate`).
+
+Where the compiled loop runs the scene (:attr:`refsim.Simulation.loop`),
+the run goes a sample at a time through it, and a sample in which a
+contact began (or the run diverged) is taken again from its start one
+readable step at a time, for the events' response speeds
+(:func:`_sample_interval`). The loop and the readable step give the same
+bits, so the record is the same either way (a test compares them field
+for field); only the wall time differs.
 
 Cost: the simulation's own (see :mod:`refsim.dynamics.simulation`) times
-``repeats``, plus O(B) per step for the velocities before the responses and
-O(B) per sample.
+``repeats``, plus O(B) per step for the velocities before the responses
+(on the readable steps), O(B) per sample, and the samples with an onset
+twice.
 """
 
 from __future__ import annotations
@@ -60,6 +69,7 @@ import numpy as np
 from refsim.advisor.records import Fidelity
 from refsim.bundled import models_dir
 from refsim.dynamics.simulation import BATCH_VERTICES, Simulation
+from refsim.dynamics.start import start_kernel
 from refsim.errors import DivergenceError, StateError, check_count
 from refsim.scenes.loader import SHAPE_KEYS, scene_from_dict
 from refsim.scenes.schema import Scene
@@ -146,8 +156,8 @@ class CountingSimulation(Simulation):
     linear scan, the walk's for the incremental update).
     """
 
-    def __init__(self, scene: Scene):
-        super().__init__(scene)
+    def __init__(self, scene: Scene, kernel: str | None = None):
+        super().__init__(scene, kernel=kernel)
         self.narrow_phase_calls = 0
         self.box_visits = 0
         self._batched_visits = sum(b.mesh.n_vertices for b in self.bodies
@@ -212,9 +222,19 @@ def measure_run(*, seed: int, scene: dict, solver: str, step: float, level: str,
     return record
 
 
-def _run(scene: Scene, n_steps: int, every: int) -> dict:
-    """One simulation, sampled every ``every`` steps (see :func:`measure_run`)."""
-    sim = CountingSimulation(scene)
+def _run(scene: Scene, n_steps: int, every: int, kernel: str | None = "start") -> dict:
+    """One simulation, sampled every ``every`` steps (see :func:`measure_run`).
+
+    ``kernel``: the simulation's (:class:`refsim.Simulation`); "start", the
+    default, asks :func:`refsim.dynamics.start.start_kernel` (a short run
+    does not wait for the loop's compile). On the compiled loop the run
+    goes a sample at a time through :func:`_sample_interval`; else one
+    :meth:`~refsim.Simulation.step` at a time. The record is the same,
+    field for field, either way (but ``wall_seconds``).
+    """
+    if kernel == "start":
+        kernel = start_kernel(scene, n_steps)
+    sim = CountingSimulation(scene, kernel=kernel)
     B = len(sim.bodies)
     index = {name: i for i, name in enumerate(sim.names)}
     samples = n_steps // every + 1
@@ -232,6 +252,15 @@ def _run(scene: Scene, n_steps: int, every: int) -> dict:
         orientation[j] = sim.R
         energy[j] = sim.energy().sum()
 
+    def steps(count: int) -> None:
+        for _ in range(count):
+            seen = len(sim.events)
+            sim.step()
+            if len(sim.events) > seen:
+                _note_events(sim, seen, radius, index, events)
+
+    # the loop counts no box visits of a tracker: such runs take the steps
+    in_loop = sim.loop is None and not sim._tracked
     sample(0)
     taken = 1
     diverged = None
@@ -239,14 +268,13 @@ def _run(scene: Scene, n_steps: int, every: int) -> dict:
         # overflow on the way to a divergence is reported by the loop's
         # check stage; numpy's own warnings of it are silenced (as in Simulation.run)
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            for _ in range(n_steps):
-                seen = len(sim.events)
-                sim.step()
-                if len(sim.events) > seen:
-                    _note_events(sim, seen, radius, index, events)
-                if sim.steps % every == 0:
-                    sample(taken)
-                    taken += 1
+            while sim.steps < n_steps:
+                if in_loop:
+                    _sample_interval(sim, every, steps)
+                else:
+                    steps(every)
+                sample(taken)
+                taken += 1
     except DivergenceError as exc:
         diverged = {"step": exc.step, "time": exc.time, "message": exc.message}
     stages = SOLVERS[scene.integration.solver].stages
@@ -258,6 +286,36 @@ def _run(scene: Scene, n_steps: int, every: int) -> dict:
         "narrow_phase_calls": sim.narrow_phase_calls, "box_visits": sim.box_visits,
         "diverged": diverged,
     }
+
+
+def _sample_interval(sim: CountingSimulation, count: int, steps) -> None:
+    """``count`` steps of ``sim`` on the compiled loop
+    (:meth:`~refsim.Simulation.advance`), kept when they began no contact
+    and raised no divergence; else taken again from the same state one
+    :meth:`~refsim.Simulation.step` at a time by ``steps(count)``, which
+    notes each event's response speed (the velocities before the
+    responses are seen in the check stage of a readable step only). The
+    loop and the steps give the same bits, so the retaken steps repeat the
+    same trajectory.
+
+    The counts: the loop's steps visit every vertex of the batched bodies
+    (the run has no tracker: :func:`_run`) and call no narrow phase (a
+    step whose boxes overlap at a triangle level is handed back to
+    :meth:`~refsim.Simulation.step`, which counts its calls).
+    """
+    start = sim.snapshot()
+    seen, calls, visits, looped = (len(sim.events), sim.narrow_phase_calls, sim.box_visits,
+                                   sim.loop_steps)
+    try:
+        sim.advance(count)
+        if len(sim.events) == seen:
+            sim.box_visits += sim._batched_visits * (sim.loop_steps - looped)
+            return
+    except DivergenceError:
+        pass                         # the steps below raise it again, events noted
+    sim.restore(start)
+    sim.narrow_phase_calls, sim.box_visits = calls, visits
+    steps(count)
 
 
 def _note_events(sim: CountingSimulation, seen: int, radius: list, index: dict,
