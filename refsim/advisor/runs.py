@@ -44,17 +44,16 @@ step untouched, so the trajectory is the simulation's own, bit for bit (a
 test checks it against :func:`refsim.simulate`).
 
 Where the compiled loop runs the scene (:attr:`refsim.Simulation.loop`),
-the run goes a sample at a time through it, and a sample in which a
-contact began (or the run diverged) is taken again from its start one
-readable step at a time, for the events' response speeds
-(:func:`_sample_interval`). The loop and the readable step give the same
-bits, so the record is the same either way (a test compares them field
-for field); only the wall time differs.
+the run goes through it a sample at a time, but for the steps that begin
+a contact: each is taken by the readable step, for its events' response
+speeds (:func:`_sample_interval`). The loop and the readable step give
+the same bits, so the record is the same either way (a test compares them
+field for field); only the wall time differs.
 
 Cost: the simulation's own (see :mod:`refsim.dynamics.simulation`) times
 ``repeats``, plus O(B) per step for the velocities before the responses
-(on the readable steps), O(B) per sample, and the samples with an onset
-twice.
+(on the readable steps), O(B) per sample; on the loop, the steps before
+an onset within a sample are taken twice.
 """
 
 from __future__ import annotations
@@ -289,33 +288,52 @@ def _run(scene: Scene, n_steps: int, every: int, kernel: str | None = "start") -
 
 
 def _sample_interval(sim: CountingSimulation, count: int, steps) -> None:
-    """``count`` steps of ``sim`` on the compiled loop
-    (:meth:`~refsim.Simulation.advance`), kept when they began no contact
-    and raised no divergence; else taken again from the same state one
-    :meth:`~refsim.Simulation.step` at a time by ``steps(count)``, which
-    notes each event's response speed (the velocities before the
-    responses are seen in the check stage of a readable step only). The
-    loop and the steps give the same bits, so the retaken steps repeat the
-    same trajectory.
+    """``count`` steps of ``sim``: on the compiled loop
+    (:meth:`~refsim.Simulation.advance`), but for each step that begins a
+    contact, taken by ``steps(1)`` (one readable
+    :meth:`~refsim.Simulation.step`, which notes the events' response
+    speeds: the velocities before the responses are seen in the check
+    stage of a readable step only).
+
+    The loop does not know beforehand which step begins a contact: it runs
+    to the end of the interval, and when a contact began, the simulation
+    goes back to where it was (:meth:`~refsim.Simulation.restore`), runs
+    the loop again up to the step before the first onset, takes that step
+    readable, and goes on from there. A divergence sends the rest of the
+    interval to ``steps``, which raises it at the same step. The loop and
+    the readable step give the same bits, so the steps taken again repeat
+    the same trajectory.
 
     The counts: the loop's steps visit every vertex of the batched bodies
     (the run has no tracker: :func:`_run`) and call no narrow phase (a
     step whose boxes overlap at a triangle level is handed back to
     :meth:`~refsim.Simulation.step`, which counts its calls).
     """
-    start = sim.snapshot()
-    seen, calls, visits, looped = (len(sim.events), sim.narrow_phase_calls, sim.box_visits,
-                                   sim.loop_steps)
-    try:
-        sim.advance(count)
-        if len(sim.events) == seen:
-            sim.box_visits += sim._batched_visits * (sim.loop_steps - looped)
+    end = sim.steps + count
+
+    def advance(n: int) -> None:
+        looped = sim.loop_steps
+        sim.advance(n)
+        sim.box_visits += sim._batched_visits * (sim.loop_steps - looped)
+
+    while sim.steps < end:
+        start = sim.snapshot()
+        seen, calls, visits = len(sim.events), sim.narrow_phase_calls, sim.box_visits
+        try:
+            advance(end - sim.steps)
+            if len(sim.events) == seen:
+                return
+            onset = sim.events[seen].step            # the steps count after that step
+        except DivergenceError:
+            onset = None
+        sim.restore(start)
+        sim.narrow_phase_calls, sim.box_visits = calls, visits
+        if onset is None:
+            steps(end - sim.steps)
             return
-    except DivergenceError:
-        pass                         # the steps below raise it again, events noted
-    sim.restore(start)
-    sim.narrow_phase_calls, sim.box_visits = calls, visits
-    steps(count)
+        if onset - 1 > sim.steps:
+            advance(onset - 1 - sim.steps)           # no contact begins before the onset
+        steps(1)
 
 
 def _note_events(sim: CountingSimulation, seen: int, radius: list, index: dict,
