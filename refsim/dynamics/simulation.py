@@ -378,6 +378,14 @@ class Simulation:
         return int(self._counters[slot.C_LOOP_STEPS])
 
     @property
+    def loop_body_steps(self) -> int:
+        """Of :attr:`loop_steps`, those whose body stage (narrow phase and
+        body response) ran in Python between two calls of the loop
+        (:meth:`CompiledLoop.body_stage
+        <refsim.dynamics.compiled_loop.CompiledLoop.body_stage>`)."""
+        return int(self._counters[slot.C_BODY_STEPS])
+
+    @property
     def events(self) -> list[Event]:
         """The onsets of wall and body contacts so far (the compiled loop's
         last ones added first, :meth:`CompiledLoop.note_events

@@ -106,10 +106,10 @@ def test_spinning_cube_scene_bit_for_bit():
 
 
 def test_exact_level_hands_contact_steps_back_bit_for_bit():
-    # the corrected response: the loop takes the flight and hands back every
-    # step whose boxes overlap
+    # the corrected response: the loop takes every step, and runs the body
+    # stage of each step whose boxes overlap between two of its calls
     readable, compiled = _pair(_two_cubes_at_level_exact(), 1500, every=3)
-    assert 0 < compiled.loop_steps < 1500
+    assert compiled.loop_steps == 1500 and 0 < compiled.loop_body_steps < 1500
     _assert_same(readable, compiled)
     assert any(e.kind == "body" for e in compiled.events)
 
@@ -186,7 +186,8 @@ def test_one_step_per_call_is_one_call_and_the_readable_step_bit_for_bit(case):
     assert calls.loop_steps == whole.loop_steps > 0
     assert readable.events                    # wall contacts at least
     if case == "exact level":
-        assert calls.loop_steps < n and any(e.kind == "body" for e in calls.events)
+        assert calls.loop_steps == n and any(e.kind == "body" for e in calls.events)
+        assert calls.loop_body_steps == whole.loop_body_steps > 0
 
 
 def test_event_rows_left_by_an_interrupted_call_are_added_once():
@@ -244,11 +245,13 @@ def test_bundled_scenes_bit_for_bit(name):
 @pytest.mark.parametrize("rotation", ["off", "seed"])
 def test_cubes_at_level_exact_hand_back_bit_for_bit(rotation):
     # the 40 cubes' contacts, found exactly: every step with overlapping
-    # boxes goes back to the readable stages, walls and spin included
+    # boxes runs its body stage between two calls of the loop, walls and
+    # spin included
     scene = cubes_scene(40, rotation, seed=9)
     scene = replace(scene, collision=replace(scene.collision, level="exact"))
     readable, compiled = _pair(scene, 800, every=9)
-    assert compiled.loop is None and 0 < compiled.loop_steps < 800
+    assert compiled.loop is None and compiled.loop_steps == 800
+    assert 0 < compiled.loop_body_steps < 800
     _assert_same(readable, compiled)
     assert {e.kind for e in compiled.events} == {"wall", "body"}
 
@@ -457,12 +460,14 @@ def test_each_rotation_with_each_wall_response_bit_for_bit(rotation, wall_respon
 @pytest.mark.parametrize("level", ["aabb", "exact"])
 def test_impulse_body_contacts_are_handed_back_bit_for_bit(level):
     # the corrected body response is the readable step's: each step with
-    # overlapping boxes goes back, walls and the exact rotation included
+    # overlapping boxes runs its body stage between two calls of the loop,
+    # walls and the exact rotation included
     scene = cubes_scene(40, "impulse", seed=13)
     scene = replace(scene, collision=replace(scene.collision, level=level),
                     dynamics=replace(scene.dynamics, body_response="impulse"))
     readable, compiled = _pair(scene, 800, every=9)
-    assert compiled.loop is None and 0 < compiled.loop_steps < 800
+    assert compiled.loop is None and compiled.loop_steps == 800
+    assert 0 < compiled.loop_body_steps < 800
     _assert_same(readable, compiled)
     assert {e.kind for e in compiled.events} == {"wall", "body"}
 
