@@ -43,23 +43,37 @@ What it runs (one step, the stages of the readable outline, same order):
 6. broad-phase  every pair of boxes, in the sorted order of
                 :func:`refsim.collision.broad_phase.overlapping_pairs_sweep`;
 8. response     at level "aabb", the seed's exchange,
-                :func:`refsim.dynamics.body_response.exchange_velocities_seed`.
+                :func:`refsim.dynamics.body_response.exchange_velocities_seed`;
+                any other level or body response: stages 7 and 8 in Python
+                between two calls (``STOP_BODY_STAGE`` below).
 
 Each is written in the readable function's operations and order (each
 product and sum rounded once, no fused multiply-add: numba compiles without
 fast-math), so the loop and the readable step agree bit for bit;
 tests/dynamics/test_compiled_loop.py checks whole trajectories.
 
-Hand-back. The kernel returns to Python, with the state of the last whole
-step, when
+Hand-back. The kernel returns to Python before a step is whole when
 
-- ``STOP_READABLE``: a step needs what the kernel does not do (a pair of
-  boxes overlaps and the scene's level or body response is not the seed's
-  exchange at level "aabb"; or the energy bound is above half the
-  divergence limit, or not finite). The state is restored to the start of
-  that step, and the caller takes it with the readable step, which decides
-  (and raises DivergenceError where it must);
-- ``STOP_EVENTS``: the event buffer cannot hold another step's events.
+- ``STOP_BODY_STAGE``: a pair of boxes overlaps and the scene's level or
+  body response is not the seed's exchange at level "aabb"
+  (``BODY_HAND_BACK``). Stages 1-6 of the step are done and kept; the
+  step's pairs are in ``pairs``, and, with the corrected wall response,
+  the wall contacts its island solve needs in ``wall_r`` and ``wall_at``
+  and the wall impulse records in ``impulse_now``. The step's contacts and
+  events are not noted yet and it is not counted:
+  :meth:`refsim.dynamics.compiled_loop.CompiledLoop.body_stage` runs the
+  narrow phase and body response of :mod:`refsim.dynamics.body_stage` (the
+  readable step's own, with their compiled kernels), then
+  :func:`finish_body_step` notes and counts the step, and the loop is
+  called again. The exact query, the contact points and the island solve
+  stay out of this kernel: compiled into it, they made its first compile
+  take several times as long (docs/decisions/body-contact-speed.md);
+- ``STOP_READABLE``: the energy bound is above half the divergence limit,
+  or not finite. The state is restored to the start of that step, and the
+  caller takes it with the readable step, which decides (and raises
+  DivergenceError where it must);
+- ``STOP_EVENTS``: the event buffer cannot hold another step's events
+  (the state is that of the last whole step).
 
 The energy check is conservative: the readable check sums with ``einsum``,
 whose order differs, so the kernel hands back at half the limit instead of

@@ -11,7 +11,10 @@ module adds is bookkeeping: the arrays the kernel reads (tableau, masses,
 vertices), packed with the simulation's state in three flat arrays
 (:mod:`refsim.dynamics.loop_layout`), the contacts as flags instead of a
 set, and the kernel's event rows turned into
-:class:`~refsim.dynamics.trajectory.Event` in the readable order.
+:class:`~refsim.dynamics.trajectory.Event` in the readable order; and the
+body stage of a step whose boxes overlap when the scene's body stage is
+not the loop's (:meth:`CompiledLoop.body_stage`: the readable narrow
+phase and body response on the kernel's pairs, between two calls).
 
 Why a loop and not faster stages: the readable step's cost is mostly the
 interpreter's calls between little arithmetic; stage kernels keep the calls,
@@ -56,8 +59,10 @@ def loop_support(sim: Simulation) -> str | None:
     responses (the seed's, with either wall speed, and the corrected
     impulses), any solver, linear or quadratic drag, ``world.mu`` and the
     restitution threshold, and body-body contacts at every level but
-    "sphere" (the seed's exchange at level "aabb" in the loop; any other
-    level or response hands the steps with overlapping boxes back). The
+    "sphere" (the seed's exchange at level "aabb" in the loop; at any other
+    level or with any other response, a step with overlapping boxes runs
+    its narrow phase and body response in Python between two calls of the
+    loop, :meth:`CompiledLoop.body_stage`, and stays the loop's step). The
     loads of :mod:`refsim.dynamics.loads` beyond these (a tilted gravity,
     forces, torques, fixed bodies, missing walls, coefficients per body)
     run on the readable step.
@@ -489,8 +494,7 @@ class CompiledLoop:
         if sim.level != "aabb":
             hits = sim._narrow_phase(candidates)
             timer.lap("narrow-phase")
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            sim._body_response(hits, set())      # the contacts: every pair in hits
+        sim._body_response(hits, set())          # the contacts: every pair in hits
         timer.lap("body-response")
         rows = np.array(hits, np.int64).reshape(-1, 2)
         found = np.zeros((len(rows), impulse.IMPULSE_RECORD))
@@ -522,6 +526,9 @@ class CompiledLoop:
         sim = self.sim
         names = sim.names
         rows = self.events[:pending].tolist()
+        # the records as Python floats: impulse_and_point's tests and quotients
+        # are the same IEEE operations on them, at a fraction of the cost
+        data = self.event_data[:pending].tolist()
         found = []
         for row, (step, kind, i, j) in enumerate(rows):
             if kind == 0:
@@ -534,7 +541,7 @@ class CompiledLoop:
         new = []
         for step, body, other, kind, row in found[noted:]:
             n = step + 1
-            J, point = impulse.impulse_and_point(self.event_data[row])
+            J, point = impulse.impulse_and_point(data[row])
             new.append(Event(kind=kind, step=n, time=n * sim.h, body=body, other=other,
                              impulse=J, point=point))
         listed.extend(new)
