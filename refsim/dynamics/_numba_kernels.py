@@ -43,23 +43,37 @@ What it runs (one step, the stages of the readable outline, same order):
 6. broad-phase  every pair of boxes, in the sorted order of
                 :func:`refsim.collision.broad_phase.overlapping_pairs_sweep`;
 8. response     at level "aabb", the seed's exchange,
-                :func:`refsim.dynamics.body_response.exchange_velocities_seed`.
+                :func:`refsim.dynamics.body_response.exchange_velocities_seed`;
+                any other level or body response: stages 7 and 8 in Python
+                between two calls (``STOP_BODY_STAGE`` below).
 
 Each is written in the readable function's operations and order (each
 product and sum rounded once, no fused multiply-add: numba compiles without
 fast-math), so the loop and the readable step agree bit for bit;
 tests/dynamics/test_compiled_loop.py checks whole trajectories.
 
-Hand-back. The kernel returns to Python, with the state of the last whole
-step, when
+Hand-back. The kernel returns to Python before a step is whole when
 
-- ``STOP_READABLE``: a step needs what the kernel does not do (a pair of
-  boxes overlaps and the scene's level or body response is not the seed's
-  exchange at level "aabb"; or the energy bound is above half the
-  divergence limit, or not finite). The state is restored to the start of
-  that step, and the caller takes it with the readable step, which decides
-  (and raises DivergenceError where it must);
-- ``STOP_EVENTS``: the event buffer cannot hold another step's events.
+- ``STOP_BODY_STAGE``: a pair of boxes overlaps and the scene's level or
+  body response is not the seed's exchange at level "aabb"
+  (``BODY_HAND_BACK``). Stages 1-6 of the step are done and kept; the
+  step's pairs are in ``pairs``, and, with the corrected wall response,
+  the wall contacts its island solve needs in ``wall_r`` and ``wall_at``
+  and the wall impulse records in ``impulse_now``. The step's contacts and
+  events are not noted yet and it is not counted:
+  :meth:`refsim.dynamics.compiled_loop.CompiledLoop.body_stage` runs the
+  narrow phase and body response of :mod:`refsim.dynamics.body_stage` (the
+  readable step's own, with their compiled kernels), then
+  :func:`finish_body_step` notes and counts the step, and the loop is
+  called again. The exact query, the contact points and the island solve
+  stay out of this kernel: compiled into it, they made its first compile
+  take several times as long (docs/decisions/body-contact-speed.md);
+- ``STOP_READABLE``: the energy bound is above half the divergence limit,
+  or not finite. The state is restored to the start of that step, and the
+  caller takes it with the readable step, which decides (and raises
+  DivergenceError where it must);
+- ``STOP_EVENTS``: the event buffer cannot hold another step's events
+  (the state is that of the last whole step).
 
 The energy check is conservative: the readable check sums with ``einsum``,
 whose order differs, so the kernel hands back at half the limit instead of
@@ -111,7 +125,7 @@ from refsim.dynamics.walls import bounce_advance, crossing_time, deepest_speed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "f3da3ba0dab86aeb"
+SOURCES_DIGEST = "80fe80b57f536281"
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -119,11 +133,16 @@ DONE = 0
 STOP_READABLE = 1
 #: The event buffer is nearly full; call again after reading it.
 STOP_EVENTS = 2
+#: A step's boxes overlap and the scene's body stage is not the loop's:
+#: stages 1-6 of the step are done, its pairs are in ``PAIRS``, and Python
+#: runs the body stage and ends the step (:func:`finish_body_step`).
+STOP_BODY_STAGE = 3
 
 #: Body-body modes of the loop.
 BODY_NONE = 0           # no body-body stage (one body, level "none", response "off")
 BODY_EXCHANGE = 1       # level "aabb", the seed's exchange (S8): done in the loop
-BODY_HAND_BACK = 2      # any other: a step with an overlapping pair of boxes goes back
+BODY_HAND_BACK = 2      # any other: a step with an overlapping pair of boxes stops the
+                        # kernel after its broad phase (STOP_BODY_STAGE)
 
 #: Rotation models of the loop (the scene's ``dynamics.rotation``).
 ROTATION_OFF = 0
@@ -155,7 +174,7 @@ def advance(n_steps, floats, ints, flags):
     counters = _view1(ints, ints, slot.COUNTERS)
     settings = _view1(ints, ints, slot.SETTINGS)
     scalars = _view1(floats, ints, slot.SCALARS)
-    done, n_events, stop = _steps(
+    done, n_events, stop, n_pairs = _steps(
         n_steps, counters[slot.C_STEPS], counters[slot.C_PENDING],
         scalars[slot.S_H], _view2(floats, ints, slot.HA), _view1(floats, ints, slot.HB),
         scalars[slot.S_GRAVITY], _view1(floats, ints, slot.DRAG_RATE),
@@ -187,12 +206,14 @@ def advance(n_steps, floats, ints, flags):
         _view1(ints, ints, slot.PAST), _view2(floats, ints, slot.R_A),
         _view2(floats, ints, slot.P), _view1(floats, ints, slot.N),
         _view2(floats, ints, slot.ORIGIN), _view2(flags, ints, slot.NOW_WALLS),
-        _view2(ints, ints, slot.PAIRS))
+        _view2(ints, ints, slot.PAIRS), _view2(floats, ints, slot.WALL_R),
+        _view3(ints, ints, slot.WALL_AT))
     counters[slot.C_STEPS] += done
     counters[slot.C_LOOP_STEPS] += done
     counters[slot.C_PENDING] = n_events
     counters[slot.C_LEFT] = n_steps - done
     counters[slot.C_STOP] = stop
+    counters[slot.C_PAIRS] = n_pairs
     return 0 if done == n_steps and n_events == 0 else 1
 
 
@@ -241,12 +262,13 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
            x, v, w, R, lo, hi, walls, bodies, events, tracked, tracker_rows, trackers_f,
            trackers_i, impulse_now, event_data,
            y, y_i, K, x0, v0, w0, R0, A, E, L, corr, past, r_a, P, n, origin, now_walls,
-           pairs):
+           pairs, wall_r, wall_at):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation.step`, up to
-    ``n_steps`` times, in place; returns ``(steps, events, stop)`` (module
-    docstring: the readable function of each stage, and the hand-back),
-    ``events`` the number of event rows now written (:func:`advance`
-    unpacks the arguments).
+    ``n_steps`` times, in place; returns ``(steps, events, stop, pairs)``
+    (module docstring: the readable function of each stage, and the
+    hand-back), ``events`` the number of event rows now written, ``pairs``
+    the rows of ``pairs`` of a step stopped with ``STOP_BODY_STAGE``
+    (:func:`advance` unpacks the arguments).
 
     Parameters (B bodies, s solver stages; float64 unless said)
     ----------
@@ -299,15 +321,23 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
         ``r_a`` (M, 3), impulses ``P`` (M, 4) and normal ``n`` (3,), M the
         most vertices of a body; ``origin`` (B, 3); ``now_walls`` (B, 6)
         bool; ``pairs`` (max(B (B - 1) / 2, 1), 2) int64
+    wall_r, wall_at : with the corrected wall response and ``BODY_HAND_BACK``,
+        the step's wall contacts as the readable wall stage leaves them in
+        ``Simulation._wall_contacts`` (every vertex past the wall, less the
+        centroid, before the push-back): those of body b's wall 2k (low) or
+        2k + 1 (high) are rows ``wall_at[b, wall, 0]`` on, ``wall_at[b,
+        wall, 1]`` of them (0: none), of ``wall_r`` (3 N, 3) float64, N the
+        vertices of all bodies (a body meets at most three walls a step)
     """
     B = x.shape[0]
     s = hb.shape[0]
     d = 3 * B
     per_step = 6 * B + B * (B - 1) // 2
     k_friction = 1.0 - friction
+    keep = wall_impulse and body_mode == BODY_HAND_BACK      # the wall contacts, for Python
     for step in range(n_steps):
         if n_events + per_step > events.shape[0]:
-            return step, n_events, STOP_EVENTS
+            return step, n_events, STOP_EVENTS, 0
         for b in range(B):
             for k in range(3):
                 x0[b, k] = x[b, k]
@@ -367,7 +397,7 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
                 + mass[b] * gravity * (x[b, 1] + half_size)
         if not (total <= 0.5 * energy_limit):
             _restore(x, v, w, R, x0, v0, w0, R0)
-            return step, n_events, STOP_READABLE
+            return step, n_events, STOP_READABLE, 0
 
         # 4. bounds: the linear scan, r_k = (R_k0 x + R_k1 y) + R_k2 z, + origin
         for b in range(B):
@@ -398,11 +428,14 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
 
         # 5. walls (S3, S7; S9's spin first with the seed's rotation; or the
         # corrected impulses)
+        kept = 0
         for b in range(B):
             for k in range(6):
                 now_walls[b, k] = False
                 for j in range(7):
                     impulse_now[b, k, j] = 0.0
+                if keep:
+                    wall_at[b, k, 1] = 0
             beyond = False
             for k in range(3):
                 if lo[b, k] < -half_size or hi[b, k] > half_size:
@@ -419,10 +452,11 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
                     corr[k] = (below if below > 0.0 else 0.0) - (above if above > 0.0 else 0.0)
             if wall_impulse:
                 _world_inertia(R[b], I_body_inv[b], E)
-                _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres,
-                              first_leaf, x, center, v, w, R, lo, hi, h, half_size, gravity,
-                              restitution, friction, threshold, iterations, inv_mass[b], E,
-                              past, r_a, P, n, L, A, impulse_now)
+                kept = _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres,
+                                     first_leaf, x, center, v, w, R, lo, hi, h, half_size,
+                                     gravity, restitution, friction, threshold, iterations,
+                                     inv_mass[b], E, past, r_a, P, n, L, A, impulse_now, keep,
+                                     wall_r, wall_at, kept)
             else:
                 if rotation_mode == ROTATION_SEED:
                     _wall_spin_seed(b, corr, vertices_t, first_vertex[b], first_vertex[b + 1],
@@ -457,9 +491,10 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
                         pairs[n_pairs, 1] = j
                         n_pairs += 1
             if n_pairs and body_mode == BODY_HAND_BACK:
-                _restore(x, v, w, R, x0, v0, w0, R0)        # the readable step redoes this one
-                return step, n_events, STOP_READABLE
-        # the wall contacts that began (committed only now: a hand-back above
+                # Python runs the body stage, then finish_body_step commits
+                # the step (its flags and events: none written yet)
+                return step, n_events, STOP_BODY_STAGE, n_pairs
+        # the wall contacts that began (committed only now: a stop above
         # leaves the previous step's flags)
         for b in range(B):
             for k in range(6):
@@ -495,7 +530,7 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
                                 event_data[n_events, c] = 0.0
                             n_events += 1
                     bodies[i, j] = now
-    return n_steps, n_events, DONE
+    return n_steps, n_events, DONE, 0
 
 
 #: Columns of ``tracker_rows`` (one row per tracked body): the number of
@@ -770,7 +805,7 @@ def _offsets(b, x, R, vertices_t, o, past, count, r_a):
 def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, first_leaf, x,
                   center, v, w, R, lo, hi, h, half_size, gravity, restitution, friction,
                   threshold, iterations, inv_mass, I_inv, past, r_a, P, n, v_contact,
-                  turn, impulse_now):
+                  turn, impulse_now, keep, wall_r, wall_at, kept):
     """Mirrors :meth:`refsim.dynamics.simulation.Simulation._wall_impulse` for
     body b, in place: for each crossed wall, the vertices past it (found by
     :func:`_vertices_past_wall`, world coordinates as
@@ -785,7 +820,11 @@ def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, fir
     :func:`~refsim.dynamics.walls.bounce_advance`, compiled from the same
     source), the box ``lo``, ``hi`` moving with the body. ``I_inv`` is the
     body's world inverse inertia; ``v_contact`` (3,) and ``turn`` (3, 3)
-    scratch."""
+    scratch. With ``keep``, each wall's vertices past it (offsets from the
+    centroid before the push-back, what the readable stage keeps in
+    ``Simulation._wall_contacts``) go to rows ``kept`` on of ``wall_r``,
+    their start and count to ``wall_at[b, wall]``; returns the rows of
+    ``wall_r`` used so far."""
     for k in range(3):
         if corr[k] == 0.0:
             continue
@@ -800,6 +839,14 @@ def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, fir
         # deepest contact moving into the wall faster than the threshold)
         # began at the deepest ones
         _offsets(b, x, R, vertices_t, o, past, count, r_a)
+        if keep:
+            side = 2 * k + (0 if low else 1)
+            wall_at[b, side, 0] = kept
+            wall_at[b, side, 1] = count
+            for i in range(count):
+                for j in range(3):
+                    wall_r[kept + i, j] = r_a[i, j]
+            kept += count
         u = _deepest_speed(r_a, count, k, low, v[b], w[b]) if count else 0.0
         if bounce or (u < -threshold if low else u > threshold):
             count = _deepest(b, k, low, wall, o[k], R, vertices_t, past, count)
@@ -822,3 +869,61 @@ def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, fir
         if tau > 0.0:
             _bounce_advance(x[b], v[b], v_contact, R[b], w[b], w[b, 0] - w0, w[b, 1] - w1,
                             w[b, 2] - w2, turn, lo[b], hi[b], k, low, a_k, tau)
+    return kept
+
+
+@numba.njit(cache=True, nogil=True)
+def finish_body_step(hits, records, walls, now_walls, bodies, impulse_now, events, event_data,
+                     counters):
+    """The end of a step the kernel stopped in with ``STOP_BODY_STAGE``,
+    after Python ran its body stage: what :func:`_steps` does after its
+    broad phase, with the pairs in contact ``hits`` (m, 2) int64 (rows
+    ``i < j``, in the order of the broad phase's rows) and ``records`` (m,
+    7) the impulse record of each (:func:`refsim.dynamics.impulse.contact_sum_python`,
+    zeros where no impulse acted). The wall contacts that began are noted
+    with ``impulse_now``'s records (which the body stage's island solve
+    added to), then the body contacts; the flags become the step's; the
+    step is counted (``C_STEPS``, ``C_LOOP_STEPS``, ``C_BODY_STEPS``; one
+    fewer ``C_LEFT``) with its event rows (``C_PENDING``).
+
+    One compiled call, so that a signal handled in Python finds the step
+    either not committed (its flags, events and counts those of the step
+    before; the caller restores the state) or committed whole."""
+    step = counters[slot.C_STEPS]
+    n_events = counters[slot.C_PENDING]
+    B = walls.shape[0]
+    for b in range(B):
+        for k in range(6):
+            if now_walls[b, k] and not walls[b, k]:
+                events[n_events, 0] = step
+                events[n_events, 1] = 0
+                events[n_events, 2] = b
+                events[n_events, 3] = k
+                for j in range(7):
+                    event_data[n_events, j] = impulse_now[b, k, j]
+                n_events += 1
+            walls[b, k] = now_walls[b, k]
+    q = 0
+    m = hits.shape[0]
+    for i in range(B):
+        for j in range(i + 1, B):
+            now = q < m and hits[q, 0] == i and hits[q, 1] == j
+            if now:
+                if not bodies[i, j]:
+                    events[n_events, 0] = step
+                    events[n_events, 1] = 1
+                    events[n_events, 2] = i
+                    events[n_events, 3] = j
+                    for c in range(7):
+                        event_data[n_events, c] = records[q, c]
+                    n_events += 1
+                q += 1
+            bodies[i, j] = now
+    counters[slot.C_STEPS] += 1
+    counters[slot.C_LOOP_STEPS] += 1
+    counters[slot.C_BODY_STEPS] += 1
+    counters[slot.C_PENDING] = n_events
+    counters[slot.C_LEFT] -= 1
+    counters[slot.C_STOP] = DONE
+    counters[slot.C_PAIRS] = 0
+    return q == m

@@ -11,7 +11,10 @@ module adds is bookkeeping: the arrays the kernel reads (tableau, masses,
 vertices), packed with the simulation's state in three flat arrays
 (:mod:`refsim.dynamics.loop_layout`), the contacts as flags instead of a
 set, and the kernel's event rows turned into
-:class:`~refsim.dynamics.trajectory.Event` in the readable order.
+:class:`~refsim.dynamics.trajectory.Event` in the readable order; and the
+body stage of a step whose boxes overlap when the scene's body stage is
+not the loop's (:meth:`CompiledLoop.body_stage`: the readable narrow
+phase and body response on the kernel's pairs, between two calls).
 
 Why a loop and not faster stages: the readable step's cost is mostly the
 interpreter's calls between little arithmetic; stage kernels keep the calls,
@@ -46,6 +49,7 @@ EVENT_ROWS = 4096
 #: Vertices per leaf of :func:`vertex_leaves`, at most.
 LEAF_VERTICES = 16
 WALLS = tuple("xyz"[k // 2] + "-+"[k % 2] for k in range(6))     # flag index -> wall name
+_WALL_INDEX = {name: k for k, name in enumerate(WALLS)}
 
 
 def loop_support(sim: Simulation) -> str | None:
@@ -55,8 +59,10 @@ def loop_support(sim: Simulation) -> str | None:
     responses (the seed's, with either wall speed, and the corrected
     impulses), any solver, linear or quadratic drag, ``world.mu`` and the
     restitution threshold, and body-body contacts at every level but
-    "sphere" (the seed's exchange at level "aabb" in the loop; any other
-    level or response hands the steps with overlapping boxes back). The
+    "sphere" (the seed's exchange at level "aabb" in the loop; at any other
+    level or with any other response, a step with overlapping boxes runs
+    its narrow phase and body response in Python between two calls of the
+    loop, :meth:`CompiledLoop.body_stage`, and stays the loop's step). The
     loads of :mod:`refsim.dynamics.loads` beyond these (a tilted gravity,
     forces, torques, fixed bodies, missing walls, coefficients per body)
     run on the readable step.
@@ -149,6 +155,42 @@ class _Packing:
                 np.concatenate([np.zeros(0, np.bool_), *self.parts[np.bool_]]))
 
 
+class _KeptWallContacts(dict):
+    """``Simulation._wall_contacts`` during :meth:`CompiledLoop.body_stage`:
+    ``get((body, axis, low))`` is the kernel's kept rows of that wall (a
+    view of ``WALL_R``), or ``default`` where the wall stage found no vertex
+    past it (which the island solve treats as the readable stage's empty
+    entry). Only ``get`` is used there."""
+
+    def __init__(self, wall_r: np.ndarray, wall_at: np.ndarray):
+        super().__init__()
+        self.wall_r, self.wall_at = wall_r, wall_at
+
+    def get(self, key, default=None):
+        i, k, low = key
+        start, count = self.wall_at[i, 2 * k + (0 if low else 1)].tolist()
+        return self.wall_r[start:start + count] if count else default
+
+
+class _StepRecords(dict):
+    """``Simulation._impulses`` during :meth:`CompiledLoop.body_stage`: a
+    wall's record is the kernel's (a view of ``IMPULSE_NOW``, holding what
+    the wall stage added), so that the island solve adds to it in place as
+    the readable step adds to the one its wall stage made; a body pair's
+    record is an entry of the dict itself."""
+
+    def __init__(self, impulse_now: np.ndarray):
+        super().__init__()
+        self.impulse_now = impulse_now
+
+    def __contains__(self, key) -> bool:
+        return key[1] in _WALL_INDEX or dict.__contains__(self, key)
+
+    def __getitem__(self, key):
+        k = _WALL_INDEX.get(key[1])
+        return dict.__getitem__(self, key) if k is None else self.impulse_now[key[0], k]
+
+
 class CompiledLoop:
     """The compiled loop of one simulation: its arrays, packed (the constant
     ones, the simulation's state, the contact flags, the event buffer, the
@@ -164,6 +206,7 @@ class CompiledLoop:
 
         self.kernels = kernels
         self.DONE, self.STOP_READABLE = kernels.DONE, kernels.STOP_READABLE
+        self.STOP_BODY_STAGE = kernels.STOP_BODY_STAGE
         self.sim = sim
         B = len(sim.bodies)
         world = sim.scene.world
@@ -181,6 +224,9 @@ class CompiledLoop:
         else:
             body_mode = kernels.BODY_HAND_BACK
         capacity = max(EVENT_ROWS, 4 * (6 * B + B * (B - 1) // 2))
+        # the wall stage's contacts, kept for the body stage (at most three walls a body)
+        keep = body_mode == kernels.BODY_HAND_BACK and sim.wall_response == "impulse"
+        wall_rows = max(1, 3 * int(self.first_vertex[-1])) if keep else 1
         most = max(1, max(len(vs) for vs in vertices))     # vertices of a body, at most
         s = len(method.b_)
         f, i, b = np.float64, np.int64, np.bool_
@@ -220,7 +266,7 @@ class CompiledLoop:
                 (slot.E, np.zeros((3, 3)), f), (slot.L, np.zeros(3), f),
                 (slot.CORR, np.zeros(3), f), (slot.R_A, np.zeros((most, 3)), f),
                 (slot.P, np.zeros((most, 4)), f), (slot.N, np.zeros(3), f),
-                (slot.ORIGIN, np.zeros((B, 3)), f),
+                (slot.ORIGIN, np.zeros((B, 3)), f), (slot.WALL_R, np.zeros((wall_rows, 3)), f),
                 (slot.SETTINGS, settings, i), (slot.COUNTERS, sim._counters, i),
                 (slot.FIRST_VERTEX, self.first_vertex, i), (slot.LEAF_ORDER, self.leaf_order, i),
                 (slot.LEAF_START, self.leaf_start, i), (slot.FIRST_LEAF, self.first_leaf, i),
@@ -228,6 +274,7 @@ class CompiledLoop:
                 (slot.TRACKERS_I, self.trackers_i, i), (slot.EVENTS, np.zeros((capacity, 4)), i),
                 (slot.PAST, np.zeros(most), i),
                 (slot.PAIRS, np.zeros((max(B * (B - 1) // 2, 1), 2)), i),
+                (slot.WALL_AT, np.zeros((B, 6, 2)), i),
                 (slot.WALLS, np.zeros((B, 6)), b), (slot.BODIES, np.zeros((B, B)), b),
                 (slot.NOW_WALLS, np.zeros((B, 6)), b)):
             packing.put(k, array, dtype)
@@ -241,6 +288,10 @@ class CompiledLoop:
         self.bodies = self.view(slot.BODIES)
         self.events = self.view(slot.EVENTS)
         self.event_data = self.view(slot.EVENT_DATA)
+        self._body_stage_arrays = (self.view(slot.PAIRS), self.view(slot.NOW_WALLS),
+                                   self.view(slot.IMPULSE_NOW), self.view(slot.WALL_R),
+                                   self.view(slot.WALL_AT))
+        self._start_of_step = tuple(self.view(k) for k in (slot.X0, slot.V0, slot.W0, slot.R0))
         self._call = (kernels.advance, self.floats, self.ints, self.flags)
         self._index = {name: i for i, name in enumerate(sim.names)}
         self._flags_stale = False        # the set changed since the flags were built
@@ -377,21 +428,85 @@ class CompiledLoop:
         whatever interrupts this method leaves steps, time and contacts
         accounting for the state, and the events are added at the next
         :meth:`note_events` (:attr:`Simulation.events` calls it).
+
+        A step the kernel stops in with ``STOP_BODY_STAGE`` (its boxes
+        overlap, and the scene's body stage is not the loop's) is ended here
+        by :meth:`body_stage`, and the kernel is called again for the steps
+        left. If an exception (a signal's ``KeyboardInterrupt``) comes
+        before :meth:`body_stage` has committed that step, the state goes
+        back to the step's start, where steps, time, contacts and events
+        still are, and the exception goes on.
         """
         if self._flags_stale:
             self._sync_flags()
         self._set_stale = True
         kernel, floats, ints, flags = self._call
-        start = perf_counter()
-        busy = kernel(n_steps, floats, ints, flags)
-        self.sim.loop_seconds += perf_counter() - start
-        if not busy:                       # every step taken, no event
-            return 0
-        self.note_events()
         counters = self.counters
-        left = int(counters[slot.C_LEFT])
-        self.stop = int(counters[slot.C_STOP]) if left else self.DONE
+        sim = self.sim
+        try:
+            start = perf_counter()
+            busy = kernel(n_steps, floats, ints, flags)
+            sim.loop_seconds += perf_counter() - start
+            if not busy:                       # every step taken, no event
+                return 0
+            left = int(counters[slot.C_LEFT])
+            stop = int(counters[slot.C_STOP]) if left else self.DONE
+            while stop == self.STOP_BODY_STAGE:
+                self.body_stage()
+                left -= 1
+                stop = self.DONE
+                if left:
+                    start = perf_counter()
+                    kernel(left, floats, ints, flags)
+                    sim.loop_seconds += perf_counter() - start
+                    left = int(counters[slot.C_LEFT])
+                    stop = int(counters[slot.C_STOP]) if left else self.DONE
+        except BaseException:
+            if counters[slot.C_STOP] == self.STOP_BODY_STAGE:     # a step not committed
+                self.kernels._restore(sim.x, sim.v, sim.w, sim.R, *self._start_of_step)
+                counters[slot.C_STOP] = self.DONE
+            raise
+        self.note_events()
+        self.stop = stop
         return left
+
+    def body_stage(self) -> None:
+        """The body stage of the step the kernel stopped in with
+        ``STOP_BODY_STAGE`` (stages 1-6 done), as :meth:`Simulation.step
+        <refsim.dynamics.simulation.Simulation.step>` runs it after its
+        broad phase: the narrow phase on the kernel's pairs of boxes, then
+        the body response (:mod:`refsim.dynamics.body_stage`, with its
+        compiled kernels), whose island solve reads the wall contacts the
+        kernel's wall stage kept (``WALL_R``, ``WALL_AT``: what the readable
+        wall stage leaves in ``Simulation._wall_contacts``) and adds to its
+        wall impulse records (``IMPULSE_NOW``). Then one compiled call,
+        :func:`refsim.dynamics._numba_kernels.finish_body_step`, notes the
+        step's contacts and events and counts the step. The same state,
+        contacts and events as the readable step, bit for bit."""
+        sim = self.sim
+        pairs, now_walls, impulse_now, wall_r, wall_at = self._body_stage_arrays
+        candidates = pairs[:int(self.counters[slot.C_PAIRS])]
+        sim._wall_contacts = _KeptWallContacts(wall_r, wall_at)
+        records = sim._impulses = _StepRecords(impulse_now)
+        timer = sim.timer
+        timer.start()
+        hits: np.ndarray | list = candidates
+        if sim.level != "aabb":
+            hits = sim._narrow_phase(candidates)
+            timer.lap("narrow-phase")
+        sim._body_response(hits, set())          # the contacts: every pair in hits
+        timer.lap("body-response")
+        rows = np.array(hits, np.int64).reshape(-1, 2)
+        found = np.zeros((len(rows), impulse.IMPULSE_RECORD))
+        names = sim.names
+        for q, (a, b) in enumerate(rows.tolist()):
+            record = dict.get(records, (a, names[b]))
+            if record is not None:
+                found[q] = record
+        ordered = self.kernels.finish_body_step(rows, found, self.walls, now_walls, self.bodies,
+                                                impulse_now, self.events, self.event_data,
+                                                self.counters)
+        assert ordered, "the narrow phase's pairs are a subsequence of the broad phase's rows"
 
     def note_events(self) -> None:
         """The kernel's pending event rows as Events in the simulation's list,
@@ -411,6 +526,9 @@ class CompiledLoop:
         sim = self.sim
         names = sim.names
         rows = self.events[:pending].tolist()
+        # the records as Python floats: impulse_and_point's tests and quotients
+        # are the same IEEE operations on them, at a fraction of the cost
+        data = self.event_data[:pending].tolist()
         found = []
         for row, (step, kind, i, j) in enumerate(rows):
             if kind == 0:
@@ -423,7 +541,7 @@ class CompiledLoop:
         new = []
         for step, body, other, kind, row in found[noted:]:
             n = step + 1
-            J, point = impulse.impulse_and_point(self.event_data[row])
+            J, point = impulse.impulse_and_point(data[row])
             new.append(Event(kind=kind, step=n, time=n * sim.h, body=body, other=other,
                              impulse=J, point=point))
         listed.extend(new)

@@ -34,15 +34,17 @@ from __future__ import annotations
  I_BODY_INV, LEAF_SPHERES, TRACKERS_F, IMPULSE_NOW, EVENT_DATA,
  X, V, W, R, LO, HI,
  # scratch of the kernel (its values do not carry from one call to the next)
- Y, Y_I, K, X0, V0, W0, R0, A, E, L, CORR, R_A, P, N, ORIGIN) = range(37)
+ Y, Y_I, K, X0, V0, W0, R0, A, E, L, CORR, R_A, P, N, ORIGIN,
+ # the wall stage's contacts of the step, kept for a body stage run in Python
+ WALL_R) = range(38)
 # -- int64 arrays (``ints``, after the header) ----------------------------------------------
 (SETTINGS, COUNTERS, FIRST_VERTEX, LEAF_ORDER, LEAF_START, FIRST_LEAF, TRACKED,
  TRACKER_ROWS, TRACKERS_I, EVENTS,
- PAST, PAIRS) = range(37, 49)                                     # the last two: scratch
+ PAST, PAIRS, WALL_AT) = range(38, 51)          # PAST: scratch; PAIRS, WALL_AT: of the step
 # -- bool arrays (``flags``) ----------------------------------------------------------------
-WALLS, BODIES, NOW_WALLS = range(49, 52)                         # the last: scratch
+WALLS, BODIES, NOW_WALLS = range(51, 54)        # NOW_WALLS: of the step
 #: How many arrays the header describes.
-ARRAYS = 52
+ARRAYS = 54
 
 #: Entries of ``SCALARS`` (float64).
 S_H, S_GRAVITY, S_RESTITUTION, S_FRICTION, S_THRESHOLD, S_HALF_SIZE, S_ENERGY_LIMIT = range(7)
@@ -58,5 +60,11 @@ S_H, S_GRAVITY, S_RESTITUTION, S_FRICTION, S_THRESHOLD, S_HALF_SIZE, S_ENERGY_LI
 #: be in the list already: ``CompiledLoop.note_events`` adds the others and
 #: then clears the rows). ``C_LEFT``, ``C_STOP``: of the last call, the
 #: steps it did not take and why (the kernel's ``DONE``, ``STOP_*``).
-C_STEPS, C_LOOP_STEPS, C_EVENT_BASE, C_PENDING, C_LEFT, C_STOP = range(6)
-COUNTER_COUNT = 6
+#: ``C_PAIRS``: the overlapping pairs of boxes (rows of ``PAIRS``) of a step
+#: the kernel stopped in with ``STOP_BODY_STAGE``. ``C_BODY_STEPS``: the
+#: loop's steps whose body stage ran in Python between two calls of the
+#: kernel (:meth:`CompiledLoop.body_stage
+#: <refsim.dynamics.compiled_loop.CompiledLoop.body_stage>`), counted in
+#: ``C_LOOP_STEPS`` too.
+C_STEPS, C_LOOP_STEPS, C_EVENT_BASE, C_PENDING, C_LEFT, C_STOP, C_PAIRS, C_BODY_STEPS = range(8)
+COUNTER_COUNT = 8

@@ -25,7 +25,11 @@ take their steps K at a time in one compiled call
 for the choices the loop covers, and hand each step it does not take back to
 :meth:`Simulation.step`; the same state, events and frames, bit for bit. The
 loop's wall time is ``loop_seconds`` (not split into stages), its steps
-``loop_steps``.
+``loop_steps``. A step whose boxes overlap, when the scene's body stage
+is not the loop's (any level or body response but the seed's exchange at
+level "aabb"), stays the loop's: its narrow phase and body response run
+in Python between two calls (``loop_body_steps`` counts them; their time
+is in ``stage_seconds``).
 
 Stages 2, 6-8 run only when needed: no rotation work with ``rotation =
 "off"``; no body-body work for one body, ``collision.level = "none"`` or
@@ -376,6 +380,14 @@ class Simulation:
     def loop_steps(self) -> int:
         """The steps the compiled loop took (the others: :meth:`step`)."""
         return int(self._counters[slot.C_LOOP_STEPS])
+
+    @property
+    def loop_body_steps(self) -> int:
+        """Of :attr:`loop_steps`, those whose body stage (narrow phase and
+        body response) ran in Python between two calls of the loop
+        (:meth:`CompiledLoop.body_stage
+        <refsim.dynamics.compiled_loop.CompiledLoop.body_stage>`)."""
+        return int(self._counters[slot.C_BODY_STEPS])
 
     @property
     def events(self) -> list[Event]:

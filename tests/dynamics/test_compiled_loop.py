@@ -106,10 +106,10 @@ def test_spinning_cube_scene_bit_for_bit():
 
 
 def test_exact_level_hands_contact_steps_back_bit_for_bit():
-    # the corrected response: the loop takes the flight and hands back every
-    # step whose boxes overlap
+    # the corrected response: the loop takes every step, and runs the body
+    # stage of each step whose boxes overlap between two of its calls
     readable, compiled = _pair(_two_cubes_at_level_exact(), 1500, every=3)
-    assert 0 < compiled.loop_steps < 1500
+    assert compiled.loop_steps == 1500 and 0 < compiled.loop_body_steps < 1500
     _assert_same(readable, compiled)
     assert any(e.kind == "body" for e in compiled.events)
 
@@ -186,7 +186,8 @@ def test_one_step_per_call_is_one_call_and_the_readable_step_bit_for_bit(case):
     assert calls.loop_steps == whole.loop_steps > 0
     assert readable.events                    # wall contacts at least
     if case == "exact level":
-        assert calls.loop_steps < n and any(e.kind == "body" for e in calls.events)
+        assert calls.loop_steps == n and any(e.kind == "body" for e in calls.events)
+        assert calls.loop_body_steps == whole.loop_body_steps > 0
 
 
 def test_event_rows_left_by_an_interrupted_call_are_added_once():
@@ -244,11 +245,13 @@ def test_bundled_scenes_bit_for_bit(name):
 @pytest.mark.parametrize("rotation", ["off", "seed"])
 def test_cubes_at_level_exact_hand_back_bit_for_bit(rotation):
     # the 40 cubes' contacts, found exactly: every step with overlapping
-    # boxes goes back to the readable stages, walls and spin included
+    # boxes runs its body stage between two calls of the loop, walls and
+    # spin included
     scene = cubes_scene(40, rotation, seed=9)
     scene = replace(scene, collision=replace(scene.collision, level="exact"))
     readable, compiled = _pair(scene, 800, every=9)
-    assert compiled.loop is None and 0 < compiled.loop_steps < 800
+    assert compiled.loop is None and compiled.loop_steps == 800
+    assert 0 < compiled.loop_body_steps < 800
     _assert_same(readable, compiled)
     assert {e.kind for e in compiled.events} == {"wall", "body"}
 
@@ -275,7 +278,8 @@ def test_claim_c11_scenes_bit_for_bit(case, response):
     seconds = 1.0 if (case, response) == ("stack", "impulse") else 2.0
     scene = c11_scene(case, response, duration=seconds, step=1e-3)
     readable, compiled = _pair(scene, round(seconds / 1e-3), every=1)
-    assert compiled.loop is None and compiled.loop_steps > 0
+    assert compiled.loop is None and compiled.loop_steps == round(seconds / 1e-3)
+    assert compiled.loop_body_steps > 0        # the body stage between two calls
     _assert_same(readable, compiled)
     assert any(e.kind == "body" for e in compiled.events)
     if case == "stack":
@@ -457,12 +461,14 @@ def test_each_rotation_with_each_wall_response_bit_for_bit(rotation, wall_respon
 @pytest.mark.parametrize("level", ["aabb", "exact"])
 def test_impulse_body_contacts_are_handed_back_bit_for_bit(level):
     # the corrected body response is the readable step's: each step with
-    # overlapping boxes goes back, walls and the exact rotation included
+    # overlapping boxes runs its body stage between two calls of the loop,
+    # walls and the exact rotation included
     scene = cubes_scene(40, "impulse", seed=13)
     scene = replace(scene, collision=replace(scene.collision, level=level),
                     dynamics=replace(scene.dynamics, body_response="impulse"))
     readable, compiled = _pair(scene, 800, every=9)
-    assert compiled.loop is None and 0 < compiled.loop_steps < 800
+    assert compiled.loop is None and compiled.loop_steps == 800
+    assert 0 < compiled.loop_body_steps < 800
     _assert_same(readable, compiled)
     assert {e.kind for e in compiled.events} == {"wall", "body"}
 
@@ -655,3 +661,186 @@ def test_impulse_sphere_rolling_on_the_floor_bit_for_bit(monkeypatch):
     # at the ring of vertices a deeper landing leaves past the floor
     assert len(contacts) >= 300 and max(contacts) <= 2
     assert np.abs(compiled.w).max() > 0.05                        # rolling, not at rest
+
+
+# -- body-contact steps in the loop (the body stage between two of its calls) -----------------
+
+def _contact_scene(count: int, solver: str):
+    """The body-contact benchmark's cubes (tests/benchmarks/test_bench_dynamics.py
+    ``contact_scene``): exact level, every response "impulse", mu 0.3."""
+    from refsim.studies.bounce import bench_scene
+
+    scene = bench_scene(f"{count} cubes", "impulse")[0]
+    return replace(
+        scene, world=replace(scene.world, mu=0.3),
+        integration=replace(scene.integration, solver=solver),
+        collision=replace(scene.collision, level="exact"),
+        dynamics=replace(scene.dynamics, rotation="impulse", body_response="impulse",
+                         wall_response="impulse"))
+
+
+#: Steps before the compared ones: the benchmark's "in flight" (the cubes
+#: meet in the air) and "settled" (the ten rest on the floor, apart under
+#: Euler; most of the forty rest on each other).
+_CONTACT_STATES = {"in flight": 500, "settled": 3000}
+
+
+@pytest.mark.parametrize("solver", ["euler", "rk4"])
+@pytest.mark.parametrize("state", sorted(_CONTACT_STATES))
+@pytest.mark.parametrize("count", [10, 40])
+def test_body_contact_steps_in_the_loop_bit_for_bit(count, state, solver):
+    # From the same state (reached by the compiled loop, written into both),
+    # the readable step and the loop take the same steps: the loop takes
+    # every one, and runs the body stage of those with overlapping boxes
+    # between two of its calls.
+    scene = _contact_scene(count, solver)
+    lead = Simulation(scene, kernel="compiled")
+    lead.advance(_CONTACT_STATES[state])
+    readable = Simulation(scene, kernel="readable")
+    compiled = Simulation(scene, kernel="compiled")
+    for sim in (readable, compiled):
+        for name in ("x", "v", "w", "R"):
+            getattr(sim, name)[...] = getattr(lead, name)
+        sim.record()
+        sim.run(120, every=3)
+    _assert_same(readable, compiled)
+    assert compiled.loop_steps == 120
+    if (count, state) == (10, "settled"):
+        pass            # apart under Euler, some touching under rk4: the bits above
+    elif state == "settled":                     # resting contacts: nearly every step
+        assert compiled.loop_body_steps >= 100
+        assert any(e.kind == "body" for e in compiled.events)
+    else:
+        assert compiled.loop_body_steps > 0
+        assert any(e.kind == "body" for e in compiled.events)
+
+
+def test_body_contact_steps_one_call_each_bit_for_bit():
+    # advance(1) per step (the fast path): the body stage runs inside the call
+    scene = _contact_scene(10, "euler")
+    calls = Simulation(scene, kernel="compiled")
+    whole = Simulation(scene, kernel="compiled")
+    readable = Simulation(scene, kernel="readable")
+    for _ in range(700):
+        calls.advance(1)
+    whole.advance(700)
+    readable.advance(700)
+    for sim in (calls, whole):
+        for name in ("x", "v", "w", "R", "lo", "hi"):
+            assert getattr(sim, name).tobytes() == getattr(readable, name).tobytes(), name
+        assert sim.events == readable.events and sim.steps == 700
+        assert sim.loop_steps == 700
+    assert calls.loop_body_steps == whole.loop_body_steps > 0
+
+
+def test_divergence_after_body_contact_steps_is_raised_at_the_same_step():
+    # cubes meeting in the air, then a drag that makes Euler unstable
+    # (|1 - h k / m| = 2): the loop's body-stage steps come first, then the
+    # readable step raises at the same step as on the readable kernel
+    scene = _contact_scene(10, "euler")
+    lead = Simulation(scene, kernel="compiled")
+    lead.advance(500)
+    unstable = replace(scene, world=replace(scene.world, drag=3000.0))
+    errors, body_steps = [], []
+    for kernel in ("readable", "compiled"):
+        sim = Simulation(unstable, kernel=kernel)
+        for name in ("x", "v", "w", "R"):
+            getattr(sim, name)[...] = getattr(lead, name)
+        with pytest.raises(DivergenceError) as info:
+            sim.run(2000, every=1)
+        errors.append(info.value)
+        body_steps.append(sim.loop_body_steps)
+    assert errors[0].step == errors[1].step > 5
+    assert errors[0].body == errors[1].body
+    assert errors[0].partial.velocity.tobytes() == errors[1].partial.velocity.tobytes()
+    assert body_steps[0] == 0 < body_steps[1]
+
+
+# the interrupt Hypothesis's gc callback drops is reported as unraisable (as above)
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_ctrl_c_during_body_contact_steps_leaves_the_simulation_consistent():
+    # advance(1) calls on a stack of cubes in contact, each step a body stage
+    # in Python after the kernel stopped inside the step: an interrupt before
+    # the step is committed puts the state back to the step's start, so
+    # steps, t, contacts and events account for the state wherever it lands
+    import os
+    import signal
+    import threading
+
+    from refsim.studies.dynamics import c11_scene
+
+    scene = c11_scene("stack", "impulse", duration=1000.0, step=1e-3)
+    sim = Simulation(scene, kernel="compiled")
+    sim.advance(1000)                           # in contact from about step 670 on
+    start, body_steps = sim.snapshot(), sim.loop_body_steps
+    caught = []
+
+    def interrupt(signum, frame):
+        if not caught:
+            raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, interrupt)
+    stop = threading.Event()
+
+    def send():
+        while not stop.wait(0.05):
+            os.kill(os.getpid(), signal.SIGINT)
+
+    sender = threading.Thread(target=send, daemon=True)
+    sender.start()
+    try:
+        for _ in range(5_000_000):             # bounded: never fills memory
+            sim.advance(1)
+    except KeyboardInterrupt:
+        caught.append(True)
+    finally:
+        stop.set()
+        sender.join()
+        signal.signal(signal.SIGINT, previous)
+    assert caught, "no interrupt reached the loop"
+    assert sim.steps > start["steps"] and sim.t == sim.steps * sim.h
+    assert sim.loop_body_steps - body_steps == sim.steps - start["steps"]   # each one
+    again = Simulation(scene, kernel="compiled")
+    again.advance(sim.steps)
+    for name in ("x", "v", "w", "R"):
+        assert getattr(sim, name).tobytes() == getattr(again, name).tobytes(), name
+    assert sim.events == again.events and sim.events
+    sim.advance(50)                             # and it goes on as if not interrupted
+    again.advance(50)
+    for name in ("x", "v", "w", "R"):
+        assert getattr(sim, name).tobytes() == getattr(again, name).tobytes(), name
+    assert sim.events == again.events
+
+
+def test_an_exception_in_the_body_stage_puts_the_step_back():
+    # an interrupt raised inside the body stage (here from the body
+    # response, deterministically): the step is not committed, the state is
+    # the step's start, and the next call takes the step from there
+    from refsim.studies.dynamics import c11_scene
+
+    scene = c11_scene("stack", "impulse", duration=10.0, step=1e-3)
+    sim = Simulation(scene, kernel="compiled")
+    reference = Simulation(scene, kernel="compiled")
+    sim.advance(1000)
+    reference.advance(1000)
+    before = {name: getattr(sim, name).copy() for name in ("x", "v", "w", "R")}
+    events, body_steps = list(sim.events), sim.loop_body_steps
+    respond = sim._body_response
+
+    def interrupted(pairs, touching):
+        respond(pairs, touching)               # the state moved, then the interrupt
+        raise KeyboardInterrupt
+
+    sim._body_response = interrupted
+    with pytest.raises(KeyboardInterrupt):
+        sim.advance(5)
+    del sim._body_response
+    assert sim.steps == 1000 and sim.loop_body_steps == body_steps
+    for name, value in before.items():
+        assert getattr(sim, name).tobytes() == value.tobytes(), name
+    assert sim.events == events
+    sim.advance(200)
+    reference.advance(200)
+    for name in ("x", "v", "w", "R"):
+        assert getattr(sim, name).tobytes() == getattr(reference, name).tobytes(), name
+    assert sim.events == reference.events and sim.loop_body_steps == reference.loop_body_steps
