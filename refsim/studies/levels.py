@@ -18,7 +18,8 @@ tests gate on and the report draws; nothing here prints or plots
 - :func:`measure_body_oracles`: refsim's exact answers against FCL's
   intersecting face pairs, FCL's boolean query and trimesh's
   ``CollisionManager``, every disagreement classified
-  (:func:`classify_body_disagreement`; pairs by
+  (:func:`classify_body_disagreement`, the conformance kit's classifier:
+  a class and a reason; pairs by
   :func:`refsim.studies.triangles.classify_disagreement`).
 - :func:`measure_hierarchy_speed`: the 2k-triangle sphere and torus pairs in
   three configurations, and two touching pairs (cubes face to face, a cube
@@ -49,9 +50,14 @@ import numpy as np
 
 from refsim.collision.bodies import LEVELS, bodies_collide, intersecting_pairs
 from refsim.collision.boxes import world_vertices
-from refsim.collision.containment import contains_point
-from refsim.collision.disagreement import strict_crossing
+from refsim.collision.disagreement import (
+    BODY_CLASSES,
+    BODY_REASONS,
+    BodyVerdict,
+    classify_bodies,
+)
 from refsim.collision.spheres import bounding_sphere
+from refsim.engines import body_conventions
 from refsim.kernels import choose_kernel
 from refsim.studies import TIMED
 from refsim.studies.triangles import DISAGREEMENT_KINDS, classify_disagreement
@@ -433,78 +439,24 @@ def measure_levels(configurations: tuple[Configuration, ...] = CONFIGURATIONS,
 # agreement with body-level oracles
 # --------------------------------------------------------------------------
 
-#: Classes of a body-level disagreement, in the order they are tried.
-BODY_DISAGREEMENT_KINDS = ("containment", "float32 transform", "touching", "tolerance", "bug")
-
-#: A disagreement counts as "tolerance" when moving B by this fraction of the
-#: larger bounding radius along the line of centres flips refsim's answer to
-#: the oracle's: the answer turns on a gap or a depth that small. FCL's GJK
-#: (used by trimesh for convex meshes) stops at a tolerance of about 1e-6,
-#: and float32 coordinates (trimesh's transforms) are good to ~6e-8 relative;
-#: 1e-6 covers both, and is far below any feature of the bundled models.
-BODY_TOLERANCE = 1e-6
-
-
-def _moved(pose_a, pose_b, mesh_a, mesh_b, toward: bool) -> Pose:
-    """B's pose moved by BODY_TOLERANCE * max radius along the line of
-    bounding-sphere centres (toward A or away from it)."""
-    ca, ra = bounding_sphere(mesh_a)
-    cb, rb = bounding_sphere(mesh_b)
-    line = (pose_b[0] @ cb + pose_b[1]) - (pose_a[0] @ ca + pose_a[1])
-    norm = np.linalg.norm(line)
-    unit = line / norm if norm > 0 else np.array([1.0, 0.0, 0.0])
-    step = BODY_TOLERANCE * max(ra, rb) * (-1.0 if toward else 1.0)
-    return pose_b[0], pose_b[1] + step * unit
+#: The classes of a body-level disagreement, in the order the study
+#: tabulates them: the conformance kit's classes
+#: (:data:`refsim.collision.disagreement.BODY_CLASSES`), each disagreement's
+#: finer reason kept beside its class.
+BODY_DISAGREEMENT_KINDS = BODY_CLASSES
 
 
 def classify_body_disagreement(mesh_a, pose_a, mesh_b, pose_b, ours: bool,
-                               engine, kernel: str | None = None) -> str:
-    """Why a ``collide`` engine's answer differs from refsim's exact ``ours``.
-
-    The engine may declare two conventions (:mod:`refsim.engines`):
-    ``is_solid(vertices, faces) -> bool``, whether it treats a mesh as a
-    solid, and ``pose_used(pose) -> pose``, the pose it really applies.
-    Tried in order:
-
-    - ``"containment"``: refsim False, engine True, one body lies inside the
-      other (:func:`refsim.collision.containment.contains_point` of a vertex)
-      and the engine treats the container as a solid (volume against surface semantics);
-    - ``"float32 transform"``: refsim, run on the poses the engine really
-      applies (``engine.pose_used``), gives the engine's answer;
-    - ``"touching"``: refsim True, oracle False, and no intersecting triangle
-      pair has an edge crossing the other's open interior with strict signs:
-      the bodies meet only where an orientation is exactly zero (a shared
-      face, edge or corner; minimum distance exactly 0);
-    - ``"tolerance"``: moving B by ``BODY_TOLERANCE`` of the larger radius
-      along the line of centres (toward A when refsim says False, away when
-      True) gives the oracle's answer;
-    - ``"bug"``: anything else.
-    """
-    theirs = not ours
-    is_solid = getattr(engine, "is_solid", None)
-    pose_used = getattr(engine, "pose_used", None)
-    if not ours and is_solid is not None:
-        if ((is_solid(mesh_a.vertices, mesh_a.faces)
-             and contains_point(mesh_a, pose_a, world_vertices(mesh_b, pose_b)[0]))
-                or (is_solid(mesh_b.vertices, mesh_b.faces)
-                    and contains_point(mesh_b, pose_b, world_vertices(mesh_a, pose_a)[0]))):
-            return "containment"
-    if pose_used is not None:
-        if bodies_collide(mesh_a, pose_used(pose_a), mesh_b, pose_used(pose_b),
-                          kernel=kernel) == theirs:
-            return "float32 transform"
-    if ours:
-        world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
-        pairs = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel)
-        crossing = any(strict_crossing(tuple(map(tuple, world_a[mesh_a.faces[i]].tolist())),
-                                       tuple(map(tuple, world_b[mesh_b.faces[j]].tolist())))
-                       for i, j in pairs)
-        if not crossing:
-            return "touching"
-    moved = _moved(pose_a, pose_b, mesh_a, mesh_b, toward=not ours)
-    if bodies_collide(mesh_a, pose_a, mesh_b, moved, kernel=kernel) == theirs:
-        return "tolerance"
-    return "bug"
+                               engine, kernel: str | None = None) -> BodyVerdict:
+    """Why a ``collide`` engine's answer differs from refsim's exact ``ours``:
+    :func:`refsim.collision.disagreement.classify_bodies` (the conformance
+    kit's ``collide.agreement`` classifier) with the engine's declared
+    conventions (:func:`refsim.engines.body_conventions`: its distance
+    tolerance, unit roundoff, ``solid`` or ``is_solid``, ``pose_used``).
+    The verdict's ``kind`` is the class, ``reason`` the finer reason and
+    ``gap`` the gap in metres."""
+    return classify_bodies(mesh_a, pose_a, mesh_b, pose_b, not ours, kernel=kernel,
+                           **body_conventions(engine))
 
 
 @dataclass(frozen=True)
@@ -513,7 +465,9 @@ class BodyDisagreement:
     case: str               # the configuration name or "model_a / model_b #k"
     refsim: bool
     oracle: bool
-    kind: str
+    kind: str               # the class (BODY_DISAGREEMENT_KINDS)
+    reason: str = ""        # a key of refsim.collision.disagreement.BODY_REASONS
+    gap: float = 0.0        # metres: distance apart, or minus the deepest pair's depth
 
 
 @dataclass(frozen=True)
@@ -528,6 +482,7 @@ class BodyAgreement:
     oracle_true: int
     counts: dict = field(default_factory=dict)      # kind -> disagreements
     disagreements: tuple = ()
+    reasons: dict = field(default_factory=dict)     # reason -> disagreements (those met)
 
 
 @dataclass(frozen=True)
@@ -612,9 +567,10 @@ def measure_body_oracles(collide_engines: tuple = (), pairs_engine=None, *,
         arrays = (mesh_a.vertices, mesh_a.faces, pose_a, mesh_b.vertices, mesh_b.faces, pose_b)
         for engine in collide_engines:
             theirs = bool(engine.bodies_collide(*arrays))
-            kind = "" if theirs == ours else classify_body_disagreement(
+            verdict = None if theirs == ours else classify_body_disagreement(
                 mesh_a, pose_a, mesh_b, pose_b, ours, engine, kernel)
-            body_rows.setdefault((engine.name, source), []).append((case, ours, theirs, kind))
+            body_rows.setdefault((engine.name, source), []).append(
+                (case, ours, theirs, verdict))
         if pairs_engine is not None:
             mine = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel)
             other = np.asarray(pairs_engine.intersecting_pairs(*arrays), dtype=np.int64)
@@ -634,13 +590,15 @@ def measure_body_oracles(collide_engines: tuple = (), pairs_engine=None, *,
 
     bodies = []
     for (name, source), rows in body_rows.items():
-        body_found = tuple(BodyDisagreement(source, case, ours, theirs, kind)
-                           for case, ours, theirs, kind in rows if kind)
+        body_found = tuple(BodyDisagreement(source, case, ours, theirs, v.kind, v.reason, v.gap)
+                           for case, ours, theirs, v in rows if v is not None)
         bodies.append(BodyAgreement(
             oracle=name, source=source, n=len(rows), agree=len(rows) - len(body_found),
             refsim_true=sum(r[1] for r in rows), oracle_true=sum(r[2] for r in rows),
             counts={k: sum(d.kind == k for d in body_found) for k in BODY_DISAGREEMENT_KINDS},
-            disagreements=body_found))
+            disagreements=body_found,
+            reasons={r: n for r in BODY_REASONS
+                     if (n := sum(d.reason == r for d in body_found))}))
     pairs = []
     for source, rows in pair_rows.items():
         pair_found = tuple(d for r in rows for d in r[3])
