@@ -1,5 +1,5 @@
-"""Why two answers on a triangle pair may differ: the classes exact
-predicates decide.
+"""Why two answers may differ, on a triangle pair or on two whole bodies:
+refsim's one classifier of disagreements.
 
 When another engine's answer on two closed triangles differs from refsim's
 exact one (:func:`refsim.collision.triangle.triangles_intersect`), some
@@ -24,13 +24,29 @@ lies within the rounding bound (float64's, scaled by the engine's unit
 roundoff) or the engine's declared distance tolerance, ``"bug"`` beyond
 both: one vocabulary (:data:`CLASSES`) and one tolerance measure.
 
+Two bodies (:func:`classify_bodies`): an engine's boolean answer on two
+posed closed meshes. The class is one of the conformance kit's
+(:data:`BODY_CLASSES`, a subset of
+:data:`refsim.conformance.results.CLASSES`), with a finer **reason**
+(:data:`BODY_REASONS`) and the gap in metres: the deepest exact pair's
+depth when refsim finds the surfaces meeting, their distance when it does
+not. Exact explanations come first (refsim's own pair answer against the
+rational test; a contact resting on exact zeros; the engine's declared
+``pose_used``; a body inside one the engine tests as a solid), then the
+measured gap against the rounding bound and the engine's declared
+``distance_tolerance``; "bug" only when none holds.
+
 Both the studies' comparison with oracles (:mod:`refsim.studies.triangles`,
 :mod:`refsim.studies.levels`) and the conformance kit
 (:mod:`refsim.conformance.checks_geometry`) classify with these, so that one
-pair gets one class wherever it is met.
+pair, or one pose of two bodies, gets one class wherever it is met.
 
 Cost: O(1) orientation predicates per pair (filtered, exact where the
-filter cannot decide), plus one rational separating-axis test.
+filter cannot decide), plus one rational separating-axis test. Two bodies:
+one triangle pair's cost per exact pair, or O(m_a m_b) face boxes and at
+most :data:`GAP_PAIRS` triangle distances for surfaces apart, plus one
+winding number per connected part of each body against the other's faces
+and, with ``pose_used``, one exact query.
 """
 
 from __future__ import annotations

@@ -9,10 +9,11 @@ x = 0.5 with no rounding anywhere, and (1, 1, 1) makes them share one corner.
 Measured (seed 0, 10 random poses per model pair; reproduce with
 ``refsim study collision-levels --quick``): zero false negatives
 at every level; FCL's face pairs and boolean answers equal refsim's on every
-query; trimesh's CollisionManager differs only by "containment" (a small
-convex body inside a convex one: a solid for trimesh, two surfaces apart for
-refsim) and "touching" (cubes sharing a face or a corner: GJK on two
-fcl.Convex says apart).
+query; trimesh's CollisionManager differs only by "known-divergence",
+reason "containment" (a small convex body inside a convex one: a solid for
+trimesh, two surfaces apart for refsim) and "touching" (cubes sharing a face
+or a corner: GJK on two fcl.Convex says apart). The classifier itself is
+tested on constructed cases in tests/collision/test_body_disagreement.py.
 """
 
 from __future__ import annotations
