@@ -345,7 +345,7 @@ def classify_bodies(mesh_a, pose_a, mesh_b, pose_b, answer: bool, *, exact_pairs
                 for i, j in pairs):
             return BodyVerdict("bug", "refsim against the exact test", gap, bound)
         if kind in ("touching", "coplanar"):
-            return BodyVerdict(kind, kind, gap, bound)
+            return BodyVerdict(kind, kind, 0.0, bound)      # not -0.0: no depth at all
         if rounded_poses_agree():
             return BodyVerdict("tolerance", "float32 transform", gap, bound)
         reason = "gap within tolerance" if kind == "tolerance" else "gap beyond tolerance"
