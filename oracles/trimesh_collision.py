@@ -61,14 +61,24 @@ class TrimeshCollisionOracle:
     boolean query (capability ``collide``).
 
     Besides ``bodies_collide`` it declares its conventions, which the levels
-    study uses to classify a disagreement: :meth:`pose_used` (the float32
-    pose it applies) and :meth:`is_solid` (a convex mesh is a solid to it).
+    study and the conformance kit use to classify a disagreement
+    (:func:`refsim.engines.body_conventions`): :meth:`pose_used` (the
+    float32 pose it applies), :meth:`is_solid` (a convex mesh is a solid to
+    it) and ``distance_tolerance``.
 
     Raises :class:`refsim.oracles.OracleUnavailable` when trimesh or python-fcl is
     not installed.
     """
 
     name = "trimesh"
+
+    #: Metres (:func:`refsim.engines.declarations`): FCL's GJK, which the
+    #: CollisionManager runs on two convex meshes, stops at a tolerance of
+    #: about 1e-6 (its default ``gjk_tolerance``), so a gap or an overlap that
+    #: small between convex bodies can go either way (the conformance kit's
+    #: trimesh engine, :class:`refsim.conformance.shipped.TrimeshEngine`,
+    #: declares the same).
+    distance_tolerance = 1e-6
 
     def __init__(self):
         self.trimesh = import_engine("trimesh", "trimesh")

@@ -17,10 +17,15 @@ declares (:func:`refsim.engines.declarations`):
   the world triangles (refsim's transform arithmetic, as the truth used),
   classified as above; a case takes its most serious class
   (:func:`refsim.conformance.results.worst_class`) and reports its largest
-  gap. A false "collide" with one body's centroid inside the other is
-  "known-divergence" for an engine that declares ``solid = True`` and "bug"
-  for any other (refsim's surfaces do not meet); else it is classed by the
-  smallest gap between the surfaces;
+  gap;
+- bodies (``collide``): :func:`refsim.collision.disagreement.classify_bodies`,
+  the classifier the studies use too, with the engine's conventions
+  (:func:`refsim.engines.body_conventions`): a class and a finer ``reason``
+  (a false "apart" by the exact pairs it missed; a false "collide" with one
+  body inside the other is "known-divergence" for an engine that tests that
+  body as a solid and "bug" for any other, refsim's surfaces not meeting;
+  otherwise by the gap between the surfaces, or by the engine's declared
+  ``pose_used``);
 - boxes: per side, how far the box stands inside the exact one (``aabb.encloses``)
   or outside it (``aabb.tight``), in metres; within the rounding bound of
   :mod:`refsim.conformance.cases_boxes` it passes, within the declared
@@ -48,22 +53,13 @@ from fractions import Fraction
 
 import numpy as np
 
-from refsim.collision.gaps import (
-    UNIT_ROUNDOFF,
-    face_box_distances,
-    rounding_bound,
-    signed_gap,
-)
+from refsim.collision.disagreement import classify_bodies, worst_pair
+from refsim.collision.gaps import UNIT_ROUNDOFF
 from refsim.conformance.results import CheckResult, Crash, attempt, tally, worst_class
 from refsim.conformance.shrink import minimal_failure
 
 #: Seeded failing cases kept in ``examples`` per class (after the shrunk one).
 EXAMPLES_PER_CLASS = 2
-
-#: Face pairs whose triangle distances are computed, at most, to measure the
-#: gap of a false "collide" (the pairs whose boxes are nearest); beyond it
-#: the gap reported is the boxes' lower bound (``gap_is_lower_bound``).
-GAP_PAIRS = 500
 
 
 @dataclass(frozen=True)
@@ -295,12 +291,9 @@ def _classify_face_pairs(case, differing, tolerance: float, roundoff: float = 1.
     """The most serious class of the face pairs ``differing``, with the gap
     of the pair farthest from touching."""
     world_a, world_b = _world(case)
-    fa, fb = case.mesh_a.faces, case.mesh_b.faces
-    verdicts = [classify_triangles(world_a[fa[i]], world_b[fb[j]], tolerance, roundoff)
-                for i, j in differing]
-    kind = worst_class(v["class"] for v in verdicts)
-    widest = max(verdicts, key=lambda v: abs(v["gap_metres"]))
-    return {**widest, "class": kind}
+    kind, widest = worst_pair(world_a, case.mesh_a.faces, world_b, case.mesh_b.faces, differing,
+                              tolerance, roundoff)
+    return _verdict(kind, widest.gap, widest.bound, tolerance, roundoff)
 
 
 def classify_pairs(case, got, tolerance: float = 0.0, roundoff: float = 1.0) -> dict:
@@ -310,46 +303,28 @@ def classify_pairs(case, got, tolerance: float = 0.0, roundoff: float = 1.0) -> 
     return _classify_face_pairs(case, sorted(truth ^ answer), tolerance, roundoff)
 
 
-def _surface_gap(case, tolerance: float, roundoff: float = 1.0) -> dict:
-    """The class of a false "collide" between surfaces that do not meet, by
-    their smallest distance: the triangle distances of the face pairs whose
-    boxes are within reach (at most :data:`GAP_PAIRS`, nearest first)."""
-    world_a, world_b = _world(case)
-    fa, fb = case.mesh_a.faces, case.mesh_b.faces
-    boxes = face_box_distances(world_a, fa, world_b, fb)
-    order = np.argsort(boxes, axis=None, kind="stable")[:GAP_PAIRS]
-    pairs = [np.unravel_index(k, boxes.shape) for k in order]
-    gaps = [signed_gap(world_a[fa[i]], world_b[fb[j]], False) for i, j in pairs]
-    gap = min(gaps)
-    # exact when no pair left out could be nearer: its box is at least as far
-    lower_bound = len(order) < boxes.size and float(boxes.flat[order[-1]]) < gap
-    if lower_bound:
-        gap = float(boxes.flat[order[-1]])
-    bound = max(rounding_bound(world_a), rounding_bound(world_b)) * roundoff
-    kind = "tolerance" if gap <= max(bound, tolerance) and not lower_bound else "bug"
-    return {**_verdict(kind, gap, bound, tolerance, roundoff), "gap_is_lower_bound": lower_bound}
-
-
 def classify_collide(case, got: bool, tolerance: float = 0.0, solid: bool = False,
-                     roundoff: float = 1.0) -> dict:
-    """The class of an engine's boolean answer that differs from the truth
-    (module docstring): a false "apart" takes the most serious class of the
-    exact pairs it missed (the deepest gap); a false "collide" with one
-    body's centroid inside the other is "known-divergence" for an engine
-    that declares itself ``solid`` and "bug" for any other (its surfaces do
-    not meet); else it is classed by the surfaces' distance."""
-    from refsim.collision.containment import contains_point
-
-    if len(case.truth) > 0:
-        return _classify_face_pairs(case, [tuple(p) for p in np.asarray(case.truth)], tolerance,
-                                    roundoff)
-    centroid_a = np.asarray(case.pose_a[0]) @ case.mesh_a.vertices.mean(axis=0) + case.pose_a[1]
-    centroid_b = np.asarray(case.pose_b[0]) @ case.mesh_b.vertices.mean(axis=0) + case.pose_b[1]
-    if (contains_point(case.mesh_a, case.pose_a, centroid_b)
-            or contains_point(case.mesh_b, case.pose_b, centroid_a)):
-        return {"class": "known-divergence" if solid else "bug", "contained": True,
-                "solid_declared": solid}
-    return _surface_gap(case, tolerance, roundoff)
+                     roundoff: float = 1.0, *, is_solid=None, pose_used=None) -> dict:
+    """The class of an engine's boolean answer that differs from the truth,
+    with its reason and gap, as example fields: the verdict of
+    :func:`refsim.collision.disagreement.classify_bodies` on the case's
+    exact pairs (its rules), with the engine's declared ``tolerance``
+    (metres), ``solid``, ``roundoff`` (over float64's) and, where it has
+    them, its ``is_solid`` and ``pose_used`` methods. A false "collide"
+    also gives ``gap_is_lower_bound``, and one body inside the other
+    ``contained`` and ``solid_declared`` (whether the engine tests that
+    container as a solid)."""
+    verdict = classify_bodies(case.mesh_a, case.pose_a, case.mesh_b, case.pose_b, got,
+                              exact_pairs=case.truth, distance_tolerance=tolerance,
+                              roundoff=roundoff, solid=solid, is_solid=is_solid,
+                              pose_used=pose_used)
+    fields = {**_verdict(verdict.kind, verdict.gap, verdict.bound, tolerance, roundoff),
+              "reason": verdict.reason}
+    if len(case.truth) == 0:
+        fields["gap_is_lower_bound"] = verdict.gap_is_lower_bound
+    if verdict.contained:
+        fields.update(contained=True, solid_declared=verdict.solid)
+    return fields
 
 
 def _answer_counts(failures: list[dict]) -> dict:
@@ -379,11 +354,13 @@ def _ask_collide(prepared, case) -> bool:
 
 
 def _judge_collide(prepared, case, got: bool) -> dict | None:
-    _, declared = prepared
+    _, conventions = prepared
     if got == (len(case.truth) > 0):
         return None
-    return {**classify_collide(case, got, declared.distance_tolerance, declared.solid,
-                               _roundoff(declared)),
+    return {**classify_collide(case, got, conventions["distance_tolerance"],
+                               conventions["solid"], conventions["roundoff"],
+                               is_solid=conventions["is_solid"],
+                               pose_used=conventions["pose_used"]),
             "answer": got}
 
 
@@ -404,7 +381,13 @@ def _with_declarations(engine):
 
 PAIRS_AGREEMENT = CaseCheck("pairs", "agreement", _with_declarations, _ask_pairs, _judge_pairs,
                             _answer_counts, "gap_metres")
-COLLIDE_AGREEMENT = CaseCheck("collide", "agreement", _with_declarations, _ask_collide,
+def _with_conventions(engine):
+    from refsim.engines import body_conventions
+
+    return engine, body_conventions(engine)
+
+
+COLLIDE_AGREEMENT = CaseCheck("collide", "agreement", _with_conventions, _ask_collide,
                               _judge_collide, lambda failures: {}, "gap_metres")
 
 

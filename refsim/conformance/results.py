@@ -53,7 +53,9 @@ CLASS_DEFINITIONS: dict[str, str] = {
                  "engine's declared distance_tolerance; or a "
                  "measured quantity misses its tolerance by at most a factor of two; or "
                  "a free body's drift, within 10 %, falls at the engine's declared "
-                 "integrator_order when the step is halved (its truncation error).",
+                 "integrator_order when the step is halved (its truncation error); or "
+                 "refsim's answer on the poses the engine declares it applies (pose_used, "
+                 "e.g. rounded to float32) is the engine's.",
     "touching": "the exact answer turns on an exact contact: the two sets share a point but "
                 "nothing crosses transversally (gap exactly 0). A float engine may answer "
                 "either way.",

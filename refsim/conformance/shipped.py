@@ -55,7 +55,8 @@ class TrimeshEngine:
     distance_tolerance = 1e-6
 
     #: The CollisionManager tests a convex mesh as the solid it bounds (GJK on
-    #: its hull), so a body wholly inside another collides.
+    #: its hull), so a body wholly inside another collides; :meth:`is_solid`
+    #: says which meshes (a non-convex one stays a surface).
     solid = True
 
     def __init__(self):
@@ -71,6 +72,19 @@ class TrimeshEngine:
     def bodies_collide(self, vertices_a, faces_a, pose_a, vertices_b, faces_b, pose_b) -> bool:
         return self._collision.bodies_collide(vertices_a, faces_a, pose_a, vertices_b, faces_b,
                                               pose_b)
+
+    def is_solid(self, vertices, faces) -> bool:
+        """Whether the CollisionManager tests the mesh as a solid (a convex
+        mesh only): the container of a "containment" must be one."""
+        return self._collision.is_solid(vertices, faces)
+
+    @staticmethod
+    def pose_used(pose):
+        """The float32 pose the CollisionManager applies
+        (:func:`refsim.oracles.trimesh_collision.float32_pose`)."""
+        from refsim.oracles.trimesh_collision import float32_pose
+
+        return float32_pose(pose)
 
 
 def trimesh() -> TrimeshEngine:

@@ -73,6 +73,15 @@ attribute                meaning
                          (GJK on convex shapes does): a body wholly inside
                          the other collides, class "known-divergence";
                          undeclared, that answer is a "bug".
+``is_solid``             optional method ``is_solid(vertices, faces) ->
+                         bool``: per mesh, whether ``bodies_collide``
+                         tests it as a solid (trimesh's CollisionManager:
+                         a convex mesh only); where given it decides, not
+                         ``solid``.
+``pose_used``            optional method ``pose_used(pose) -> pose``: the
+                         pose the engine really applies (trimesh rounds
+                         it to float32). refsim's answer on those poses
+                         equal to the engine's is class "tolerance".
 ``integrator_order``     ``None`` (the default): the order of the rigid
                          engine's time step (1 for semi-implicit Euler, as
                          Bullet, MuJoCo's "Euler" and Drake's discrete
@@ -274,6 +283,20 @@ class Declarations:
     solid: bool = False
     integrator_order: int | None = None
     unit_roundoff: float = 2.0 ** -53
+
+
+def body_conventions(engine) -> dict:
+    """What :func:`refsim.collision.disagreement.classify_bodies` needs of a
+    ``collide`` engine, as its keyword arguments: the declared
+    ``distance_tolerance``, ``roundoff`` (``unit_roundoff`` over float64's),
+    ``solid``, and the optional ``is_solid`` and ``pose_used`` methods (None
+    where the engine has none). The kit and the studies both read an
+    engine's conventions here, so that one answer gets one class."""
+    declared = declarations(engine)
+    return {"distance_tolerance": declared.distance_tolerance,
+            "roundoff": declared.unit_roundoff / 2.0 ** -53, "solid": declared.solid,
+            "is_solid": getattr(engine, "is_solid", None),
+            "pose_used": getattr(engine, "pose_used", None)}
 
 
 def declarations(engine) -> Declarations:

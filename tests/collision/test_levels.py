@@ -9,10 +9,11 @@ x = 0.5 with no rounding anywhere, and (1, 1, 1) makes them share one corner.
 Measured (seed 0, 10 random poses per model pair; reproduce with
 ``refsim study collision-levels --quick``): zero false negatives
 at every level; FCL's face pairs and boolean answers equal refsim's on every
-query; trimesh's CollisionManager differs only by "containment" (a small
-convex body inside a convex one: a solid for trimesh, two surfaces apart for
-refsim) and "touching" (cubes sharing a face or a corner: GJK on two
-fcl.Convex says apart).
+query; trimesh's CollisionManager differs only by "known-divergence",
+reason "containment" (a small convex body inside a convex one: a solid for
+trimesh, two surfaces apart for refsim) and "touching" (cubes sharing a face
+or a corner: GJK on two fcl.Convex says apart). The classifier itself is
+tested on constructed cases in tests/collision/test_body_disagreement.py.
 """
 
 from __future__ import annotations
@@ -94,10 +95,12 @@ def engine_collides(engine, mesh_a, pose_a, mesh_b, pose_b) -> bool:
 
 
 class Answering:
-    """A ``collide`` engine that gives one answer to every query."""
+    """A ``collide`` engine that gives one answer to every query, with the
+    declarations given (refsim.engines.declarations)."""
 
-    def __init__(self, name, answer):
+    def __init__(self, name, answer, **declared):
         self.name, self.answer = name, answer
+        self.__dict__.update(declared)
 
     def bodies_collide(self, *arrays):
         return self.answer
@@ -175,9 +178,10 @@ def test_containment_collides_for_trimesh(trimesh_oracle):
     # so the small one inside the big one collides; refsim says False.
     cube, small = bundled_mesh("cube"), bundled_mesh("cube", 0.5)
     assert engine_collides(trimesh_oracle, cube, IDENTITY, small, IDENTITY) is True
-    kind = classify_body_disagreement(cube, IDENTITY, small, IDENTITY, False,
-                                      trimesh_oracle)
-    assert kind == "containment"
+    verdict = classify_body_disagreement(cube, IDENTITY, small, IDENTITY, False,
+                                         trimesh_oracle)
+    assert (verdict.kind, verdict.reason) == ("known-divergence", "containment")
+    assert verdict.gap == 0.25                  # the small cube's faces to the big one's
 
 
 @pytest.mark.oracle
@@ -201,33 +205,55 @@ def test_float32_transform_is_classified(trimesh_oracle):
     assert bodies_collide(beam, IDENTITY, beam, pose_b) is False
     assert bodies_collide(beam, IDENTITY, beam, float32_pose(pose_b)) is True
     assert engine_collides(trimesh_oracle, beam, IDENTITY, beam, pose_b) is True
-    kind = classify_body_disagreement(beam, IDENTITY, beam, pose_b, False,
-                                      trimesh_oracle)
-    assert kind == "float32 transform"
+    verdict = classify_body_disagreement(beam, IDENTITY, beam, pose_b, False,
+                                         trimesh_oracle)
+    assert (verdict.kind, verdict.reason) == ("tolerance", "float32 transform")
+    assert verdict.gap == 2.0 ** -30            # the beams' faces z = 0.5 and 0.5 + 2**-30
 
 
 @pytest.mark.oracle
 def test_touching_cubes_are_classified(trimesh_oracle):
     cube = bundled_mesh("cube")
     assert engine_collides(trimesh_oracle, cube, IDENTITY, cube, at(1.0)) is False
-    kind = classify_body_disagreement(cube, IDENTITY, cube, at(1.0), True,
-                                      trimesh_oracle)
-    assert kind == "touching"
+    verdict = classify_body_disagreement(cube, IDENTITY, cube, at(1.0), True,
+                                         trimesh_oracle)
+    assert (verdict.kind, verdict.reason, verdict.gap) == ("touching", "touching", 0.0)
 
 
 def test_tolerance_and_bug_classes():
-    # An engine that always says "apart": on cubes overlapping by 2**-24 it is
-    # within tolerance (moving B away by 1e-6 separates them); on cubes
-    # overlapping by 0.25 it is a bug.
-    apart = Answering("apart", False)
+    # An engine that always says "apart", declaring GJK's distance tolerance
+    # of 1e-6 m: on cubes overlapping by 2**-24 (z from 0.5 - 2**-24 to 0.5,
+    # exact) it is within its tolerance; on cubes overlapping by 0.25 it is a
+    # bug. The gap is minus the deepest exact pair's depth.
+    apart = Answering("apart", False, distance_tolerance=1e-6)
     cube = bundled_mesh("cube")
     shallow = at(0.25, 0.125, 1.0 - 2.0 ** -24)
-    assert classify_body_disagreement(cube, IDENTITY, cube, shallow, True, apart) == "tolerance"
+    verdict = classify_body_disagreement(cube, IDENTITY, cube, shallow, True, apart)
+    assert (verdict.kind, verdict.reason) == ("tolerance", "gap within tolerance")
+    assert verdict.gap == -(2.0 ** -24)
     deep = at(0.25, 0.125, 0.75)
-    assert classify_body_disagreement(cube, IDENTITY, cube, deep, True, apart) == "bug"
+    verdict = classify_body_disagreement(cube, IDENTITY, cube, deep, True, apart)
+    assert (verdict.kind, verdict.reason, verdict.gap) == ("bug", "gap beyond tolerance", -0.25)
     # An engine that always says "collide" on bodies 0.5 apart: a bug.
-    always = Answering("always", True)
-    assert classify_body_disagreement(cube, IDENTITY, cube, at(1.5), False, always) == "bug"
+    always = Answering("always", True, distance_tolerance=1e-6)
+    verdict = classify_body_disagreement(cube, IDENTITY, cube, at(1.5), False, always)
+    assert (verdict.kind, verdict.reason, verdict.gap) == ("bug", "gap beyond tolerance", 0.5)
+
+
+def test_an_undeclared_tolerance_is_not_granted():
+    # The study's former rule called any answer that a move of 1e-6 of the
+    # larger radius along the line of centres flips "tolerance", whatever the
+    # engine declared; the kit holds an engine that declares no tolerance to
+    # float64's rounding bound. An overlap of 2**-24 m on unit cubes is 2**29
+    # units of float64 roundoff: not rounding, so missed by an engine that
+    # declares nothing it is a bug (the kit's rule, now both's).
+    apart = Answering("apart", False)
+    cube = bundled_mesh("cube")
+    verdict = classify_body_disagreement(cube, IDENTITY, cube, at(0.25, 0.125, 1.0 - 2.0 ** -24),
+                                         True, apart)
+    assert (verdict.kind, verdict.reason) == ("bug", "gap beyond tolerance")
+    assert verdict.gap == -(2.0 ** -24)
+    assert verdict.bound < 2.0 ** -30           # 2**14 ulps of the coordinates (1.5): 1.4e-12
 
 
 # -- the measurement ---------------------------------------------------------------------
@@ -283,13 +309,18 @@ def test_oracle_agreement_has_no_bug(fcl, trimesh_oracle):
     for source in ("constructed", "random"):
         assert result.body("fcl", source).agree == result.body("fcl", source).n
     # trimesh on the constructed configurations: exactly the documented cases.
-    found = {(d.case, d.kind) for d in result.body("trimesh", "constructed").disagreements}
-    assert found == {("cubes-face", "touching"), ("cubes-corner", "touching"),
-                     ("icosahedron-in-sphere", "containment"),
-                     ("cube-in-cube", "containment")}
+    found = {(d.case, d.kind, d.reason)
+             for d in result.body("trimesh", "constructed").disagreements}
+    assert found == {("cubes-face", "touching", "touching"),
+                     ("cubes-corner", "touching", "touching"),
+                     ("icosahedron-in-sphere", "known-divergence", "containment"),
+                     ("cube-in-cube", "known-divergence", "containment")}
     random = result.body("trimesh", "random")
-    assert set(d.kind for d in random.disagreements) <= {"containment", "touching",
-                                                         "float32 transform", "tolerance"}
+    assert set((d.kind, d.reason) for d in random.disagreements) <= {
+        ("known-divergence", "containment"), ("touching", "touching"),
+        ("tolerance", "float32 transform"), ("tolerance", "gap within tolerance")}
+    for d in random.disagreements:              # a tolerance is within trimesh's declared one
+        assert d.kind != "tolerance" or abs(d.gap) <= 1e-6
 
 
 # -- the benchmark configurations --------------------------------------------------------

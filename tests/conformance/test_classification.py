@@ -205,3 +205,50 @@ def test_declarations_default_to_exact_and_restitution():
     assert declarations(_Declaring()) == Declarations(0.0, 0.0, "restitution")
     assert declarations(_Declaring(distance_tolerance=1e-6, contact_law="hunt-crossley")) == \
         Declarations(1e-6, 0.0, "hunt-crossley")
+
+
+def test_the_body_classes_are_the_kits():
+    # one vocabulary: every class of the body classifier is a kit class, in
+    # the kit's order of seriousness, and so is the order of the pair classes
+    from refsim.collision.disagreement import BODY_CLASSES, BODY_REASONS, PAIR_SEVERITY
+    from refsim.conformance.results import CLASSES
+
+    for order in (BODY_CLASSES, PAIR_SEVERITY):
+        assert list(order) == [c for c in CLASSES if c in order]
+    assert {kind for kind, _ in BODY_REASONS.values()} == set(BODY_CLASSES)
+
+
+class _RoundsPoses:
+    """Says "collide" everywhere; declares that it applies float32 poses and
+    tests no mesh as a solid."""
+
+    name = "rounds-poses"
+
+    def bodies_collide(self, *arrays) -> bool:
+        return True
+
+    @staticmethod
+    def pose_used(pose):
+        return (np.asarray(pose[0], np.float32).astype(np.float64),
+                np.asarray(pose[1], np.float32).astype(np.float64))
+
+    @staticmethod
+    def is_solid(vertices, faces) -> bool:
+        return False
+
+
+def test_the_kit_reads_the_engines_pose_and_solid_conventions():
+    # unit cubes 2**-30 apart along z (float32: sharing a face), and the
+    # tetrahedron inside the sphere: the engine's "collide" is its float32
+    # pose on the first, and a bug on the second (it tests no mesh as a
+    # solid, though it declares nothing else)
+    grazing = _case("cube.ac", IDENTITY, "cube.ac",
+                    (np.eye(3), np.array([0.0, 0.0, 1.0 + 2.0 ** -30])))
+    inside = _case("sphere-2k.ac", IDENTITY, "tetrahedron.ac",
+                   (np.eye(3), np.array([0.1, 0.05, 0])))
+    result = check_collide_agreement(_RoundsPoses(), PoseCases(cases=(grazing, inside), seed=0))
+    seeded = {e["case"]: e for e in result.examples if not e.get("shrunk")}
+    assert (seeded[0]["class"], seeded[0]["reason"]) == ("tolerance", "float32 transform")
+    assert seeded[0]["gap_metres"] == 2.0 ** -30
+    assert (seeded[1]["class"], seeded[1]["reason"]) == ("bug", "containment without solid")
+    assert seeded[1]["contained"] is True and seeded[1]["solid_declared"] is False

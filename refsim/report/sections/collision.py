@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import asdict
 
 from refsim.claims.collision import speed_findings
+from refsim.collision.disagreement import BODY_REASONS
 from refsim.report.charts import Series, line_chart
 from refsim.report.plan import command
 from refsim.report.section import (
@@ -137,15 +138,15 @@ def build(ctx) -> Section:
                     *(b.counts[k] for k in measure_levels.BODY_DISAGREEMENT_KINDS))
                    for b in agreement.bodies),
         caption=("FCL: fcl.collide on two BVHModels (surfaces, like refsim). trimesh: "
-                 "CollisionManager, which makes convex meshes fcl.Convex solids (a body "
-                 "inside a convex one collides: 'containment') and rounds transforms to "
-                 "float32 ('float32 transform': refsim on the rounded poses agrees). "
-                 "'touching': refsim's contact rests on exact zeros (shared face or corner); "
-                 "'tolerance': moving a body by "
-                 f"{measure_levels.BODY_TOLERANCE:g} of its radius flips refsim's answer. "
-                 "Disagreements: "
+                 "CollisionManager, which makes convex meshes fcl.Convex solids and rounds "
+                 "transforms to float32. Every disagreement classified by the conformance "
+                 "kit's classifier (refsim.collision.disagreement.classify_bodies, the "
+                 "classes of refsim conform), with its reason and gap in metres; reasons: "
+                 + "; ".join(f"'{reason}' ({kind}): {meaning}" for reason, (kind, meaning)
+                             in BODY_REASONS.items())
+                 + ". Disagreements: "
                  + ("; ".join(f"{d.case} ({d.source}, refsim {d.refsim}, {b.oracle} "
-                              f"{d.oracle}): {d.kind}"
+                              f"{d.oracle}): {d.kind}, {d.reason}, gap {d.gap:.3g} m"
                               for b in agreement.bodies for d in b.disagreements) or "none")
                  + f". Reproduce: {BODY_ORACLES_COMMAND}")))
 
@@ -353,7 +354,8 @@ def _ratio_x(value) -> str:
     return "n/a" if value is None else f"{value:.2g}x"
 
 
-#: What each class of disagreement means, for the divergence catalogue.
+#: What each class of a triangle-pair disagreement means, for the divergence
+#: catalogue (a body-level one says its reason, refsim.collision.disagreement.BODY_REASONS).
 KIND_MEANING = {
     "coplanar": "all six vertices lie in one plane, exactly; the oracle's float test "
                 "decides the in-plane overlap differently",
@@ -361,10 +363,6 @@ KIND_MEANING = {
                 "exact predicates count it, the oracle's floats may not",
     "tolerance": "a decision within rounding of the boundary: the oracle's float answer "
                  "differs from the exact one on the same coordinates",
-    "containment": "one body inside a convex one: trimesh tests solids (fcl.Convex), "
-                   "refsim tests surfaces",
-    "float32 transform": "trimesh rounds the pose to float32 in add_object; refsim on the "
-                         "rounded pose agrees",
     "bug": "no explanation found: a defect to fix",
 }
 
@@ -386,11 +384,16 @@ def _divergences(triangle_rows, agreement) -> list[Divergence]:
                 + f" ({KIND_MEANING[kind]})", "collision-fcl-pairs"))
     for kind in measure_levels.BODY_DISAGREEMENT_KINDS:
         bodies = [b for b in agreement.bodies if b.counts[kind]]
+        reasons = [r for r, (k, _) in BODY_REASONS.items() if k == kind
+                   and any(b.reasons.get(r) for b in bodies)]
         if bodies:
             entries.append(Divergence(
                 f"body-level answers: {kind}", f"oracle disagreement: {kind}",
-                "; ".join(f"{b.oracle} ({b.source}): {b.counts[kind]} of {b.n}" for b in bodies)
-                + f" ({KIND_MEANING[kind]})", "collision-body-oracles"))
+                "; ".join(f"{b.oracle} ({b.source}): {b.counts[kind]} of {b.n} ("
+                          + ", ".join(f"{r} {b.reasons[r]}" for r in reasons
+                                      if b.reasons.get(r)) + ")" for b in bodies)
+                + " (" + "; ".join(f"{r}: {BODY_REASONS[r][1]}" for r in reasons) + ")",
+                "collision-body-oracles"))
     return entries
 
 
