@@ -140,7 +140,7 @@ def unit_exponent(largest):
     return math.frexp(largest)[1]
 
 
-@numba.njit(cache=True)
+@numba.njit("(float64[::1], float64[::1], float64[::1], float64, intp, intp, float64, float64, float64)", cache=True)
 def block_sums(x, y, z, f, lo, n, m0, m1, m2):
     """numpy's pairwise sum of at most PAIRWISE_BLOCK terms (module
     docstring) of each of the six products ``d_i d_j`` a covariance needs,
@@ -341,16 +341,6 @@ def covariance(x, y, z, n, largest, a, scaled):
     a[1, 2] = a[2, 1] = 0.0 + yz
 
 
-@numba.njit(cache=True)
-def symmetric_eigenvectors(a, axes, count):
-    """Mirrors: bvh_exact.symmetric_eigenvectors, of ``count`` matrices
-    ``a`` (count, 3, 3), left unchanged; the eigenvectors (columns) go to
-    ``axes`` (count, 3, 3). Two at a time (:func:`eigenvectors_of_pair`),
-    the last of an odd count with itself."""
-    for m in range(0, count, 2):
-        eigenvectors_of_pair(a, axes, m, min(m + 1, count - 1))
-
-
 @numba.njit(cache=True, inline="always")
 def jacobi_rotation(app, apq, apr, aqp, aqq, aqr, arp, arq, v0p, v0q, v1p, v1q, v2p, v2q):
     """One rotation of bvh_exact.symmetric_eigenvectors, the one that zeroes
@@ -467,6 +457,15 @@ def sorted_columns(d0, d1, d2, columns, axes):
         axes[0, column], axes[1, column], axes[2, column] = c0, c1, c2
 
 
+@numba.njit("(float64[:, :, ::1], float64[:, :, ::1], intp)", cache=True)
+def symmetric_eigenvectors(a, axes, count):
+    """Mirrors: bvh_exact.symmetric_eigenvectors, of ``count`` matrices
+    ``a`` (count, 3, 3), left unchanged; the eigenvectors (columns) go to
+    ``axes`` (count, 3, 3). Two at a time (:func:`eigenvectors_of_pair`),
+    the last of an odd count with itself."""
+    for m in range(0, count, 2):
+        eigenvectors_of_pair(a, axes, m, min(m + 1, count - 1))
+
 
 @numba.njit(cache=True, inline="always")
 def project(p0, p1, p2, a0, a1, a2):
@@ -502,7 +501,7 @@ def extents(x, y, z, n, axes):
 # -- ranking ------------------------------------------------------------------------
 
 
-@numba.njit(cache=True)
+@numba.njit("(float64[::1], intp[::1], intp[::1], intp, intp)", cache=True)
 def insertion_sort(key, members, ranked, lo, hi):
     """``ranked[lo:hi]`` put in ``np.lexsort((members, key))`` order (keys
     without NaN): by key, ties by member."""
@@ -519,7 +518,7 @@ def insertion_sort(key, members, ranked, lo, hi):
         ranked[s] = p
 
 
-@numba.njit(cache=True)
+@numba.njit("(float64[::1], intp[::1], intp[::1], intp, intp)", cache=True)
 def sort_by_argsort(key, members, ranked, lo, hi):
     """``ranked[lo:hi]`` put in ``np.lexsort((members, key))`` order by a
     stable sort of the keys and a sort by member of each run of ties (keys
@@ -607,7 +606,7 @@ def least_axis(measures):
     return chosen
 
 
-@numba.njit(cache=True)
+@numba.njit("(float64[::1], float64[::1], float64[::1], intp[::1], intp[::1], intp, intp, float64[::1], float64[::1], float64[::1])", cache=True)
 def gather(tx, ty, tz, members, ranked, lo, hi, x, y, z):
     """The vertices of triangles ``members[ranked[lo:hi]]`` into x, y, z,
     three a triangle (``triangles[...].reshape(-1, 3)``): ``(their number,
@@ -703,7 +702,7 @@ def chosen_axis(v0, v1, v2, s0, s1, s2):
     return best
 
 
-@numba.njit(cache=True)
+@numba.njit("(float64[:, ::1], float64[:, ::1], intp[::1], intp, intp)", cache=True)
 def surface_area(tri_lo, tri_hi, ranked, lo, hi):
     """Mirrors: bvh._surface_area, of the boxes ``ranked[lo:hi]`` (columns
     of ``tri_lo``, ``tri_hi`` (3, k))."""
@@ -858,7 +857,7 @@ def oriented_box(x, y, z, n, axes, box):
             box[6 + 3 * i + j] = axes[i, j]
 
 
-@numba.njit(cache=True)
+@numba.njit("(float64[::1], float64[::1], float64[::1], intp[:, ::1], intp[::1], intp[::1], intp[::1], intp[::1], intp[::1], boolean, float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1])", cache=True)
 def visit_nodes(vx, vy, vz, faces, left, right, start, count, order, boxing, a, axes, boxes):
     """Each node's points, ``vertices[np.unique(faces[members])]`` (its
     vertex indices in increasing order), in turn: their covariance into

@@ -75,6 +75,12 @@ from refsim.rounding import O2D_ERRBOUND_A, O3D_ERRBOUND_A
 #: this module (tests/test_kernels.py checks it).
 SOURCES_DIGEST = "1944e2d253670386"
 
+#: The expansion operations' signatures, given so that numba compiles each
+#: once: the callers pass offsets that are constants, and numba would type
+#: each constant as its own literal and compile a version per combination.
+EXPANSION_SUM = "intp(float64[::1], intp, intp, intp, intp, intp)"
+EXPANSION_SCALE = "intp(float64[::1], intp, intp, float64, intp)"
+
 #: Dekker's splitter for float64: 2**ceil(53 / 2) + 1 (Shewchuk, section 2.5).
 SPLITTER = 134217729.0
 
@@ -144,7 +150,7 @@ def two_one_diff(a1, a0, b):
     return x2, x1, x0
 
 
-@numba.njit(cache=True)
+@numba.njit("(float64, float64, float64, float64, float64[::1], intp)", cache=True)
 def minor(p0, p1, q0, q1, out, at):
     """The 2 x 2 minor ``p0 q1 - p1 q0`` as an expansion written to ``out``
     from ``at`` on, smallest component first; returns its length (1 to 4).
@@ -166,7 +172,7 @@ def minor(p0, p1, q0, q1, out, at):
     return n
 
 
-@numba.njit(cache=True)
+@numba.njit(EXPANSION_SUM, cache=True)
 def fast_expansion_sum(w, e, e_len, f, f_len, h):
     """``w[h:]`` = ``w[e:e + e_len]`` + ``w[f:f + f_len]``; returns the
     result's length (Fast-Expansion-Sum with zero elimination, Theorem 13).
@@ -239,7 +245,7 @@ def fast_expansion_sum(w, e, e_len, f, f_len, h):
     return h_len
 
 
-@numba.njit(cache=True)
+@numba.njit(EXPANSION_SCALE, cache=True)
 def scale_expansion(w, e, e_len, b, h):
     """``w[h:]`` = b ``w[e:e + e_len]``; returns the result's length
     (Scale-Expansion with zero elimination, Theorem 19). The result must not
@@ -469,7 +475,7 @@ def orient2d(a, b, c):
 # -- the edge-triangle test (refsim.collision.triangle, steps 1-4) -------------------
 
 
-@numba.njit(cache=True)
+@numba.njit("(UniTuple(float64, 3), intp)", cache=True)
 def drop(p, axis):
     """Mirrors :func:`refsim.collision.triangle._drop`."""
     if axis == 0:

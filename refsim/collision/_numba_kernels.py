@@ -30,7 +30,7 @@ from refsim.rounding import O2D_ERRBOUND_A, O3D_ERRBOUND_A
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "b21636d5d6852463"
+SOURCES_DIGEST = "93f8352e1cf32731"
 
 # -- the certified triangle-pair filter (triangle_numba's steps 1-4) -------------------
 #
@@ -276,7 +276,7 @@ def traverse(left_a, right_a, start_a, count_a, order_a, lo_a, hi_a, tlo_a, thi_
         top += 2
     return out[:found]
 
-@numba.njit(cache=True)
+@numba.njit("(intp[:, ::1], intp)", cache=True)
 def grow(rows, used):
     """``rows`` (k, 2) copied into an array twice as long (amortized O(1) appends)."""
     bigger = np.empty((2 * rows.shape[0], 2), dtype=np.int64)
