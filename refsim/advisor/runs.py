@@ -305,9 +305,10 @@ def _sample_interval(sim: CountingSimulation, count: int, steps) -> None:
     the same trajectory.
 
     The counts: the loop's steps visit every vertex of the batched bodies
-    (the run has no tracker: :func:`_run`) and call no narrow phase (a
-    step whose boxes overlap at a triangle level is handed back to
-    :meth:`~refsim.Simulation.step`, which counts its calls).
+    (the run has no tracker: :func:`_run`); a loop step whose boxes overlap
+    runs its narrow phase through ``sim._narrow_phase`` (the loop's body
+    stage, :meth:`refsim.dynamics.compiled_loop.CompiledLoop.body_stage`),
+    which counts its calls as a readable step's does.
     """
     end = sim.steps + count
 

@@ -518,27 +518,49 @@ def insertion_sort(key, members, ranked, lo, hi):
         ranked[s] = p
 
 
+@numba.njit("(float64[::1], intp[::1], intp, intp)", cache=True)
+def ranks_before(key, members, p, q):
+    """Whether position p comes before q in ``np.lexsort((members, key))``
+    order: by key, a NaN after every number, ties (equal keys, -0.0 and 0.0
+    among them, or both NaN) by member."""
+    kp, kq = key[p], key[q]
+    if kp == kp and kq == kq:
+        return kp < kq or (kp == kq and members[p] < members[q])
+    if kp != kp and kq != kq:
+        return members[p] < members[q]
+    return kp == kp                           # a number before a NaN
+
+
 @numba.njit("(float64[::1], intp[::1], intp[::1], intp, intp)", cache=True)
-def sort_by_argsort(key, members, ranked, lo, hi):
-    """``ranked[lo:hi]`` put in ``np.lexsort((members, key))`` order by a
-    stable sort of the keys and a sort by member of each run of ties (keys
-    equal, or both NaN)."""
-    run = ranked[lo:hi].copy()
-    by_key = np.argsort(key[run], kind="mergesort")
-    for i in range(hi - lo):
-        ranked[lo + i] = run[by_key[i]]
-    first = lo
-    for r in range(lo + 1, hi + 1):
-        if r < hi:
-            x, y = key[ranked[r]], key[ranked[first]]
-            if x == y or (x != x and y != y):
-                continue
-        if r - first > 1:
-            insertion_by_member = ranked[first:r].copy()
-            order = np.argsort(members[insertion_by_member])
-            for i in range(r - first):
-                ranked[first + i] = insertion_by_member[order[i]]
-        first = r
+def merge_sort(key, members, ranked, lo, hi):
+    """``ranked[lo:hi]`` put in ``np.lexsort((members, key))`` order
+    (:func:`ranks_before`) by a bottom-up merge sort: O(k log k) for the runs
+    the buckets of :func:`rank` cannot split. The order is unique (members
+    differ), so it is numpy's whatever the sort. Written out rather than
+    numpy's argsort, whose compiled sorts cost seconds of every empty
+    cache's compile."""
+    k = hi - lo
+    source, target = ranked[lo:hi], np.empty(k, dtype=np.intp)
+    in_ranked = True                          # source is ranked[lo:hi] itself
+    width = 1
+    while width < k:
+        for first in range(0, k, 2 * width):
+            mid, end = min(first + width, k), min(first + 2 * width, k)
+            i, j = first, mid
+            for out in range(first, end):
+                if j >= end or (i < mid and not ranks_before(key, members, source[j],
+                                                             source[i])):
+                    target[out] = source[i]
+                    i += 1
+                else:
+                    target[out] = source[j]
+                    j += 1
+        source, target = target, source
+        in_ranked = not in_ranked
+        width *= 2
+    if not in_ranked:
+        for i in range(k):
+            ranked[lo + i] = source[i]
 
 
 @numba.njit(cache=True)
@@ -551,26 +573,26 @@ def rank(key, members, k, ranked, bucket, counts):
     (k / (hi - lo))`` rounded down, which never decreases as the key grows
     (each operation is monotone) and puts equal keys together, and each
     bucket is then sorted by comparisons. Keys with a NaN, or too close for
-    the buckets, go to :func:`sort_by_argsort`. ``bucket`` (k,) and
+    the buckets, go to :func:`merge_sort`. ``bucket`` (k,) and
     ``counts`` (k + 1,) are scratch."""
     for i in range(k):
         ranked[i] = i
     if k <= INSERTION_RUN:
         for i in range(k):
             if key[i] != key[i]:
-                sort_by_argsort(key, members, ranked, 0, k)
+                merge_sort(key, members, ranked, 0, k)
                 return
         insertion_sort(key, members, ranked, 0, k)
         return
     lo, hi = np.inf, -np.inf
     for i in range(k):
         if key[i] != key[i]:
-            sort_by_argsort(key, members, ranked, 0, k)
+            merge_sort(key, members, ranked, 0, k)
             return
         lo, hi = min(lo, key[i]), max(hi, key[i])
     scale = k / (hi - lo) if hi > lo else np.inf
     if not scale < np.inf:
-        sort_by_argsort(key, members, ranked, 0, k)
+        merge_sort(key, members, ranked, 0, k)
         return
     counts[:k + 1] = 0
     for i in range(k):
@@ -586,7 +608,7 @@ def rank(key, members, k, ranked, bucket, counts):
     for b in range(k):
         end = counts[b]
         if end - first > INSERTION_RUN:
-            sort_by_argsort(key, members, ranked, first, end)
+            merge_sort(key, members, ranked, first, end)
         elif end - first > 1:
             insertion_sort(key, members, ranked, first, end)
         first = end
@@ -743,6 +765,16 @@ def least_area_split(tx, ty, tz, members, k, mid, work):
 # -- the build ----------------------------------------------------------------------
 
 
+@numba.njit("(float64[:, ::1], float64[:, ::1])", cache=True)
+def copy3x3(src, dst):
+    """``dst[:] = src`` for two (3, 3) arrays, written out: numba's array
+    assignment checks the shapes with an error message whose text
+    formatting costs seconds of every empty cache's compile."""
+    for i in range(3):
+        for j in range(3):
+            dst[i, j] = src[i, j]
+
+
 @numba.njit(cache=True)
 def build_tree(tx, ty, tz, leaf_size, rule):
     """Mirrors: bvh.build_tree, with its split ``bvh.least_area_split``
@@ -776,11 +808,12 @@ def build_tree(tx, ty, tz, leaf_size, rule):
         if hi - lo <= leaf_size:
             continue
         k, mid = hi - lo, (hi - lo) // 2
-        members[:k] = order[lo:hi]
+        for r in range(k):                    # element by element: an array assignment
+            members[r] = order[lo + r]        # compiles numba's shape-error text
         if rule == LEAST_AREA:
             chosen = least_area_split(tx, ty, tz, members, k, mid, work)
         else:
-            axes[NODE] = stack_axes[top]
+            copy3x3(stack_axes[top], axes[NODE])
             chosen = least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work)
         for r in range(k):
             order[lo + r] = members[ranked[chosen, r]]
@@ -793,8 +826,8 @@ def build_tree(tx, ty, tz, leaf_size, rule):
         stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3] = b, lo + mid, hi, known
         stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2], stack[top + 1, 3] = \
             a, lo, lo + mid, known
-        stack_axes[top] = axes[2 * chosen + 1]
-        stack_axes[top + 1] = axes[2 * chosen]
+        copy3x3(axes[2 * chosen + 1], stack_axes[top])
+        copy3x3(axes[2 * chosen], stack_axes[top + 1])
         top += 2                              # a, then its subtree, before b
     return (left[:nodes].copy(), right[:nodes].copy(), start[:nodes].copy(),
             count[:nodes].copy(), order)
@@ -996,13 +1029,29 @@ def frame_tree_arrays(vertices, faces, leaf_size):
     for node in range(nodes):
         links[node, 0], links[node, 1] = left[node], right[node]
         links[node, 2], links[node, 3] = start[node], count[node]
+    # laid end to end element by element: numba's array assignment compiles
+    # its shape-error text, seconds of every empty cache's compile
     floats = np.empty(2 + 3 * n + 15 * nodes)
     floats[0], floats[1] = reach, deviation
-    floats[2:2 + 3 * n] = vertices.ravel()
-    floats[2 + 3 * n:] = boxes.ravel()
+    at = 2
+    for i in range(n):
+        for j in range(3):
+            floats[at + 3 * i + j] = vertices[i, j]
+    at += 3 * n
+    for node in range(nodes):
+        for j in range(15):
+            floats[at + 15 * node + j] = boxes[node, j]
     ints = np.empty(3 + 3 * m + 4 * nodes + m, dtype=np.int64)
     ints[0], ints[1], ints[2] = n, m, nodes
-    ints[3:3 + 3 * m] = faces.ravel()
-    ints[3 + 3 * m:3 + 3 * m + 4 * nodes] = links.ravel()
-    ints[3 + 3 * m + 4 * nodes:] = order
+    at = 3
+    for i in range(m):
+        for j in range(3):
+            ints[at + 3 * i + j] = faces[i, j]
+    at += 3 * m
+    for node in range(nodes):
+        for j in range(4):
+            ints[at + 4 * node + j] = links[node, j]
+    at += 4 * nodes
+    for i in range(m):
+        ints[at + i] = order[i]
     return left, right, start, count, order, links, boxes, deviation, reach, floats, ints

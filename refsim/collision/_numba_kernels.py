@@ -280,7 +280,9 @@ def traverse(left_a, right_a, start_a, count_a, order_a, lo_a, hi_a, tlo_a, thi_
 def grow(rows, used):
     """``rows`` (k, 2) copied into an array twice as long (amortized O(1) appends)."""
     bigger = np.empty((2 * rows.shape[0], 2), dtype=np.int64)
-    bigger[:used] = rows[:used]
+    for i in range(used):                     # element by element: an array assignment
+        bigger[i, 0] = rows[i, 0]             # compiles numba's shape-error text
+        bigger[i, 1] = rows[i, 1]
     return bigger
 
 

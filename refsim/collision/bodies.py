@@ -59,7 +59,7 @@ EXACT_QUERY = Tier("exact collision query",
                     "refsim.collision._numba_kernels:exact_collide",
                     "refsim.collision._numba_build:frame_tree_arrays",
                     "refsim.collision._numba_build:build_tree",
-                    "refsim.collision._numba_build:frame_boxes"), compile_seconds=60.0)
+                    "refsim.collision._numba_build:frame_boxes"), compile_seconds=45.0)
 
 #: A body with more triangles than this takes the compiled query even on a
 #: cold cache: the readable build of its hierarchy, in one call, would cost

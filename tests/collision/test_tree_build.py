@@ -188,3 +188,25 @@ def test_a_ring_is_cut_into_arcs_not_into_flat_rings():
             xy = centroids[members, :2]
             directions = xy / np.linalg.norm(xy, axis=1)[:, None]
             assert np.linalg.norm(directions.mean(axis=0)) > 0.5, kernel
+
+
+@pytest.mark.parametrize("keys", ["normal", "ties, zeros of both signs and NaN"])
+def test_the_ranking_merge_sort_gives_numpys_lexsort_order(keys):
+    """merge_sort, the ranking's sort for the runs its buckets cannot split
+    (and for keys with a NaN), puts any stretch of ``ranked`` in the order
+    of ``np.lexsort((members, key))``: by key, a NaN last, ties by member."""
+    nb = bvh.build_kernels()
+    rng = np.random.default_rng(SEED)
+    values = np.array([0.0, -0.0, 1.0, 2.0, np.nan, -1.5, 3.25])
+    for _ in range(400):
+        k = int(rng.integers(0, 70))
+        key = rng.normal(size=k) if keys == "normal" else rng.choice(values, size=k)
+        members = rng.permutation(1000)[:k].astype(np.intp)
+        lo = int(rng.integers(0, k + 1))
+        hi = int(rng.integers(lo, k + 1))
+        ranked = rng.permutation(k).astype(np.intp)
+        expected = ranked.copy()
+        stretch = expected[lo:hi]
+        expected[lo:hi] = stretch[np.lexsort((members[stretch], key[stretch]))]
+        nb.merge_sort(np.ascontiguousarray(key), members, ranked, lo, hi)
+        assert np.array_equal(ranked, expected), (k, lo, hi)

@@ -844,3 +844,18 @@ def test_an_exception_in_the_body_stage_puts_the_step_back():
     for name in ("x", "v", "w", "R"):
         assert getattr(sim, name).tobytes() == getattr(reference, name).tobytes(), name
     assert sim.events == reference.events and sim.loop_body_steps == reference.loop_body_steps
+
+
+def test_the_loops_sort_of_vertex_indices_is_numpys():
+    """_sort_ascending (the wall stage's vertices past a wall, in increasing
+    order) sorts ``a[:n]`` and leaves the rest, for lengths 0 to 300."""
+    from refsim.dynamics import _numba_kernels
+
+    rng = np.random.default_rng(7)
+    for _ in range(300):
+        n = int(rng.integers(0, 301))
+        a = rng.permutation(5000)[:n + 3].astype(np.int64)
+        expected = a.copy()
+        expected[:n] = np.sort(expected[:n])
+        _numba_kernels._sort_ascending(a, n)
+        assert np.array_equal(a, expected), n
