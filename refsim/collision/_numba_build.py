@@ -140,7 +140,8 @@ def unit_exponent(largest):
     return math.frexp(largest)[1]
 
 
-@numba.njit("(float64[::1], float64[::1], float64[::1], float64, intp, intp, float64, float64, float64)", cache=True)
+@numba.njit("(float64[::1], float64[::1], float64[::1], float64, intp, intp,"
+            " float64, float64, float64)", cache=True)
 def block_sums(x, y, z, f, lo, n, m0, m1, m2):
     """numpy's pairwise sum of at most PAIRWISE_BLOCK terms (module
     docstring) of each of the six products ``d_i d_j`` a covariance needs,
@@ -628,7 +629,8 @@ def least_axis(measures):
     return chosen
 
 
-@numba.njit("(float64[::1], float64[::1], float64[::1], intp[::1], intp[::1], intp, intp, float64[::1], float64[::1], float64[::1])", cache=True)
+@numba.njit("(float64[::1], float64[::1], float64[::1], intp[::1], intp[::1], intp, intp,"
+            " float64[::1], float64[::1], float64[::1])", cache=True)
 def gather(tx, ty, tz, members, ranked, lo, hi, x, y, z):
     """The vertices of triangles ``members[ranked[lo:hi]]`` into x, y, z,
     three a triangle (``triangles[...].reshape(-1, 3)``): ``(their number,
@@ -890,7 +892,9 @@ def oriented_box(x, y, z, n, axes, box):
             box[6 + 3 * i + j] = axes[i, j]
 
 
-@numba.njit("(float64[::1], float64[::1], float64[::1], intp[:, ::1], intp[::1], intp[::1], intp[::1], intp[::1], intp[::1], boolean, float64[:, :, ::1], float64[:, :, ::1], float64[:, ::1])", cache=True)
+@numba.njit("(float64[::1], float64[::1], float64[::1], intp[:, ::1], intp[::1], intp[::1],"
+            " intp[::1], intp[::1], intp[::1], boolean, float64[:, :, ::1], float64[:, :, ::1],"
+            " float64[:, ::1])", cache=True)
 def visit_nodes(vx, vy, vz, faces, left, right, start, count, order, boxing, a, axes, boxes):
     """Each node's points, ``vertices[np.unique(faces[members])]`` (its
     vertex indices in increasing order), in turn: their covariance into

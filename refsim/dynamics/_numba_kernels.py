@@ -496,17 +496,8 @@ def _steps(n_steps, first_step, n_events, h, hA, hb, gravity, drag_rate, quadrat
                 return step, n_events, STOP_BODY_STAGE, n_pairs
         # the wall contacts that began (committed only now: a stop above
         # leaves the previous step's flags)
-        for b in range(B):
-            for k in range(6):
-                if now_walls[b, k] and not walls[b, k]:
-                    events[n_events, 0] = first_step + step
-                    events[n_events, 1] = 0
-                    events[n_events, 2] = b
-                    events[n_events, 3] = k
-                    for j in range(7):
-                        event_data[n_events, j] = impulse_now[b, k, j]
-                    n_events += 1
-                walls[b, k] = now_walls[b, k]
+        n_events = _note_wall_onsets(first_step + step, walls, now_walls, impulse_now, events,
+                                     event_data, n_events)
         # 8. the seed's exchange (S8) for each pair, in order
         if body_mode == BODY_EXCHANGE:
             for p in range(n_pairs):
@@ -900,6 +891,26 @@ def _wall_impulse(b, corr, vertices_t, leaf_order, leaf_start, leaf_spheres, fir
 
 
 @numba.njit(cache=True, nogil=True)
+def _note_wall_onsets(step, walls, now_walls, impulse_now, events, event_data, n_events):
+    """The wall contacts that began in ``step`` (``now_walls[b, k]`` and not
+    ``walls[b, k]``) as event rows ``(step, 0, b, k)`` from row ``n_events``
+    on, each with its impulse record ``impulse_now[b, k]``; then ``walls``
+    becomes ``now_walls``. Returns the new number of rows."""
+    for b in range(walls.shape[0]):
+        for k in range(6):
+            if now_walls[b, k] and not walls[b, k]:
+                events[n_events, 0] = step
+                events[n_events, 1] = 0
+                events[n_events, 2] = b
+                events[n_events, 3] = k
+                for j in range(7):
+                    event_data[n_events, j] = impulse_now[b, k, j]
+                n_events += 1
+            walls[b, k] = now_walls[b, k]
+    return n_events
+
+
+@numba.njit(cache=True, nogil=True)
 def finish_body_step(hits, records, walls, now_walls, bodies, impulse_now, events, event_data,
                      counters):
     """The end of a step the kernel stopped in with ``STOP_BODY_STAGE``,
@@ -919,17 +930,8 @@ def finish_body_step(hits, records, walls, now_walls, bodies, impulse_now, event
     step = counters[slot.C_STEPS]
     n_events = counters[slot.C_PENDING]
     B = walls.shape[0]
-    for b in range(B):
-        for k in range(6):
-            if now_walls[b, k] and not walls[b, k]:
-                events[n_events, 0] = step
-                events[n_events, 1] = 0
-                events[n_events, 2] = b
-                events[n_events, 3] = k
-                for j in range(7):
-                    event_data[n_events, j] = impulse_now[b, k, j]
-                n_events += 1
-            walls[b, k] = now_walls[b, k]
+    n_events = _note_wall_onsets(step, walls, now_walls, impulse_now, events, event_data,
+                                 n_events)
     q = 0
     m = hits.shape[0]
     for i in range(B):

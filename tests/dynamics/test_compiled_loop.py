@@ -5,6 +5,9 @@ the hand-backs."""
 
 from __future__ import annotations
 
+import os
+import signal
+import threading
 from dataclasses import replace
 
 import numpy as np
@@ -292,10 +295,6 @@ def test_ctrl_c_during_the_loop_leaves_the_simulation_consistent():
     # and events account for exactly the state reached (a handler that
     # raised between the kernel's return and its bookkeeping left the state
     # up to a chunk of steps ahead of them)
-    import os
-    import signal
-    import threading
-
     scene = cubes_scene(10, "seed", seed=3, solver="rk4")
     sim = Simulation(scene, kernel="compiled")
     sim.run(10)                                   # compiled and loaded: not timed below
@@ -322,42 +321,10 @@ def test_ctrl_c_during_one_step_calls_leaves_the_simulation_consistent():
     # the same with advance(1) in a Python loop, the fast path without the
     # signal hold: wherever the interrupt lands, the kernel has counted the
     # steps it took and its event rows, and they show in steps, t and events
-    import os
-    import signal
-    import threading
-
     scene = cubes_scene(10, "seed", seed=3, solver="rk4")
     sim = Simulation(scene, kernel="compiled")
     sim.advance(1)
-    # Ctrl-C raises KeyboardInterrupt in whatever Python code runs when it is
-    # handled, and one raised inside a garbage-collector callback (Hypothesis
-    # registers one) is reported and dropped, not propagated: so the signal
-    # is sent until the loop has caught one
-    caught = []
-
-    def interrupt(signum, frame):
-        if not caught:
-            raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGINT, interrupt)
-    stop = threading.Event()
-
-    def send():
-        while not stop.wait(0.3):
-            os.kill(os.getpid(), signal.SIGINT)
-
-    sender = threading.Thread(target=send, daemon=True)
-    sender.start()
-    try:
-        for _ in range(5_000_000):             # bounded: never fills memory
-            sim.advance(1)
-    except KeyboardInterrupt:
-        caught.append(True)
-    finally:
-        stop.set()
-        sender.join()
-        signal.signal(signal.SIGINT, previous)
-    assert caught, "no interrupt reached the loop"
+    _interrupt_one_step_calls(sim, 0.3)
     assert 10 < sim.steps and sim.t == sim.steps * sim.h
     again = Simulation(scene, kernel="compiled")
     again.run(sim.steps)
@@ -763,41 +730,13 @@ def test_ctrl_c_during_body_contact_steps_leaves_the_simulation_consistent():
     # in Python after the kernel stopped inside the step: an interrupt before
     # the step is committed puts the state back to the step's start, so
     # steps, t, contacts and events account for the state wherever it lands
-    import os
-    import signal
-    import threading
-
     from refsim.studies.dynamics import c11_scene
 
     scene = c11_scene("stack", "impulse", duration=1000.0, step=1e-3)
     sim = Simulation(scene, kernel="compiled")
     sim.advance(1000)                           # in contact from about step 670 on
     start, body_steps = sim.snapshot(), sim.loop_body_steps
-    caught = []
-
-    def interrupt(signum, frame):
-        if not caught:
-            raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGINT, interrupt)
-    stop = threading.Event()
-
-    def send():
-        while not stop.wait(0.05):
-            os.kill(os.getpid(), signal.SIGINT)
-
-    sender = threading.Thread(target=send, daemon=True)
-    sender.start()
-    try:
-        for _ in range(5_000_000):             # bounded: never fills memory
-            sim.advance(1)
-    except KeyboardInterrupt:
-        caught.append(True)
-    finally:
-        stop.set()
-        sender.join()
-        signal.signal(signal.SIGINT, previous)
-    assert caught, "no interrupt reached the loop"
+    _interrupt_one_step_calls(sim, 0.05)
     assert sim.steps > start["steps"] and sim.t == sim.steps * sim.h
     assert sim.loop_body_steps - body_steps == sim.steps - start["steps"]   # each one
     again = Simulation(scene, kernel="compiled")
@@ -859,3 +798,36 @@ def test_the_loops_sort_of_vertex_indices_is_numpys():
         expected[:n] = np.sort(expected[:n])
         _numba_kernels._sort_ascending(a, n)
         assert np.array_equal(a, expected), n
+
+
+def _interrupt_one_step_calls(sim: Simulation, period: float) -> None:
+    """SIGINT every ``period`` seconds while ``sim`` takes one step per call,
+    until the call in progress raises KeyboardInterrupt. Ctrl-C raises it in
+    whatever Python code runs when it is handled, and one raised inside a
+    garbage-collector callback (Hypothesis registers one) is reported and
+    dropped, not propagated: so the signal is sent until one arrives."""
+    caught = []
+
+    def interrupt(signum, frame):
+        if not caught:
+            raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, interrupt)
+    stop = threading.Event()
+
+    def send():
+        while not stop.wait(period):
+            os.kill(os.getpid(), signal.SIGINT)
+
+    sender = threading.Thread(target=send, daemon=True)
+    sender.start()
+    try:
+        for _ in range(5_000_000):             # bounded: never fills memory
+            sim.advance(1)
+    except KeyboardInterrupt:
+        caught.append(True)
+    finally:
+        stop.set()
+        sender.join()
+        signal.signal(signal.SIGINT, previous)
+    assert caught, "no interrupt reached the loop"
