@@ -1034,7 +1034,8 @@ def frame_tree_arrays(vertices, faces, leaf_size):
         links[node, 0], links[node, 1] = left[node], right[node]
         links[node, 2], links[node, 3] = start[node], count[node]
     # laid end to end element by element: numba's array assignment compiles
-    # its shape-error text, seconds of every empty cache's compile
+    # its shape-error text, seconds of every empty cache's compile (and one
+    # helper for the five arrays would compile a version per array type)
     floats = np.empty(2 + 3 * n + 15 * nodes)
     floats[0], floats[1] = reach, deviation
     at = 2
