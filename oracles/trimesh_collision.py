@@ -76,7 +76,7 @@ class TrimeshCollisionOracle:
     #: CollisionManager runs on two convex meshes, stops at a tolerance of
     #: about 1e-6 (its default ``gjk_tolerance``), so a gap or an overlap that
     #: small between convex bodies can go either way (the conformance kit's
-    #: trimesh engine, :class:`refsim.conformance.shipped.TrimeshEngine`,
+    #: trimesh engine, :class:`refsim.oracles.trimesh_engine.TrimeshEngine`,
     #: declares the same).
     distance_tolerance = 1e-6
 

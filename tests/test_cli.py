@@ -115,12 +115,16 @@ def test_study_needs_a_known_name(capsys):
 def test_study_without_its_oracle_is_a_user_error(capsys, monkeypatch):
     from refsim.oracles import OracleUnavailable
 
-    from refsim.report import plan
+    from refsim.engines import registry
 
-    def missing():
-        raise OracleUnavailable("oracle engine 'trimesh' is not installed")
+    shipped = registry.build
 
-    monkeypatch.setitem(plan.ENGINES, "trimesh", missing)
+    def build(name, **settings):
+        if name == "trimesh-mesh":
+            raise OracleUnavailable("oracle engine 'trimesh' is not installed")
+        return shipped(name, **settings)
+
+    monkeypatch.setattr(registry, "build", build)
     assert main(["study", "bounds-agreement", "--quick"]) == EXIT_USER_ERROR
     err = capsys.readouterr().err
     assert "bounds-agreement" in err and "trimesh" in err and "Traceback" not in err

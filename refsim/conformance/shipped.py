@@ -10,17 +10,16 @@ fcl                 refsim.oracles.fcl_adapter:engine                 triangles,
                                                                       collide
 coal                refsim.oracles.coal_adapter:engine                triangles, pairs,
                                                                       collide
-trimesh             refsim.conformance.shipped:trimesh                collide, aabb
+trimesh             refsim.oracles.trimesh_engine:engine              collide, aabb
 pybullet            refsim.oracles.pybullet_adapter:engine            rigid
 mujoco              refsim.oracles.mujoco_adapter:engine              rigid
 drake               refsim.oracles.drake_adapter:engine               rigid
 drake-hydroelastic  refsim.oracles.drake_adapter:engine_hydroelastic  rigid
 ==================  ================================================  ==================
 
-trimesh has two adapters, one per question it answers (its boxes,
-:mod:`refsim.oracles.trimesh_adapter`; its CollisionManager,
-:mod:`refsim.oracles.trimesh_collision`); :func:`trimesh` puts them behind
-one engine so that the matrix has one trimesh column.
+trimesh has two adapters, one per question it answers;
+:mod:`refsim.oracles.trimesh_engine` puts them behind one engine so that
+the matrix has one trimesh column.
 
 The table is :data:`refsim.engines.registry.SHIPPED` (titles and extras
 too); ``SHIPPED_ENGINES`` is its name -> spec view. Each shipped engine's
@@ -35,58 +34,3 @@ from __future__ import annotations
 from refsim.engines.registry import SHIPPED
 
 SHIPPED_ENGINES: dict[str, str] = {e.name: e.spec for e in SHIPPED}
-
-
-class TrimeshEngine:
-    """trimesh's boxes (``aabb``) and its CollisionManager (``collide``) as
-    one engine named "trimesh"; both adapters load lazily and raise
-    :class:`refsim.oracles.OracleUnavailable` when trimesh (or python-fcl,
-    for the CollisionManager) is missing."""
-
-    name = "trimesh"
-
-    #: Metres (:func:`refsim.engines.declarations`). The CollisionManager tests
-    #: convex meshes as GJK solids, and FCL's GJK stops at a tolerance of 1e-6
-    #: (its default ``gjk_tolerance``); it also rounds both poses to float32
-    #: (6e-8 relative: below 3e-7 m at the kit's coordinates of a few metres).
-    #: The boxes skip a transform within 1e-8 of the identity
-    #: (:data:`refsim.oracles.trimesh_adapter.TRIMESH_IDENTITY_ATOL`), off by
-    #: at most 1e-8 (|x| + |y| + |z| + 1), within the same tolerance.
-    distance_tolerance = 1e-6
-
-    #: The CollisionManager tests a convex mesh as the solid it bounds (GJK on
-    #: its hull), so a body wholly inside another collides; :meth:`is_solid`
-    #: says which meshes (a non-convex one stays a surface).
-    solid = True
-
-    def __init__(self):
-        from refsim.oracles.trimesh_adapter import TrimeshOracle
-        from refsim.oracles.trimesh_collision import TrimeshCollisionOracle
-
-        self._boxes = TrimeshOracle()
-        self._collision = TrimeshCollisionOracle()
-
-    def aabb(self, vertices, pose):
-        return self._boxes.aabb(vertices, pose)
-
-    def bodies_collide(self, vertices_a, faces_a, pose_a, vertices_b, faces_b, pose_b) -> bool:
-        return self._collision.bodies_collide(vertices_a, faces_a, pose_a, vertices_b, faces_b,
-                                              pose_b)
-
-    def is_solid(self, vertices, faces) -> bool:
-        """Whether the CollisionManager tests the mesh as a solid (a convex
-        mesh only): the container of a "containment" must be one."""
-        return self._collision.is_solid(vertices, faces)
-
-    @staticmethod
-    def pose_used(pose):
-        """The float32 pose the CollisionManager applies
-        (:func:`refsim.oracles.trimesh_collision.float32_pose`)."""
-        from refsim.oracles.trimesh_collision import float32_pose
-
-        return float32_pose(pose)
-
-
-def trimesh() -> TrimeshEngine:
-    """The engine factory (``refsim.conformance.shipped:trimesh``)."""
-    return TrimeshEngine()

@@ -350,17 +350,15 @@ def engine_name(engine) -> str:
     return name
 
 
-def load_engine(spec: str, **kwargs):
-    """The engine ``module:factory`` names: ``factory(**kwargs)`` imported from
-    ``module``.
+def resolve_factory(spec: str):
+    """The callable ``module:factory`` names, imported from ``module``.
 
     Raises
     ------
     OptionError
-        The spec is not ``module:factory``, the module or the factory cannot
-        be found, or the factory's result has no name or no capability. The
-        message names the spec; an engine whose own import fails is reported
-        with that failure's one line.
+        The spec is not ``module:factory``, or the module or the factory
+        cannot be found; the message names the spec, and a module whose own
+        import fails is reported with that failure's one line.
     """
     if not isinstance(spec, str) or spec.count(":") != 1 or not all(spec.split(":")):
         raise OptionError(f"engine {spec!r}: expected 'module:factory', e.g. "
@@ -373,7 +371,22 @@ def load_engine(spec: str, **kwargs):
     factory = getattr(module, factory_name, None)
     if not callable(factory):
         raise OptionError(f"engine {spec!r}: {module_name} has no callable {factory_name!r}")
-    engine = factory(**kwargs)
+    return factory
+
+
+def load_engine(spec: str, **kwargs):
+    """The engine ``module:factory`` names: ``factory(**kwargs)`` imported from
+    ``module`` (:func:`resolve_factory`).
+
+    Raises
+    ------
+    OptionError
+        The spec is not ``module:factory``, the module or the factory cannot
+        be found, or the factory's result has no name or no capability. The
+        message names the spec; an engine whose own import fails is reported
+        with that failure's one line.
+    """
+    engine = resolve_factory(spec)(**kwargs)
     try:
         engine_name(engine)
     except ArgumentTypeError as exc:

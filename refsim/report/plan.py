@@ -7,10 +7,10 @@ measures it and the seed claims it backs. The entry functions live in
 collision, solvers, particles, dynamics, conformance, replays, advisor,
 sweep), each with the study functions it calls, its sizes for the quick and
 the full report and the records it returns. The engines they measure
-against (the oracle adapters of :mod:`refsim.oracles`) are chosen here and
-nowhere else (:data:`ENGINES`); an entry asks its run for one by name. The
-report's sections ask a :class:`refsim.report.run.Run` for an entry's
-records and arrange them; ``refsim study NAME`` runs the same entry and
+against are rows of the one engine table
+(:data:`refsim.engines.registry.ENGINES`); an entry asks its run for one by
+name. The report's sections ask a :class:`refsim.report.run.Run` for an
+entry's records and arrange them; ``refsim study NAME`` runs the same entry and
 prints them, so the command printed under a figure reproduces that figure
 (docs/design.md, Architecture: an engine is chosen only at a composition
 root).
@@ -95,72 +95,6 @@ from refsim.report.entries.solvers import (
 )
 from refsim.report.entries.sweep import sweep_speed
 from refsim.report.run import Study
-
-# -- engines -------------------------------------------------------------------------------
-
-
-def _trimesh():
-    from refsim.oracles.trimesh_adapter import TrimeshOracle
-
-    return TrimeshOracle()
-
-
-def _fcl():
-    from refsim.oracles.fcl_adapter import FCLOracle
-
-    return FCLOracle()
-
-
-def _trimesh_collision():
-    from refsim.oracles.trimesh_collision import TrimeshCollisionOracle
-
-    return TrimeshCollisionOracle()
-
-
-def _pybullet():
-    from refsim.oracles.pybullet_adapter import PybulletOracle
-
-    return PybulletOracle()
-
-
-def _scipy():
-    from refsim.oracles.scipy_ivp import ScipyReference
-
-    return ScipyReference()
-
-
-#: The oracle engines the report uses, by name: a factory each. One engine of
-#: each is made per run and shared by the entries (one pybullet client serves
-#: every bounce scene; each ``simulate`` resets it).
-ENGINES: dict[str, Callable[[], Any]] = {
-    "trimesh": _trimesh,
-    "fcl": _fcl,
-    "trimesh-collision": _trimesh_collision,
-    "pybullet": _pybullet,
-    "scipy": _scipy,
-}
-
-
-def pybullet_variants() -> list[tuple[str, Any]]:
-    """pybullet with the oracle's settings, then with one setting at a time
-    back at (or near) pybullet's default: ``(label, engine)`` pairs."""
-    from dataclasses import replace
-
-    from refsim.oracles.pybullet_adapter import PybulletOracle, PybulletSettings
-
-    base = PybulletSettings()
-    changes = (
-        ("none (the oracle's settings)", base),
-        ("useMaximalCoordinates=False (multibody)", replace(base, use_maximal_coordinates=False)),
-        ("contactProcessingThreshold=1e30 (Bullet's default: all)",
-         replace(base, contact_processing_threshold=1e30)),
-        ("useSplitImpulse=0", replace(base, use_split_impulse=0)),
-        ("restitutionVelocityThreshold=0.2 (Bullet's default)",
-         replace(base, restitution_velocity_threshold=0.2)),
-        ("linear/angular damping 0.04 (pybullet's default)",
-         replace(base, linear_damping=0.04, angular_damping=0.04)),
-    )
-    return [(label, PybulletOracle(settings)) for label, settings in changes]
 
 
 def command(name: str) -> str:

@@ -2,12 +2,13 @@
 scheduler that measures entries beside each other on local processes.
 
 A :class:`Run` measures each entry of :data:`refsim.report.plan.STUDIES`
-once, makes each engine of :data:`refsim.report.plan.ENGINES` once, and
+once, makes each engine it is asked for once (by its name in
+:data:`refsim.engines.registry.ENGINES`), and
 judges each seed claim from the records of the entry that backs it
 (:data:`refsim.report.plan.CLAIM_STUDY`). A :class:`Study` is one entry of
 that table. The plan imports this module to build its table, so a run reads
-the table and the engines from the plan inside the methods that use them
-(an import at the top would be circular).
+the table from the plan inside the methods that use it (an import at the
+top would be circular).
 
 With ``workers``, :meth:`Run.prefetch` sends the entries that may run
 elsewhere (:data:`refsim.report.plan.SWEEP_ENTRIES` and
@@ -163,14 +164,16 @@ class Run:
         return self._records[name]
 
     def engine(self, name: str):
-        """The oracle engine ``name`` of :data:`refsim.report.plan.ENGINES`;
-        raises :class:`refsim.oracles.OracleUnavailable` when it is missing."""
+        """The engine ``name`` of :data:`refsim.engines.registry.ENGINES`,
+        made once per run and shared by the entries (one pybullet client
+        serves every bounce scene; each ``simulate`` resets it); raises
+        :class:`refsim.oracles.OracleUnavailable` when it is missing."""
+        from refsim.engines import registry
         from refsim.oracles import OracleUnavailable
-        from refsim.report.plan import ENGINES
 
         if name not in self._engines:
             try:
-                self._engines[name] = ENGINES[name]()
+                self._engines[name] = registry.build(name)
             except OracleUnavailable as exc:
                 self._engines[name] = None
                 self.missing[name] = str(exc)

@@ -36,18 +36,11 @@ import pickle
 from pathlib import Path
 from typing import Any
 
-#: The demos :func:`write_replay_demo` knows, by name: (function of
-#: :mod:`refsim.viewer.demos`, the engine it runs beside refsim or None).
+#: The demos :func:`write_replay_demo` knows, by name: the engine of
+#: :data:`refsim.engines.registry.ENGINES` it runs beside refsim, or None
+#: (refsim's seed model beside its corrected one).
 DEMO_ENGINES = {"c12-spin": None, "c11-interpenetration": None,
                 "wall-bounce-pybullet": "pybullet", "wall-bounce-mujoco": "mujoco"}
-
-
-def _mujoco_trajectory(scene):
-    """The scene run by MuJoCo (raises OracleUnavailable without it)."""
-    from refsim.dynamics.simulate import default_every
-    from refsim.oracles.mujoco_adapter import MujocoOracle
-
-    return MujocoOracle().simulate(scene, every=default_every(scene.integration.n_steps))
 
 
 def write_replay_demo(*, seed: int, name: str, path: str, max_bytes: int) -> dict:
@@ -66,17 +59,8 @@ def write_replay_demo(*, seed: int, name: str, path: str, max_bytes: int) -> dic
     try:
         require_viser()
         engine = DEMO_ENGINES[name]
-        if engine == "pybullet":
-            from refsim.oracles.pybullet_adapter import PybulletOracle
-
-            PybulletOracle().close()                 # raises here when pybullet is missing
-            info = demo_wall_bounce(path, max_bytes=max_bytes)
-        elif engine == "mujoco":
-            from refsim.oracles.mujoco_adapter import MujocoOracle
-
-            MujocoOracle()                           # raises here when MuJoCo is missing
-            info = demo_wall_bounce(path, external=_mujoco_trajectory, label="MuJoCo",
-                                    max_bytes=max_bytes)
+        if engine is not None:
+            info = demo_wall_bounce(path, engine=engine, max_bytes=max_bytes)
         elif name == "c12-spin":
             info = demo_c12(path, max_bytes=max_bytes)
         else:

@@ -11,8 +11,9 @@
   body sinks into the bottom one, beside ``"impulse"``, where it does not.
 - :func:`demo_wall_bounce`: one wall bounce (``scenes/bounce.toml``, 3 s:
   the drop, the bounce and the rise) by refsim beside the same scene run by
-  pybullet (:mod:`refsim.oracles.pybullet_adapter`). ``external`` is the
-  hook for another engine: any function from a scene to a Trajectory.
+  pybullet (:mod:`refsim.oracles.pybullet_adapter`), or any other rigid
+  engine of the registry (:mod:`refsim.engines.registry`) named by
+  ``engine``.
 
 Each returns the :class:`~refsim.viewer.replay.ReplayInfo` of the file it
 wrote (its size and frame stride). The demos run their simulations; they
@@ -91,28 +92,31 @@ def demo_c11(path, *, case: str = C11_CASE, duration: float = C11_SECONDS,
                               f"exchange against the corrected impulse")
 
 
-def pybullet_trajectory(scene):
-    """The scene run by pybullet (raises refsim.oracles.OracleUnavailable
-    when pybullet is not installed)."""
-    from refsim.dynamics.simulate import default_every
-    from refsim.oracles.pybullet_adapter import PybulletOracle
-
-    with PybulletOracle() as engine:
-        return engine.simulate(scene, every=default_every(scene.integration.n_steps))
-
-
-def demo_wall_bounce(path, *, external=pybullet_trajectory, label: str = "pybullet",
-                     scene=None, duration: float = BOUNCE_SECONDS,
+def demo_wall_bounce(path, *, engine: str = "pybullet", scene=None,
+                     duration: float = BOUNCE_SECONDS,
                      max_bytes: int = REPLAY_MAX_BYTES) -> ReplayInfo:
-    """One wall bounce by refsim beside another engine's run of the same
-    scene (``external(scene) -> Trajectory``; default pybullet)."""
-    from refsim.dynamics.simulate import simulate
+    """One wall bounce by refsim beside the same scene run by ``engine``, a
+    rigid engine of :data:`refsim.engines.registry.ENGINES` by name
+    (default pybullet), shown under its title.
+
+    Raises :class:`refsim.oracles.OracleUnavailable` when that engine is not
+    installed, before any simulation runs.
+    """
+    from refsim.dynamics.simulate import default_every, simulate
+    from refsim.engines.registry import build, title
 
     scene = _for(scene or _bundled("bounce.toml"), duration)
+    other = build(engine)
+    try:
+        external = other.simulate(scene, every=default_every(scene.integration.n_steps))
+    finally:
+        close = getattr(other, "close", None)
+        if close is not None:
+            close()
     runs = [run_from_scene("refsim", scene, simulate(scene)),
-            run_from_scene(label, scene, external(scene))]
+            run_from_scene(title(engine), scene, external)]
     return write_replay(runs, path, max_bytes=max_bytes,
-                        title=f"a wall bounce: refsim beside {label}")
+                        title=f"a wall bounce: refsim beside {title(engine)}")
 
 
 DEMOS: dict[str, Callable[..., ReplayInfo]] = {

@@ -227,18 +227,29 @@ def test_demo_replays_are_valid_standalone_files(tmp_path):
     assert "body_response = impulse" in c11.path.read_text()
 
 
-def test_wall_bounce_demo_takes_any_engine(tmp_path):
-    calls = []
-
-    def other_engine(scene):
-        calls.append(scene.integration.duration)
-        return refsim.simulate(scene)                     # a stand-in engine
-
-    info = demos.demo_wall_bounce(tmp_path / "bounce.html", external=other_engine,
-                                  label="stand-in", duration=0.5)
-    assert calls == [0.5]
-    assert info.runs == ("refsim", "stand-in")
+def test_wall_bounce_demo_takes_any_rigid_engine_of_the_registry(tmp_path):
+    # refsim's corrected model stands in for an external engine
+    info = demos.demo_wall_bounce(tmp_path / "bounce.html", engine="refsim-corrected",
+                                  duration=0.5)
+    assert info.runs == ("refsim", "refsim corrected")
     _check_page(info.path, 0.5)
+
+
+def test_wall_bounce_demo_refuses_a_missing_engine_before_simulating(tmp_path, monkeypatch):
+    from refsim.oracles import OracleUnavailable
+
+    from refsim.engines import registry
+
+    def build(name, **settings):
+        raise OracleUnavailable(f"{name} is not installed")
+
+    simulated = []
+    monkeypatch.setattr(registry, "build", build)
+    monkeypatch.setattr("refsim.dynamics.simulate.simulate",
+                        lambda scene, **kw: simulated.append(scene))
+    with pytest.raises(OracleUnavailable, match="pybullet is not installed"):
+        demos.demo_wall_bounce(tmp_path / "bounce.html", duration=0.5)
+    assert simulated == [] and not (tmp_path / "bounce.html").exists()
 
 
 @pytest.mark.oracle

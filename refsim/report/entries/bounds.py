@@ -35,7 +35,7 @@ def bounds_error(run: Run):
 def bounds_agreement(run: Run):
     from refsim.studies import bounds
 
-    return bounds.measure_bounds_agreement(run.engine("trimesh"), poses=run.size(50, 200),
+    return bounds.measure_bounds_agreement(run.engine("trimesh-mesh"), poses=run.size(50, 200),
                                            seed=run.seed)
 
 

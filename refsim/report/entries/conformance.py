@@ -74,9 +74,9 @@ def textbook_convergence(run: Run):
     from refsim.conformance import cases_rigid as R
     from refsim.conformance.registry import check_by_key
     from refsim.conformance.textbook_problems import TEXTBOOK_PROBLEMS
-    from refsim.engines import load_engine
+    from refsim.engines.registry import build
 
-    engine = load_engine("refsim.engines.refsim_engines:corrected")
+    engine = build("refsim-corrected")
     steps = tuple(run.size(*TEXTBOOK_STEPS))
     problems = [p for p in TEXTBOOK_PROBLEMS if not run.quick or p.check in TEXTBOOK_QUICK]
     scenes = R.rigid_scenes()

@@ -69,14 +69,31 @@ def dynamics_cost(run: Run):
     return CostRun(study, bounce.fit_error_orders(study))
 
 
+#: pybullet with the oracle's settings, then with one setting at a time back
+#: at (or near) pybullet's default: (label, fields of
+#: :class:`refsim.oracles.pybullet_adapter.PybulletSettings` changed).
+PYBULLET_VARIANTS: tuple[tuple[str, dict], ...] = (
+    ("none (the oracle's settings)", {}),
+    ("useMaximalCoordinates=False (multibody)", {"use_maximal_coordinates": False}),
+    ("contactProcessingThreshold=1e30 (Bullet's default: all)",
+     {"contact_processing_threshold": 1e30}),
+    ("useSplitImpulse=0", {"use_split_impulse": 0}),
+    ("restitutionVelocityThreshold=0.2 (Bullet's default)",
+     {"restitution_velocity_threshold": 0.2}),
+    ("linear/angular damping 0.04 (pybullet's default)",
+     {"linear_damping": 0.04, "angular_damping": 0.04}),
+)
+
+
 def dynamics_pybullet_settings(run: Run):
     """Empty in a quick run and without pybullet."""
-    from refsim.report.plan import pybullet_variants
+    from refsim.engines.registry import build
     from refsim.studies import bounce
 
     if run.optional("pybullet") is None or run.quick:
         return []
-    return bounce.measure_engine_variants(pybullet_variants())
+    return bounce.measure_engine_variants(
+        [(label, build("pybullet", **changes)) for label, changes in PYBULLET_VARIANTS])
 
 
 def dynamics_step_cost(run: Run):
@@ -95,17 +112,17 @@ def dynamics_spin(run: Run):
     """C12 runs its full 6 s in the quick report too: a shorter run stops
     before the corrected model comes to rest and would change the verdict.
     pybullet runs the same scene in a client of its own (a second engine
-    from the plan's factory, not the run's shared one)."""
+    built from the registry, not the run's shared one)."""
     from refsim.bundled import scenes_dir
     from refsim.dynamics.simulate import default_every
-    from refsim.report.plan import ENGINES
+    from refsim.engines.registry import build
     from refsim.scenes.loader import load_scene
     from refsim.studies import dynamics
 
     if run.optional("pybullet") is None:
         return dynamics.measure_spin()
     scene = load_scene(scenes_dir() / SPIN_SCENE)
-    with ENGINES["pybullet"]() as oracle:
+    with build("pybullet") as oracle:
         external = oracle.simulate(scene, every=default_every(scene.integration.n_steps))
     return dynamics.measure_spin(scene, external=external)
 

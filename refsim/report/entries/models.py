@@ -21,4 +21,4 @@ def models_agreement(run: Run):
     from refsim.bundled import bundled_models
     from refsim.studies.models import measure_mesh_facts_agreement
 
-    return measure_mesh_facts_agreement(run.engine("trimesh"), bundled_models())
+    return measure_mesh_facts_agreement(run.engine("trimesh-mesh"), bundled_models())
