@@ -79,7 +79,7 @@ def quick_report(tmp_path_factory, worker_id):
     run_matrix = conformance_matrix.run_matrix
 
     def shared_matrix(specs=None, *, cases, seed=0, out_dir=None, only=None, **options):
-        kept, results, pages = shipped_matrix_in(shared)
+        kept, results, pages = shipped_matrix_in(shared, run_matrix)
         if specs is not None or only is not None or (cases, seed) != (MATRIX_CASES, MATRIX_SEED):
             return run_matrix(specs, cases=cases, seed=seed, out_dir=out_dir, only=only,
                               **options)
