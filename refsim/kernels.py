@@ -489,10 +489,12 @@ ORIENTED_NODE_BOXES = KernelPair(
     mirror=("refsim.collision.bvh_exact:build_frame_tree",
             "refsim.collision._numba_build:frame_boxes"))
 HIERARCHY_REFIT = KernelPair(
-    "hierarchy refit", "refsim.collision.bvh:refit", "refsim.collision._numba_kernels:prepare")
+    "hierarchy refit", "refsim.collision.bvh:prepare", "refsim.collision._numba_kernels:prepare",
+    mirror=("refsim.collision.bvh:refit", "refsim.collision._numba_kernels:prepare"))
 HIERARCHY_TRAVERSAL = KernelPair(
-    "hierarchy traversal", "refsim.collision.bvh:_pairs_python",
-    "refsim.collision._numba_kernels:traverse")
+    "hierarchy traversal", "refsim.collision.bvh:traverse",
+    "refsim.collision._numba_kernels:traverse",
+    mirror=("refsim.collision.bvh:_pairs_python", "refsim.collision._numba_kernels:traverse"))
 CERTIFIED_FILTER = KernelPair(
     "certified triangle filter", "refsim.collision.seed_levels:intersecting_batch",
     "refsim.collision.seed_levels:intersecting_compiled",

@@ -291,9 +291,6 @@ CHOSEN_BY_HAND = {
                        "the kernel",
     "hierarchy build": "the two builds take their split rule differently (a callable, a "
                        "name): the pair decides (runs_compiled), the caller calls",
-    "hierarchy refit": "one step of a compiled query pipeline whose readable side is three "
-                       "calls",
-    "hierarchy traversal": "one step of a compiled query pipeline",
     "exact hierarchy query": "one step of a compiled query pipeline",
     "exact triangle stage": "called from inside the compiled query",
 }

@@ -23,10 +23,11 @@ trees together from the roots, dropping every pair of nodes whose boxes are
 apart, and at pairs of leaves test the triangle boxes themselves. Each pair
 of leaves is reached at most once, so each triangle pair is reported once.
 
-Two kernels do the same arithmetic: ``refit`` and ``_pairs_python`` (plain
-loops, the reference) and a numba-compiled mirror of them
-(:mod:`refsim.collision._numba_kernels`), selected by ``kernel=``
-(:mod:`refsim.kernels`: "readable" or "compiled").
+Two kernels do the same arithmetic: :func:`prepare` and :func:`traverse`
+(``refit`` and ``_pairs_python``: plain loops, the reference) and a
+numba-compiled mirror of each (:mod:`refsim.collision._numba_kernels`), each
+pair chosen by ``kernel=`` through its :class:`refsim.kernels.KernelPair`
+("readable" or "compiled").
 The build too: :func:`build_tree` (the reference) and
 :func:`build_tree_compiled` (:mod:`refsim.collision._numba_build`), the same
 tree bit for bit, chosen by :func:`tree_of`'s ``kernel=``.
@@ -49,9 +50,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from refsim.collision.boxes import triangle_boxes, world_vertices
+from refsim.bounds.aabb_linear import transform_vertices
+from refsim.collision.boxes import triangle_boxes
 from refsim.errors import check_option
-from refsim.kernels import HIERARCHY_BUILD
+from refsim.kernels import HIERARCHY_BUILD, HIERARCHY_REFIT, HIERARCHY_TRAVERSAL
 from refsim.types import unit_exponent
 
 #: Triangles per leaf. Small leaves prune more; each leaf-leaf visit costs
@@ -249,28 +251,44 @@ def _size(lo, hi) -> float:
     return d[0] + d[1] + d[2]
 
 
-# -- the compiled kernel ----------------------------------------------------------
+def prepare(vertices, faces, rotation, translation, left, right, start, count, order):
+    """A body's per-pose work (readable): its world vertices, its
+    triangles' boxes and the node boxes refit from them, ``(world, lo, hi,
+    tri_lo, tri_hi)``. The tree comes as its five arrays, the signature of
+    the compiled twin (:data:`refsim.kernels.HIERARCHY_REFIT`)."""
+    world = transform_vertices(vertices, (rotation, translation))
+    tri_lo, tri_hi = triangle_boxes(world, faces)
+    lo, hi = refit(TriangleTree(left, right, start, count, order), tri_lo, tri_hi)
+    return world, lo, hi, tri_lo, tri_hi
 
-@functools.cache
-def _compiled():
-    """``(prepare, traverse)`` compiled with numba.
 
-    The same steps as ``world_vertices``, ``triangle_boxes``, ``refit`` and
-    ``_pairs_python`` in plain loops (:mod:`refsim.collision._numba_kernels`),
-    with refsim's one transform arithmetic ((R[k,0] x + R[k,1] y) + R[k,2] z
-    + t[k], see refsim.bounds.aabb_linear), so the boxes are the same floats.
+def traverse(left_a, right_a, start_a, count_a, order_a, lo_a, hi_a, tri_lo_a, tri_hi_a,
+             left_b, right_b, start_b, count_b, order_b, lo_b, hi_b, tri_lo_b, tri_hi_b,
+             first_only: bool) -> np.ndarray:
+    """:func:`_pairs_python` over two trees given as their arrays, the
+    signature of the compiled twin (:data:`refsim.kernels.HIERARCHY_TRAVERSAL`):
+    the (k, 2) int64 pairs in the order found."""
+    found = _pairs_python(TriangleTree(left_a, right_a, start_a, count_a, order_a),
+                          lo_a, hi_a, tri_lo_a, tri_hi_a,
+                          TriangleTree(left_b, right_b, start_b, count_b, order_b),
+                          lo_b, hi_b, tri_lo_b, tri_hi_b, first_only)
+    return np.array(found, dtype=np.int64).reshape(-1, 2)
 
-    DEVIATION from a lazier design, measured and rejected: carrying each
-    node's body-space box to the world at every visit (the box of the rotated
-    box) instead of refitting touches less up front but yields boxes up to
-    sqrt(3) larger, and visited ~3x more node pairs on the 2k-triangle
-    benchmarks, slower in every configuration. (The exact level's traversal,
-    :mod:`refsim.collision.bvh_exact`, is lazy too but tests the rotated box
-    itself, by separating axes, which is as tight as the body-space box.)
-    """
-    from refsim.collision import _numba_kernels as nk
 
-    return nk.prepare, nk.traverse
+# -- a query: both kernels through their pairs ------------------------------------
+#
+# The compiled twins of prepare and traverse (refsim.collision._numba_kernels)
+# do the same steps in plain loops, with refsim's one transform arithmetic
+# ((R[k,0] x + R[k,1] y) + R[k,2] z + t[k], see refsim.bounds.aabb_linear), so
+# the boxes are the same floats.
+#
+# DEVIATION from a lazier design, measured and rejected: carrying each node's
+# body-space box to the world at every visit (the box of the rotated box)
+# instead of refitting touches less up front but yields boxes up to sqrt(3)
+# larger, and visited about 3x more node pairs on the 2k-triangle benchmarks,
+# slower in every configuration. (The exact level's traversal,
+# refsim.collision.bvh_exact, is lazy too but tests the rotated box itself, by
+# separating axes, which is as tight as the body-space box.)
 
 
 @dataclass(frozen=True)
@@ -288,33 +306,24 @@ class PreparedBody:
 
 
 def prepare_body(mesh, pose, kernel: str) -> PreparedBody:
-    """Transform, box and refit one body."""
+    """Transform, box and refit one body (``kernel`` already chosen)."""
     tree = tree_of(mesh, kernel)
-    if kernel == "readable":
-        world = world_vertices(mesh, pose)
-        tri_lo, tri_hi = triangle_boxes(world, mesh.faces)
-        lo, hi = refit(tree, tri_lo, tri_hi)
-    else:
-        world, lo, hi, tri_lo, tri_hi = _compiled()[0](
-            mesh.vertices, mesh.faces, pose[0], pose[1], tree.left, tree.right,
-            tree.start, tree.count, tree.order)
+    world, lo, hi, tri_lo, tri_hi = HIERARCHY_REFIT.pick(kernel)(
+        mesh.vertices, mesh.faces, pose[0], pose[1], tree.left, tree.right, tree.start,
+        tree.count, tree.order)
     return PreparedBody(mesh, tree, world, lo, hi, tri_lo, tri_hi)
 
 
 def tree_box_pairs(pa: PreparedBody, pb: PreparedBody, kernel: str,
                    first_only: bool = False) -> np.ndarray:
-    """Every (i, j) whose world triangle boxes overlap, via the hierarchy.
+    """Every (i, j) whose world triangle boxes overlap, via the hierarchy
+    (``kernel`` already chosen).
 
     Returns (k, 2) int64 with rows sorted; with ``first_only`` at most one row.
     """
-    if kernel == "readable":
-        found = _pairs_python(pa.tree, pa.lo, pa.hi, pa.tri_lo, pa.tri_hi,
-                              pb.tree, pb.lo, pb.hi, pb.tri_lo, pb.tri_hi, first_only)
-        pairs = np.array(found, dtype=np.int64).reshape(-1, 2)
-    else:
-        ta, tb = pa.tree, pb.tree
-        pairs = _compiled()[1](
-            ta.left, ta.right, ta.start, ta.count, ta.order, pa.lo, pa.hi, pa.tri_lo, pa.tri_hi,
-            tb.left, tb.right, tb.start, tb.count, tb.order, pb.lo, pb.hi, pb.tri_lo, pb.tri_hi,
-            first_only)
+    ta, tb = pa.tree, pb.tree
+    pairs = HIERARCHY_TRAVERSAL.pick(kernel)(
+        ta.left, ta.right, ta.start, ta.count, ta.order, pa.lo, pa.hi, pa.tri_lo, pa.tri_hi,
+        tb.left, tb.right, tb.start, tb.count, tb.order, pb.lo, pb.hi, pb.tri_lo, pb.tri_hi,
+        first_only)
     return pairs[np.lexsort((pairs[:, 1], pairs[:, 0]))]

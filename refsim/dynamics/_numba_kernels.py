@@ -125,7 +125,7 @@ from refsim.dynamics.walls import bounce_advance, crossing_time, deepest_speed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "80fe80b57f536281"
+SOURCES_DIGEST = "03d992b3bf3cd894"
 
 #: The kernel took every step it was asked for.
 DONE = 0
