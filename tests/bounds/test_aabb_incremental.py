@@ -186,6 +186,8 @@ def test_visits_per_update_stay_flat_as_the_mesh_grows():
 
 def test_without_numba_the_readable_kernel_is_the_default(monkeypatch):
     monkeypatch.setattr(kernels, "numba_error", lambda: "ImportError: no numba here")
+    monkeypatch.delenv(kernels.KERNELS_ENV, raising=False)
+    kernels._warn_readable.cache_clear()      # once per process: another test may have warned
     with pytest.warns(kernels.KernelWarning, match="no numba here"):
         tracker = IncrementalAABB(shapes.icosahedron())
     assert tracker.kernel == "readable"
