@@ -469,11 +469,6 @@ class KernelPair:
 
     __call__ = choose
 
-    def runs_compiled(self, kernel: str | None) -> bool:
-        """Whether ``kernel=`` (None: the default) runs the compiled twin:
-        for callers whose two sides differ beyond the function called."""
-        return choose_kernel(kernel) == "compiled"
-
 
 # The pairs, by area. A module that dispatches takes its pair from here.
 
@@ -481,8 +476,9 @@ BROAD_PHASE_SWEEP = KernelPair(
     "broad-phase sweep", "refsim.collision.broad_phase:overlapping_pairs_sweep",
     "refsim.collision.broad_phase:overlapping_pairs_sweep_compiled", COMPILED_FROM_SOURCE)
 HIERARCHY_BUILD = KernelPair(
-    "hierarchy build", "refsim.collision.bvh:build_tree",
-    "refsim.collision._numba_build:build_tree")
+    "hierarchy build", "refsim.collision.bvh:build_tree_by_name",
+    "refsim.collision.bvh:build_tree_compiled",
+    mirror=("refsim.collision.bvh:build_tree", "refsim.collision._numba_build:build_tree"))
 ORIENTED_NODE_BOXES = KernelPair(
     "oriented node boxes", "refsim.collision.bvh_exact:build_frame_tree",
     "refsim.collision.bvh_exact:build_frame_tree_compiled",
@@ -501,8 +497,14 @@ CERTIFIED_FILTER = KernelPair(
     mirror=("refsim.collision.triangle_batch:triangles_intersect_batch",
             "refsim.collision._numba_kernels:certified"))
 EXACT_HIERARCHY_QUERY = KernelPair(
-    "exact hierarchy query", "refsim.collision.bvh_exact:descend",
-    "refsim.collision._numba_kernels:exact_query")
+    "exact hierarchy query", "refsim.collision.bvh_exact:pairs_readable",
+    "refsim.collision.bvh_exact:pairs_compiled",
+    mirror=("refsim.collision.bvh_exact:descend", "refsim.collision._numba_kernels:exact_query"))
+EXACT_HIERARCHY_COLLIDE = KernelPair(
+    "exact hierarchy collide", "refsim.collision.bvh_exact:collide_readable",
+    "refsim.collision.bvh_exact:collide_compiled",
+    mirror=("refsim.collision.bvh_exact:descend",
+            "refsim.collision._numba_kernels:exact_collide"))
 EXACT_TRIANGLE_STAGE = KernelPair(
     "exact triangle stage", "refsim.collision.triangle:_triangle_vs_triangle",
     "refsim.collision._numba_exact:triangle_vs_triangle")

@@ -210,6 +210,15 @@ def _exact_hierarchy(kernel):
                               kernel=kernel)]
 
 
+def _exact_collide(kernel):
+    """Unit cubes touching, 2^-40 apart, overlapping and far apart; then
+    the torus and the star at the shared poses (both answers occur)."""
+    offsets = ([1.0, 0.0, 0.0], [1.0 + 2.0 ** -40, 0.0, 0.0], [0.5, 0.5, 0.0], [3.0, 0.0, 0.0])
+    return [refsim.bodies_collide(CUBE, IDENTITY, CUBE, (np.eye(3), np.array(offset)),
+                                  kernel=kernel) for offset in offsets] + [
+        refsim.bodies_collide(TORUS, IDENTITY, STAR, pose, kernel=kernel) for pose in _poses(6)]
+
+
 def _exact_stage(kernel):
     """Touching bodies, where every candidate pair reaches the exact stage."""
     sphere = refsim.load_model("sphere-2k.ac")
@@ -266,6 +275,7 @@ CASES = {
     "hierarchy traversal": _hierarchy_boxes,
     "certified triangle filter": _certified_filter,
     "exact hierarchy query": _exact_hierarchy,
+    "exact hierarchy collide": _exact_collide,
     "exact triangle stage": _exact_stage,
     "fused particle steps": _particles,
     "simulation loop": _simulation_loop,
@@ -289,9 +299,6 @@ CHOSEN_BY_HAND = {
     "simulation loop": "the simulation runs the compiled loop only where it does the "
                        "scene's choices (loop_support): a choice of the scene as much as of "
                        "the kernel",
-    "hierarchy build": "the two builds take their split rule differently (a callable, a "
-                       "name): the pair decides (runs_compiled), the caller calls",
-    "exact hierarchy query": "one step of a compiled query pipeline",
     "exact triangle stage": "called from inside the compiled query",
 }
 
@@ -330,9 +337,9 @@ def test_a_pair_chooses_as_the_switch_does(monkeypatch):
     assert pair("readable") is pair.pick("readable") is pair.readable
     assert pair("compiled") is pair.pick("compiled") is pair.compiled
     monkeypatch.setenv(kernels.KERNELS_ENV, "readable")
-    assert pair(None) is pair.readable and not pair.runs_compiled(None)
+    assert pair(None) is pair.readable
     monkeypatch.setenv(kernels.KERNELS_ENV, "compiled")
-    assert pair(None) is pair.compiled and pair.runs_compiled(None)
+    assert pair(None) is pair.compiled
     with pytest.raises(OptionError, match="kernel"):
         pair("fast")
     with pytest.raises(ValueError, match="exists already"):

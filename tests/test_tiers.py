@@ -78,15 +78,18 @@ def test_the_environment_and_a_compiled_family_bypass_a_tier(cold, monkeypatch):
 
 
 def _spy_on_the_exact_query(monkeypatch) -> list[str]:
+    """The kernel of each exact query made from now on, in order (a spy on
+    both sides of the query's two kernel pairs)."""
     kernels: list[str] = []
-    for name in ("intersecting_pairs_bvh", "collide_bvh"):
-        original = getattr(bodies, name)
+    for pair in (bodies.EXACT_HIERARCHY_QUERY, bodies.EXACT_HIERARCHY_COLLIDE):
+        for side in ("readable", "compiled"):
+            original = getattr(pair, side)
 
-        def spy(*args, _original=original):
-            kernels.append(args[-1])
-            return _original(*args)
+            def spy(*args, _original=original, _side=side):
+                kernels.append(_side)
+                return _original(*args)
 
-        monkeypatch.setattr(bodies, name, spy)
+            monkeypatch.setattr(pair, f"_{side}", spy)
     return kernels
 
 

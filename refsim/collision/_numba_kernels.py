@@ -699,7 +699,7 @@ def exact_query(floats_a, ints_a, rotation_a, translation_a,
 #: numba's cache) for this signature alone and then turns compiling off
 #: (bvh_exact's ``_compiled``), so that numba refuses any other argument
 #: types with a TypeError instead of compiling for them, and the caller need
-#: not check a pose's layout before the call (bvh_exact.collide_bvh). It is
+#: not check a pose's layout before the call (bvh_exact.collide_compiled). It is
 #: not compiled as this module is imported: importing the module must stay
 #: cheap, so that whether numba's cache holds its kernels can be asked
 #: without compiling them (refsim.kernels.Tier).
@@ -713,9 +713,10 @@ EXACT_COLLIDE_SIGNATURE = numba.int64(
 def exact_collide(floats_a, ints_a, rotation_a, translation_a,
                   floats_b, ints_b, rotation_b, translation_b,
                   tol, margin_rounding, margin_per_deviation):
-    """:func:`exact_query` in mode FIRST_HIT, answered as one code (APART,
-    HIT, UNDECIDED, BAD_POSE_A, BAD_POSE_B): returning a number instead of
-    two arrays spares the caller numba's boxing of the arrays."""
+    """Mirrors :func:`refsim.collision.bvh_exact.descend` as :func:`exact_query`
+    does, in mode FIRST_HIT, answered as one code (APART, HIT, UNDECIDED,
+    BAD_POSE_A, BAD_POSE_B): returning a number instead of two arrays
+    spares the caller numba's boxing of the arrays."""
     # the mode as an int64, not the literal a global constant is typed as:
     # exact_query then reuses the machine code of its calls from Python
     # instead of compiling a second specialization for the literal

@@ -32,11 +32,10 @@ import numpy as np
 
 from refsim.collision.boxes import boxes_overlap, world_vertices
 from refsim.collision.bvh import prepare_body, tree_box_pairs
-from refsim.collision.bvh_exact import collide_bvh, intersecting_pairs_bvh
 from refsim.collision.seed_levels import exact_pairs, triangle_box_pairs
 from refsim.collision.spheres import spheres_overlap
 from refsim.errors import check_option
-from refsim.kernels import Tier, choose_kernel
+from refsim.kernels import EXACT_HIERARCHY_COLLIDE, EXACT_HIERARCHY_QUERY, Tier, choose_kernel
 from refsim.models.mesh import require_mesh
 from refsim.types import as_pose
 
@@ -107,8 +106,8 @@ def intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
     if level == "exact" and method == "bvh":
         if kernel is None and not EXACT_QUERY.settled and _readable_first(mesh_a, mesh_b):
             with EXACT_QUERY.charged():
-                return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, "readable")
-        return intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, choose_kernel(kernel))
+                return EXACT_HIERARCHY_QUERY.readable(mesh_a, pose_a, mesh_b, pose_b)
+        return EXACT_HIERARCHY_QUERY.pick(choose_kernel(kernel))(mesh_a, pose_a, mesh_b, pose_b)
     kernel = choose_kernel(kernel)
     pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
     if method == "seed":
@@ -161,8 +160,9 @@ def bodies_collide(mesh_a, pose_a, mesh_b, pose_b, level: str = "exact",
     if level == "exact" and method == "bvh":
         if kernel is None and not EXACT_QUERY.settled and _readable_first(mesh_a, mesh_b):
             with EXACT_QUERY.charged():
-                return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, "readable")
-        return collide_bvh(mesh_a, pose_a, mesh_b, pose_b, choose_kernel(kernel))
+                return EXACT_HIERARCHY_COLLIDE.readable(mesh_a, pose_a, mesh_b, pose_b)
+        return EXACT_HIERARCHY_COLLIDE.pick(choose_kernel(kernel))(mesh_a, pose_a, mesh_b,
+                                                                   pose_b)
     kernel = choose_kernel(kernel)
     pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
     if level == "sphere":

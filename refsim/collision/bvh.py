@@ -53,7 +53,7 @@ import numpy as np
 from refsim.bounds.aabb_linear import transform_vertices
 from refsim.collision.boxes import triangle_boxes
 from refsim.errors import check_option
-from refsim.kernels import HIERARCHY_BUILD, HIERARCHY_REFIT, HIERARCHY_TRAVERSAL
+from refsim.kernels import HIERARCHY_BUILD, HIERARCHY_REFIT, HIERARCHY_TRAVERSAL, resolve
 from refsim.types import unit_exponent
 
 #: Triangles per leaf. Small leaves prune more; each leaf-leaf visit costs
@@ -157,10 +157,22 @@ def build_kernels():
     return _numba_build
 
 
-#: The split rules the compiled build knows, by the names :func:`build_tree_compiled`
-#: takes: this module's :func:`least_area_split` and the exact level's
-#: :func:`refsim.collision.bvh_exact.least_volume_split`.
-SPLIT_RULES = ("least-area", "least-volume")
+#: The split rules both builds know, by the names :func:`build_tree_by_name`
+#: and :func:`build_tree_compiled` take: this module's :func:`least_area_split`
+#: and the exact level's :func:`refsim.collision.bvh_exact.least_volume_split`
+#: (as ``module:function``, imported on use: that module imports this one).
+SPLITS = {"least-area": "refsim.collision.bvh:least_area_split",
+          "least-volume": "refsim.collision.bvh_exact:least_volume_split"}
+SPLIT_RULES = tuple(SPLITS)
+
+
+def build_tree_by_name(vertices: np.ndarray, faces: np.ndarray, split: str = "least-area",
+                       leaf_size: int = LEAF_SIZE) -> TriangleTree:
+    """:func:`build_tree` with the split rule named by ``split``
+    (:data:`SPLIT_RULES`): the readable twin of :func:`build_tree_compiled`,
+    with its signature (:data:`refsim.kernels.HIERARCHY_BUILD`)."""
+    check_option("split", split, SPLIT_RULES)
+    return build_tree(vertices, faces, leaf_size, split=resolve(SPLITS[split]))
 
 
 def build_tree_compiled(vertices: np.ndarray, faces: np.ndarray, split: str = "least-area",
@@ -192,9 +204,7 @@ def tree_of(mesh, kernel: str | None = None) -> TriangleTree:
     the readable :func:`build_tree` or its compiled twin (``kernel``, see
     :mod:`refsim.kernels`; the same tree either way)."""
     def build(m) -> TriangleTree:
-        if not HIERARCHY_BUILD.runs_compiled(kernel):
-            return build_tree(m.vertices, m.faces)
-        return build_tree_compiled(m.vertices, m.faces, "least-area")
+        return HIERARCHY_BUILD(kernel)(m.vertices, m.faces, "least-area")
 
     return mesh.derived("triangle_tree", build)
 

@@ -96,7 +96,7 @@ all of them) are answered by the compiled exact stage
 (:mod:`refsim.collision._numba_exact`: the readable triangle test over exact
 expansion predicates), and the few it does not take (degenerate triangles,
 coordinates outside the filter's range) by the readable exact kernel. The
-boolean query (:func:`collide_bvh`) runs that stage inside the traversal,
+boolean query (:func:`collide_compiled`) runs that stage inside the traversal,
 pair by pair, and stops at the first pair either decides intersecting; the
 all-pairs query collects the open pairs and answers them after.
 
@@ -131,15 +131,16 @@ from refsim.collision.bvh import (
     LEAF_SIZE,
     TriangleTree,
     build_kernels,
-    build_tree,
-    build_tree_compiled,
     kernel_array,
 )
 from refsim.collision.seed_levels import exact_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.collision.triangle_numba import compiled_exact_kernels
 from refsim.errors import StateError
-from refsim.kernels import HIERARCHY_BUILD, ORIENTED_NODE_BOXES
+from refsim.kernels import (
+    HIERARCHY_BUILD,
+    ORIENTED_NODE_BOXES,
+)
 from refsim.types import ORTHONORMAL_TOL, as_pose, unit_exponent
 
 #: The node test's margin, relative to the scene's size S (see the module
@@ -348,9 +349,7 @@ def frame_topology_of(mesh, kernel: str | None = None) -> TriangleTree:
     mesh, by the readable :func:`refsim.collision.bvh.build_tree` or its
     compiled twin (``kernel``, :mod:`refsim.kernels`: the same tree)."""
     def build(m) -> TriangleTree:
-        if not HIERARCHY_BUILD.runs_compiled(kernel):
-            return build_tree(m.vertices, m.faces, split=least_volume_split)
-        return build_tree_compiled(m.vertices, m.faces, "least-volume")
+        return HIERARCHY_BUILD(kernel)(m.vertices, m.faces, "least-volume")
 
     return mesh.derived("frame_topology", build)
 
@@ -660,21 +659,26 @@ def _resolve(mesh_a, pose_a, mesh_b, pose_b, uncertain: np.ndarray,
     return answer
 
 
-def intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> np.ndarray:
-    """All intersecting face pairs, (k, 2) int64 with rows sorted.
+def pairs_readable(mesh_a, pose_a, mesh_b, pose_b) -> np.ndarray:
+    """All intersecting face pairs, readable: the candidates of the
+    traversal (:func:`candidate_pairs`, :func:`descend`), then the exact
+    triangle test on each."""
+    pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
+    candidates = candidate_pairs(mesh_a, pose_a, mesh_b, pose_b, kernel="readable")
+    return exact_pairs(world_vertices(mesh_a, pose_a), mesh_a.faces,
+                       world_vertices(mesh_b, pose_b), mesh_b.faces, candidates, "readable")
 
-    The compiled path asks the boolean query first (:func:`_collide_code`):
-    most pairs of bodies a scene asks about are apart, and its answer (a
-    code, no arrays; it stops at the first hit) costs less than the full
-    query's when there is nothing to find. When it finds them apart, no
-    pair intersects, from the same exact stage; otherwise the full query
-    runs, and the boolean query's cost is added to a longer one (figures:
+
+def pairs_compiled(mesh_a, pose_a, mesh_b, pose_b) -> np.ndarray:
+    """:func:`pairs_readable` compiled: the same pairs.
+
+    It asks the boolean query first (:func:`_collide_code`): most pairs of
+    bodies a scene asks about are apart, and its answer (a code, no
+    arrays; it stops at the first hit) costs less than the full query's
+    when there is nothing to find. When it finds them apart, no pair
+    intersects, from the same exact stage; otherwise the full query runs,
+    and the boolean query's cost is added to a longer one (figures:
     docs/decisions/query-fixed-cost.md)."""
-    if kernel == "readable":
-        pose_a, pose_b = as_pose(pose_a, what="pose_a"), as_pose(pose_b, what="pose_b")
-        candidates = candidate_pairs(mesh_a, pose_a, mesh_b, pose_b, kernel=kernel)
-        return exact_pairs(world_vertices(mesh_a, pose_a), mesh_a.faces,
-                           world_vertices(mesh_b, pose_b), mesh_b.faces, candidates, "readable")
     answer, pose_a, pose_b = _collide_code(mesh_a, pose_a, mesh_b, pose_b)
     if answer == _compiled().APART:
         return np.empty((0, 2), dtype=np.int64)
@@ -685,14 +689,18 @@ def intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> np.nd
     return _sorted(found)
 
 
-def collide_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel: str) -> bool:
-    """Whether any pair of triangles intersects; the compiled query stops at
-    the first (``exact_collide``: the float filter, else the compiled exact
-    stage, pair by pair). Only pairs that stage cannot take (degenerate
+def collide_readable(mesh_a, pose_a, mesh_b, pose_b) -> bool:
+    """Whether any pair of triangles intersects, readable: whether
+    :func:`pairs_readable` finds one."""
+    return len(pairs_readable(mesh_a, pose_a, mesh_b, pose_b)) > 0
+
+
+def collide_compiled(mesh_a, pose_a, mesh_b, pose_b) -> bool:
+    """:func:`collide_readable` compiled, stopping at the first hit
+    (``exact_collide``: the float filter, else the compiled exact stage,
+    pair by pair). Only pairs that stage cannot take (degenerate
     triangles, coordinates outside the filter's range) come back to the
     readable exact kernel, through a second traversal."""
-    if kernel == "readable":
-        return len(intersecting_pairs_bvh(mesh_a, pose_a, mesh_b, pose_b, kernel)) > 0
     answer, pose_a, pose_b = _collide_code(mesh_a, pose_a, mesh_b, pose_b)
     nk = _compiled()
     if answer == nk.APART or answer == nk.HIT:
