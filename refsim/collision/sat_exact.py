@@ -25,9 +25,9 @@ comparison is exact integer arithmetic: no tolerance anywhere, and no
 fraction reduced on the way. It is a different algorithm from refsim's
 edge-triangle test, so agreement between the two is evidence for both.
 
-Cost: 17 axes x 6 dot products of integers of a few hundred bits, about 50
-microseconds per pair (``fractions.Fraction`` took 6 ms: a gcd per
-operation).
+Cost: 17 axes x 6 dot products of integers of a few hundred bits per pair,
+with no gcd (``fractions.Fraction`` would reduce at every operation, about
+a hundred times slower).
 """
 
 from __future__ import annotations
