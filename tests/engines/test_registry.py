@@ -67,6 +67,20 @@ def test_build_takes_an_adapters_settings_and_refuses_an_unknown_name():
         build("bullet")
 
 
+def test_each_pybullet_variant_of_the_report_builds_with_its_settings_changed():
+    from dataclasses import asdict
+
+    from refsim.report.entries.dynamics import PYBULLET_VARIANTS
+
+    with build("pybullet") as oracle:
+        base = asdict(oracle.settings)
+    assert PYBULLET_VARIANTS[0][1] == {}                   # the oracle's own settings first
+    for label, changes in PYBULLET_VARIANTS:
+        with build("pybullet", **changes) as engine:
+            settings = asdict(engine.settings)
+        assert {k: v for k, v in settings.items() if v != base[k]} == changes, label
+
+
 def test_each_replay_demo_runs_beside_a_rigid_engine_of_the_registry():
     names = {e.name: e for e in ENGINES}
     assert {v for v in DEMO_ENGINES.values() if v} == {"pybullet", "mujoco"}
