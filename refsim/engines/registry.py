@@ -26,6 +26,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from refsim.errors import check_option
+
 
 @dataclass(frozen=True)
 class EngineEntry:
@@ -83,17 +85,16 @@ def build(name: str, **settings):
 
     Raises
     ------
-    KeyError
-        No shipped engine is called ``name`` (a programming error: a user's
-        engine is named by its spec, :func:`refsim.engines.load_engine`).
+    OptionError
+        No shipped engine is called ``name`` (a user's own engine is named
+        by its spec instead: :func:`refsim.engines.load_engine`).
     refsim.oracles.OracleUnavailable
         The engine's package is not installed (the message names the
         extra that brings it).
     """
     from refsim.engines import resolve_factory
 
-    if name not in BY_NAME:
-        raise KeyError(f"no shipped engine {name!r} (engines: {', '.join(BY_NAME)})")
+    check_option("engine", name, tuple(BY_NAME))
     return resolve_factory(BY_NAME[name].spec)(**settings)
 
 

@@ -12,6 +12,7 @@ from refsim.oracles import OracleUnavailable
 from refsim.conformance.shipped import SHIPPED_ENGINES
 from refsim.engines import capabilities
 from refsim.engines.registry import ENGINES, SHIPPED, build, install_hint, title
+from refsim.errors import OptionError
 from refsim.report.sections.conformance import ENGINE_TITLES
 from refsim.report.tasks import DEMO_ENGINES
 
@@ -63,7 +64,7 @@ def test_each_row_builds_the_engine_it_names(entry):
 def test_build_takes_an_adapters_settings_and_refuses_an_unknown_name():
     with build("pybullet", use_split_impulse=0) as engine:
         assert engine.settings.use_split_impulse == 0
-    with pytest.raises(KeyError, match="no shipped engine 'bullet'"):
+    with pytest.raises(OptionError, match="engine must be one of 'refsim-seed', .*got 'bullet'"):
         build("bullet")
 
 
