@@ -26,8 +26,8 @@ fraction reduced on the way. It is a different algorithm from refsim's
 edge-triangle test, so agreement between the two is evidence for both.
 
 Cost: 17 axes x 6 dot products of integers of a few hundred bits per pair,
-with no gcd (``fractions.Fraction`` would reduce at every operation, about
-a hundred times slower).
+with no gcd (``fractions.Fraction`` reduces at every operation; the figures
+as first measured: docs/decisions/library-cost-figures.md).
 """
 
 from __future__ import annotations
