@@ -5,9 +5,10 @@ C11: "the body-body response lets slow or same-direction bodies
 interpenetrate", judged on :func:`refsim.studies.dynamics.measure_interpenetration`.
 C12: "the angular velocity does not damp to rest", judged on
 :func:`refsim.studies.dynamics.measure_spin`. The findings read the records
-of :mod:`refsim.studies.bounce`: how close the apex ratios come to e^2, which
-error series stay at rounding, how refsim's step cost compares with
-pybullet's, and when a cube counts as tipping.
+of :mod:`refsim.studies.bounce` (long-form: one row per case and engine):
+how close the apex ratios come to e^2, which error series stay at rounding,
+how refsim's step cost compares with the oracle's (:data:`ORACLE`), and when
+a cube counts as tipping.
 """
 
 from __future__ import annotations
@@ -41,6 +42,10 @@ NOTICEABLE_SPIN = 0.01
 #: refsim's step-cost target: at most this many times pybullet's time per
 #: step at the largest body count.
 STEP_COST_TARGET = 2.0
+
+#: The engine the bounce findings set beside refsim: the records hold any
+#: engine's rows under its name; the findings and divergences speak of this one.
+ORACLE = "pybullet"
 
 #: The cube of the bounce studies (refsim.studies.bounce.CUBE).
 CUBE = "cube.ac"
@@ -126,31 +131,41 @@ def _finite(values) -> list[float]:
     return [float(v) for v in values if v is not None and math.isfinite(v)]
 
 
+def _of(rows, engine: str) -> list:
+    return [r for r in rows if r.engine == engine]
+
+
 def apex_findings(rows: Sequence[ApexRow], target: float = APEX_RATIO_TARGET,
                   rounding: float = ROUNDING_ERROR) -> dict:
-    """The apex table's findings: the largest error from e^2 with rotation
-    off (at ``rounding``? within the apex-ratio ``target``?), of the seed's
-    literal wall speed, of the cube face down; the cube with the seed's
-    rotation (its spin, its error, how often above e^2); and whether
-    pybullet's cube tips (a spin above :data:`NOTICEABLE_SPIN`)."""
+    """The apex table's findings: refsim's largest error from e^2 with
+    rotation off (at ``rounding``? within the apex-ratio ``target``?), that
+    of the seed's literal wall speed, of the cube face down; the cube with
+    the seed's rotation (its spin, its error, how often above e^2); and
+    whether the oracle's cube tips (a spin above :data:`NOTICEABLE_SPIN`)."""
     found: dict = {"target": target, "rounding": rounding}
-    off = [r for r in rows if r.rotation == "off"]
+    ours = _of(rows, bounce.REFSIM)
+    off = [r for r in ours if r.rotation == "off"]
     if off:
-        worst = max(r.refsim_error for r in off)
-        literal = max(r.seed_speed_error for r in off)
+        worst = max(r.error for r in off)
         found |= {"off_worst": worst, "off_at_rounding": worst <= rounding,
-                  "off_within_target": worst <= target, "literal_worst": literal,
-                  "literal_within_target": literal <= target}
+                  "off_within_target": worst <= target}
+    literal = [r.error for r in _of(rows, bounce.SEED_WALL_SPEED) if r.rotation == "off"]
+    if literal:
+        found |= {"literal_worst": max(literal), "literal_within_target": max(literal) <= target}
     cubes_off = [r for r in off if r.body == CUBE]
     if cubes_off:
-        found["cube_off_worst"] = max(r.refsim_error for r in cubes_off)
-    seeded = [r for r in rows if r.body == CUBE and r.rotation == "seed"]
+        found["cube_off_worst"] = max(r.error for r in cubes_off)
+    # the cube's drops with the seed's rotation, refsim's row beside the analytic one
+    seeded = [(d[bounce.REFSIM], d[bounce.ANALYTIC])
+              for d in bounce.by_case(rows, bounce.APEX_CASE).values()
+              if bounce.REFSIM in d and bounce.ANALYTIC in d
+              and d[bounce.REFSIM].body == CUBE and d[bounce.REFSIM].rotation == "seed"]
     if seeded:
         found |= {"seeded_drops": len(seeded),
-                  "seeded_above_e2": sum(r.refsim_ratio > r.analytic_ratio for r in seeded),
-                  "seeded_max_spin": max(r.refsim_max_spin for r in seeded),
-                  "seeded_worst": max(r.refsim_error for r in seeded)}
-    cube_spins = _finite(r.pybullet_max_spin for r in rows if r.body == CUBE)
+                  "seeded_above_e2": sum(r.ratio > closed.ratio for r, closed in seeded),
+                  "seeded_max_spin": max(r.max_spin for r, _ in seeded),
+                  "seeded_worst": max(r.error for r, _ in seeded)}
+    cube_spins = _finite(r.max_spin for r in _of(rows, ORACLE) if r.body == CUBE)
     if cube_spins:
         found |= {"pybullet_cube_spin": max(cube_spins),
                   "pybullet_cube_tips": max(cube_spins) > NOTICEABLE_SPIN,
@@ -159,10 +174,10 @@ def apex_findings(rows: Sequence[ApexRow], target: float = APEX_RATIO_TARGET,
 
 
 def tipping_spin(rows: Sequence[ApexRow]) -> float | None:
-    """The largest spin of pybullet's cube over the drops where it tips
+    """The largest spin of the oracle's cube over the drops where it tips
     (above :data:`NOTICEABLE_SPIN`), or None when it never does."""
-    spins = [r.pybullet_max_spin for r in rows if r.body.startswith("cube")
-             and r.pybullet_max_spin and r.pybullet_max_spin > NOTICEABLE_SPIN]
+    spins = [r.max_spin for r in _of(rows, ORACLE) if r.body.startswith("cube")
+             and r.max_spin > NOTICEABLE_SPIN]
     return max(spins) if spins else None
 
 
@@ -174,47 +189,69 @@ def rounding_series(cost: CostStudy, rounding: float = ROUNDING_ERROR) -> list[s
                    if p.solver == solver and math.isfinite(p.error))]
 
 
+def step_cost_pairs(rows: Sequence[StepCost]) -> list[dict]:
+    """refsim's time per step beside the oracle's for each timed scene
+    (refsim's order): the scene (:data:`refsim.studies.bounce.STEP_CASE`),
+    ``refsim_seconds``, ``pybullet_seconds`` (nan when the oracle did not
+    run), ``ratio`` (refsim / oracle), refsim's ``stage_seconds`` and the
+    ``steps`` and ``repeats`` timed."""
+    pairs = []
+    for case, by_engine in bounce.by_case(rows, bounce.STEP_CASE).items():
+        ours = by_engine.get(bounce.REFSIM)
+        if ours is None:
+            continue
+        theirs = by_engine[ORACLE].seconds if ORACLE in by_engine else math.nan
+        pairs.append({**dict(zip(bounce.STEP_CASE, case, strict=True)),
+                      "refsim_seconds": ours.seconds, "pybullet_seconds": theirs,
+                      "ratio": ours.seconds / theirs, "stage_seconds": ours.stage_seconds,
+                      "steps": ours.steps, "repeats": ours.repeats})
+    return pairs
+
+
 def step_cost_findings(rows: Sequence[StepCost]) -> dict:
-    """The step-cost table's findings (timings), over the rows timed after
-    the shortest warm-up: the rows of the fewest bodies (refsim's and
-    pybullet's time per step) and the largest stage of refsim's step in the
-    first of them that was timed by stage (its share of the step); the rows
-    timed after a longer warm-up (the cubes settled); refsim / pybullet by
-    body count, whether the mean ratio falls as bodies are added (None when
-    fewer than two counts or a ratio is not finite), and at the largest body
-    count whether each ratio is within :data:`STEP_COST_TARGET`."""
-    early = [r for r in rows if r.warmup == min(x.warmup for x in rows)]
-    counts = sorted(dict.fromkeys(r.bodies for r in early))
-    ratios = {c: [r.ratio for r in early if r.bodies == c] for c in counts}
+    """The step-cost table's findings (timings), over the scenes timed after
+    the shortest warm-up (:func:`step_cost_pairs`): the scenes of the fewest
+    bodies (refsim's and the oracle's time per step) and the largest stage
+    of refsim's step in the first of them that was timed by stage (its share
+    of the step); the scenes timed after a longer warm-up (the cubes
+    settled); refsim / oracle by body count, whether the mean ratio falls as
+    bodies are added (None when fewer than two counts or a ratio is not
+    finite), and at the largest body count whether each ratio is within
+    :data:`STEP_COST_TARGET`."""
+    pairs = step_cost_pairs(rows)
+    first = min(p["warmup"] for p in pairs)
+    early = [p for p in pairs if p["warmup"] == first]
+    counts = sorted(dict.fromkeys(p["bodies"] for p in early))
+    ratios = {c: [p["ratio"] for p in early if p["bodies"] == c] for c in counts}
     means = [float(np.mean(ratios[c])) for c in counts]
     falling = None
     if len(means) > 1 and all(math.isfinite(m) for m in means):
         falling = all(b < a for a, b in zip(means, means[1:], strict=False))
-    biggest = max(r.bodies for r in rows)
-    single = [r for r in early if r.bodies == min(x.bodies for x in early)]
+    biggest = max(p["bodies"] for p in pairs)
+    single = [p for p in early if p["bodies"] == min(counts)]
     largest_stage = None
-    for r in single:
-        stages = r.refsim_stage_seconds
+    for p in single:
+        stages = p["stage_seconds"]
         if stages:
             top = max(stages, key=stages.__getitem__)
-            largest_stage = {"rotation": r.rotation, "stage": top,
-                             "fraction": stages[top] / r.refsim_seconds}
+            largest_stage = {"rotation": p["rotation"], "stage": top,
+                             "fraction": stages[top] / p["refsim_seconds"]}
             break
-    late = [r for r in rows if r.warmup > min(x.warmup for x in rows)]
     return {
-        "single": [{"bodies": r.bodies, "rotation": r.rotation,
-                    "refsim_seconds": r.refsim_seconds, "pybullet_seconds": r.pybullet_seconds}
-                   for r in single],
+        "single": [{"bodies": p["bodies"], "rotation": p["rotation"],
+                    "refsim_seconds": p["refsim_seconds"],
+                    "pybullet_seconds": p["pybullet_seconds"]} for p in single],
         "largest_stage": largest_stage,
-        "settled": [{"warmup": r.warmup, "refsim_seconds": r.refsim_seconds,
-                     "pybullet_seconds": r.pybullet_seconds} for r in late],
+        "settled": [{"warmup": p["warmup"], "refsim_seconds": p["refsim_seconds"],
+                     "pybullet_seconds": p["pybullet_seconds"]}
+                    for p in pairs if p["warmup"] > first],
         "ratios": ratios,
         "ratio_falls": falling,
         "target": STEP_COST_TARGET,
         "largest_bodies": biggest,
-        "at_largest": [{"rotation": r.rotation, "warmup": r.warmup, "ratio": r.ratio,
-                        "within_target": r.ratio <= STEP_COST_TARGET}
-                       for r in rows if r.bodies == biggest],
+        "at_largest": [{"rotation": p["rotation"], "warmup": p["warmup"], "ratio": p["ratio"],
+                        "within_target": p["ratio"] <= STEP_COST_TARGET}
+                       for p in pairs if p["bodies"] == biggest],
     }
 
 
@@ -225,35 +262,50 @@ def _max_gap(a, b) -> float:
     return max(gaps) if gaps else math.nan
 
 
-def height_gaps(series: DropEnergy, rows: Sequence[ApexRow]) -> dict:
+def height_gaps(series: Sequence[DropEnergy], rows: Sequence[ApexRow]) -> dict:
     """The heights chart's findings: the largest height difference (m) of
-    refsim and of pybullet from the analytic curve and, from the apex row of
-    the same drop with rotation off, the largest difference of their apex
-    times from the analytic ones (ms) over the bounces measured."""
-    found: dict = {"refsim_height": _max_gap(series.refsim_height, series.analytic_height),
-                   "pybullet_height": _max_gap(series.pybullet_height, series.analytic_height)}
-    row = next((r for r in rows if r.body == series.body and r.e == series.e
-                and r.rotation == "off"), None)
-    if row is not None:
-        found |= {"bounces": len(row.analytic_times) - 1,
-                  "refsim_apex_ms": 1e3 * _max_gap(row.refsim_times, row.analytic_times),
-                  "pybullet_apex_ms": 1e3 * _max_gap(row.pybullet_times, row.analytic_times)}
+    refsim and of the oracle from the analytic curve (nan for an engine that
+    did not run) and, from the apex rows of the same drop with rotation off,
+    the largest difference of their apex times from the analytic ones (ms)
+    over the bounces measured."""
+    curves = {s.engine: s for s in series}
+    closed = curves[bounce.ANALYTIC]
+
+    def height_gap(engine):
+        return _max_gap(curves[engine].height, closed.height) if engine in curves else math.nan
+
+    found: dict = {"refsim_height": height_gap(bounce.REFSIM),
+                   "pybullet_height": height_gap(ORACLE)}
+    drop = next((d for d in bounce.by_case(rows, bounce.APEX_CASE).values()
+                 if bounce.ANALYTIC in d and d[bounce.ANALYTIC].body == closed.body
+                 and d[bounce.ANALYTIC].e == closed.e
+                 and d[bounce.ANALYTIC].rotation == "off"), None)
+    if drop is not None:
+        times = drop[bounce.ANALYTIC].times
+
+        def apex_gap(engine):
+            return 1e3 * _max_gap(drop[engine].times, times) if engine in drop else math.nan
+
+        found |= {"bounces": len(times) - 1, "refsim_apex_ms": apex_gap(bounce.REFSIM),
+                  "pybullet_apex_ms": apex_gap(ORACLE)}
     return found
 
 
 def rest_findings(rows: Sequence[RestRow]) -> list[dict]:
-    """The time-to-rest table's findings, one per row: the bounce after which
-    each engine settles, refsim's settling time less the analytic one (ms)
-    and, when pybullet settles, its bounces after (+) or before (-) the
-    analytic bounce."""
+    """The time-to-rest table's findings, one per drop: the bounce after
+    which each engine settles, refsim's settling time less the analytic one
+    (ms) and, when the oracle settles, its bounces after (+) or before (-)
+    the analytic bounce."""
     found = []
-    for r in rows:
-        item = {"e": r.e, "analytic_bounces": r.analytic_bounces,
-                "refsim_bounces": r.refsim_bounces,
-                "refsim_offset_ms": 1e3 * (r.refsim_settle - r.analytic_settle)}
-        if r.pybullet_bounces:
-            item |= {"pybullet_bounces": r.pybullet_bounces,
-                     "pybullet_bounces_late": r.pybullet_bounces - r.analytic_bounces}
+    for drop in bounce.by_case(rows, bounce.REST_CASE).values():
+        closed, ours = drop[bounce.ANALYTIC], drop[bounce.REFSIM]
+        item = {"e": closed.e, "analytic_bounces": closed.bounces,
+                "refsim_bounces": ours.bounces,
+                "refsim_offset_ms": 1e3 * (ours.settle - closed.settle)}
+        theirs = drop.get(ORACLE)
+        if theirs is not None and theirs.bounces:
+            item |= {"pybullet_bounces": theirs.bounces,
+                     "pybullet_bounces_late": theirs.bounces - closed.bounces}
         found.append(item)
     return found
 
@@ -261,51 +313,58 @@ def rest_findings(rows: Sequence[RestRow]) -> list[dict]:
 def agreement_findings(apex: Sequence[ApexRow], oblique: Sequence[ObliqueRow]) -> dict:
     """The summary's agreement figures: over the drops with rotation off, the
     largest apex-ratio error of refsim (against :data:`APEX_RATIO_TARGET`) and
-    of pybullet; over the spheres' oblique bounces pybullet measured, its
+    of the oracle; over the spheres' oblique bounces the oracle ran, its
     largest relative difference from Coulomb's lateral speed for a ball."""
     found: dict = {"target": APEX_RATIO_TARGET, "step": bounce.STEP}
-    off = [r for r in apex if r.rotation == "off"]
+    off = [r for r in _of(apex, bounce.REFSIM) if r.rotation == "off"]
     if off:
         found |= {"restitutions": list(dict.fromkeys(r.e for r in off)),
-                  "refsim_worst": max(r.refsim_error for r in off), "drops": len(off)}
-        measured = [r for r in off if r.pybullet_error is not None]
-        if measured:
-            found |= {"pybullet_worst": max(r.pybullet_error for r in measured),
-                      "pybullet_drops": len(measured)}
-    sliding = [r for r in oblique if r.body.startswith("sphere") and r.pybullet is not None]
+                  "refsim_worst": max(r.error for r in off), "drops": len(off)}
+    measured = [r for r in _of(apex, ORACLE) if r.rotation == "off"]
+    if measured:
+        found |= {"pybullet_worst": max(r.error for r in measured),
+                  "pybullet_drops": len(measured)}
+    sliding = [r for r in _of(oblique, ORACLE) if r.body.startswith("sphere")]
     if sliding:
-        found |= {"coulomb_worst": max(abs(r.pybullet - r.coulomb_ball) / r.coulomb_ball
+        found |= {"coulomb_worst": max(abs(r.lateral - r.coulomb_ball) / r.coulomb_ball
                                        for r in sliding),
                   "coulomb_bounces": len(sliding)}
     return found
 
 
 def divergences(apex: Sequence[ApexRow], oblique: Sequence[ObliqueRow]) -> list[dict]:
-    """Where pybullet or the seed's literal words part from the analytic
+    """Where the oracle or the seed's literal words part from the analytic
     answers, each with its key, its class (:data:`DIVERGENCE_CLASSES`) and
-    its figures: pybullet's worst apex ratio (rotation off), the seed's
-    literal wall flip's worst, the spheres' lateral speed after an oblique
-    bounce, and pybullet's cube tipping (:func:`tipping_spin`)."""
+    its figures: the oracle's worst apex ratio (rotation off, beside
+    refsim's error on the same drop), the seed's literal wall flip's worst,
+    the spheres' lateral speed after an oblique bounce, and the oracle's
+    cube tipping (:func:`tipping_spin`)."""
     found = []
 
     def add(key: str, **facts) -> None:
         found.append({"key": key, "class": DIVERGENCE_CLASSES[key], **facts})
 
-    rounds = [r for r in apex if r.rotation == "off" and r.pybullet_error is not None]
+    drops = bounce.by_case(apex, bounce.APEX_CASE)
+    rounds = [d for d in drops.values() if ORACLE in d and d[ORACLE].rotation == "off"]
     if rounds:
-        worst = max(rounds, key=lambda r: abs(r.pybullet_error))
-        add("pybullet-apex", body=worst.body, e=worst.e, pybullet_error=worst.pybullet_error,
-            refsim_error=worst.refsim_error)
-    literal = [r for r in apex if r.seed_speed_error is not None and r.rotation == "off"]
+        worst = max(rounds, key=lambda d: abs(d[ORACLE].error))
+        ours = worst.get(bounce.REFSIM)
+        add("pybullet-apex", body=worst[ORACLE].body, e=worst[ORACLE].e,
+            pybullet_error=worst[ORACLE].error,
+            refsim_error=math.nan if ours is None else ours.error)
+    literal = [r for r in _of(apex, bounce.SEED_WALL_SPEED) if r.rotation == "off"]
     if literal:
-        worst = max(literal, key=lambda r: abs(r.seed_speed_error))
-        add("literal-wall-flip", body=worst.body, e=worst.e,
-            seed_speed_error=worst.seed_speed_error)
-    slides = [r for r in oblique if r.body.startswith("sphere") and r.pybullet is not None]
+        worst_row = max(literal, key=lambda r: abs(r.error))
+        add("literal-wall-flip", body=worst_row.body, e=worst_row.e,
+            seed_speed_error=worst_row.error)
+    bounces = bounce.by_case(oblique, bounce.OBLIQUE_CASE)
+    slides = [b for b in bounces.values() if ORACLE in b and b[ORACLE].body.startswith("sphere")]
     if slides:
-        add("lateral-friction", bounces=[{"v_t": r.v_t, "refsim": r.refsim,
-                                          "pybullet": r.pybullet, "coulomb": r.coulomb_ball}
-                                         for r in slides])
+        add("lateral-friction", bounces=[
+            {"v_t": b[ORACLE].v_t,
+             "refsim": b[bounce.REFSIM].lateral if bounce.REFSIM in b else math.nan,
+             "pybullet": b[ORACLE].lateral, "coulomb": b[ORACLE].coulomb_ball}
+            for b in slides])
     spin = tipping_spin(apex)
     if spin is not None:
         add("pybullet-tips", spin=spin)

@@ -23,6 +23,13 @@ The ``rigid`` capability runs the scene's world, bodies, solver and collision
 level under the engine's model: the engine overrides the scene's
 ``[dynamics]`` table (and the wall law), nothing else.
 
+A third engine runs a scene as it is posed, with no model of its own:
+:func:`as_posed` (``refsim``: the scene's ``[dynamics]`` and wall speed, the
+engine a study of the scene's own choices receives) and
+:func:`as_posed_seed_wall_speed` (``refsim-seed-wall-speed``: the same with
+the seed's literal wall speed, S7). Only its ``rigid`` capability exists;
+the kit does not list it (:mod:`refsim.engines.registry`).
+
 DEVIATION: the seed engine's RK4 is refsim's classical RK4, not the seed's
 literal weights (which sum to 5/3; :data:`refsim.SEED_LITERAL_VARIANTS`): an
 engine declares the order it has, and the literal reading has none.
@@ -138,3 +145,47 @@ def seed(solver: str = "rk4") -> RefsimEngine:
 def corrected(solver: str = "rk4") -> RefsimEngine:
     """The corrected model as an engine (``refsim.engines.refsim_engines:corrected``)."""
     return RefsimEngine("corrected", solver)
+
+
+class PosedRefsim:
+    """refsim running a scene's own dynamics as the scene poses them (its
+    rotation model, body response and wall law), with the wall speed
+    ``wall_speed`` ("wall", "seed", or None for the scene's
+    ``world.wall_speed``). The bounce studies receive it as "refsim": what
+    they study is the scene's choices, not one model's.
+
+    ``simulate`` records every step unless told otherwise (as the oracles'
+    do), so that a bounce is read from every frame.
+    """
+
+    def __init__(self, wall_speed: str | None = None):
+        if wall_speed is not None:
+            check_option("wall_speed", wall_speed, ("wall", "seed"))
+        self.wall_speed = wall_speed
+        self.name = "refsim-seed-wall-speed" if wall_speed == "seed" else "refsim"
+
+    def __repr__(self) -> str:
+        return f"<PosedRefsim {self.name}>"
+
+    @property
+    def honoured_keys(self) -> frozenset:
+        """Every scene key (:data:`refsim.scenes.support.LOAD_KEYS`): the
+        scene is run as posed."""
+        from refsim.scenes.support import LOAD_KEYS
+
+        return frozenset(LOAD_KEYS)
+
+    def simulate(self, scene, *, every: int = 1, **kwargs):
+        """``refsim.simulate(scene, every=every)`` with this engine's wall speed."""
+        return simulate(scene, every=every, wall_speed=self.wall_speed, **kwargs)
+
+
+def as_posed() -> PosedRefsim:
+    """refsim running the scene as posed (``refsim.engines.refsim_engines:as_posed``)."""
+    return PosedRefsim()
+
+
+def as_posed_seed_wall_speed() -> PosedRefsim:
+    """The scene as posed with the seed's literal wall speed
+    (``refsim.engines.refsim_engines:as_posed_seed_wall_speed``)."""
+    return PosedRefsim("seed")

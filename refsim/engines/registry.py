@@ -12,9 +12,12 @@ Two kinds of rows:
 
 - *kit engines* (``kit=True``, :data:`SHIPPED`): the matrix's columns,
   each answering the kit's capabilities (:mod:`refsim.engines`);
-- *oracles only the report asks* (``kit=False``): trimesh's mesh facts and
-  its CollisionManager on their own, and SciPy's tight ODE reference (a
-  :class:`refsim.engines.ReferenceSolver`, not a kit capability).
+- *engines only the report asks* (``kit=False``): trimesh's mesh facts and
+  its CollisionManager on their own, SciPy's tight ODE reference (a
+  :class:`refsim.engines.ReferenceSolver`, not a kit capability), and
+  refsim running a scene as posed, with the scene's wall speed or the
+  seed's (:class:`refsim.engines.refsim_engines.PosedRefsim`: the bounce
+  studies' refsim).
 
 Which capabilities an engine has is not written here: it is read from the
 engine itself (:func:`refsim.engines.capabilities`).
@@ -62,6 +65,9 @@ ENGINES: tuple[EngineEntry, ...] = (
     EngineEntry("trimesh-collision", "trimesh (CollisionManager)",
                 "refsim.oracles.trimesh_collision:engine", "oracles", kit=False),
     EngineEntry("scipy", "SciPy solve_ivp", "refsim.oracles.scipy_ivp:engine", None, kit=False),
+    EngineEntry("refsim", "refsim", "refsim.engines.refsim_engines:as_posed", None, kit=False),
+    EngineEntry("refsim-seed-wall-speed", "refsim, the seed's literal wall speed",
+                "refsim.engines.refsim_engines:as_posed_seed_wall_speed", None, kit=False),
 )
 
 #: The kit's engines (its matrix's columns), in the matrix's order.

@@ -1,9 +1,14 @@
 """Bounce studies: refsim's wall response against the analytic answer and pybullet.
 
 What: a body dropped onto the floor of the world cube (seed S5, S7), run by
-``refsim.simulate`` and by the pybullet oracle (:mod:`refsim.oracles.pybullet_adapter`)
-on the same scene, and compared with the closed forms of
-:mod:`refsim.dynamics.analytic`:
+each engine a study receives on the same scene and compared with the closed
+forms of :mod:`refsim.dynamics.analytic`. refsim is received as an engine
+too (:func:`refsim_engines`: the scene as posed, and with the seed's
+literal wall speed); the report adds the pybullet oracle
+(:mod:`refsim.oracles.pybullet_adapter`). The records are long-form: one
+row per case and engine, the engine's name in its ``engine`` field, the
+closed form a row of its own (:data:`ANALYTIC`) where it has the engines'
+shape; :func:`by_case` groups them back by case.
 
 - :func:`measure_apexes`: apex heights and times of the first bounces, and
   the apex ratio (ideal ``e^2``), for a sphere-like body (``sphere-2k.ac``,
@@ -21,8 +26,9 @@ on the same scene, and compared with the closed forms of
 - :func:`measure_engine_variants`: the oracle's bounce with one pybullet
   setting at a time put back to its default (why each setting);
 - :func:`measure_step_cost`: seconds per step of 1, 10 and 40 cubes
-  (:func:`cubes_scene`), refsim's ``Simulation.step()`` against pybullet's
-  ``stepSimulation`` (the benchmarks in tests/benchmarks/test_bench_dynamics.py
+  (:func:`cubes_scene`), refsim's ``Simulation.advance`` beside each
+  engine's own stepping (pybullet's ``stepSimulation``; the benchmarks in
+  tests/benchmarks/test_bench_dynamics.py
   time the same scenes).
 
 How heights are read from a trajectory: the height is the body's lowest
@@ -46,12 +52,13 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import asdict, dataclass, field
+from typing import Any
 
 import numpy as np
 
 from refsim.dynamics import analytic
 from refsim.dynamics.energy import trajectory_energy
-from refsim.solvers.methods import SOLVERS
+from refsim.errors import StateError
 from refsim.studies import TIMED
 
 #: The sphere-like body and the cube of the studies (bundled models).
@@ -132,19 +139,6 @@ def duration_for(e: float, bounces: int, height: float = DROP_HEIGHT) -> float:
     # gains height, and so flight time, at every bounce).
     return float(analytic.apex_times(height, GRAVITY, e, bounces)[-1]
                  + 0.5 * analytic.fall_time(height, GRAVITY) + 0.1)
-
-
-def run_refsim(scene, wall_speed: str = "wall"):
-    """``refsim.simulate(scene, every=1)`` and its wall time, seconds.
-
-    ``wall_speed``: "wall" (refsim's default: the normal speed the body had at
-    the wall, energy-consistent) or "seed" (the seed's literal speed at the
-    penetrated position); see :mod:`refsim.dynamics.walls`."""
-    from refsim.dynamics.simulate import simulate
-
-    start = time.perf_counter()
-    trajectory = simulate(scene, every=1, wall_speed=wall_speed)
-    return trajectory, time.perf_counter() - start
 
 
 def run_engine(scene, engine):
@@ -229,17 +223,65 @@ def energy_above_touch(scene, trajectory, y_touch: float) -> np.ndarray:
 
 # -- the studies --------------------------------------------------------------------
 
+#: The names the records carry in their ``engine`` field besides an engine's
+#: own: the closed-form answer (a row of its own where it has the engines'
+#: shape: apexes, time to rest, energy) and refsim's two engines
+#: (:class:`refsim.engines.refsim_engines.PosedRefsim`: the scene as posed,
+#: and the same with the seed's literal wall speed).
+ANALYTIC = "analytic"
+REFSIM = "refsim"
+SEED_WALL_SPEED = "refsim-seed-wall-speed"
+
+#: The fields that name one case of each long-form record (the rest is one
+#: engine's answer to it): :func:`by_case` groups rows by them.
+APEX_CASE = ("body", "rotation", "e", "step", "solver")
+OBLIQUE_CASE = ("body", "rotation", "e", "friction", "v_t", "v_n")
+REST_CASE = ("body", "e")
+STEP_CASE = ("bodies", "rotation", "warmup")
+
+
+def refsim_engines(seed_wall_speed: bool = True) -> tuple:
+    """refsim as the studies receive it when not told otherwise: the scene as
+    posed (:data:`REFSIM`) and, with ``seed_wall_speed``, the same with the
+    seed's literal wall speed (:data:`SEED_WALL_SPEED`); built from
+    :mod:`refsim.engines.registry`."""
+    from refsim.engines.registry import build
+
+    return tuple(build(name) for name in
+                 ((REFSIM, SEED_WALL_SPEED) if seed_wall_speed else (REFSIM,)))
+
+
+def by_case(rows, fields) -> dict[tuple, dict]:
+    """Long-form ``rows`` grouped by the values of ``fields`` (in the order
+    the cases first appear), each group a dict from engine name to row."""
+    groups: dict[tuple, dict] = {}
+    for row in rows:
+        groups.setdefault(tuple(getattr(row, f) for f in fields), {})[row.engine] = row
+    return groups
+
+
+def _received(engines, seed_wall_speed: bool):
+    return refsim_engines(seed_wall_speed) if engines is None else tuple(engines)
+
+
+def bounces_of(trajectory, y_touch: float) -> Bounces:
+    """:func:`read_bounces` of body 0's height in ``trajectory``."""
+    return read_bounces(trajectory.t, trajectory.position[:, 0, 1],
+                        trajectory.velocity[:, 0, 1], y_touch)
+
 
 @dataclass(frozen=True)
 class ApexRow:
-    """Apexes of one body and restitution: refsim, pybullet and analytic.
+    """Apexes of one drop as one engine ran it, or as the closed form gives
+    them (``engine`` :data:`ANALYTIC`).
 
-    ``*_heights``/``*_times``: the first ``BOUNCES + 1`` apexes (release
-    included); ``*_ratio``: geometric mean apex ratio; ``*_error``: its
-    relative error against ``e^2``; ``*_first_ratio``: h_1 / h_0.
-    ``refsim_*`` is refsim's default wall response (the normal speed at the
-    wall), ``seed_speed_*`` the seed's literal one (the speed at the
-    penetrated position, ``wall_speed="seed"``).
+    The drop is ``body``, ``rotation``, the restitution ``e``, ``step`` and
+    ``solver`` (:data:`APEX_CASE`). ``heights``/``times``: the first
+    ``BOUNCES + 1`` apexes, the release included (nan past the last one
+    read); ``ratio``: the geometric mean apex ratio; ``first_ratio``:
+    h_1 / h_0; ``error``: ``|ratio - e^2| / e^2``; ``max_spin``: the largest
+    angular velocity component over the run, rad/s. The analytic row's ratio
+    is e^2 itself, its error and spin 0.
     """
 
     body: str
@@ -247,25 +289,13 @@ class ApexRow:
     e: float
     step: float
     solver: str
-    analytic_heights: list[float]
-    analytic_times: list[float]
-    refsim_heights: list[float]
-    refsim_times: list[float]
-    pybullet_heights: list[float]
-    pybullet_times: list[float]
-    analytic_ratio: float
-    refsim_ratio: float
-    pybullet_ratio: float
-    refsim_first_ratio: float
-    pybullet_first_ratio: float
-    refsim_error: float
-    pybullet_error: float
-    seed_speed_heights: list[float]
-    seed_speed_ratio: float
-    seed_speed_first_ratio: float
-    seed_speed_error: float
-    refsim_max_spin: float
-    pybullet_max_spin: float
+    engine: str
+    heights: list[float]
+    times: list[float]
+    ratio: float
+    first_ratio: float
+    error: float
+    max_spin: float
 
 
 def _first(values, k) -> list[float]:
@@ -273,44 +303,33 @@ def _first(values, k) -> list[float]:
     return values + [math.nan] * (k - len(values))
 
 
-def measure_apex_row(model: str, e: float, *, rotation: str = "off", step: float = STEP,
-                     solver: str = SOLVER, bounces: int = BOUNCES,
-                     oracle=None) -> ApexRow:
+def measure_apex_drop(model: str, e: float, *, rotation: str = "off", step: float = STEP,
+                      solver: str = SOLVER, bounces: int = BOUNCES,
+                      engines=None) -> list[ApexRow]:
+    """The apexes of one drop: the analytic row, then one row per engine of
+    ``engines`` (rigid-body engines; default :func:`refsim_engines`)."""
     scene = drop_scene(model, e, step=step, solver=solver, rotation=rotation,
                        duration=duration_for(e, bounces))
     y_touch = touch_height(scene)
-    h0 = DROP_HEIGHT
-    ours, _ = run_refsim(scene)
-    b = read_bounces(ours.t, ours.position[:, 0, 1], ours.velocity[:, 0, 1], y_touch)
-    literal, _ = run_refsim(scene, wall_speed="seed")
-    s = read_bounces(literal.t, literal.position[:, 0, 1], literal.velocity[:, 0, 1], y_touch)
-    s_ratio = apex_ratio(s.apex_heights, bounces)
-    if oracle is not None:
-        theirs, _ = run_engine(scene, oracle)
-        p = read_bounces(theirs.t, theirs.position[:, 0, 1], theirs.velocity[:, 0, 1], y_touch)
-        p_heights, p_times = p.apex_heights, p.apex_times
-        p_spin = float(np.abs(theirs.angular_velocity).max())
-    else:
-        p_heights, p_times, p_spin = np.array([]), np.array([]), math.nan
     k = bounces + 1
-    a_heights = analytic.apex_heights(h0, e, bounces)
-    a_times = np.concatenate([[0.0], analytic.apex_times(h0, GRAVITY, e, bounces)])
     ideal = analytic.apex_ratio(e)
-    r_ratio = apex_ratio(b.apex_heights, bounces)
-    p_ratio = apex_ratio(p_heights, bounces)
-    return ApexRow(
-        body=model, rotation=rotation, e=e, step=step, solver=solver,
-        analytic_heights=_first(a_heights, k), analytic_times=_first(a_times, k),
-        refsim_heights=_first(b.apex_heights, k), refsim_times=_first(b.apex_times, k),
-        pybullet_heights=_first(p_heights, k), pybullet_times=_first(p_times, k),
-        analytic_ratio=ideal, refsim_ratio=r_ratio, pybullet_ratio=p_ratio,
-        refsim_first_ratio=apex_ratio(b.apex_heights, 1),
-        pybullet_first_ratio=apex_ratio(p_heights, 1),
-        refsim_error=abs(r_ratio - ideal) / ideal, pybullet_error=abs(p_ratio - ideal) / ideal,
-        seed_speed_heights=_first(s.apex_heights, k), seed_speed_ratio=s_ratio,
-        seed_speed_first_ratio=apex_ratio(s.apex_heights, 1),
-        seed_speed_error=abs(s_ratio - ideal) / ideal,
-        refsim_max_spin=float(np.abs(ours.angular_velocity).max()), pybullet_max_spin=p_spin)
+    drop: dict[str, Any] = {"body": model, "rotation": rotation, "e": e, "step": step,
+                            "solver": solver}
+    a_times = np.concatenate([[0.0], analytic.apex_times(DROP_HEIGHT, GRAVITY, e, bounces)])
+    rows = [ApexRow(**drop, engine=ANALYTIC,
+                    heights=_first(analytic.apex_heights(DROP_HEIGHT, e, bounces), k),
+                    times=_first(a_times, k), ratio=ideal, first_ratio=ideal, error=0.0,
+                    max_spin=0.0)]
+    for engine in _received(engines, seed_wall_speed=True):
+        trajectory, _ = run_engine(scene, engine)
+        b = bounces_of(trajectory, y_touch)
+        ratio = apex_ratio(b.apex_heights, bounces)
+        rows.append(ApexRow(**drop, engine=engine.name, heights=_first(b.apex_heights, k),
+                            times=_first(b.apex_times, k), ratio=ratio,
+                            first_ratio=apex_ratio(b.apex_heights, 1),
+                            error=abs(ratio - ideal) / ideal,
+                            max_spin=float(np.abs(trajectory.angular_velocity).max())))
+    return rows
 
 
 def _variants(models) -> list[tuple[str, str]]:
@@ -320,20 +339,24 @@ def _variants(models) -> list[tuple[str, str]]:
 
 
 def measure_apexes(models=(SPHERE, CUBE), restitutions=RESTITUTIONS, *, step: float = STEP,
-                   solver: str = SOLVER, oracle=None) -> list[ApexRow]:
-    """Apex rows for each model and restitution: the sphere-like body with
-    rotation "off"; the cube with rotation "off" and with the seed's model."""
+                   solver: str = SOLVER, engines=None) -> list[ApexRow]:
+    """:func:`measure_apex_drop` for each model and restitution: the
+    sphere-like body with rotation "off"; the cube with rotation "off" and
+    with the seed's model."""
+    engines = _received(engines, seed_wall_speed=True)
     rows = []
     for model, rotation in _variants(models):
         for e in restitutions:
-            rows.append(measure_apex_row(model, e, rotation=rotation, step=step,
-                                         solver=solver, oracle=oracle))
+            rows += measure_apex_drop(model, e, rotation=rotation, step=step, solver=solver,
+                                      engines=engines)
     return rows
 
 
 @dataclass(frozen=True)
 class ObliqueRow:
-    """Lateral velocity after one oblique bounce (v_t along +x, v_n into the floor)."""
+    """One engine's lateral velocity after one oblique bounce (v_t along +x,
+    v_n into the floor: :data:`OBLIQUE_CASE`), beside what each law gives
+    for the same bounce."""
 
     body: str
     rotation: str
@@ -345,9 +368,9 @@ class ObliqueRow:
     coulomb_point: float          # max(v_t - mu (1 + e) v_n, 0)
     coulomb_ball: float           # point mass unless the ball reaches rolling (5/7 v_t)
     ball_slides: bool             # the ball slides through the impact
-    refsim: float
-    pybullet: float
-    pybullet_spin: float          # |w| after the bounce, rad/s
+    engine: str
+    lateral: float                # the centre's x velocity at the end, m/s
+    spin: float                   # |w| at the end, rad/s
 
 
 #: The oblique bounces: (v_t, v_n). With mu = 0.3 and e = 0.8 the first keeps
@@ -360,9 +383,11 @@ OBLIQUE_E = 0.8
 
 def measure_oblique(models=(SPHERE, CUBE), cases=OBLIQUE_CASES, *, friction=OBLIQUE_FRICTION,
                     e=OBLIQUE_E, step: float = STEP, solver: str = SOLVER,
-                    oracle=None) -> list[ObliqueRow]:
+                    engines=None) -> list[ObliqueRow]:
     """Lateral velocity after the first bounce of a body released 5 cm above
-    the floor moving at ``(v_t, -v_n, 0)``; read at the apex after it."""
+    the floor moving at ``(v_t, -v_n, 0)``, read at the apex after it, in
+    each of ``engines`` (default: refsim as posed)."""
+    engines = _received(engines, seed_wall_speed=False)
     rows = []
     for model, rotation in _variants(models):
         for v_t, v_n in cases:
@@ -373,41 +398,38 @@ def measure_oblique(models=(SPHERE, CUBE), cases=OBLIQUE_CASES, *, friction=OBLI
             scene = drop_scene(model, e, step=step, solver=solver, rotation=rotation,
                                friction=friction, height=height, duration=duration,
                                velocity=(v_t, -v_n, 0.0))
-            ours, _ = run_refsim(scene)
-            after_ours = float(ours.velocity[-1, 0, 0])
-            if oracle is not None:
-                theirs, _ = run_engine(scene, oracle)
-                after_theirs = float(theirs.velocity[-1, 0, 0])
+            case = {"body": model, "rotation": rotation, "e": e, "friction": friction,
+                    "v_t": v_t, "v_n": v_impact,
+                    "seed_analytic": analytic.lateral_velocity_seed(v_t, friction),
+                    "coulomb_point": analytic.lateral_velocity_coulomb(v_t, v_impact,
+                                                                       friction, e),
+                    "coulomb_ball": analytic.lateral_velocity_coulomb_ball(v_t, v_impact,
+                                                                           friction, e),
+                    "ball_slides": analytic.sliding_throughout(v_t, v_impact, friction, e)}
+            for engine in engines:
+                trajectory, _ = run_engine(scene, engine)
                 # The centre's velocity (the mesh origin's includes w x r).
-                spin = float(np.linalg.norm(theirs.angular_velocity[-1, 0]))
-            else:
-                after_theirs, spin = math.nan, math.nan
-            rows.append(ObliqueRow(
-                body=model, rotation=rotation, e=e, friction=friction, v_t=v_t,
-                v_n=v_impact,
-                seed_analytic=analytic.lateral_velocity_seed(v_t, friction),
-                coulomb_point=analytic.lateral_velocity_coulomb(v_t, v_impact, friction, e),
-                coulomb_ball=analytic.lateral_velocity_coulomb_ball(v_t, v_impact, friction, e),
-                ball_slides=analytic.sliding_throughout(v_t, v_impact, friction, e),
-                refsim=after_ours, pybullet=after_theirs, pybullet_spin=spin))
+                rows.append(ObliqueRow(
+                    **case, engine=engine.name,
+                    lateral=float(trajectory.velocity[-1, 0, 0]),
+                    spin=float(np.linalg.norm(trajectory.angular_velocity[-1, 0]))))
     return rows
 
 
 @dataclass(frozen=True)
 class RestRow:
-    """Time until the bounces die out: the analytic Zeno time, the analytic
-    time of the bounce after which apexes stay below ``REST_FRACTION h0``,
-    and that time measured in refsim and pybullet."""
+    """When one engine's bounces die out, or the analytic series' (``engine``
+    :data:`ANALYTIC`): ``settle``, the time of the bounce after which every
+    apex stays below ``REST_FRACTION h0``, and ``bounces``, that bounce's
+    number (nan and 0 when the run never settles); ``zeno``, the analytic
+    Zeno time of the drop."""
 
     body: str
     e: float
     zeno: float
-    analytic_settle: float
-    refsim_settle: float
-    pybullet_settle: float
-    refsim_bounces: int
-    pybullet_bounces: int
-    analytic_bounces: int
+    engine: str
+    settle: float
+    bounces: int
 
 
 def settle_time(bounces: Bounces, h0: float, fraction: float = REST_FRACTION) -> tuple[float, int]:
@@ -422,73 +444,69 @@ def settle_time(bounces: Bounces, h0: float, fraction: float = REST_FRACTION) ->
 
 
 def measure_rest(model: str = SPHERE, restitutions=(0.5, 0.8), *, step: float = STEP,
-                 solver: str = SOLVER, oracle=None) -> list[RestRow]:
+                 solver: str = SOLVER, engines=None) -> list[RestRow]:
+    """The time to rest of each restitution: the analytic row, then one row
+    per engine (default: refsim as posed)."""
+    engines = _received(engines, seed_wall_speed=False)
     rows = []
     for e in restitutions:
         h0 = DROP_HEIGHT
         zeno = analytic.time_to_rest(h0, GRAVITY, e)
         scene = drop_scene(model, e, step=step, solver=solver, duration=zeno + 0.5)
         y_touch = touch_height(scene)
-        ours, _ = run_refsim(scene)
-        r_t, r_k = settle_time(read_bounces(ours.t, ours.position[:, 0, 1],
-                                            ours.velocity[:, 0, 1], y_touch), h0)
-        if oracle is not None:
-            theirs, _ = run_engine(scene, oracle)
-            p_t, p_k = settle_time(read_bounces(theirs.t, theirs.position[:, 0, 1],
-                                                theirs.velocity[:, 0, 1], y_touch), h0)
-        else:
-            p_t, p_k = math.nan, 0
-        rows.append(RestRow(body=model, e=e, zeno=zeno,
-                            analytic_settle=analytic.time_to_settle(h0, GRAVITY, e,
-                                                                    REST_FRACTION),
-                            refsim_settle=r_t, pybullet_settle=p_t, refsim_bounces=r_k,
-                            pybullet_bounces=p_k,
-                            analytic_bounces=analytic.bounces_until(e, REST_FRACTION)))
+        rows.append(RestRow(body=model, e=e, zeno=zeno, engine=ANALYTIC,
+                            settle=analytic.time_to_settle(h0, GRAVITY, e, REST_FRACTION),
+                            bounces=analytic.bounces_until(e, REST_FRACTION)))
+        for engine in engines:
+            trajectory, _ = run_engine(scene, engine)
+            settle, k = settle_time(bounces_of(trajectory, y_touch), h0)
+            rows.append(RestRow(body=model, e=e, zeno=zeno, engine=engine.name, settle=settle,
+                                bounces=k))
     return rows
 
 
 @dataclass(frozen=True)
 class DropEnergy:
-    """Height and energy over time for one drop (every ``stride``-th frame)."""
+    """Height and energy over time of one drop (every ``stride``-th frame)
+    as one engine ran it, or the closed form (``engine`` :data:`ANALYTIC`,
+    at the first engine's frame times)."""
 
     body: str
     e: float
+    engine: str
     t: list[float]
-    refsim_height: list[float]
-    pybullet_height: list[float]
-    analytic_height: list[float]
-    refsim_energy: list[float]
-    pybullet_energy: list[float]
-    analytic_energy: list[float]
+    height: list[float]
+    energy: list[float]
 
 
 def measure_drop_energy(model: str = SPHERE, e: float = 0.8, *, duration: float = 6.0,
-                   step: float = STEP, solver: str = SOLVER, stride: int = 10,
-                        oracle=None) -> DropEnergy:
+                        step: float = STEP, solver: str = SOLVER, stride: int = 10,
+                        engines=None) -> list[DropEnergy]:
     """Height above the touching height and mechanical energy (per unit
-    weight ``m g``: metres) over time."""
+    weight ``m g``: metres) over time: the analytic curves, then one per
+    engine (default: refsim as posed; at least one engine)."""
+    engines = _received(engines, seed_wall_speed=False)
+    if not engines:
+        raise StateError("measure_drop_energy: give at least one engine (the analytic "
+                         "curves are drawn at its frame times)")
     scene = drop_scene(model, e, step=step, solver=solver, duration=duration)
     y_touch = touch_height(scene)
-    ours, _ = run_refsim(scene)
-    t = ours.t[::stride]
-    g = GRAVITY
-    r_h = ours.position[::stride, 0, 1] - y_touch
-    r_e = energy_above_touch(scene, ours, y_touch)[::stride]
-    if oracle is not None:
-        theirs, _ = run_engine(scene, oracle)
-        p_h = theirs.position[::stride, 0, 1] - y_touch
-        p_e = energy_above_touch(scene, theirs, y_touch)[::stride]
-    else:
-        p_h = p_e = np.full(len(t), math.nan)
-    return DropEnergy(
-        body=model, e=e, t=t.tolist(), refsim_height=r_h.tolist(),
-        pybullet_height=list(map(float, p_h)),
-        analytic_height=analytic.height(t, DROP_HEIGHT, g, e).tolist(),
-        refsim_energy=r_e.tolist(), pybullet_energy=list(map(float, p_e)),
-        analytic_energy=(analytic.energy(t, DROP_HEIGHT, g, e) / g).tolist())
+    curves = []
+    for engine in engines:
+        trajectory, _ = run_engine(scene, engine)
+        curves.append(DropEnergy(
+            body=model, e=e, engine=engine.name, t=trajectory.t[::stride].tolist(),
+            height=(trajectory.position[::stride, 0, 1] - y_touch).tolist(),
+            energy=energy_above_touch(scene, trajectory, y_touch)[::stride].tolist()))
+    t = np.asarray(curves[0].t)
+    closed = DropEnergy(body=model, e=e, engine=ANALYTIC, t=curves[0].t,
+                        height=analytic.height(t, DROP_HEIGHT, GRAVITY, e).tolist(),
+                        energy=(analytic.energy(t, DROP_HEIGHT, GRAVITY, e) / GRAVITY).tolist())
+    return [closed, *curves]
 
 
-#: The cost study's series of RK4 with the seed's literal wall speed.
+#: The cost study's series of RK4 with the seed's literal wall speed (the
+#: series of engine :data:`SEED_WALL_SPEED`).
 SEED_SPEED_SERIES = "rk4, seed wall speed"
 
 
@@ -496,8 +514,8 @@ SEED_SPEED_SERIES = "rk4, seed wall speed"
 class CostPoint:
     """One point of the speed-vs-accuracy study."""
 
-    engine: str            # "refsim" or "pybullet"
-    solver: str            # refsim's solver, or "pybullet"
+    engine: str            # the engine's name: "refsim", "refsim-seed-wall-speed", "pybullet"
+    solver: str            # the series: refsim's solver, SEED_SPEED_SERIES, or the engine's name
     step: float
     ratio: float           # measured apex ratio (geometric mean over BOUNCES)
     error: float           # |ratio - e^2| / e^2
@@ -513,45 +531,44 @@ class CostStudy:
 
 
 def measure_cost(steps=COST_STEPS, solvers=COST_SOLVERS, *, model: str = SPHERE,
-                 e: float = 0.8, bounces: int = BOUNCES,
-                 oracle=None) -> CostStudy:
+                 e: float = 0.8, bounces: int = BOUNCES, engines=None) -> CostStudy:
     """Apex-ratio error against wall time per simulated second, per step size.
 
-    refsim runs each solver with its default wall response and, as the
-    series ``SEED_SPEED_SERIES``, RK4 with the seed's literal wall speed;
-    ``oracle`` (a rigid-body engine, or None) runs each step size once.
-    refsim's time is the whole ``refsim.simulate`` call (its loop, its wall
-    test and recording the frames); the oracle's is what :func:`run_engine`
-    reports (pybullet's ``stepSimulation`` calls alone, not the reading of
+    Each engine of ``engines`` (default :func:`refsim_engines`) is one
+    series at every step size with the solver :data:`SOLVER`, but refsim as
+    posed (:data:`REFSIM`), which is a series per solver of ``solvers``;
+    refsim with the seed's wall speed is the series
+    :data:`SEED_SPEED_SERIES`, any other engine the series of its name. The
+    time is what :func:`run_engine` reports: refsim's whole
+    ``refsim.simulate`` call (its loop, its wall test and recording the
+    frames), pybullet's ``stepSimulation`` calls alone (not the reading of
     state through the Python API, which would otherwise dominate).
     """
     ideal = analytic.apex_ratio(e)
     duration = duration_for(e, bounces)
     points = []
-    engines = ([("refsim", s) for s in solvers] + [("refsim", SEED_SPEED_SERIES)]
-               + ([(oracle.name, oracle.name)] if oracle is not None else []))
-    for engine, solver in engines:
+    series = []
+    for engine in _received(engines, seed_wall_speed=True):
+        if engine.name == REFSIM:
+            series += [(engine, solver, solver) for solver in solvers]
+        else:
+            label = SEED_SPEED_SERIES if engine.name == SEED_WALL_SPEED else engine.name
+            series.append((engine, label, SOLVER))
+    for engine, label, method in series:
         for h in steps:
-            method = solver if engine == "refsim" and solver in SOLVERS else SOLVER
             scene = drop_scene(model, e, step=h, solver=method, duration=duration)
-            y_touch = touch_height(scene)
-            if engine != "refsim":
-                traj, seconds = run_engine(scene, oracle)
-            else:
-                traj, seconds = run_refsim(
-                    scene, wall_speed="seed" if solver == SEED_SPEED_SERIES else "wall")
-            b = read_bounces(traj.t, traj.position[:, 0, 1], traj.velocity[:, 0, 1], y_touch)
-            ratio = apex_ratio(b.apex_heights, bounces)
-            points.append(CostPoint(engine=engine, solver=solver, step=float(h), ratio=ratio,
-                                    error=abs(ratio - ideal) / ideal,
+            traj, seconds = run_engine(scene, engine)
+            ratio = apex_ratio(bounces_of(traj, touch_height(scene)).apex_heights, bounces)
+            points.append(CostPoint(engine=engine.name, solver=label, step=float(h),
+                                    ratio=ratio, error=abs(ratio - ideal) / ideal,
                                     seconds_per_second=seconds / traj.t[-1]))
     return CostStudy(e=e, body=model, bounces=bounces, points=points)
 
 
 def fit_error_orders(study: CostStudy, floor: float = ROUNDING_ERROR) -> dict[str, float]:
-    """Per solver of ``study``: the least-squares slope of log(error) against
+    """Per series of ``study``: the least-squares slope of log(error) against
     log(step) over its points with a finite error above ``floor`` (the
-    observed order in h); solvers with fewer than two such points are left out."""
+    observed order in h); series with fewer than two such points are left out."""
     orders = {}
     for solver in dict.fromkeys(p.solver for p in study.points):
         pts = [p for p in study.points
@@ -591,7 +608,7 @@ def measure_engine_variants(variants, e: float = 0.8, duration: float = 9.0
     rows = []
     for label, engine in variants:
         traj, _ = run_engine(scene, engine)
-        b = read_bounces(traj.t, traj.position[:, 0, 1], traj.velocity[:, 0, 1], y_touch)
+        b = bounces_of(traj, y_touch)
         ratio = apex_ratio(b.apex_heights, BOUNCES)
         _, k = settle_time(b, DROP_HEIGHT)
         rows.append(SettingRow(change=label, ratio=ratio, error=(ratio - ideal) / ideal,
@@ -681,27 +698,50 @@ LOOP_STAGE = "compiled loop"
 
 @dataclass(frozen=True)
 class StepCost:
-    """Mean seconds per step of one scene: refsim's ``Simulation.advance``
-    and pybullet's ``stepSimulation``, and their ratio (refsim / pybullet)."""
+    """Mean seconds per step of one scene (:data:`STEP_CASE`) in one engine:
+    refsim's ``Simulation.advance`` (``engine`` :data:`REFSIM`, with its
+    stages), or an engine's own stepping (pybullet's ``stepSimulation``)."""
 
     bodies: int
     rotation: str
     warmup: int                         # steps taken before the timed ones
-    refsim_seconds: float = field(metadata=TIMED)
-    pybullet_seconds: float = field(metadata=TIMED)
-    ratio: float = field(metadata=TIMED)
-    refsim_stage_seconds: dict = field(metadata=TIMED)  # per step, by stage of refsim's loop
+    engine: str
+    seconds: float = field(metadata=TIMED)
+    stage_seconds: dict = field(metadata=TIMED)    # per step, by stage of refsim's loop
     steps: int = 0                      # timed steps per repeat
     repeats: int = 0                    # repeats (the fastest kept)
 
 
+def _refsim_step_cost(scene, steps: int, warmup: int, repeats: int) -> tuple[float, dict]:
+    """refsim's fastest mean seconds per step over ``repeats`` runs of
+    ``scene``, and that repeat's stage breakdown (:func:`measure_step_cost`)."""
+    from refsim.dynamics.simulation import Simulation
+
+    ours, stages = math.inf, {}
+    for _ in range(repeats):
+        sim = Simulation(scene)
+        sim.advance(warmup)
+        before = dict(sim.stage_seconds)
+        loop_before = sim.loop_seconds
+        start = time.perf_counter()
+        sim.advance(steps)
+        mean = (time.perf_counter() - start) / steps
+        if mean < ours:
+            ours = mean
+            stages = {k: (sim.stage_seconds[k] - before[k]) / steps for k in before}
+            if sim.loop_seconds > loop_before:
+                stages[LOOP_STAGE] = (sim.loop_seconds - loop_before) / steps
+    return ours, stages
+
+
 def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: int = 200,
                       warmup: int = 20, repeats: int = 5,
-                      oracle=None) -> list[StepCost]:
-    """Seconds per step of each cubes scene in refsim and in ``oracle`` (a
-    rigid-body engine with ``step_time(scene, steps, warmup)``: pybullet's).
-    refsim's steps are ``Simulation.advance``'s: the compiled loop where the
-    scene allows it, whose time is the stage ``LOOP_STAGE`` (not split).
+                      engines=()) -> list[StepCost]:
+    """Seconds per step of each cubes scene in refsim and in each of
+    ``engines`` (rigid-body engines with ``step_time(scene, steps,
+    warmup)``: pybullet's). refsim's steps are ``Simulation.advance``'s: the
+    compiled loop where the scene allows it, whose time is the stage
+    ``LOOP_STAGE`` (not split).
 
     Each engine runs the scene ``repeats`` times from its start: ``warmup``
     untimed steps (they also pay any first-call compilation), then ``steps``
@@ -709,33 +749,18 @@ def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: 
     other processes on a shared machine). The stage breakdown is refsim's
     ``stage_seconds`` over the timed steps of that repeat.
     """
-    from refsim.dynamics.simulation import Simulation
-
     rows = []
     for count in counts:
         for rotation in rotations:
             scene = cubes_scene(count, rotation)
-            ours, stages = math.inf, {}
-            for _ in range(repeats):
-                sim = Simulation(scene)
-                sim.advance(warmup)
-                before = dict(sim.stage_seconds)
-                loop_before = sim.loop_seconds
-                start = time.perf_counter()
-                sim.advance(steps)
-                mean = (time.perf_counter() - start) / steps
-                if mean < ours:
-                    ours = mean
-                    stages = {k: (sim.stage_seconds[k] - before[k]) / steps for k in before}
-                    if sim.loop_seconds > loop_before:
-                        stages[LOOP_STAGE] = (sim.loop_seconds - loop_before) / steps
-            theirs = math.nan
-            if oracle is not None:
-                theirs = min(oracle.step_time(scene, steps, warmup) for _ in range(repeats))
-            rows.append(StepCost(bodies=count, rotation=rotation, warmup=warmup,
-                                 refsim_seconds=ours, pybullet_seconds=theirs,
-                                 ratio=ours / theirs, refsim_stage_seconds=stages,
-                                 steps=steps, repeats=repeats))
+            case = {"bodies": count, "rotation": rotation, "warmup": warmup, "steps": steps,
+                    "repeats": repeats}
+            ours, stages = _refsim_step_cost(scene, steps, warmup, repeats)
+            rows.append(StepCost(**case, engine=REFSIM, seconds=ours, stage_seconds=stages))
+            for engine in engines:
+                theirs = min(engine.step_time(scene, steps, warmup) for _ in range(repeats))
+                rows.append(StepCost(**case, engine=engine.name, seconds=theirs,
+                                     stage_seconds={}))
     return rows
 
 

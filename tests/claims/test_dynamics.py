@@ -101,15 +101,24 @@ def test_c12_facts():
 
 
 def apex(body="sphere-2k.ac", rotation="off", error=1e-3, literal=0.02, ratio=0.64,
-         pybullet_spin=math.nan, refsim_spin=0.0) -> ApexRow:
-    return ApexRow(body=body, rotation=rotation, e=0.8, step=1e-3, solver="rk4",
-                   analytic_heights=[], analytic_times=[], refsim_heights=[], refsim_times=[],
-                   pybullet_heights=[], pybullet_times=[], analytic_ratio=0.64,
-                   refsim_ratio=ratio, pybullet_ratio=0.63, refsim_first_ratio=0.64,
-                   pybullet_first_ratio=0.63, refsim_error=error, pybullet_error=0.01,
-                   seed_speed_heights=[], seed_speed_ratio=0.65, seed_speed_first_ratio=0.65,
-                   seed_speed_error=literal, refsim_max_spin=refsim_spin,
-                   pybullet_max_spin=pybullet_spin)
+         pybullet_spin=math.nan, refsim_spin=0.0, pybullet=True, e=0.8) -> list[ApexRow]:
+    """One drop's long-form rows: analytic, refsim, refsim with the seed's
+    wall speed and (unless ``pybullet`` is False) pybullet."""
+    drop = {"body": body, "rotation": rotation, "e": e, "step": 1e-3, "solver": "rk4"}
+    rows = [ApexRow(**drop, engine=bounce.ANALYTIC, heights=[], times=[], ratio=e * e,
+                    first_ratio=e * e, error=0.0, max_spin=0.0),
+            ApexRow(**drop, engine=bounce.REFSIM, heights=[], times=[], ratio=ratio,
+                    first_ratio=0.64, error=error, max_spin=refsim_spin),
+            ApexRow(**drop, engine=bounce.SEED_WALL_SPEED, heights=[], times=[], ratio=0.65,
+                    first_ratio=0.65, error=literal, max_spin=0.0)]
+    if pybullet:
+        rows.append(ApexRow(**drop, engine="pybullet", heights=[], times=[], ratio=0.63,
+                            first_ratio=0.63, error=0.01, max_spin=pybullet_spin))
+    return rows
+
+
+def drops(*groups) -> list:
+    return [row for group in groups for row in group]
 
 
 TARGET, ROUNDING = 0.005, 1e-9
@@ -119,16 +128,18 @@ TARGET, ROUNDING = 0.005, 1e-9
     (ROUNDING, True, True), (ROUNDING * 1.001, False, True),
     (TARGET, False, True), (TARGET * 1.001, False, False)])
 def test_apex_findings_targets(error, at_rounding, within):
-    found = apex_findings([apex(error=error, literal=TARGET * 1.001)], TARGET, ROUNDING)
+    found = apex_findings(apex(error=error, literal=TARGET * 1.001), TARGET, ROUNDING)
     assert found["off_at_rounding"] is at_rounding
     assert found["off_within_target"] is within
     assert found["literal_within_target"] is False
 
 
 def test_apex_findings_cube_and_pybullet():
-    found = apex_findings([apex(), apex("cube.ac", error=2e-3, pybullet_spin=NOTICEABLE_SPIN),
-                           apex("cube.ac", "seed", error=0.05, ratio=0.7, refsim_spin=3.0),
-                           apex("cube.ac", "seed", error=0.02, ratio=0.6, refsim_spin=1.0)],
+    found = apex_findings(drops(apex(), apex("cube.ac", error=2e-3,
+                                             pybullet_spin=NOTICEABLE_SPIN),
+                                apex("cube.ac", "seed", error=0.05, ratio=0.7, refsim_spin=3.0),
+                                apex("cube.ac", "seed", error=0.02, ratio=0.6, refsim_spin=1.0,
+                                     e=0.9)),
                           TARGET, ROUNDING)
     assert found["cube_off_worst"] == 2e-3
     assert (found["seeded_drops"], found["seeded_above_e2"]) == (2, 1)
@@ -140,7 +151,15 @@ def test_apex_findings_cube_and_pybullet():
 @pytest.mark.parametrize(("spin_", "tips"), [(NOTICEABLE_SPIN, None),
                                              (NOTICEABLE_SPIN * 1.001, NOTICEABLE_SPIN * 1.001)])
 def test_tipping_spin(spin_, tips):
-    assert tipping_spin([apex("cube.ac", pybullet_spin=spin_), apex()]) == tips
+    assert tipping_spin(drops(apex("cube.ac", pybullet_spin=spin_), apex())) == tips
+
+
+def test_apex_findings_without_the_oracle_or_the_seed_wall_speed():
+    rows = [r for r in apex("cube.ac", pybullet=False) if r.engine != bounce.SEED_WALL_SPEED]
+    found = apex_findings(rows)
+    assert found["off_worst"] == 1e-3 and found["cube_off_worst"] == 1e-3
+    assert "literal_worst" not in found and "pybullet_cube_spin" not in found
+    assert tipping_spin(rows) is None
 
 
 def test_rounding_series():
@@ -152,16 +171,19 @@ def test_rounding_series():
         ["rk4", "pybullet"]      # a series with no finite error has none above rounding
 
 
-def step(bodies, ratio, warmup=20, rotation="off") -> StepCost:
-    return StepCost(bodies=bodies, rotation=rotation, warmup=warmup, refsim_seconds=ratio * 1e-5,
-                    pybullet_seconds=1e-5, ratio=ratio, refsim_stage_seconds={}, steps=50,
-                    repeats=3)
+def step(bodies, ratio, warmup=20, rotation="off", stages=None) -> list[StepCost]:
+    """refsim's and pybullet's rows of one timed scene, refsim ``ratio``
+    times slower."""
+    case = {"bodies": bodies, "rotation": rotation, "warmup": warmup, "steps": 50, "repeats": 3}
+    return [StepCost(**case, engine=bounce.REFSIM, seconds=ratio * 1e-5,
+                     stage_seconds=stages or {}),
+            StepCost(**case, engine="pybullet", seconds=1e-5, stage_seconds={})]
 
 
 @pytest.mark.parametrize(("ratio", "within"), [(STEP_COST_TARGET, True),
                                                 (STEP_COST_TARGET * 1.001, False)])
 def test_step_cost_target(ratio, within):
-    found = step_cost_findings([step(1, 30.0), step(10, 6.0), step(40, ratio)])
+    found = step_cost_findings(drops(step(1, 30.0), step(10, 6.0), step(40, ratio)))
     assert found["at_largest"] == [{"rotation": "off", "warmup": 20, "ratio": ratio,
                                     "within_target": within}]
     assert found["ratio_falls"] is True
@@ -169,21 +191,24 @@ def test_step_cost_target(ratio, within):
 
 
 def test_step_cost_ratio_must_fall_at_every_count():
-    found = step_cost_findings([step(1, 30.0), step(10, 6.0), step(40, 6.0),
-                                step(40, 1.0, warmup=3000)])
+    found = step_cost_findings(drops(step(1, 30.0), step(10, 6.0), step(40, 6.0),
+                                     step(40, 1.0, warmup=3000)))
     assert found["ratio_falls"] is False            # 6.0 then 6.0: not falling
     assert [r["warmup"] for r in found["at_largest"]] == [20, 3000]
-    assert step_cost_findings([step(1, 30.0)])["ratio_falls"] is None
+    assert step_cost_findings(step(1, 30.0))["ratio_falls"] is None
+    # without the oracle's rows every ratio is nan, and nothing is said to fall
+    alone = step_cost_findings([r for r in drops(step(1, 30.0), step(10, 6.0))
+                                if r.engine == bounce.REFSIM])
+    assert alone["ratio_falls"] is None and all(math.isnan(r) for (r,) in alone["ratios"].values())
 
 
 def test_step_cost_single_body_stage_and_settled_rows():
-    rows = [step(1, 30.0), step(1, 20.0, rotation="seed"), step(40, 6.0),
-            step(40, 1.0, warmup=3000)]
-    rows[1] = StepCost(**{**rows[1].__dict__, "refsim_stage_seconds": {"a": 1e-5, "b": 3e-5}})
+    rows = drops(step(1, 30.0), step(1, 20.0, rotation="seed", stages={"a": 1e-5, "b": 3e-5}),
+                 step(40, 6.0), step(40, 1.0, warmup=3000))
     found = step_cost_findings(rows)
     assert [r["rotation"] for r in found["single"]] == ["off", "seed"]
     assert found["largest_stage"] == {"rotation": "seed", "stage": "b",
-                                      "fraction": 3e-5 / rows[1].refsim_seconds}
+                                      "fraction": 3e-5 / rows[2].seconds}
     assert found["settled"] == [{"warmup": 3000, "refsim_seconds": 1e-5,
                                  "pybullet_seconds": 1e-5}]
 
@@ -192,58 +217,78 @@ def test_thresholds_sit_beside_the_claims():
     assert APEX_RATIO_TARGET == 0.005
     # the findings and the study's fitted orders call the same errors rounding
     assert ROUNDING_ERROR == bounce.ROUNDING_ERROR
-    assert apex_findings([apex()])["target"] == APEX_RATIO_TARGET
+    assert apex_findings(apex())["target"] == APEX_RATIO_TARGET
+
+
+def curve(engine, height) -> DropEnergy:
+    return DropEnergy(body="sphere-2k.ac", e=0.8, engine=engine, t=[0.0, 1.0, 2.0],
+                      height=height, energy=[])
 
 
 def test_height_gaps():
-    series = DropEnergy(body="sphere-2k.ac", e=0.8, t=[0.0, 1.0, 2.0],
-                        refsim_height=[1.0, 0.5, None], pybullet_height=[1.0, 0.2, 0.3],
-                        analytic_height=[1.0, 0.25, 0.5], refsim_energy=[], pybullet_energy=[],
-                        analytic_energy=[])
-    row = ApexRow(**{**apex().__dict__, "analytic_times": [0.0, 1.0, 2.0],
-                     "refsim_times": [0.0, 1.001, 2.0], "pybullet_times": [0.0, 1.0, 2.01]})
-    found = height_gaps(series, [row])
+    series = [curve(bounce.ANALYTIC, [1.0, 0.25, 0.5]), curve(bounce.REFSIM, [1.0, 0.5, None]),
+              curve("pybullet", [1.0, 0.2, 0.3])]
+    times = {bounce.ANALYTIC: [0.0, 1.0, 2.0], bounce.REFSIM: [0.0, 1.001, 2.0],
+             "pybullet": [0.0, 1.0, 2.01]}
+    rows = [ApexRow(**{**r.__dict__, "times": times.get(r.engine, [])}) for r in apex()]
+    found = height_gaps(series, rows)
     assert found["refsim_height"] == 0.25 and found["pybullet_height"] == 0.2
     assert found["bounces"] == 2
     assert found["refsim_apex_ms"] == pytest.approx(1.0)
     assert found["pybullet_apex_ms"] == pytest.approx(10.0)
-    assert "bounces" not in height_gaps(series, [ApexRow(**{**row.__dict__, "rotation": "seed"})])
+    seeded = [ApexRow(**{**r.__dict__, "rotation": "seed"}) for r in rows]
+    assert "bounces" not in height_gaps(series, seeded)
+    alone = height_gaps(series[:2], [r for r in rows if r.engine != "pybullet"])
+    assert math.isnan(alone["pybullet_height"]) and math.isnan(alone["pybullet_apex_ms"])
 
 
 def test_rest_findings():
-    rows = [RestRow(body="s", e=0.5, zeno=3.0, analytic_settle=2.0, refsim_settle=2.5,
-                    pybullet_settle=2.0, refsim_bounces=5, pybullet_bounces=7,
-                    analytic_bounces=5),
-            RestRow(body="s", e=0.8, zeno=3.0, analytic_settle=2.0, refsim_settle=2.0,
-                    pybullet_settle=math.nan, refsim_bounces=5, pybullet_bounces=0,
-                    analytic_bounces=5)]
-    found = rest_findings(rows)
+    def drop(e, refsim, pybullet):
+        case = {"body": "s", "e": e, "zeno": 3.0}
+        return [RestRow(**case, engine=bounce.ANALYTIC, settle=2.0, bounces=5),
+                RestRow(**case, engine=bounce.REFSIM, settle=refsim, bounces=5),
+                RestRow(**case, engine="pybullet", settle=pybullet[0], bounces=pybullet[1])]
+
+    found = rest_findings(drops(drop(0.5, 2.5, (2.0, 7)), drop(0.8, 2.0, (math.nan, 0))))
     assert found[0]["refsim_offset_ms"] == 500.0 and found[0]["pybullet_bounces_late"] == 2
     assert "pybullet_bounces" not in found[1]
+    assert [f["e"] for f in found] == [0.5, 0.8]
 
 
-def oblique(body="sphere-2k.ac", pybullet=1.0, coulomb=1.25) -> ObliqueRow:
-    return ObliqueRow(body=body, rotation="off", e=0.8, friction=0.3, v_t=2.0, v_n=5.0,
-                      seed_analytic=1.4,
-                      coulomb_point=1.0, coulomb_ball=coulomb, ball_slides=False, refsim=1.4,
-                      pybullet=pybullet, pybullet_spin=0.0)
+def oblique(body="sphere-2k.ac", pybullet=1.0, coulomb=1.25) -> list[ObliqueRow]:
+    """One oblique bounce's rows: refsim's and, unless ``pybullet`` is None,
+    pybullet's lateral speed."""
+    case = {"body": body, "rotation": "off", "e": 0.8, "friction": 0.3, "v_t": 2.0,
+            "v_n": 5.0, "seed_analytic": 1.4, "coulomb_point": 1.0, "coulomb_ball": coulomb,
+            "ball_slides": False}
+    lateral = {bounce.REFSIM: 1.4, "pybullet": pybullet}
+    return [ObliqueRow(**case, engine=name, lateral=value, spin=0.0)
+            for name, value in lateral.items() if value is not None]
 
 
 def test_agreement_findings():
-    found = agreement_findings([apex(error=1e-3), apex(error=2e-3),
-                                apex(rotation="seed", error=0.5)],
-                               [oblique(), oblique(pybullet=None), oblique("cube.ac", 0.0)])
+    found = agreement_findings(drops(apex(error=1e-3), apex("cube.ac", error=2e-3),
+                                     apex(rotation="seed", error=0.5)),
+                               drops(oblique(), oblique(pybullet=None), oblique("cube.ac", 0.0)))
     assert found["refsim_worst"] == 2e-3 and found["drops"] == 2
     assert found["pybullet_worst"] == 0.01 and found["pybullet_drops"] == 2
     assert found["coulomb_worst"] == 0.2 and found["coulomb_bounces"] == 1
     assert found["target"] == APEX_RATIO_TARGET and found["step"] == bounce.STEP
     assert agreement_findings([], []) == {"target": APEX_RATIO_TARGET, "step": bounce.STEP}
+    # without the oracle's rows there is no oracle figure (not a nan one)
+    alone = agreement_findings(apex(pybullet=False), oblique(pybullet=None))
+    assert alone["refsim_worst"] == 1e-3 and "pybullet_worst" not in alone
+    assert "coulomb_worst" not in alone
 
 
 def test_divergences_are_classed():
-    found = divergences([apex(literal=-0.03), apex("cube.ac", pybullet_spin=1.0)], [oblique()])
+    found = divergences(drops(apex(literal=-0.03), apex("cube.ac", pybullet_spin=1.0)),
+                        oblique())
     assert [d["key"] for d in found] == ["pybullet-apex", "literal-wall-flip",
                                          "lateral-friction", "pybullet-tips"]
     assert all(d["class"] == DIVERGENCE_CLASSES[d["key"]] for d in found)
     assert found[1]["seed_speed_error"] == -0.03 and found[3]["spin"] == 1.0
+    assert (found[0]["pybullet_error"], found[0]["refsim_error"]) == (0.01, 1e-3)
+    assert found[2]["bounces"] == [{"v_t": 2.0, "refsim": 1.4, "pybullet": 1.0,
+                                    "coulomb": 1.25}]
     assert divergences([], []) == []

@@ -39,8 +39,32 @@ def test_each_extra_named_exists_and_the_hint_installs_those_engines():
 def test_the_kit_shows_the_kit_rows_and_every_name_is_one_row():
     assert [e.name for e in SHIPPED] == [e.name for e in ENGINES if e.kit]
     assert len({e.name for e in ENGINES}) == len(ENGINES)
-    assert {"trimesh-mesh", "trimesh-collision", "scipy"} <= {e.name for e in ENGINES
-                                                              if not e.kit}
+    assert {"trimesh-mesh", "trimesh-collision", "scipy", "refsim",
+            "refsim-seed-wall-speed"} == {e.name for e in ENGINES if not e.kit}
+
+
+def test_refsim_as_posed_runs_the_scene_with_its_own_or_the_seeds_wall_speed():
+    """The bounce studies' refsim: the scene's own dynamics, every step
+    recorded; the seed-wall-speed row differs only by the wall law."""
+    import numpy as np
+
+    from refsim.dynamics.simulate import simulate
+    from refsim.studies.bounce import drop_scene
+
+    scene = drop_scene("cube.ac", 0.8, duration=1.2, rotation="seed")
+    posed, literal = build("refsim"), build("refsim-seed-wall-speed")
+    ours = posed.simulate(scene)
+    assert (posed.name, literal.name) == ("refsim", "refsim-seed-wall-speed")
+    assert len(ours.t) == scene.integration.n_steps + 1
+    np.testing.assert_array_equal(ours.position, simulate(scene, every=1).position)
+    seed = literal.simulate(scene)
+    np.testing.assert_array_equal(seed.position,
+                                  simulate(scene, every=1, wall_speed="seed").position)
+    assert not np.array_equal(seed.position, ours.position)   # the bounce differs
+    from refsim.engines.refsim_engines import PosedRefsim
+
+    with pytest.raises(OptionError, match="wall_speed must be one of 'wall', 'seed'"):
+        PosedRefsim("fast")
 
 
 @pytest.mark.parametrize("entry", ENGINES, ids=lambda e: e.name)

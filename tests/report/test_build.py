@@ -136,7 +136,7 @@ def test_timings_are_marked_by_metadata_not_by_name(quick_report):
         in paths
     assert section + ("collision", "results", "hierarchy_speed", "ratios") in paths
     assert section + ("solvers", "results", "drag_models", "cost_ratio") in paths
-    assert section + ("dynamics", "results", "step_cost", "*", "ratio") in paths
+    assert section + ("dynamics", "results", "step_cost", "*", "seconds") in paths
     assert not any("apex_ratios" in p or "answers" in p or "configurations" == p[-1]
                    for p in paths)
     assert all(p[:1] == section and p[2] == "results" for p in paths)

@@ -10,17 +10,27 @@ import pytest
 
 from refsim.claims.dynamics import APEX_RATIO_TARGET
 from refsim.dynamics import analytic
+from refsim.errors import StateError
 from refsim.studies.bounce import (
+    ANALYTIC,
+    APEX_CASE,
     BOUNCES,
     CUBE,
     DROP_HEIGHT,
     GRAVITY,
+    OBLIQUE_CASES,
+    REFSIM,
+    REST_CASE,
+    SEED_WALL_SPEED,
     SPHERE,
     STEP,
     apex_ratio,
-    measure_apex_row,
+    by_case,
+    measure_apex_drop,
+    measure_drop_energy,
     measure_oblique,
     measure_rest,
+    measure_step_cost,
     read_bounces,
 )
 
@@ -134,24 +144,29 @@ def simulate():
 ROUNDING_LEVEL = 1e-9
 
 
+def drop(model, e, **kwargs) -> dict:
+    """The rows of one drop by engine name (analytic, refsim, refsim with
+    the seed's wall speed)."""
+    return {r.engine: r for r in measure_apex_drop(model, e, **kwargs)}
+
+
 @pytest.mark.parametrize("e", [0.5, 0.8, 0.9])
 def test_refsim_apex_ratio_meets_the_target(simulate, e):
     """refsim's accuracy goal: with RK4 at h = 1e-3, the mean apex ratio over the
     first BOUNCES bounces is within APEX_RATIO_TARGET (0.5%) of e^2."""
-    row = measure_apex_row(SPHERE, e, step=STEP, solver="rk4")
-    print(f"refsim e={e}: apex ratio {row.refsim_ratio:.6f} (e^2 {e * e:.6f}), "
-          f"relative error {row.refsim_error:.2e}; heights {row.refsim_heights}")
-    assert row.refsim_error <= APEX_RATIO_TARGET
-    assert row.refsim_error <= ROUNDING_LEVEL
-    assert row.refsim_max_spin == 0.0                   # rotation "off"
+    row = drop(SPHERE, e, step=STEP, solver="rk4")[REFSIM]
+    print(f"refsim e={e}: apex ratio {row.ratio:.6f} (e^2 {e * e:.6f}), "
+          f"relative error {row.error:.2e}; heights {row.heights}")
+    assert row.error <= APEX_RATIO_TARGET
+    assert row.error <= ROUNDING_LEVEL
+    assert row.max_spin == 0.0                   # rotation "off"
 
 
 def test_refsim_apex_times_follow_the_analytic_ones(simulate):
     """Bounce k+1 comes 2 e^k v0 / g after bounce k; refsim's apex times are
     off by at most a step per bounce."""
-    e = 0.8
-    row = measure_apex_row(SPHERE, e)
-    error = np.abs(np.subtract(row.refsim_times, row.analytic_times))
+    rows = drop(SPHERE, 0.8)
+    error = np.abs(np.subtract(rows[REFSIM].times, rows[ANALYTIC].times))
     assert error.max() <= (BOUNCES + 1) * STEP
 
 
@@ -160,18 +175,71 @@ def test_seed_literal_wall_speed_also_meets_the_target(simulate, e):
     """The seed's literal flip (speed at the penetrated position) gains about
     delta / h0 per bounce, delta <= v h: 0.2% here, inside the 0.5% target,
     and above e^2 (it adds energy)."""
-    row = measure_apex_row(SPHERE, e)
-    print(f"refsim, seed's wall speed, e={e}: apex ratio {row.seed_speed_ratio:.6f}, "
-          f"relative error {row.seed_speed_error:.2e}")
-    assert row.seed_speed_error <= APEX_RATIO_TARGET
-    assert row.seed_speed_ratio > e * e
+    row = drop(SPHERE, e)[SEED_WALL_SPEED]
+    print(f"refsim, seed's wall speed, e={e}: apex ratio {row.ratio:.6f}, "
+          f"relative error {row.error:.2e}")
+    assert row.error <= APEX_RATIO_TARGET
+    assert row.ratio > e * e
+
+
+def test_one_drop_is_one_row_per_engine_under_its_name(simulate):
+    """Long form: the analytic row first (e^2 itself, error 0), then one
+    row per engine received, each carrying the drop's fields."""
+    rows = measure_apex_drop(SPHERE, 0.5, bounces=2)
+    assert [r.engine for r in rows] == [ANALYTIC, REFSIM, SEED_WALL_SPEED]
+    assert {tuple(getattr(r, f) for f in APEX_CASE) for r in rows} == \
+        {(SPHERE, "off", 0.5, STEP, "rk4")}
+    closed = rows[0]
+    assert (closed.ratio, closed.first_ratio, closed.error, closed.max_spin) == \
+        (0.25, 0.25, 0.0, 0.0)
+    assert closed.heights == [DROP_HEIGHT, 1.0, 0.25]
+    assert all(len(r.heights) == len(r.times) == 3 for r in rows)
+    assert list(by_case(rows, APEX_CASE).values()) == [{r.engine: r for r in rows}]
+
+
+class Renamed:
+    """An engine that is another under a new name (a study must take the
+    engines it is given, and name its rows after them)."""
+
+    def __init__(self, engine, name):
+        self._engine, self.name = engine, name
+
+    def simulate(self, scene):
+        return self._engine.simulate(scene)
+
+    def step_time(self, scene, steps, warmup=0):
+        return 1e-5
+
+
+def test_a_study_runs_the_engines_it_receives(simulate):
+    from refsim.engines.registry import build
+
+    twin = Renamed(build(REFSIM), "twin")
+    rows = measure_rest(restitutions=(0.5,), engines=[build(REFSIM), twin])
+    assert [r.engine for r in rows] == [ANALYTIC, REFSIM, "twin"]
+    assert (rows[1].settle, rows[1].bounces) == (rows[2].settle, rows[2].bounces)
+    assert measure_rest(restitutions=(0.5,), engines=[])[0].engine == ANALYTIC
+    with pytest.raises(StateError, match="at least one engine"):
+        measure_drop_energy(engines=[])
+
+
+def test_step_cost_rows_are_refsims_then_each_engines():
+    from refsim.claims.dynamics import step_cost_pairs
+
+    rows = measure_step_cost(counts=(1,), rotations=("off",), steps=3, warmup=1, repeats=1,
+                             engines=[Renamed(None, "pybullet")])
+    assert [(r.engine, r.bodies, r.warmup) for r in rows] == [(REFSIM, 1, 1),
+                                                              ("pybullet", 1, 1)]
+    assert rows[0].seconds > 0 and rows[1].seconds == 1e-5 and rows[1].stage_seconds == {}
+    (pair,) = step_cost_pairs(rows)
+    assert pair["ratio"] == rows[0].seconds / 1e-5
+    assert pair["stage_seconds"] is rows[0].stage_seconds
 
 
 def test_cube_face_down_bounces_like_the_sphere(simulate):
     """Without rotation the seed's box-based wall test sees the same interval
     problem for a face-down cube as for the sphere: same ratio target."""
-    row = measure_apex_row(CUBE, 0.8, rotation="off")
-    assert row.refsim_error <= APEX_RATIO_TARGET
+    assert drop(CUBE, 0.8, rotation="off")[REFSIM].error <= APEX_RATIO_TARGET
 
 
 def test_seed_rotation_spins_a_face_down_cube(simulate):
@@ -179,18 +247,20 @@ def test_seed_rotation_spins_a_face_down_cube(simulate):
     its single contact vertex (one of four tied, AMBIGUITY A4) gives a torque
     Pi x I that a symmetric bounce should not have: the cube spins and its
     later apexes leave e^2 (measured 5% at e = 0.8; reported, not a target)."""
-    row = measure_apex_row(CUBE, 0.8, rotation="seed")
-    assert row.refsim_first_ratio == pytest.approx(0.64, rel=1e-9)
-    assert row.refsim_max_spin > 1.0
-    assert row.refsim_error > APEX_RATIO_TARGET
+    row = drop(CUBE, 0.8, rotation="seed")[REFSIM]
+    assert row.first_ratio == pytest.approx(0.64, rel=1e-9)
+    assert row.max_spin > 1.0
+    assert row.error > APEX_RATIO_TARGET
 
 
 def test_refsim_lateral_velocity_is_the_seed_s_damping(simulate):
     """The seed's friction keeps (1 - friction) of the lateral velocity,
     whatever the normal speed (not Coulomb's mu (1 + e) |v_n| loss)."""
     rows = measure_oblique(models=(SPHERE,))
+    assert [r.engine for r in rows] == [REFSIM] * len(OBLIQUE_CASES)
     for row in rows:
-        assert row.refsim == pytest.approx(row.seed_analytic, rel=1e-12)
+        assert row.lateral == pytest.approx(row.seed_analytic, rel=1e-12)
+        assert row.spin == 0.0                      # rotation "off"
 
 
 @pytest.mark.oracle
@@ -206,19 +276,19 @@ def test_pybullet_lateral_velocity_is_coulomb_s(simulate, oracle):
     from refsim.oracles.pybullet_adapter import PybulletOracle
 
     with oracle(PybulletOracle) as pybullet:           # skip when pybullet is missing
-        rows = measure_oblique(models=(SPHERE,), oracle=pybullet)
+        rows = measure_oblique(models=(SPHERE,), engines=[pybullet])
+    assert [r.engine for r in rows] == ["pybullet"] * len(OBLIQUE_CASES)
     for row in rows:
         print(row)
-        assert row.pybullet == pytest.approx(row.coulomb_ball, abs=0.02 * row.v_t)
+        assert row.lateral == pytest.approx(row.coulomb_ball, abs=0.02 * row.v_t)
 
 
 def test_refsim_time_to_rest_matches_the_analytic_settling(simulate):
     """Apexes stay below REST_FRACTION h0 after the same bounce as the
     analytic series, within a few steps per bounce of its time."""
-    rows = measure_rest(restitutions=(0.5,))
-    for row in rows:
-        assert row.refsim_bounces == row.analytic_bounces
-        assert row.refsim_settle == pytest.approx(row.analytic_settle,
-                                                  abs=2 * row.analytic_bounces * STEP)
-        assert row.refsim_settle < row.zeno
+    for d in by_case(measure_rest(restitutions=(0.5,)), REST_CASE).values():
+        closed, ours = d[ANALYTIC], d[REFSIM]
+        assert ours.bounces == closed.bounces
+        assert ours.settle == pytest.approx(closed.settle, abs=2 * closed.bounces * STEP)
+        assert ours.settle < ours.zeno
     assert GRAVITY == G

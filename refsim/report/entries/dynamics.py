@@ -4,9 +4,9 @@ C11 and C12).
 The bounce studies of :mod:`refsim.studies.bounce` against the analytic
 answers and pybullet (apexes, oblique bounces, time to rest, energy, error
 against cost, pybullet's settings, step cost) and the C11/C12 measurements
-of :mod:`refsim.studies.dynamics`. Each runs without pybullet
-(``run.optional``), its pybullet columns then empty; the pybullet engines
-are the plan's (:mod:`refsim.report.plan`). A quick run has fewer
+of :mod:`refsim.studies.dynamics`. Each bounce study receives its engines
+(:func:`_engines`: refsim's own from the registry, then pybullet); without
+pybullet (``run.optional``) it has no pybullet rows. A quick run has fewer
 restitutions, step sizes and solvers, a shorter C11 run and fewer timed
 steps.
 """
@@ -30,34 +30,47 @@ class CostRun:
     orders: dict                # series -> slope of log error against log h
 
 
+#: refsim's engines of the bounce studies (refsim.engines.registry): the
+#: scene as posed, and with the seed's literal wall speed.
+REFSIM, SEED_WALL_SPEED = "refsim", "refsim-seed-wall-speed"
+
+
+def _engines(run: Run, *refsim: str) -> list:
+    """The engines a bounce study receives: refsim's named ones, then the
+    pybullet oracle when it is installed (all built by the run, from the
+    registry)."""
+    oracle = run.optional("pybullet")
+    return [run.engine(name) for name in refsim] + ([oracle] if oracle is not None else [])
+
+
 def dynamics_apex(run: Run):
     from refsim.studies import bounce
 
-    pb = run.optional("pybullet")
+    engines = _engines(run, REFSIM, SEED_WALL_SPEED)
     if run.quick:
-        rows = bounce.measure_apexes(models=(bounce.SPHERE,), oracle=pb)
-        rows.append(bounce.measure_apex_row(bounce.CUBE, 0.8, rotation="seed", oracle=pb))
+        rows = bounce.measure_apexes(models=(bounce.SPHERE,), engines=engines)
+        rows += bounce.measure_apex_drop(bounce.CUBE, 0.8, rotation="seed", engines=engines)
         return rows
-    return bounce.measure_apexes(oracle=pb)
+    return bounce.measure_apexes(engines=engines)
 
 
 def dynamics_oblique(run: Run):
     from refsim.studies import bounce
 
-    return bounce.measure_oblique(oracle=run.optional("pybullet"))
+    return bounce.measure_oblique(engines=_engines(run, REFSIM))
 
 
 def dynamics_rest(run: Run):
     from refsim.studies import bounce
 
     return bounce.measure_rest(restitutions=run.size((0.5,), (0.5, 0.8)),
-                               oracle=run.optional("pybullet"))
+                               engines=_engines(run, REFSIM))
 
 
 def dynamics_energy(run: Run):
     from refsim.studies import bounce
 
-    return bounce.measure_drop_energy(oracle=run.optional("pybullet"))
+    return bounce.measure_drop_energy(engines=_engines(run, REFSIM))
 
 
 def dynamics_cost(run: Run):
@@ -65,7 +78,7 @@ def dynamics_cost(run: Run):
 
     study = bounce.measure_cost(run.size(bounce.COST_STEPS_QUICK, bounce.COST_STEPS),
                                 run.size(bounce.COST_SOLVERS_QUICK, bounce.COST_SOLVERS),
-                                oracle=run.optional("pybullet"))
+                                engines=_engines(run, REFSIM, SEED_WALL_SPEED))
     return CostRun(study, bounce.fit_error_orders(study))
 
 
@@ -99,12 +112,12 @@ def dynamics_pybullet_settings(run: Run):
 def dynamics_step_cost(run: Run):
     from refsim.studies import bounce
 
-    pb = run.optional("pybullet")
+    peers = _engines(run)
     rows = bounce.measure_step_cost(steps=run.size(50, 200), warmup=run.size(10, 20),
-                                    repeats=run.size(3, 5), oracle=pb)
+                                    repeats=run.size(3, 5), engines=peers)
     if not run.quick:
         rows += bounce.measure_step_cost(counts=(bounce.BENCH_COUNTS[-1],),
-                                         warmup=bounce.LATE_WARMUP, repeats=3, oracle=pb)
+                                         warmup=bounce.LATE_WARMUP, repeats=3, engines=peers)
     return rows
 
 

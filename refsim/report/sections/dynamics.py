@@ -52,7 +52,14 @@ def _f(x, digits: int = 5) -> str:
 
 
 def _pct(x) -> str:
-    return "n/a" if not math.isfinite(x) else f"{100 * x:.3g}%"
+    return "n/a" if x is None or not math.isfinite(x) else f"{100 * x:.3g}%"
+
+
+def _at(case: dict, engine: str, field: str, missing=None):
+    """``field`` of ``engine``'s row in one case of a long-form record
+    (:func:`refsim.studies.bounce.by_case`), ``missing`` when the engine did
+    not run it."""
+    return getattr(case[engine], field) if engine in case else missing
 
 
 def build(ctx) -> Section:
@@ -70,6 +77,7 @@ def build(ctx) -> Section:
     cost = cost_run.study
     settings_rows = run.get("dynamics-pybullet-settings")
     step_rows = run.get("dynamics-step-cost")
+    step_pairs = judged.step_cost_pairs(step_rows)
     spin_rows = run.get("dynamics-spin")
     c11_rows = run.get("dynamics-interpenetration")
     pb = "pybullet" not in run.missing
@@ -82,38 +90,46 @@ def build(ctx) -> Section:
     def stride(values, n=5):
         return list(values)[::n]
 
+    curves = {c.engine: c for c in series}
+    closed = curves[bounce.ANALYTIC]
+
+    def curve_series(labels: dict, field: str) -> list:
+        return [Series(label, stride(curves[engine].t),
+                       stride(getattr(curves[engine], field)), style)
+                for engine, (label, style) in labels.items() if engine in curves]
+
     figures.append(Figure(
         id="dynamics-bounce-heights", title="Bounce heights over time",
-        svg=line_chart([
-            Series("analytic", stride(series.t), stride(series.analytic_height), "-"),
-            Series("refsim (seed wall response, RK4)", stride(series.t),
-                   stride(series.refsim_height), "--"),
-            Series("pybullet", stride(series.t), stride(series.pybullet_height), ":"),
-        ], xlabel="time (s)", ylabel="height of the lowest point above the floor (m)",
+        svg=line_chart(curve_series({
+            bounce.ANALYTIC: ("analytic", "-"),
+            bounce.REFSIM: ("refsim (seed wall response, RK4)", "--"),
+            judged.ORACLE: ("pybullet", ":")}, "height"),
+            xlabel="time (s)", ylabel="height of the lowest point above the floor (m)",
             size=CHART_SIZE),
-        caption=f"{series.body}, e = {series.e}, dropped from {bounce.DROP_HEIGHT} m, "
+        caption=f"{closed.body}, e = {closed.e}, dropped from {bounce.DROP_HEIGHT} m, "
                 f"h = {bounce.STEP} s, rotation off. "
                 f"{_height_gaps(judged.height_gaps(series, apex_rows))}"
                 f"{pb_note} Reproduce: {CMD_ENERGY}; {CMD_APEX}"))
     figures.append(Figure(
         id="dynamics-energy", title="Mechanical energy over time",
-        svg=line_chart([
-            Series("analytic (e^(2k) after bounce k)", stride(series.t),
-                   stride(series.analytic_energy), "-"),
-            Series("refsim", stride(series.t), stride(series.refsim_energy), "--"),
-            Series("pybullet", stride(series.t), stride(series.pybullet_energy), ":"),
-        ], xlabel="time (s)", ylabel="energy / (m g) (m)", size=CHART_SIZE),
+        svg=line_chart(curve_series({
+            bounce.ANALYTIC: ("analytic (e^(2k) after bounce k)", "-"),
+            bounce.REFSIM: ("refsim", "--"),
+            judged.ORACLE: ("pybullet", ":")}, "energy"),
+            xlabel="time (s)", ylabel="energy / (m g) (m)", size=CHART_SIZE),
         caption="Potential energy above the touching height plus kinetic, per unit weight. "
                 "Between bounces it is constant (RK4 is exact for free flight; Bullet's "
                 "symplectic Euler nearly so); each bounce multiplies it by e^2. "
                 f"Reproduce: {CMD_ENERGY}"))
 
+    ours, literal, theirs = bounce.REFSIM, bounce.SEED_WALL_SPEED, judged.ORACLE
     apex_table_rows = tuple(
-        (r.body, r.rotation, r.e, _f(r.analytic_ratio), _f(r.refsim_ratio),
-         _pct(r.refsim_error), _f(r.seed_speed_ratio), _pct(r.seed_speed_error),
-         _f(r.pybullet_ratio), _pct(r.pybullet_error), _f(r.refsim_max_spin, 3),
-         _f(r.pybullet_max_spin, 3))
-        for r in apex_rows)
+        (d[bounce.ANALYTIC].body, d[bounce.ANALYTIC].rotation, d[bounce.ANALYTIC].e,
+         _f(d[bounce.ANALYTIC].ratio), _f(_at(d, ours, "ratio")), _pct(_at(d, ours, "error")),
+         _f(_at(d, literal, "ratio")), _pct(_at(d, literal, "error")),
+         _f(_at(d, theirs, "ratio")), _pct(_at(d, theirs, "error")),
+         _f(_at(d, ours, "max_spin"), 3), _f(_at(d, theirs, "max_spin"), 3))
+        for d in bounce.by_case(apex_rows, bounce.APEX_CASE).values())
     tables.append(Table(
         id="dynamics-apex-ratios", title="Apex ratios against e^2",
         columns=("body", "rotation", "e", "e^2", "refsim", "error", "refsim, seed's literal "
@@ -137,8 +153,10 @@ def build(ctx) -> Section:
                  "ball slides", "refsim", "pybullet", "pybullet |w| after (rad/s)"),
         rows=tuple((r.body, r.rotation, r.v_t, _f(r.v_n, 4), _f(r.seed_analytic),
                     _f(r.coulomb_point), _f(r.coulomb_ball), "yes" if r.ball_slides else "no",
-                    _f(r.refsim), _f(r.pybullet), _f(r.pybullet_spin, 3))
-                   for r in oblique_rows),
+                    _f(_at(b, ours, "lateral")), _f(_at(b, theirs, "lateral")),
+                    _f(_at(b, theirs, "spin"), 3))
+                   for b in bounce.by_case(oblique_rows, bounce.OBLIQUE_CASE).values()
+                   for r in [next(iter(b.values()))]),
         caption=f"friction = {bounce.OBLIQUE_FRICTION} (the seed's fraction; pybullet's "
                 f"Coulomb mu), e = {bounce.OBLIQUE_E}, released 5 cm above the floor. The "
                 "seed keeps (1 - friction) v_t whatever the normal speed; Coulomb friction "
@@ -153,9 +171,11 @@ def build(ctx) -> Section:
         id="dynamics-rest", title="Time to rest",
         columns=("body", "e", "Zeno time (s)", "analytic settle (s)", "bounce",
                  "refsim settle (s)", "bounce", "pybullet settle (s)", "bounce"),
-        rows=tuple((r.body, r.e, _f(r.zeno), _f(r.analytic_settle), r.analytic_bounces,
-                    _f(r.refsim_settle), r.refsim_bounces, _f(r.pybullet_settle),
-                    r.pybullet_bounces) for r in rest_rows),
+        rows=tuple((r.body, r.e, _f(r.zeno), _f(r.settle), r.bounces,
+                    _f(_at(d, ours, "settle")), _at(d, ours, "bounces", 0),
+                    _f(_at(d, theirs, "settle")), _at(d, theirs, "bounces", 0))
+                   for d in bounce.by_case(rest_rows, bounce.REST_CASE).values()
+                   for r in [d[bounce.ANALYTIC]]),
         caption=f"The analytic bounces accumulate at the Zeno time t0 (1 + 2e/(1 - e)). "
                 f"Measured: the time of the bounce after which every apex stays below "
                 f"{bounce.REST_FRACTION} of the drop height. "
@@ -208,14 +228,15 @@ def build(ctx) -> Section:
         id="dynamics-step-cost", title="Time per step against pybullet", timing=True,
         columns=("cubes", "rotation", "timed after step", "refsim (us/step)",
                  "pybullet (us/step)", "refsim / pybullet", "refsim's step by stage"),
-        rows=tuple((r.bodies, r.rotation, r.warmup, _f(1e6 * r.refsim_seconds, 4),
-                    _f(1e6 * r.pybullet_seconds, 4), _f(r.ratio, 3),
-                    _stages(r.refsim_stage_seconds)) for r in step_rows),
+        rows=tuple((p["bodies"], p["rotation"], p["warmup"], _f(1e6 * p["refsim_seconds"], 4),
+                    _f(1e6 * p["pybullet_seconds"], 4), _f(p["ratio"], 3),
+                    _stages(p["stage_seconds"])) for p in step_pairs),
         caption="Unit cubes on a grid with seeded random velocities, collision level "
                 "\"aabb\", the seed's body response; the fastest of "
                 + "; ".join(f"{rep} runs of {n} steps after a warm-up of {w}"
-                            for w, n, rep in dict.fromkeys((r.warmup, r.steps, r.repeats)
-                                                           for r in step_rows))
+                            for w, n, rep in dict.fromkeys((p["warmup"], p["steps"],
+                                                            p["repeats"])
+                                                           for p in step_pairs))
                 + ". " + _step_cost_findings(judged.step_cost_findings(step_rows))
                 + " Timings vary from run to run. Reproduce: "
                 "make bench (tests/benchmarks/test_bench_dynamics.py) or " + CMD_STEP_COST))
