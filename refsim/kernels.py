@@ -546,6 +546,11 @@ CONTACT_GEOMETRY = KernelPair(
     "refsim.dynamics.body_response:contact_geometry_compiled",
     mirror=("refsim.dynamics.body_response:contact_geometry",
             "refsim.dynamics._numba_contact:contact_geometry_numba"))
+CONTACT_REGION = KernelPair(
+    "contact region", "refsim.collision.contact:contact_region_readable",
+    "refsim.collision.contact:contact_region_compiled",
+    mirror=("refsim.collision.contact:contact_points",
+            "refsim.collision._numba_contact:contact_region_numba"))
 SIMULATION_LOOP = KernelPair(
     "simulation loop", "refsim.dynamics.simulation:Simulation",
     "refsim.dynamics._numba_kernels:advance")

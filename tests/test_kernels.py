@@ -229,6 +229,21 @@ def _exact_stage(kernel):
         refsim.bodies_collide(sphere, IDENTITY, CUBE, on_top, kernel=kernel)]
 
 
+def _contact_region(kernel):
+    """A cube resting on a cube (face, edge and corner overlaps), a sphere
+    sunk into a cube, and two cubes apart (no points)."""
+    from refsim.collision.contact import contact_points
+
+    sphere = refsim.load_model("sphere-2k.ac")
+    up = np.array([0.0, 1.0, 0.0])
+    tilted = np.array([[0.8, -0.6, 0.0], [0.6, 0.8, 0.0], [0.0, 0.0, 1.0]])
+    poses = [(np.eye(3), np.array([0.0, 0.99, 0.0])), (tilted, np.array([0.4, 1.2, 0.3])),
+             (np.eye(3), np.array([0.0, 3.0, 0.0]))]
+    return [contact_points(CUBE, pose, CUBE, IDENTITY, up, kernel=kernel) for pose in poses] + [
+        contact_points(sphere, (np.eye(3), np.array([0.0, 1.45, 0.0])), CUBE, IDENTITY, up,
+                       kernel=kernel)]
+
+
 def _particles(kernel):
     out = []
     for solver in sorted(refsim.SOLVERS):
@@ -266,6 +281,7 @@ CASES = {
     "seed orientation step": _seed_rotation,
     "batched boxes": _batched_boxes,
     "contact geometry": _contact_geometry,
+    "contact region": _contact_region,
     "free rotation steps": _free_rotation,
     "linear box scan": _linear_scan,
     "incremental box": _incremental,

@@ -62,7 +62,7 @@ import numpy as np
 
 from refsim.collision.bodies import intersecting_pairs
 from refsim.collision.boxes import world_vertices
-from refsim.kernels import choose_kernel
+from refsim.kernels import CONTACT_REGION
 
 #: A point whose winding number exceeds this is inside the mesh or on its
 #: surface. Outside, the winding number is 0 up to rounding: about 1e-15,
@@ -307,21 +307,37 @@ def contact_points(mesh_a, pose_a, mesh_b, pose_b, n, kernel: str | None = None
     (:func:`deepest_points`) of the meshes' intersection region
     (:func:`intersection_points`); empty when the meshes do not meet.
 
-    ``kernel`` (:mod:`refsim.kernels`): "compiled" runs the steps after the
-    triangle pairs as one compiled call
-    (:func:`refsim.collision._numba_contact.contact_region_numba`), the same
-    points bit for bit."""
-    if choose_kernel(kernel) == "compiled":
-        from refsim.collision._numba_contact import contact_region_numba
+    ``kernel`` (:mod:`refsim.kernels`) chooses the pair
+    :data:`refsim.kernels.CONTACT_REGION`: "compiled" runs the steps after
+    the triangle pairs as one compiled call, the same points bit for bit.
+    Either side passes ``kernel`` on as given to the exact query that finds
+    the triangle pairs, so that with the default (None) the query's own
+    tier chooses its kernel (the readable one while numba's cache lacks
+    it)."""
+    return CONTACT_REGION(kernel)(mesh_a, pose_a, mesh_b, pose_b, n, kernel)
 
-        world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
-        pairs = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level="exact", kernel=kernel)
-        return contact_region_numba(world_a, mesh_a.faces, world_b, mesh_b.faces, pairs,
-                                    np.asarray(n, dtype=np.float64))
+
+def contact_region_readable(mesh_a, pose_a, mesh_b, pose_b, n, kernel: str | None = None
+                            ) -> np.ndarray:
+    """:func:`contact_points` on the readable kernel (the pairs' query on
+    ``kernel``)."""
     points, tri_a, tri_b = _region(mesh_a, pose_a, mesh_b, pose_b, kernel)
     if not len(points):
         return points
     return contact_polygon(deepest_points(points, n, tri_a, tri_b), n)
+
+
+def contact_region_compiled(mesh_a, pose_a, mesh_b, pose_b, n, kernel: str | None = None
+                            ) -> np.ndarray:
+    """:func:`contact_points` with the steps after the triangle pairs as one
+    compiled call (:func:`refsim.collision._numba_contact.contact_region_numba`;
+    the pairs' query on ``kernel``)."""
+    from refsim.collision._numba_contact import contact_region_numba
+
+    world_a, world_b = world_vertices(mesh_a, pose_a), world_vertices(mesh_b, pose_b)
+    pairs = intersecting_pairs(mesh_a, pose_a, mesh_b, pose_b, level="exact", kernel=kernel)
+    return contact_region_numba(world_a, mesh_a.faces, world_b, mesh_b.faces, pairs,
+                                np.asarray(n, dtype=np.float64))
 
 
 def _vertices_within(vertices: np.ndarray, other: np.ndarray, triangles: np.ndarray

@@ -125,7 +125,7 @@ from refsim.dynamics.walls import bounce_advance, crossing_time, deepest_speed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "cf71835ba692431f"
+SOURCES_DIGEST = "12a9c57fd42a3a29"
 
 #: The kernel took every step it was asked for.
 DONE = 0
