@@ -259,7 +259,7 @@ def _run(scene: Scene, n_steps: int, every: int, kernel: str | None = "start") -
                 _note_events(sim, seen, radius, index, events)
 
     # the loop counts no box visits of a tracker: such runs take the steps
-    in_loop = sim.loop is None and not sim._tracked
+    in_loop = sim.loop is None and not sim.tracked
     sample(0)
     taken = 1
     diverged = None

@@ -118,6 +118,13 @@ from numba.extending import intrinsic
 from refsim.bounds._numba_kernels import incremental_update_numba
 from refsim.dynamics import loop_layout as slot
 from refsim.dynamics.impulse import contact_sum_python, solve_contacts_python
+from refsim.dynamics.loop_layout import (
+    BODY_EXCHANGE,
+    BODY_HAND_BACK,
+    BODY_NONE,
+    ROTATION_EXACT,
+    ROTATION_SEED,
+)
 from refsim.dynamics.rotation_impulse import WALL_DEEPEST_FRACTION, free_rotation_step
 from refsim.dynamics.rotation_seed import axes_step_seed
 from refsim.dynamics.walls import bounce_advance, crossing_time, deepest_speed
@@ -125,7 +132,7 @@ from refsim.dynamics.walls import bounce_advance, crossing_time, deepest_speed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "12a9c57fd42a3a29"
+SOURCES_DIGEST = "0c0718ea41e9e0b6"
 
 #: The kernel took every step it was asked for.
 DONE = 0
@@ -137,17 +144,6 @@ STOP_EVENTS = 2
 #: stages 1-6 of the step are done, its pairs are in ``PAIRS``, and Python
 #: runs the body stage and ends the step (:func:`finish_body_step`).
 STOP_BODY_STAGE = 3
-
-#: Body-body modes of the loop.
-BODY_NONE = 0           # no body-body stage (one body, level "none", response "off")
-BODY_EXCHANGE = 1       # level "aabb", the seed's exchange (S8): done in the loop
-BODY_HAND_BACK = 2      # any other: a step with an overlapping pair of boxes stops the
-                        # kernel after its broad phase (STOP_BODY_STAGE)
-
-#: Rotation models of the loop (the scene's ``dynamics.rotation``).
-ROTATION_OFF = 0
-ROTATION_SEED = 1       # S9's Euler step of the axes
-ROTATION_EXACT = 2      # "impulse": the exact rotation with angular momentum
 
 #: The contact solve of the corrected wall response, compiled from the
 #: readable source (:func:`refsim.dynamics.impulse.solve_contacts_python`,

@@ -39,7 +39,7 @@ if TYPE_CHECKING:
 
 # 6. broad phase (S4 test 1)
 def broad_phase(sim: Simulation) -> np.ndarray:
-    if sim.level == "sphere":
+    if sim.plan.level == "sphere":
         from refsim.collision.spheres import bounding_sphere
 
         centres = np.empty((len(sim.bodies), 3))
@@ -55,12 +55,12 @@ def broad_phase(sim: Simulation) -> np.ndarray:
 
 # 7. narrow phase (S4 at the scene's level)
 def narrow_phase(sim: Simulation, pairs: np.ndarray) -> list:
-    if sim.kernel == "compiled" and sim.level == "exact" and len(pairs):
+    if sim.kernel == "compiled" and sim.plan.level == "exact" and len(pairs):
         return sim._narrow_phase_compiled(pairs)
     hits = []
     for a, b in pairs:
         if bodies_collide(sim.bodies[a].mesh, sim.pose(a), sim.bodies[b].mesh,
-                          sim.pose(b), level=sim.level, kernel=sim.kernel):
+                          sim.pose(b), level=sim.plan.level, kernel=sim.kernel):
             hits.append((a, b))
     return hits
 
@@ -82,7 +82,7 @@ def narrow_phase_compiled(sim: Simulation, pairs: np.ndarray) -> list:
         if code == TOUCH or (
                 code != APART
                 and bodies_collide(sim.bodies[a].mesh, sim.pose(a), sim.bodies[b].mesh,
-                                   sim.pose(b), level=sim.level, kernel=sim.kernel)):
+                                   sim.pose(b), level=sim.plan.level, kernel=sim.kernel)):
             hits.append((a, b))
     return hits
 
@@ -116,7 +116,7 @@ def body_response(sim: Simulation, pairs, touching: set) -> None:
         if sim.loads.fixed[a] and sim.loads.fixed[b]:
             continue                  # two fixed bodies: nothing can move
         touching.add(Contact("body", sim.names[a], sim.names[b]))
-        if sim.body_response == "seed":
+        if sim.plan.seed_exchange:
             sim.v[a], sim.v[b], _ = exchange_velocities_seed(
                 sim.x[a], sim.x[b], sim.v[a], sim.v[b])
             continue
@@ -140,7 +140,7 @@ def body_response(sim: Simulation, pairs, touching: set) -> None:
         dx_a, dx_b = separate_bodies(geometry, sim.inv_mass[a], sim.inv_mass[b])
         for i, dx in ((a, dx_a), (b, dx_b)):
             sim.x[i] += dx
-            if sim.rotation == "impulse" and dx.any():
+            if sim.plan.exact_rotation and dx.any():
                 sim._keep_angular_momentum(i, dx)
 
 
@@ -173,7 +173,7 @@ def solve_island(sim: Simulation, contacts) -> None:
     loads = sim.loads
     sets = []                                  # (a, b, r_a, r_b, n, e, mu)
     touched = sorted({c[0] for c in contacts} | {c[1] for c in contacts})
-    for i in touched if sim.wall_response == "impulse" else ():
+    for i in touched if sim.plan.impulse_walls else ():
         if loads.fixed[i]:
             continue                  # no wall impulse can move it
         W = sim.world_vertices(i)
@@ -199,7 +199,7 @@ def solve_island(sim: Simulation, contacts) -> None:
     static = np.zeros((1, 3))
     v, w = np.concatenate([sim.v, static]), np.concatenate([sim.w, static])
     I_inv = np.zeros((B + 1, 3, 3))
-    if sim.rotation != "off":
+    if sim.plan.rotates:
         I_inv[:B] = world_inertia(sim.R, sim.I_body_inv)     # 0 for a fixed body
     P = np.empty((int(starts[-1]), 4))
     impulse.solve_island(

@@ -67,7 +67,7 @@ def loop_support(sim: Simulation) -> str | None:
     forces, torques, fixed bodies, missing walls, coefficients per body)
     run on the readable step.
     """
-    if sim.body_body and sim.level == "sphere":
+    if sim.plan.body_body and sim.plan.level == "sphere":
         return "collision level 'sphere' (its broad phase is not the boxes')"
     loads, world = sim.loads, sim.scene.world
     if not loads.uniform:
@@ -216,16 +216,11 @@ class CompiledLoop:
         self.first_vertex[1:] = np.cumsum([len(vs) for vs in vertices])
         self._lay_out_trackers()
         # the leaves serve the corrected wall response only
-        self._lay_out_leaves(vertices if sim.wall_response == "impulse" else [])
-        if not sim.body_body:
-            body_mode = kernels.BODY_NONE
-        elif sim.level == "aabb" and sim.body_response == "seed":
-            body_mode = kernels.BODY_EXCHANGE
-        else:
-            body_mode = kernels.BODY_HAND_BACK
+        plan = sim.plan
+        self._lay_out_leaves(vertices if plan.impulse_walls else [])
         capacity = max(EVENT_ROWS, 4 * (6 * B + B * (B - 1) // 2))
         # the wall stage's contacts, kept for the body stage (at most three walls a body)
-        keep = body_mode == kernels.BODY_HAND_BACK and sim.wall_response == "impulse"
+        keep = plan.loop_body == slot.BODY_HAND_BACK and plan.impulse_walls
         wall_rows = max(1, 3 * int(self.first_vertex[-1])) if keep else 1
         most = max(1, max(len(vs) for vs in vertices))     # vertices of a body, at most
         s = len(method.b_)
@@ -234,16 +229,13 @@ class CompiledLoop:
         scalars[[slot.S_H, slot.S_GRAVITY, slot.S_RESTITUTION, slot.S_FRICTION,
                  slot.S_THRESHOLD, slot.S_HALF_SIZE, slot.S_ENERGY_LIMIT]] = (
             sim.h, world.gravity, world.restitution,
-            world.coulomb_mu if sim.wall_response == "impulse" else world.friction,
-            sim.loads.threshold, world.half_size, sim._energy_limit)
+            world.coulomb_mu if plan.impulse_walls else world.friction,
+            sim.loads.threshold, world.half_size, sim.energy_limit)
         settings = np.zeros(7, np.int64)
         settings[[slot.G_QUADRATIC, slot.G_ROTATION_MODE, slot.G_WALL_SPEED_AT_WALL,
                   slot.G_WALL_IMPULSE, slot.G_ITERATIONS, slot.G_CENTRED, slot.G_BODY_MODE]] = (
-            world.drag_model == "quadratic",
-            {"off": kernels.ROTATION_OFF, "seed": kernels.ROTATION_SEED,
-             "impulse": kernels.ROTATION_EXACT}[sim.rotation],
-            sim.wall_speed == "wall", sim.wall_response == "impulse", impulse.ITERATIONS,
-            sim._centred, body_mode)
+            world.drag_model == "quadratic", plan.loop_rotation, plan.speed_at_wall,
+            plan.impulse_walls, impulse.ITERATIONS, sim.centred, plan.loop_body)
         packing = _Packing()
         for k, array, dtype in (
                 (slot.SCALARS, scalars, f), (slot.HA, sim.h * method.A_, f),
@@ -251,7 +243,7 @@ class CompiledLoop:
                 # the drag rate r = k / m, as translational_rhs divides it
                 (slot.DRAG_RATE, world.drag / np.asarray(sim.mass, np.float64), f),
                 (slot.VERTICES_T, np.concatenate(vertices).T, f), (slot.CENTER, sim.center, f),
-                (slot.LAM, sim._lambda_max, f), (slot.MASS, sim.mass, f),
+                (slot.LAM, sim.lambda_max, f), (slot.MASS, sim.mass, f),
                 (slot.INV_MASS, sim.inv_mass, f), (slot.Q, sim.Q, f),
                 (slot.MOMENTS, sim.moments, f), (slot.I_BODY_INV, sim.I_body_inv, f),
                 (slot.LEAF_SPHERES, self.leaf_spheres, f), (slot.TRACKERS_F, self.trackers_f, f),
@@ -308,7 +300,7 @@ class CompiledLoop:
 
     def _lay_out_trackers(self) -> None:
         """The incremental trackers of the bodies that have one (the readable
-        step's ``_tracked`` bodies with a convex mesh), as slices of two flat
+        step's ``tracked`` bodies with a convex mesh), as slices of two flat
         arrays (:data:`refsim.dynamics._numba_kernels.T_N` and on). The loop's
         walks keep their own extremes and stamps: a walk from any start
         finds the same box."""
@@ -324,7 +316,7 @@ class CompiledLoop:
             assert chunks[-1].size == size
             return start + size
 
-        for b in sim._tracked:
+        for b in sim.tracked:
             tracker = sim.bodies[b].tracker
             if not isinstance(tracker, IncrementalAABB):
                 continue                              # the linear scan, in the loop
@@ -491,7 +483,7 @@ class CompiledLoop:
         timer = sim.timer
         timer.start()
         hits: np.ndarray | list = candidates
-        if sim.level != "aabb":
+        if sim.plan.narrow_phase:
             hits = sim._narrow_phase(candidates)
             timer.lap("narrow-phase")
         sim._body_response(hits, set())          # the contacts: every pair in hits

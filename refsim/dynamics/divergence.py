@@ -42,7 +42,7 @@ def energy_bound(sim: Simulation) -> np.ndarray:
     the divergence check (O(B) without (B, 3, 3) products)."""
     world = sim.scene.world
     kinetic = 0.5 * (sim.mass * np.einsum("bi,bi->b", sim.v, sim.v)
-                     + sim._lambda_max * np.einsum("bi,bi->b", sim.w, sim.w))
+                     + sim.lambda_max * np.einsum("bi,bi->b", sim.w, sim.w))
     if sim.loads.uniform:
         return kinetic + sim.mass * world.gravity * (sim.x[:, 1] + world.half_size)
     return kinetic + field_potential(sim.mass, sim.loads.accel, sim.x, world.half_size)
@@ -62,7 +62,7 @@ def check(sim: Simulation) -> None:
     # finite while w is: it is built from w by finite operations).
     energy = sim._energy_bound()
     total = energy.sum()
-    if total <= sim._energy_limit:
+    if total <= sim.energy_limit:
         return
     bad = ~(np.isfinite(sim.x).all(axis=1) & np.isfinite(sim.v).all(axis=1)
             & np.isfinite(sim.w).all(axis=1) & np.isfinite(sim.R).all(axis=(1, 2)))
@@ -70,7 +70,7 @@ def check(sim: Simulation) -> None:
         sim._diverged("state is not finite", int(np.flatnonzero(bad)[0]))
     # finite state whose energy is beyond the limit (or overflows)
     sim._diverged(f"energy {total:.6g} exceeds {DIVERGENCE_FACTOR:.0e} times its "
-                   f"initial value plus scale ({sim._energy_limit:.6g})",
+                   f"initial value plus scale ({sim.energy_limit:.6g})",
                    int(np.argmax(energy)))
 
 

@@ -46,6 +46,19 @@ WALLS, BODIES, NOW_WALLS = range(51, 54)        # NOW_WALLS: of the step
 #: How many arrays the header describes.
 ARRAYS = 54
 
+#: Body-body modes of the loop (``SETTINGS[G_BODY_MODE]``; chosen by
+#: :func:`refsim.dynamics.plan.stage_plan`).
+BODY_NONE = 0           # no body-body stage (one body, level "none", response "off")
+BODY_EXCHANGE = 1       # level "aabb", the seed's exchange (S8): done in the loop
+BODY_HAND_BACK = 2      # any other: a step with an overlapping pair of boxes stops the
+                        # kernel after its broad phase (STOP_BODY_STAGE)
+
+#: Rotation models of the loop (``SETTINGS[G_ROTATION_MODE]``: the scene's
+#: ``dynamics.rotation``).
+ROTATION_OFF = 0
+ROTATION_SEED = 1       # S9's Euler step of the axes
+ROTATION_EXACT = 2      # "impulse": the exact rotation with angular momentum
+
 #: Entries of ``SCALARS`` (float64).
 S_H, S_GRAVITY, S_RESTITUTION, S_FRICTION, S_THRESHOLD, S_HALF_SIZE, S_ENERGY_LIMIT = range(7)
 #: Entries of ``SETTINGS`` (int64; the flags 0 or 1).

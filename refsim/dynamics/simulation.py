@@ -47,7 +47,9 @@ Divergence (stage 3): the step stops with
 :class:`~refsim.errors.DivergenceError` when the state is not finite or its
 energy grows beyond all bounds (:mod:`refsim.dynamics.divergence`).
 
-Where the stages live: this module holds the state, the outline and the
+Where the stages live: the scene's choices are resolved once, by
+:func:`refsim.dynamics.plan.stage_plan`, into the plan every stage and the
+compiled loop read; this module holds the state, the outline and the
 short stages (1, 2, 4); the divergence check, the wall stage and the
 body-body stages are base classes of :class:`Simulation`, each in its own
 module (:mod:`refsim.dynamics.divergence`, :mod:`refsim.dynamics.wall_stage`,
@@ -81,11 +83,11 @@ from refsim.dynamics.energy import EnergyParts, body_energy
 from refsim.dynamics.forces import field_rhs, translational_rhs
 from refsim.dynamics.loads import apply_torques, scene_loads
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
+from refsim.dynamics.plan import stage_plan
 from refsim.dynamics.products import inverse, matvec
 from refsim.dynamics.rotation_impulse import principal_frame
 from refsim.dynamics.rotation_seed import orientation_step_seed_kernel
 from refsim.dynamics.trajectory import FRAME_ENTRIES, Contact, Event, Trajectory
-from refsim.dynamics.walls import SPEEDS
 from refsim.errors import ArgumentTypeError, StateError, check_count, check_option
 from refsim.kernels import FREE_ROTATION_STEPS, choose_kernel
 from refsim.limits import MAX_STEPS
@@ -114,8 +116,6 @@ BOXES = ("auto", "trackers", "batched")
 #: (docs/decisions/compiled-loop.md has the figures).
 LOOP_CHUNK = 4096
 
-STAGES = ("integrate", "rotation", "check", "bounds", "walls", "broad-phase", "narrow-phase",
-          "body-response")
 
 
 def _quiet_overflow() -> np.errstate:
@@ -151,15 +151,6 @@ def check_scene(scene) -> None:
                                 f"got {type(scene).__name__}")
 
 
-def resolve_wall_response(dynamics) -> str:
-    """``dynamics.wall_response`` with "auto" resolved: the corrected wall
-    impulses when the rotation model is the corrected one, else the seed's
-    per-axis response (the scene key, :mod:`refsim.scenes.schema`)."""
-    if dynamics.wall_response != "auto":
-        return dynamics.wall_response
-    return "impulse" if dynamics.rotation == "impulse" else "seed"
-
-
 @dataclass(frozen=True)
 class Body:
     """What the loop knows of one body that does not change: its (scaled)
@@ -176,11 +167,13 @@ class Body:
 class Simulation:
     """The bodies of a scene and their state; :meth:`step` advances all of them.
 
-    The scene's choices are made once, here: which rotation step (none, the
-    seed's, the exact one), which wall response (the seed's per-axis one,
-    with S9's spin change when the rotation model is the seed's, or the
-    corrected impulses; ``dynamics.wall_response``), which body response,
-    which stages run at all.
+    The scene's choices are resolved once, into ``plan``
+    (:func:`refsim.dynamics.plan.stage_plan`): which rotation step (none,
+    the seed's, the exact one), which wall response (the seed's per-axis
+    one, with S9's spin change when the rotation model is the seed's, or
+    the corrected impulses; ``dynamics.wall_response``), which body
+    response, which stages run at all. Every stage reads the plan, and so
+    does the compiled loop.
 
     Parameters
     ----------
@@ -216,41 +209,45 @@ class Simulation:
         an array bound in their place would not be the one the loop steps).
     R : (B, 3, 3) float64
         Orientations.
-    stages : tuple of str (the stages this scene runs)
+    plan : refsim.dynamics.plan.StagePlan (the scene's choices, resolved)
+    stages : tuple of str (the stages this scene runs: ``plan.stages``)
     timer : StageTimer (``timer.seconds``: dict of stage -> seconds)
+    centred : bool
+        Every body's centroid is its mesh's origin (the reported position
+        needs no ``R c``).
+    tracked : list of int
+        The bodies whose boxes come from their own tracker (the others: the
+        batched scan, ``boxes``).
+    lambda_max : (B,) float64
+        Each body's largest principal moment (the divergence check's bound).
+    energy_limit : float
+        The energy beyond which the state has diverged
+        (:mod:`refsim.dynamics.divergence`).
     """
 
     def __init__(self, scene, *, wall_speed: str | None = None, boxes: str = "auto",
                  kernel: str | None = None, sink: FrameSink | None = None):
         check_scene(scene)
-        world, dyn, col = scene.world, scene.dynamics, scene.collision
-        self.wall_speed = check_option("wall_speed",
-                                       world.wall_speed if wall_speed is None else wall_speed,
-                                       SPEEDS)
+        world, col = scene.world, scene.collision
+        self.plan = plan = stage_plan(scene, wall_speed)
         self.boxes = check_option("boxes", boxes, BOXES)
         self.kernel = choose_kernel(kernel)
         self.scene = scene
         self.h = scene.integration.step
         self.method = resolve_method(scene.integration.solver)
-        self.rotation = dyn.rotation
-        self.body_response = dyn.body_response
-        self.wall_response = resolve_wall_response(dyn)
-        self.level = col.level
         # the stage functions, chosen once
         self._rotate = {"off": None, "seed": self._rotate_seed,
-                        "impulse": self._rotate_exact}[self.rotation]
-        self._wall = {"seed": self._wall_seed, "impulse": self._wall_impulse}[
-            self.wall_response]
+                        "impulse": self._rotate_exact}[plan.rotation]
+        self._wall = self._wall_impulse if plan.impulse_walls else self._wall_seed
         B = len(scene.bodies)
         if B == 0:
             raise StateError("the scene has no [[body]] to simulate (a particle-only "
                              "scene runs with refsim.ParticleSystem)")
-        self.body_body = B >= 2 and col.level != "none" and dyn.body_response != "off"
         # what acts beyond the seed's world (refsim.dynamics.loads); refuses a
         # key these choices cannot honour
-        self.loads = scene_loads(scene, rotation=self.rotation,
-                                 body_response=self.body_response,
-                                 wall_response=self.wall_response)
+        self.loads = scene_loads(scene, rotation=plan.rotation,
+                                 body_response=plan.body_response,
+                                 wall_response=plan.wall_response)
 
         bodies = []
         for cfg in scene.bodies:
@@ -263,8 +260,7 @@ class Simulation:
             # ("assuming equal masses for each vertex"); the corrected model
             # rotates about the solid's centre of mass. Equal for every
             # bundled model but the l-beam and the star.
-            center = (props.center if "impulse" in (dyn.rotation, dyn.body_response)
-                      else mesh.centroid_vertex_average)
+            center = props.center if plan.mass_centre else mesh.centroid_vertex_average
             bodies.append(Body(name=cfg.name, mesh=mesh,
                                tracker=make_aabb_tracker(mesh, col.aabb, kernel=self.kernel),
                                mass=cfg.mass,
@@ -275,7 +271,7 @@ class Simulation:
         self.mass = np.array([b.mass for b in bodies])
         self.inv_mass = np.where(self.loads.fixed, 0.0, 1.0 / self.mass)   # fixed: no push
         self.center = np.array([b.center for b in bodies])                  # (B, 3)
-        self._centred = not self.center.any()          # every centroid at the mesh origin
+        self.centred = not self.center.any()          # every centroid at the mesh origin
         self.I_body = np.array([b.inertia for b in bodies])                 # (B, 3, 3)
         self.I_body_inv = inverse(self.I_body)           # not LAPACK: the same bits anywhere
         self.I_body_inv[self.loads.fixed] = 0.0           # fixed: no turn either
@@ -284,7 +280,7 @@ class Simulation:
         # rotation step (rotation_impulse.free_rotation_step)
         self.Q = np.zeros((B, 3, 3))
         self.moments = np.zeros((B, 3))
-        if self.rotation == "impulse":
+        if plan.exact_rotation:
             for i, b in enumerate(bodies):
                 self.Q[i], self.moments[i] = principal_frame(b.inertia)
         self._free_steps = FREE_ROTATION_STEPS.pick(self.kernel)
@@ -292,14 +288,14 @@ class Simulation:
         # Bodies whose boxes come from the batched scan, one group per mesh;
         # the others call their own tracker (see ``boxes``).
         groups: dict[int, list[int]] = {}
-        self._tracked = []
+        self.tracked = []
         for i, b in enumerate(bodies):
             batched = boxes == "batched" or (
                 boxes == "auto" and b.mesh.n_vertices <= BATCH_VERTICES)
             if batched:
                 groups.setdefault(id(b.mesh), []).append(i)
             else:
-                self._tracked.append(i)
+                self.tracked.append(i)
         # a group of all bodies indexes by a slice (a view, no copy)
         self._linear_groups = [(slice(None) if len(idx) == B else np.array(idx),
                                 np.ascontiguousarray(bodies[idx[0]].mesh.vertices.T))
@@ -312,7 +308,7 @@ class Simulation:
         self.x = origin + np.einsum("bij,bj->bi", self.R, self.center)
         self.v = np.array([c.velocity for c in scene.bodies], dtype=np.float64)
         self.w = np.array([c.angular_velocity for c in scene.bodies], dtype=np.float64)
-        if self.rotation == "off":
+        if not plan.rotates:
             self.w[:] = 0.0                       # DEVIATION D7: rotation off, no turning
         # the steps taken and the loop's event bookkeeping (refsim.dynamics.loop_layout;
         # on the compiled loop, a view of its packed arrays that the kernel writes)
@@ -333,15 +329,15 @@ class Simulation:
         self._impulses: dict[tuple[int, str], np.ndarray] = {}
         # the wall stage's contacts of the step, (body, axis, low wall) -> r
         self._wall_contacts: dict[tuple[int, int, bool], np.ndarray] = {}
-        self.stages = tuple(s for s in STAGES if self._needs(s))
+        self.stages = plan.stages
         self.timer = StageTimer(self.stages)
         self._frames: FrameSink = MemorySink() if sink is None else sink
         # the largest principal moment of each body: 1/2 lambda_max |w|^2 bounds
         # the rotational energy without a rotation of the inertia tensor
         # (contiguous: the compiled loop then has one signature for any number
         # of bodies, not a second compile for a strided column)
-        self._lambda_max = np.ascontiguousarray(np.linalg.eigvalsh(self.I_body)[:, -1])
-        self._energy_limit = DIVERGENCE_FACTOR * (self._energy_bound().sum()
+        self.lambda_max = np.ascontiguousarray(np.linalg.eigvalsh(self.I_body)[:, -1])
+        self.energy_limit = DIVERGENCE_FACTOR * (self._energy_bound().sum()
                                                   + self._energy_scale())
         # The compiled loop (many steps per call), when the kernel is compiled
         # and the loop does this scene's choices (loop_support).
@@ -350,17 +346,6 @@ class Simulation:
         self._loop: CompiledLoop | None = None
         if self.kernel == "compiled" and loop_support(self) is None:
             self._loop = CompiledLoop(self)
-
-    # -- what the scene needs ----------------------------------------------------------
-
-    def _needs(self, stage: str) -> bool:
-        if stage == "rotation":
-            return self.rotation != "off"
-        if stage in ("broad-phase", "body-response"):
-            return self.body_body
-        if stage == "narrow-phase":
-            return self.body_body and self.level != "aabb"
-        return True
 
     @property
     def steps(self) -> int:
@@ -410,7 +395,7 @@ class Simulation:
         """(B, 3) reference points (mesh origins): ``x - R c``, ``R c`` summed
         left to right (:func:`refsim.dynamics.products.matvec`, no einsum or
         BLAS: the same bits on every machine and in the compiled loop)."""
-        if self._centred:
+        if self.centred:
             return self.x.copy()
         return self.x - matvec(self.R, self.center)
 
@@ -477,11 +462,11 @@ class Simulation:
         # AMBIGUITY (A9): walls before bodies, the order of the seed's text
         self._walls(touching)
         timer.lap("walls")
-        if self.body_body:
+        if self.plan.body_body:
             candidates = self._broad_phase()
             timer.lap("broad-phase")
             pairs: np.ndarray | list = candidates
-            if self.level != "aabb":
+            if self.plan.narrow_phase:
                 pairs = self._narrow_phase(candidates)
                 timer.lap("narrow-phase")
             self._body_response(pairs, touching)
@@ -619,7 +604,7 @@ class Simulation:
             # the linear scan's r_k(v) = (R_k0 x + R_k1 y) + R_k2 z, batched
             self.lo[idx], self.hi[idx] = boxes_kernel(vertices_t, self.R[idx], origin[idx],
                                                       kernel=self.kernel)
-        for i in self._tracked:
+        for i in self.tracked:
             tracker = self.bodies[i].tracker
             # The loop's poses are finite and orthonormal by construction (the
             # check stage), so the tracker's per-call validation is skipped.
@@ -703,9 +688,9 @@ class Simulation:
                           settings=dict(settings or self._settings()))
 
     def _settings(self) -> dict:
-        s = self.scene
+        s, plan = self.scene, self.plan
         return {"solver": s.integration.solver, "step": self.h,
-                "rotation": self.rotation, "body_response": self.body_response,
-                "wall_response": self.wall_response, "collision_level": self.level,
-                "aabb": s.collision.aabb, "wall_speed": self.wall_speed, "boxes": self.boxes,
+                "rotation": plan.rotation, "body_response": plan.body_response,
+                "wall_response": plan.wall_response, "collision_level": plan.level,
+                "aabb": s.collision.aabb, "wall_speed": plan.wall_speed, "boxes": self.boxes,
                 "kernel": self.kernel, "steps": self.steps}

@@ -79,7 +79,7 @@ def start_kernel(scene, n_steps: int, *, wall_speed: str | None = None,
     probe = Simulation(scene, wall_speed=wall_speed, boxes=boxes, kernel="readable")
     if loop_support(probe) is not None:     # stage kernels then, not the loop
         return None
-    if (probe.body_body and probe.level in PAIR_LEVELS
+    if (probe.plan.body_body and probe.plan.level in PAIR_LEVELS
             and max(b.mesh.n_faces for b in probe.bodies) > PROBE_FACES):
         return None
     began = time.process_time()                 # CPU time, as LOOP charges it

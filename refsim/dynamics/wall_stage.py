@@ -64,12 +64,12 @@ def walls(sim: Simulation, touching: set) -> None:
 def wall_seed(sim: Simulation, i: int, correction: np.ndarray) -> None:
     """The seed's per-axis response (S7), after S9's change of w at the
     contact vertex when the rotation model is the seed's."""
-    if sim.rotation == "seed":
+    if sim.plan.seed_rotation:
         sim._wall_spin_seed(i, correction)
     world = sim.scene.world
     sim.x[i], sim.v[i] = wall_response_seed(
         sim.x[i], sim.v[i], correction, world.restitution, world.friction,
-        world.gravity, sim.wall_speed)
+        world.gravity, sim.plan.wall_speed)
 
 
 def wall_spin_seed(sim: Simulation, i: int, correction: np.ndarray) -> None:

@@ -92,7 +92,7 @@ def test_sphere_off_centre_bit_for_bit(rotation):
                   "velocity": [4.0, -2.0, 3.0], "angular_velocity": [1.0, 2.0, -3.0]}]})
     readable, compiled = _pair(scene, 1500, every=50)
     assert compiled.loop is None and compiled.loop_steps == 1500
-    assert not compiled._centred
+    assert not compiled.centred
     assert compiled._loop is not None and compiled._loop.tracked.tolist() == [0]  # the walk
     _assert_same(readable, compiled)
     assert len({e.other for e in compiled.events}) >= 3          # several walls
@@ -420,7 +420,7 @@ def test_each_rotation_with_each_wall_response_bit_for_bit(rotation, wall_respon
     scene = replace(scene, dynamics=replace(scene.dynamics, wall_response=wall_response))
     readable, compiled = _pair(scene, 2500, every=7)
     assert compiled.loop is None and compiled.loop_steps == 2500
-    assert compiled.wall_response == wall_response
+    assert compiled.plan.wall_response == wall_response
     _assert_same(readable, compiled)
     assert any(e.kind == "wall" for e in compiled.events)
 

@@ -88,7 +88,7 @@ def test_the_scenes_wall_speed_is_the_default_of_simulate_and_simulation():
     seed_scene = _scene(bodies, world={**world, "wall_speed": "seed"},
                         integration={"duration": 1e-3})
     v_seed = -0.5 * (-2.0 - 9.81 * 1e-3)
-    assert Simulation(seed_scene).wall_speed == "seed"
+    assert Simulation(seed_scene).plan.wall_speed == "seed"
     assert simulate(seed_scene, every=1).velocity[-1, 0, 1] == pytest.approx(v_seed, rel=1e-12)
     corrected = simulate(seed_scene, every=1, wall_speed="wall").velocity[-1, 0, 1]
     assert corrected != pytest.approx(v_seed, rel=1e-6)

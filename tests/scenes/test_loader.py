@@ -283,7 +283,8 @@ def test_a_body_resting_on_the_floor_is_inside(tmp_path):
 
 
 def test_the_wall_law_keys_and_their_defaults(tmp_path):
-    from refsim.dynamics.simulation import Simulation, resolve_wall_response
+    from refsim.dynamics.plan import resolve_wall_response
+    from refsim.dynamics.simulation import Simulation
 
     scene = load_scene(write(tmp_path, MINIMAL))
     assert scene.world.wall_speed == "wall" and scene.dynamics.wall_response == "auto"
@@ -293,7 +294,7 @@ def test_the_wall_law_keys_and_their_defaults(tmp_path):
     chosen = load_scene(write(tmp_path, '[world]\nwall_speed = "seed"\n[dynamics]\n'
                               'rotation = "impulse"\nwall_response = "seed"\n' + MINIMAL))
     sim = Simulation(chosen)
-    assert (sim.wall_speed, sim.wall_response) == ("seed", "seed")
+    assert (sim.plan.wall_speed, sim.plan.wall_response) == ("seed", "seed")
     assert sim.trajectory().settings["wall_response"] == "seed"
     assert_scene_error(tmp_path, '[world]\nwall_speed = "fast"\n' + MINIMAL,
                        "world.wall_speed", "must be one of 'wall', 'seed'")

@@ -1,0 +1,131 @@
+"""A scene's dynamics choices, resolved once into the plan that the readable
+step and the compiled loop both read.
+
+A scene names its choices as strings: ``[dynamics]`` rotation, body response
+and wall response, ``[collision]`` level, ``[world]`` wall speed. The stages
+ask questions of them ("does the body turn?", "is this the seed's wall
+response?", "does the narrow phase run?"). :func:`stage_plan` answers every
+such question once, in one place, as a :class:`StagePlan`: the readable
+stages (:class:`refsim.dynamics.simulation.Simulation` and its stage
+modules) read its flags, and the compiled loop
+(:class:`refsim.dynamics.compiled_loop.CompiledLoop`) reads the same plan's
+integer codes (:mod:`refsim.dynamics.loop_layout`). A new choice, or a
+changed rule for an old one, is then one edit here rather than one per
+path.
+
+Cost: O(1) per scene.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from refsim.dynamics import loop_layout as slot
+from refsim.dynamics.walls import SPEEDS
+from refsim.errors import check_option
+
+#: The stages of a step, in order (the outline of
+#: :mod:`refsim.dynamics.simulation`); a plan keeps those that run.
+STAGES = ("integrate", "rotation", "check", "bounds", "walls", "broad-phase", "narrow-phase",
+          "body-response")
+
+
+def resolve_wall_response(dynamics) -> str:
+    """``dynamics.wall_response`` with "auto" resolved: the corrected wall
+    impulses when the rotation model is the corrected one, else the seed's
+    per-axis response (the scene key, :mod:`refsim.scenes.schema`)."""
+    if dynamics.wall_response != "auto":
+        return dynamics.wall_response
+    return "impulse" if dynamics.rotation == "impulse" else "seed"
+
+
+@dataclass(frozen=True)
+class StagePlan:
+    """The choices of one scene and every question the stages ask of them.
+
+    The choices: ``rotation`` ("off", "seed", "impulse"), ``wall_response``
+    ("seed", "impulse"; "auto" resolved), ``body_response`` ("off", "seed",
+    "impulse"), ``level`` (the collision level), ``wall_speed`` ("wall",
+    "seed").
+
+    The answers, each a bool unless said:
+
+    - ``body_body``: two or more bodies that can meet and respond (a level
+      other than "none", a body response other than "off");
+    - ``rotates``: the rotation stage runs (DEVIATION D7: rotation "off"
+      also zeroes the initial angular velocity);
+    - ``seed_rotation``: the seed's Euler step of the axes (S9), and its
+      change of w at a wall's contact vertex;
+    - ``exact_rotation``: the corrected rotation (principal frame, angular
+      momentum kept), and a body response that keeps angular momentum when
+      it moves a body;
+    - ``impulse_walls``: the corrected wall impulses (else the seed's
+      per-axis response, S7);
+    - ``speed_at_wall``: the wall flips the speed at the wall (D1), not the
+      seed's speed at the penetrated position;
+    - ``seed_exchange``: the seed's velocity exchange between bodies (S8);
+    - ``narrow_phase``: the narrow-phase stage runs (bodies meet, at a level
+      beyond the boxes);
+    - ``mass_centre``: bodies turn about the solid's centre of mass, else
+      about the vertex average (AMBIGUITY, seed S9);
+    - ``stages``: the stages that run, in order (:data:`STAGES`);
+    - ``loop_rotation``, ``loop_body``: the compiled loop's rotation and
+      body-body modes (:mod:`refsim.dynamics.loop_layout`: the seed's
+      exchange at level "aabb" is the loop's own, any other body stage is
+      handed back to Python).
+    """
+
+    rotation: str
+    wall_response: str
+    body_response: str
+    level: str
+    wall_speed: str
+    body_body: bool
+    rotates: bool
+    seed_rotation: bool
+    exact_rotation: bool
+    impulse_walls: bool
+    speed_at_wall: bool
+    seed_exchange: bool
+    narrow_phase: bool
+    mass_centre: bool
+    stages: tuple[str, ...]
+    loop_rotation: int
+    loop_body: int
+
+
+def stage_plan(scene, wall_speed: str | None = None) -> StagePlan:
+    """The plan of ``scene`` (a :class:`refsim.Scene`), with ``wall_speed``
+    in place of the scene's ``world.wall_speed`` when given.
+
+    Raises
+    ------
+    OptionError
+        ``wall_speed`` is not one of "wall", "seed".
+    """
+    dyn, level = scene.dynamics, scene.collision.level
+    speed = check_option("wall_speed",
+                         scene.world.wall_speed if wall_speed is None else wall_speed, SPEEDS)
+    rotation, response = dyn.rotation, dyn.body_response
+    body_body = len(scene.bodies) >= 2 and level != "none" and response != "off"
+    narrow = body_body and level != "aabb"
+    runs = {"rotation": rotation != "off", "broad-phase": body_body,
+            "body-response": body_body, "narrow-phase": narrow}
+    if not body_body:
+        loop_body = slot.BODY_NONE
+    elif level == "aabb" and response == "seed":
+        loop_body = slot.BODY_EXCHANGE
+    else:
+        loop_body = slot.BODY_HAND_BACK
+    wall_response = resolve_wall_response(dyn)
+    return StagePlan(
+        rotation=rotation, wall_response=wall_response, body_response=response, level=level,
+        wall_speed=speed, body_body=body_body, rotates=rotation != "off",
+        seed_rotation=rotation == "seed", exact_rotation=rotation == "impulse",
+        impulse_walls=wall_response == "impulse", speed_at_wall=speed == "wall",
+        seed_exchange=response == "seed", narrow_phase=narrow,
+        mass_centre="impulse" in (rotation, response),
+        stages=tuple(s for s in STAGES if runs.get(s, True)),
+        loop_rotation={"off": slot.ROTATION_OFF, "seed": slot.ROTATION_SEED,
+                       "impulse": slot.ROTATION_EXACT}[rotation],
+        loop_body=loop_body)

@@ -1,0 +1,79 @@
+"""The stage plan (refsim.dynamics.plan): each question the stages ask of a
+scene's choices, answered once, for every combination of the choices."""
+
+from __future__ import annotations
+
+import itertools
+
+import pytest
+
+from refsim.dynamics import loop_layout as slot
+from refsim.dynamics.plan import STAGES, stage_plan
+from refsim.errors import OptionError
+from refsim.scenes.loader import scene_from_dict
+
+
+def scene(bodies=2, rotation="seed", response="seed", level="aabb", wall_response="auto",
+          wall_speed="wall"):
+    return scene_from_dict({
+        "world": {"wall_speed": wall_speed},
+        "collision": {"level": level},
+        "dynamics": {"rotation": rotation, "body_response": response,
+                     "wall_response": wall_response},
+        "body": [{"name": f"b{i}", "model": "cube.ac", "position": [2.5 * i - 2, 0.0, 0.0]}
+                 for i in range(bodies)]})
+
+
+ROTATIONS, RESPONSES = ("off", "seed", "impulse"), ("off", "seed", "impulse")
+LEVELS = ("none", "sphere", "aabb", "triangle-aabb", "exact")
+
+
+@pytest.mark.parametrize(("bodies", "rotation", "response", "level"),
+                         list(itertools.product((1, 2), ROTATIONS, RESPONSES, LEVELS)))
+def test_each_answer_follows_from_the_choices(bodies, rotation, response, level):
+    plan = stage_plan(scene(bodies, rotation, response, level))
+    meet = bodies == 2 and level != "none" and response != "off"
+    assert (plan.rotation, plan.body_response, plan.level) == (rotation, response, level)
+    assert plan.body_body is meet
+    assert plan.rotates is (rotation != "off")
+    assert (plan.seed_rotation, plan.exact_rotation) == (rotation == "seed",
+                                                         rotation == "impulse")
+    # "auto": the corrected walls go with the corrected rotation
+    assert plan.wall_response == ("impulse" if rotation == "impulse" else "seed")
+    assert plan.impulse_walls is (rotation == "impulse")
+    assert plan.seed_exchange is (response == "seed")
+    assert plan.narrow_phase is (meet and level != "aabb")
+    assert plan.mass_centre is ("impulse" in (rotation, response))
+    expected = [s for s in STAGES
+                if not (s == "rotation" and rotation == "off")
+                and not (s in ("broad-phase", "body-response") and not meet)
+                and not (s == "narrow-phase" and not (meet and level != "aabb"))]
+    assert list(plan.stages) == expected
+    assert plan.loop_rotation == {"off": slot.ROTATION_OFF, "seed": slot.ROTATION_SEED,
+                                  "impulse": slot.ROTATION_EXACT}[rotation]
+    assert plan.loop_body == (slot.BODY_NONE if not meet else
+                              slot.BODY_EXCHANGE if (level, response) == ("aabb", "seed")
+                              else slot.BODY_HAND_BACK)
+
+
+def test_the_wall_law_and_speed_as_chosen():
+    plan = stage_plan(scene(rotation="impulse", wall_response="seed", wall_speed="seed"))
+    assert (plan.wall_response, plan.impulse_walls) == ("seed", False)
+    assert (plan.wall_speed, plan.speed_at_wall) == ("seed", False)
+    # an argument's wall speed overrides the scene's
+    assert stage_plan(scene(wall_speed="seed"), "wall").speed_at_wall is True
+    with pytest.raises(OptionError, match="wall_speed must be one of 'wall', 'seed'"):
+        stage_plan(scene(), "fast")
+
+
+def test_the_simulation_and_its_loop_read_the_plan():
+    from refsim.dynamics.simulation import Simulation
+
+    sim = Simulation(scene(rotation="impulse", response="impulse", level="exact"),
+                     kernel="compiled")
+    assert sim.plan == stage_plan(sim.scene)
+    assert sim.stages == sim.plan.stages
+    settings = sim._loop.view(slot.SETTINGS)
+    assert (settings[slot.G_ROTATION_MODE], settings[slot.G_BODY_MODE]) == \
+        (slot.ROTATION_EXACT, slot.BODY_HAND_BACK)
+    assert (settings[slot.G_WALL_IMPULSE], settings[slot.G_WALL_SPEED_AT_WALL]) == (1, 1)
