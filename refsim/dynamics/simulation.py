@@ -276,13 +276,22 @@ class Simulation:
         self.I_body_inv = inverse(self.I_body)           # not LAPACK: the same bits anywhere
         self.I_body_inv[self.loads.fixed] = 0.0           # fixed: no turn either
         self._torqued = bool(self.loads.torque.any())
-        # the principal axes (mesh frame) and moments of the corrected
-        # rotation step (rotation_impulse.free_rotation_step)
+        # the principal axes (mesh frame) and moments of each body: the
+        # corrected rotation step's frame (rotation_impulse.free_rotation_step)
+        # and the divergence check's largest moment; by fixed-order Jacobi
+        # rotations, not LAPACK (the same bits anywhere), once per distinct tensor
+        solved: dict[bytes, tuple[np.ndarray, np.ndarray]] = {}
+        frames = []
+        for b in bodies:
+            key = b.inertia.tobytes()
+            if key not in solved:
+                solved[key] = principal_frame(b.inertia)
+            frames.append(solved[key])
         self.Q = np.zeros((B, 3, 3))
         self.moments = np.zeros((B, 3))
         if plan.exact_rotation:
-            for i, b in enumerate(bodies):
-                self.Q[i], self.moments[i] = principal_frame(b.inertia)
+            for i, (Q, moments) in enumerate(frames):
+                self.Q[i], self.moments[i] = Q, moments
         self._free_steps = FREE_ROTATION_STEPS.pick(self.kernel)
 
         # Bodies whose boxes come from the batched scan, one group per mesh;
@@ -336,7 +345,7 @@ class Simulation:
         # the rotational energy without a rotation of the inertia tensor
         # (contiguous: the compiled loop then has one signature for any number
         # of bodies, not a second compile for a strided column)
-        self.lambda_max = np.ascontiguousarray(np.linalg.eigvalsh(self.I_body)[:, -1])
+        self.lambda_max = np.array([moments.max() for _, moments in frames])
         self.energy_limit = DIVERGENCE_FACTOR * (self._energy_bound().sum()
                                                   + self._energy_scale())
         # The compiled loop (many steps per call), when the kernel is compiled

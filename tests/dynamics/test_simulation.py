@@ -244,3 +244,24 @@ def test_a_state_that_overflows_within_a_step_is_a_divergence_of_that_body():
     assert (info.value.step, info.value.body) == (1, "fast")
     assert info.value.time == pytest.approx(scene.integration.step)
     assert str(info.value).startswith("diverged at step 1, t = 0.001, body 'fast', ")
+
+
+def test_the_largest_moments_come_from_the_jacobi_frames_not_lapack():
+    """The divergence check's largest principal moment of each body is the
+    fixed-order Jacobi solve's (rotation_impulse.principal_frame: the same
+    bits on any OpenBLAS core), within rounding of LAPACK's eigvalsh; bodies
+    with the same tensor share one solve's answer."""
+    from refsim.dynamics.rotation_impulse import principal_frame
+    from refsim.studies.bounce import cubes_scene
+
+    scene = _scene([{**CUBE, "position": [0.0, 0.0, 0.0]},
+                    {"name": "ball", "model": "sphere-2k.ac", "position": [3.0, 0.0, 0.0]},
+                    {**CUBE, "name": "cube2", "position": [-3.0, 0.0, 0.0], "mass": 2.0}])
+    sim = Simulation(scene)
+    expected = [principal_frame(I)[1].max() for I in sim.I_body]
+    assert sim.lambda_max.tolist() == expected
+    np.testing.assert_allclose(sim.lambda_max, np.linalg.eigvalsh(sim.I_body)[:, -1],
+                               rtol=1e-13)
+    assert sim.lambda_max.flags.c_contiguous and sim.lambda_max[2] == 2 * sim.lambda_max[0]
+    cubes = Simulation(cubes_scene(10, "impulse"))
+    assert (cubes.moments == cubes.moments[0]).all() and (cubes.Q == cubes.Q[0]).all()
