@@ -193,8 +193,7 @@ def step_cost_pairs(rows: Sequence[StepCost]) -> list[dict]:
     """refsim's time per step beside the oracle's for each timed scene
     (refsim's order): the scene (:data:`refsim.studies.bounce.STEP_CASE`),
     ``refsim_seconds``, ``pybullet_seconds`` (nan when the oracle did not
-    run), ``ratio`` (refsim / oracle), refsim's ``stage_seconds`` and the
-    ``steps`` and ``repeats`` timed."""
+    run), ``ratio`` (refsim / oracle) and refsim's ``stage_seconds``."""
     pairs = []
     for case, by_engine in bounce.by_case(rows, bounce.STEP_CASE).items():
         ours = by_engine.get(bounce.REFSIM)
@@ -203,8 +202,7 @@ def step_cost_pairs(rows: Sequence[StepCost]) -> list[dict]:
         theirs = by_engine[ORACLE].seconds if ORACLE in by_engine else math.nan
         pairs.append({**dict(zip(bounce.STEP_CASE, case, strict=True)),
                       "refsim_seconds": ours.seconds, "pybullet_seconds": theirs,
-                      "ratio": ours.seconds / theirs, "stage_seconds": ours.stage_seconds,
-                      "steps": ours.steps, "repeats": ours.repeats})
+                      "ratio": ours.seconds / theirs, "stage_seconds": ours.stage_seconds})
     return pairs
 
 
@@ -294,14 +292,15 @@ def height_gaps(series: Sequence[DropEnergy], rows: Sequence[ApexRow]) -> dict:
 def rest_findings(rows: Sequence[RestRow]) -> list[dict]:
     """The time-to-rest table's findings, one per drop: the bounce after
     which each engine settles, refsim's settling time less the analytic one
-    (ms) and, when the oracle settles, its bounces after (+) or before (-)
-    the analytic bounce."""
+    (ms; when refsim ran) and, when the oracle settles, its bounces after
+    (+) or before (-) the analytic bounce."""
     found = []
     for drop in bounce.by_case(rows, bounce.REST_CASE).values():
-        closed, ours = drop[bounce.ANALYTIC], drop[bounce.REFSIM]
-        item = {"e": closed.e, "analytic_bounces": closed.bounces,
-                "refsim_bounces": ours.bounces,
-                "refsim_offset_ms": 1e3 * (ours.settle - closed.settle)}
+        closed, ours = drop[bounce.ANALYTIC], drop.get(bounce.REFSIM)
+        item = {"e": closed.e, "analytic_bounces": closed.bounces}
+        if ours is not None:
+            item |= {"refsim_bounces": ours.bounces,
+                     "refsim_offset_ms": 1e3 * (ours.settle - closed.settle)}
         theirs = drop.get(ORACLE)
         if theirs is not None and theirs.bounces:
             item |= {"pybullet_bounces": theirs.bounces,

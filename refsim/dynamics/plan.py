@@ -13,16 +13,28 @@ integer codes (:mod:`refsim.dynamics.loop_layout`). A new choice, or a
 changed rule for an old one, is then one edit here rather than one per
 path.
 
+What stays outside the plan: which narrow phase a level runs (the body
+stage passes the level on to the collision query, and looks at "sphere"
+and "exact" only to choose that query's form), which scenes the compiled
+loop covers (:func:`refsim.dynamics.compiled_loop.loop_support`), and the
+loads a choice refuses (:mod:`refsim.dynamics.loads`, which takes the
+choices by name).
+
 Cost: O(1) per scene.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from refsim.dynamics import loop_layout as slot
 from refsim.dynamics.walls import SPEEDS
 from refsim.errors import check_option
+
+#: The values of each choice a plan takes (the scene file's, "auto" resolved).
+ROTATIONS = ("off", "seed", "impulse")
+WALL_RESPONSES = ("seed", "impulse")
+BODY_RESPONSES = ("off", "seed", "impulse")
 
 #: The stages of a step, in order (the outline of
 #: :mod:`refsim.dynamics.simulation`); a plan keeps those that run.
@@ -43,12 +55,14 @@ def resolve_wall_response(dynamics) -> str:
 class StagePlan:
     """The choices of one scene and every question the stages ask of them.
 
-    The choices: ``rotation`` ("off", "seed", "impulse"), ``wall_response``
-    ("seed", "impulse"; "auto" resolved), ``body_response`` ("off", "seed",
-    "impulse"), ``level`` (the collision level), ``wall_speed`` ("wall",
-    "seed").
+    The choices (given): ``rotation`` ("off", "seed", "impulse"),
+    ``wall_response`` ("seed", "impulse"; "auto" resolved by
+    :func:`stage_plan`), ``body_response`` ("off", "seed", "impulse"),
+    ``level`` (the collision level), ``wall_speed`` ("wall", "seed") and
+    ``bodies`` (how many).
 
-    The answers, each a bool unless said:
+    The answers (derived from the choices when the plan is made, so that a
+    plan cannot hold answers of other choices; each a bool unless said):
 
     - ``body_body``: two or more bodies that can meet and respond (a level
       other than "none", a body response other than "off");
@@ -59,13 +73,13 @@ class StagePlan:
     - ``exact_rotation``: the corrected rotation (principal frame, angular
       momentum kept), and a body response that keeps angular momentum when
       it moves a body;
-    - ``impulse_walls``: the corrected wall impulses (else the seed's
-      per-axis response, S7);
+    - ``impulse_walls``: the corrected wall impulses, with Coulomb's mu
+      (else the seed's per-axis response with its friction fraction, S7);
     - ``speed_at_wall``: the wall flips the speed at the wall (D1), not the
       seed's speed at the penetrated position;
     - ``seed_exchange``: the seed's velocity exchange between bodies (S8);
     - ``narrow_phase``: the narrow-phase stage runs (bodies meet, at a level
-      beyond the boxes);
+      beyond the boxes; which narrow phase is the level's own dispatch);
     - ``mass_centre``: bodies turn about the solid's centre of mass, else
       about the vertex average (AMBIGUITY, seed S9);
     - ``stages``: the stages that run, in order (:data:`STAGES`);
@@ -80,18 +94,48 @@ class StagePlan:
     body_response: str
     level: str
     wall_speed: str
-    body_body: bool
-    rotates: bool
-    seed_rotation: bool
-    exact_rotation: bool
-    impulse_walls: bool
-    speed_at_wall: bool
-    seed_exchange: bool
-    narrow_phase: bool
-    mass_centre: bool
-    stages: tuple[str, ...]
-    loop_rotation: int
-    loop_body: int
+    bodies: int
+    body_body: bool = field(init=False)
+    rotates: bool = field(init=False)
+    seed_rotation: bool = field(init=False)
+    exact_rotation: bool = field(init=False)
+    impulse_walls: bool = field(init=False)
+    speed_at_wall: bool = field(init=False)
+    seed_exchange: bool = field(init=False)
+    narrow_phase: bool = field(init=False)
+    mass_centre: bool = field(init=False)
+    stages: tuple[str, ...] = field(init=False)
+    loop_rotation: int = field(init=False)
+    loop_body: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        rotation = check_option("rotation", self.rotation, ROTATIONS)
+        walls = check_option("wall_response", self.wall_response, WALL_RESPONSES)
+        response = check_option("body_response", self.body_response, BODY_RESPONSES)
+        speed = check_option("wall_speed", self.wall_speed, SPEEDS)
+        level = self.level
+        meet = self.bodies >= 2 and level != "none" and response != "off"
+        narrow = meet and level != "aabb"
+        runs = {"rotation": rotation != "off", "broad-phase": meet, "body-response": meet,
+                "narrow-phase": narrow}
+        if not meet:
+            loop_body = slot.BODY_NONE
+        elif level == "aabb" and response == "seed":
+            loop_body = slot.BODY_EXCHANGE
+        else:
+            loop_body = slot.BODY_HAND_BACK
+        answers = {
+            "body_body": meet, "rotates": rotation != "off",
+            "seed_rotation": rotation == "seed", "exact_rotation": rotation == "impulse",
+            "impulse_walls": walls == "impulse", "speed_at_wall": speed == "wall",
+            "seed_exchange": response == "seed", "narrow_phase": narrow,
+            "mass_centre": "impulse" in (rotation, response),
+            "stages": tuple(s for s in STAGES if runs.get(s, True)),
+            "loop_rotation": {"off": slot.ROTATION_OFF, "seed": slot.ROTATION_SEED,
+                              "impulse": slot.ROTATION_EXACT}[rotation],
+            "loop_body": loop_body}
+        for name, value in answers.items():
+            object.__setattr__(self, name, value)    # frozen: set once, here
 
 
 def stage_plan(scene, wall_speed: str | None = None) -> StagePlan:
@@ -103,29 +147,9 @@ def stage_plan(scene, wall_speed: str | None = None) -> StagePlan:
     OptionError
         ``wall_speed`` is not one of "wall", "seed".
     """
-    dyn, level = scene.dynamics, scene.collision.level
-    speed = check_option("wall_speed",
-                         scene.world.wall_speed if wall_speed is None else wall_speed, SPEEDS)
-    rotation, response = dyn.rotation, dyn.body_response
-    body_body = len(scene.bodies) >= 2 and level != "none" and response != "off"
-    narrow = body_body and level != "aabb"
-    runs = {"rotation": rotation != "off", "broad-phase": body_body,
-            "body-response": body_body, "narrow-phase": narrow}
-    if not body_body:
-        loop_body = slot.BODY_NONE
-    elif level == "aabb" and response == "seed":
-        loop_body = slot.BODY_EXCHANGE
-    else:
-        loop_body = slot.BODY_HAND_BACK
-    wall_response = resolve_wall_response(dyn)
+    dyn = scene.dynamics
     return StagePlan(
-        rotation=rotation, wall_response=wall_response, body_response=response, level=level,
-        wall_speed=speed, body_body=body_body, rotates=rotation != "off",
-        seed_rotation=rotation == "seed", exact_rotation=rotation == "impulse",
-        impulse_walls=wall_response == "impulse", speed_at_wall=speed == "wall",
-        seed_exchange=response == "seed", narrow_phase=narrow,
-        mass_centre="impulse" in (rotation, response),
-        stages=tuple(s for s in STAGES if runs.get(s, True)),
-        loop_rotation={"off": slot.ROTATION_OFF, "seed": slot.ROTATION_SEED,
-                       "impulse": slot.ROTATION_EXACT}[rotation],
-        loop_body=loop_body)
+        rotation=dyn.rotation, wall_response=resolve_wall_response(dyn),
+        body_response=dyn.body_response, level=scene.collision.level,
+        wall_speed=scene.world.wall_speed if wall_speed is None else wall_speed,
+        bodies=len(scene.bodies))

@@ -83,7 +83,7 @@ from refsim.dynamics.energy import EnergyParts, body_energy
 from refsim.dynamics.forces import field_rhs, translational_rhs
 from refsim.dynamics.loads import apply_torques, scene_loads
 from refsim.dynamics.mass_properties import body_mass_properties, inertia_problem
-from refsim.dynamics.plan import stage_plan
+from refsim.dynamics.plan import StagePlan, stage_plan
 from refsim.dynamics.products import inverse, matvec
 from refsim.dynamics.rotation_impulse import principal_frame
 from refsim.dynamics.rotation_seed import orientation_step_seed_kernel
@@ -142,6 +142,12 @@ class StageTimer:
         now = time.perf_counter()
         self.seconds[stage] += now - self._last
         self._last = now
+
+
+def _plan_field(name: str) -> property:
+    """A read-only attribute of :class:`Simulation` that is its plan's
+    ``name`` (:class:`refsim.dynamics.plan.StagePlan`)."""
+    return property(lambda sim: getattr(sim.plan, name), doc=f"``plan.{name}``.")
 
 
 def check_scene(scene) -> None:
@@ -209,7 +215,6 @@ class Simulation:
         an array bound in their place would not be the one the loop steps).
     R : (B, 3, 3) float64
         Orientations.
-    plan : refsim.dynamics.plan.StagePlan (the scene's choices, resolved)
     stages : tuple of str (the stages this scene runs: ``plan.stages``)
     timer : StageTimer (``timer.seconds``: dict of stage -> seconds)
     centred : bool
@@ -229,7 +234,7 @@ class Simulation:
                  kernel: str | None = None, sink: FrameSink | None = None):
         check_scene(scene)
         world, col = scene.world, scene.collision
-        self.plan = plan = stage_plan(scene, wall_speed)
+        self._plan = plan = stage_plan(scene, wall_speed)
         self.boxes = check_option("boxes", boxes, BOXES)
         self.kernel = choose_kernel(kernel)
         self.scene = scene
@@ -355,6 +360,21 @@ class Simulation:
         self._loop: CompiledLoop | None = None
         if self.kernel == "compiled" and loop_support(self) is None:
             self._loop = CompiledLoop(self)
+
+    @property
+    def plan(self) -> StagePlan:
+        """The scene's choices, resolved when the simulation was made
+        (:func:`refsim.dynamics.plan.stage_plan`; read-only: the stages and
+        the compiled loop were set up from it)."""
+        return self._plan
+
+    # The choices by the names they had before the plan (read-only: the plan's).
+    rotation = _plan_field("rotation")
+    body_response = _plan_field("body_response")
+    wall_response = _plan_field("wall_response")
+    wall_speed = _plan_field("wall_speed")
+    level = _plan_field("level")
+    body_body = _plan_field("body_body")
 
     @property
     def steps(self) -> int:

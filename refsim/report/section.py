@@ -2,8 +2,8 @@
 
 Each area of refsim contributes one :class:`Section`, built from the records
 of the plan's studies (:mod:`refsim.report.plan`) and the verdicts of
-:mod:`refsim.claims`. The report computes nothing of its own (STYLE.md,
-rule 9): a section only arranges what a measurement returned, and
+:mod:`refsim.claims`. The report computes nothing of its own
+(``docs/design.md``, Views): a section only arranges what a measurement returned, and
 ``results`` holds those records for results.json.
 
 Timings vary from run to run; everything else must not. What is a timing is

@@ -237,7 +237,7 @@ SEED_WALL_SPEED = "refsim-seed-wall-speed"
 APEX_CASE = ("body", "rotation", "e", "step", "solver")
 OBLIQUE_CASE = ("body", "rotation", "e", "friction", "v_t", "v_n")
 REST_CASE = ("body", "e")
-STEP_CASE = ("bodies", "rotation", "warmup")
+STEP_CASE = ("bodies", "rotation", "warmup", "steps", "repeats")
 
 
 def refsim_engines(seed_wall_speed: bool = True) -> tuple:
@@ -253,10 +253,22 @@ def refsim_engines(seed_wall_speed: bool = True) -> tuple:
 
 def by_case(rows, fields) -> dict[tuple, dict]:
     """Long-form ``rows`` grouped by the values of ``fields`` (in the order
-    the cases first appear), each group a dict from engine name to row."""
+    the cases first appear), each group a dict from engine name to row.
+
+    Raises
+    ------
+    StateError
+        One case has two rows of one engine name (two engines named alike,
+        or ``fields`` that leave out part of the case)."""
     groups: dict[tuple, dict] = {}
     for row in rows:
-        groups.setdefault(tuple(getattr(row, f) for f in fields), {})[row.engine] = row
+        case = tuple(getattr(row, f) for f in fields)
+        group = groups.setdefault(case, {})
+        if row.engine in group:
+            raise StateError(f"two rows of engine {row.engine!r} for one case "
+                             f"{dict(zip(fields, case, strict=True))}: each engine of a study "
+                             "needs a name of its own")
+        group[row.engine] = row
     return groups
 
 
@@ -535,8 +547,9 @@ def measure_cost(steps=COST_STEPS, solvers=COST_SOLVERS, *, model: str = SPHERE,
     """Apex-ratio error against wall time per simulated second, per step size.
 
     Each engine of ``engines`` (default :func:`refsim_engines`) is one
-    series at every step size with the solver :data:`SOLVER`, but refsim as
-    posed (:data:`REFSIM`), which is a series per solver of ``solvers``;
+    series at every step size with the solver :data:`SOLVER`, but the engine
+    named :data:`REFSIM` (refsim as posed: it runs the scene's solver),
+    which is a series per solver of ``solvers``;
     refsim with the seed's wall speed is the series
     :data:`SEED_SPEED_SERIES`, any other engine the series of its name. The
     time is what :func:`run_engine` reports: refsim's whole
@@ -739,9 +752,11 @@ def measure_step_cost(counts=BENCH_COUNTS, rotations=BENCH_ROTATIONS, *, steps: 
                       engines=()) -> list[StepCost]:
     """Seconds per step of each cubes scene in refsim and in each of
     ``engines`` (rigid-body engines with ``step_time(scene, steps,
-    warmup)``: pybullet's). refsim's steps are ``Simulation.advance``'s: the
-    compiled loop where the scene allows it, whose time is the stage
-    ``LOOP_STAGE`` (not split).
+    warmup)``: pybullet's). The one study that does not receive refsim as
+    an engine: what it times is refsim's own ``Simulation.advance``, stage by
+    stage, beside the engines; its rows are named :data:`REFSIM`. The
+    compiled loop, where the scene allows it, is the stage ``LOOP_STAGE``
+    (not split).
 
     Each engine runs the scene ``repeats`` times from its start: ``warmup``
     untimed steps (they also pay any first-call compilation), then ``steps``

@@ -4,7 +4,8 @@ A backend runs :func:`refsim.sweep.execute.execute` calls somewhere (this
 process, local worker processes, a Dask cluster) and hands back their
 outcomes as they finish. It does not retry, store, order or count: the run
 loop (:mod:`refsim.sweep.run`) does that once, the same way for all of them,
-so that the backends cannot drift apart (the trimesh lesson in STYLE.md).
+so that the backends cannot drift apart (two copies of one rule, each
+correct alone, are how two engines come to disagree).
 
 Backends are imported only when chosen: the local ones need only the
 standard library; "dask" needs ``distributed`` (``pip install

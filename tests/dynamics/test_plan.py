@@ -77,3 +77,29 @@ def test_the_simulation_and_its_loop_read_the_plan():
     assert (settings[slot.G_ROTATION_MODE], settings[slot.G_BODY_MODE]) == \
         (slot.ROTATION_EXACT, slot.BODY_HAND_BACK)
     assert (settings[slot.G_WALL_IMPULSE], settings[slot.G_WALL_SPEED_AT_WALL]) == (1, 1)
+
+
+def test_a_plan_derives_its_answers_from_its_choices_and_checks_them():
+    from dataclasses import replace
+
+    plan = stage_plan(scene(rotation="seed"))
+    turned = replace(plan, rotation="impulse", wall_response="impulse")
+    assert (turned.exact_rotation, turned.seed_rotation, turned.impulse_walls) == \
+        (True, False, True)
+    assert turned.loop_rotation == slot.ROTATION_EXACT and turned.mass_centre
+    assert replace(plan, bodies=1).stages == ("integrate", "rotation", "check", "bounds",
+                                              "walls")
+    with pytest.raises(OptionError, match="rotation must be one of 'off', 'seed', 'impulse'"):
+        replace(plan, rotation="spin")
+    with pytest.raises(OptionError, match="wall_response must be one of 'seed', 'impulse'"):
+        replace(plan, wall_response="auto")         # resolved by stage_plan, never kept
+
+
+def test_the_simulation_keeps_its_plan_and_names_its_choices():
+    from refsim.dynamics.simulation import Simulation
+
+    sim = Simulation(scene(rotation="impulse", wall_speed="seed"))
+    with pytest.raises(AttributeError):
+        sim.plan = stage_plan(scene())             # the stages were set up from it
+    assert (sim.rotation, sim.body_response, sim.wall_response, sim.wall_speed, sim.level,
+            sim.body_body) == ("impulse", "seed", "impulse", "seed", "aabb", True)

@@ -252,7 +252,6 @@ def test_the_largest_moments_come_from_the_jacobi_frames_not_lapack():
     bits on any OpenBLAS core), within rounding of LAPACK's eigvalsh; bodies
     with the same tensor share one solve's answer."""
     from refsim.dynamics.rotation_impulse import principal_frame
-    from refsim.studies.bounce import cubes_scene
 
     scene = _scene([{**CUBE, "position": [0.0, 0.0, 0.0]},
                     {"name": "ball", "model": "sphere-2k.ac", "position": [3.0, 0.0, 0.0]},
@@ -263,5 +262,24 @@ def test_the_largest_moments_come_from_the_jacobi_frames_not_lapack():
     np.testing.assert_allclose(sim.lambda_max, np.linalg.eigvalsh(sim.I_body)[:, -1],
                                rtol=1e-13)
     assert sim.lambda_max.flags.c_contiguous and sim.lambda_max[2] == 2 * sim.lambda_max[0]
+
+
+
+def test_bodies_with_one_inertia_tensor_share_one_jacobi_solve(monkeypatch):
+    from refsim.dynamics import simulation as module
+    from refsim.dynamics.rotation_impulse import principal_frame
+    from refsim.studies.bounce import cubes_scene
+
+    calls = []
+
+    def counted(I_body):
+        calls.append(I_body.copy())
+        return principal_frame(I_body)
+
+    monkeypatch.setattr(module, "principal_frame", counted)
     cubes = Simulation(cubes_scene(10, "impulse"))
+    assert len(calls) == 1                            # ten unit cubes, one tensor
     assert (cubes.moments == cubes.moments[0]).all() and (cubes.Q == cubes.Q[0]).all()
+    Simulation(_scene([CUBE, {**CUBE, "name": "heavy", "position": [3.0, 0.0, 0.0],
+                              "mass": 2.0}]))
+    assert len(calls) == 3                            # two tensors, two solves

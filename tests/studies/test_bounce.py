@@ -27,6 +27,7 @@ from refsim.studies.bounce import (
     apex_ratio,
     by_case,
     measure_apex_drop,
+    measure_cost,
     measure_drop_energy,
     measure_oblique,
     measure_rest,
@@ -221,6 +222,41 @@ def test_a_study_runs_the_engines_it_receives(simulate):
     assert measure_rest(restitutions=(0.5,), engines=[])[0].engine == ANALYTIC
     with pytest.raises(StateError, match="at least one engine"):
         measure_drop_energy(engines=[])
+    # two engines under one name cannot be told apart in the records
+    with pytest.raises(StateError, match="two rows of engine 'refsim' for one case"):
+        by_case(measure_rest(restitutions=(0.5,), engines=[build(REFSIM), build(REFSIM)]),
+                REST_CASE)
+
+
+def test_the_energy_curves_are_one_per_engine_after_the_analytic_one(simulate):
+    from refsim.engines.registry import build
+
+    curves = measure_drop_energy(duration=1.5, engines=[build(REFSIM), Renamed(build(REFSIM),
+                                                                                 "twin")])
+    assert [c.engine for c in curves] == [ANALYTIC, REFSIM, "twin"]
+    closed, ours, twin = curves
+    assert closed.t == ours.t == twin.t and ours.height == twin.height
+    # before the first impact (0.9 s from 4 m) refsim's free fall is the parabola
+    before = [i for i, t in enumerate(ours.t) if t < 0.85]
+    np.testing.assert_allclose([ours.height[i] for i in before],
+                               [closed.height[i] for i in before], rtol=0, atol=1e-12)
+    assert ours.energy[0] == pytest.approx(closed.energy[0], rel=1e-12)
+
+
+def test_the_cost_study_has_a_series_per_refsim_solver_and_per_other_engine(simulate):
+    from refsim.engines.registry import build
+
+    study = measure_cost((1 / 125,), ("euler", "rk4"),
+                         engines=[build(REFSIM), build(SEED_WALL_SPEED), Renamed(build(REFSIM),
+                                                                                 "twin")])
+    assert [(p.engine, p.solver) for p in study.points] == [
+        (REFSIM, "euler"), (REFSIM, "rk4"), (SEED_WALL_SPEED, "rk4, seed wall speed"),
+        ("twin", "twin")]
+    by_series = {p.solver: p for p in study.points}
+    # the other engine runs the study's solver (rk4): refsim's rk4 point, bit for bit
+    assert by_series["twin"].ratio == by_series["rk4"].ratio
+    # RK4 integrates free flight exactly; Euler at 1/125 s does not
+    assert by_series["rk4"].error <= ROUNDING_LEVEL < by_series["euler"].error
 
 
 def test_step_cost_rows_are_refsims_then_each_engines():

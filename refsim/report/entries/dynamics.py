@@ -5,8 +5,9 @@ The bounce studies of :mod:`refsim.studies.bounce` against the analytic
 answers and pybullet (apexes, oblique bounces, time to rest, energy, error
 against cost, pybullet's settings, step cost) and the C11/C12 measurements
 of :mod:`refsim.studies.dynamics`. Each bounce study receives its engines
-(:func:`_engines`: refsim's own from the registry, then pybullet); without
-pybullet (``run.optional``) it has no pybullet rows. A quick run has fewer
+(:func:`_engines`: refsim's own from the registry, then pybullet; the step
+cost times refsim itself, beside pybullet); without pybullet
+(``run.optional``) it has no pybullet rows. A quick run has fewer
 restitutions, step sizes and solvers, a shorter C11 run and fewer timed
 steps.
 """
@@ -30,23 +31,24 @@ class CostRun:
     orders: dict                # series -> slope of log error against log h
 
 
-#: refsim's engines of the bounce studies (refsim.engines.registry): the
-#: scene as posed, and with the seed's literal wall speed.
-REFSIM, SEED_WALL_SPEED = "refsim", "refsim-seed-wall-speed"
+def _engines(run: Run, *, seed_wall_speed: bool = False, refsim: bool = True) -> list:
+    """The engines a bounce study receives, all built by the run from the
+    registry: refsim as posed (unless ``refsim`` is False: the step cost
+    times refsim itself), with ``seed_wall_speed`` also refsim with the
+    seed's literal wall speed, then the pybullet oracle when it is
+    installed."""
+    from refsim.studies import bounce
 
-
-def _engines(run: Run, *refsim: str) -> list:
-    """The engines a bounce study receives: refsim's named ones, then the
-    pybullet oracle when it is installed (all built by the run, from the
-    registry)."""
+    names = ([bounce.REFSIM] if refsim else []) + ([bounce.SEED_WALL_SPEED]
+                                                   if seed_wall_speed else [])
     oracle = run.optional("pybullet")
-    return [run.engine(name) for name in refsim] + ([oracle] if oracle is not None else [])
+    return [run.engine(name) for name in names] + ([oracle] if oracle is not None else [])
 
 
 def dynamics_apex(run: Run):
     from refsim.studies import bounce
 
-    engines = _engines(run, REFSIM, SEED_WALL_SPEED)
+    engines = _engines(run, seed_wall_speed=True)
     if run.quick:
         rows = bounce.measure_apexes(models=(bounce.SPHERE,), engines=engines)
         rows += bounce.measure_apex_drop(bounce.CUBE, 0.8, rotation="seed", engines=engines)
@@ -57,20 +59,20 @@ def dynamics_apex(run: Run):
 def dynamics_oblique(run: Run):
     from refsim.studies import bounce
 
-    return bounce.measure_oblique(engines=_engines(run, REFSIM))
+    return bounce.measure_oblique(engines=_engines(run))
 
 
 def dynamics_rest(run: Run):
     from refsim.studies import bounce
 
     return bounce.measure_rest(restitutions=run.size((0.5,), (0.5, 0.8)),
-                               engines=_engines(run, REFSIM))
+                               engines=_engines(run))
 
 
 def dynamics_energy(run: Run):
     from refsim.studies import bounce
 
-    return bounce.measure_drop_energy(engines=_engines(run, REFSIM))
+    return bounce.measure_drop_energy(engines=_engines(run))
 
 
 def dynamics_cost(run: Run):
@@ -78,7 +80,7 @@ def dynamics_cost(run: Run):
 
     study = bounce.measure_cost(run.size(bounce.COST_STEPS_QUICK, bounce.COST_STEPS),
                                 run.size(bounce.COST_SOLVERS_QUICK, bounce.COST_SOLVERS),
-                                engines=_engines(run, REFSIM, SEED_WALL_SPEED))
+                                engines=_engines(run, seed_wall_speed=True))
     return CostRun(study, bounce.fit_error_orders(study))
 
 
@@ -112,7 +114,7 @@ def dynamics_pybullet_settings(run: Run):
 def dynamics_step_cost(run: Run):
     from refsim.studies import bounce
 
-    peers = _engines(run)
+    peers = _engines(run, refsim=False)
     rows = bounce.measure_step_cost(steps=run.size(50, 200), warmup=run.size(10, 20),
                                     repeats=run.size(3, 5), engines=peers)
     if not run.quick:

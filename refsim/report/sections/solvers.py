@@ -4,7 +4,7 @@ Claims C5-C10. Every number comes from the plan's records of
 :mod:`refsim.studies.solvers` and :mod:`refsim.studies.particles` (and the
 stability polynomials the plan reads off each tableau), every verdict and
 agreement count from :mod:`refsim.claims.solvers`; this module only
-arranges them into charts, tables and sentences (STYLE.md, rule 9).
+arranges them into charts, tables and sentences (``docs/design.md``, Views).
 
 The full report runs each measurement with the parameters of its command
 (``refsim study solvers-orders``, ``refsim study particles-jitter``, ...), so
