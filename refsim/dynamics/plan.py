@@ -31,10 +31,14 @@ from refsim.dynamics import loop_layout as slot
 from refsim.dynamics.walls import SPEEDS
 from refsim.errors import check_option
 
-#: The values of each choice a plan takes (the scene file's, "auto" resolved).
-ROTATIONS = ("off", "seed", "impulse")
-WALL_RESPONSES = ("seed", "impulse")
-BODY_RESPONSES = ("off", "seed", "impulse")
+#: The values of each choice (the scene file's keys take these:
+#: :mod:`refsim.scenes.schema`); a plan holds the wall response with "auto"
+#: resolved. The levels are "none" and the collision query's
+#: (:data:`refsim.collision.bodies.LEVELS`), in increasing cost.
+ROTATION_MODELS = ("off", "seed", "impulse")
+RESPONSE_MODELS = ("off", "seed", "impulse")
+WALL_RESPONSES = ("auto", "seed", "impulse")
+COLLISION_LEVELS = ("none", "sphere", "aabb", "triangle-aabb", "exact")
 
 #: The stages of a step, in order (the outline of
 #: :mod:`refsim.dynamics.simulation`); a plan keeps those that run.
@@ -109,11 +113,11 @@ class StagePlan:
     loop_body: int = field(init=False)
 
     def __post_init__(self) -> None:
-        rotation = check_option("rotation", self.rotation, ROTATIONS)
-        walls = check_option("wall_response", self.wall_response, WALL_RESPONSES)
-        response = check_option("body_response", self.body_response, BODY_RESPONSES)
+        rotation = check_option("rotation", self.rotation, ROTATION_MODELS)
+        walls = check_option("wall_response", self.wall_response, WALL_RESPONSES[1:])
+        response = check_option("body_response", self.body_response, RESPONSE_MODELS)
         speed = check_option("wall_speed", self.wall_speed, SPEEDS)
-        level = self.level
+        level = check_option("level", self.level, COLLISION_LEVELS)
         meet = self.bodies >= 2 and level != "none" and response != "off"
         narrow = meet and level != "aabb"
         runs = {"rotation": rotation != "off", "broad-phase": meet, "body-response": meet,

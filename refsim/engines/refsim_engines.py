@@ -45,6 +45,7 @@ from refsim.bounds.aabb_linear import aabb_linear_kernel
 from refsim.collision.bodies import bodies_collide, intersecting_pairs
 from refsim.collision.triangle import triangles_intersect
 from refsim.dynamics.simulate import simulate
+from refsim.dynamics.walls import SPEEDS
 from refsim.engines.cache import MeshCache
 from refsim.errors import StateError, check_option
 from refsim.models.mesh import Mesh
@@ -160,7 +161,7 @@ class PosedRefsim:
 
     def __init__(self, wall_speed: str | None = None):
         if wall_speed is not None:
-            check_option("wall_speed", wall_speed, ("wall", "seed"))
+            check_option("wall_speed", wall_speed, SPEEDS)
         self.wall_speed = wall_speed
         self.name = "refsim-seed-wall-speed" if wall_speed == "seed" else "refsim"
 

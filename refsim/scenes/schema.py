@@ -32,18 +32,20 @@ from typing import Any
 
 import numpy as np
 
+from refsim.dynamics import plan
 from refsim.dynamics.forces import DRAG_MODELS
+from refsim.dynamics.walls import SPEEDS
 from refsim.dynamics.world import WALL_NAMES, IntegrationConfig, WorldConfig
 from refsim.limits import MIN_POSITIVE
 from refsim.particles.config import ParticleConfig
 
 SOLVER_NAMES = ("euler", "averaged-euler", "backwards-euler", "midpoint", "rk4")
-COLLISION_LEVELS = ("none", "sphere", "aabb", "triangle-aabb", "exact")
+COLLISION_LEVELS = plan.COLLISION_LEVELS
 AABB_MODES = ("linear", "incremental", "auto")
-ROTATION_MODELS = ("off", "seed", "impulse")
-RESPONSE_MODELS = ("off", "seed", "impulse")
-WALL_RESPONSES = ("auto", "seed", "impulse")
-WALL_SPEEDS = ("wall", "seed")
+# the dynamics choices' values, where the stages read them
+ROTATION_MODELS, RESPONSE_MODELS, WALL_RESPONSES = (plan.ROTATION_MODELS, plan.RESPONSE_MODELS,
+                                                    plan.WALL_RESPONSES)
+WALL_SPEEDS = SPEEDS
 #: ``[[body]] shape``: a model file (""), or a shape built from its keys.
 SHAPES = ("", "box", "sphere")
 

@@ -103,3 +103,10 @@ def test_the_simulation_keeps_its_plan_and_names_its_choices():
         sim.plan = stage_plan(scene())             # the stages were set up from it
     assert (sim.rotation, sim.body_response, sim.wall_response, sim.wall_speed, sim.level,
             sim.body_body) == ("impulse", "seed", "impulse", "seed", "aabb", True)
+
+
+def test_the_levels_are_none_and_the_collision_querys():
+    from refsim.collision.bodies import LEVELS
+    from refsim.dynamics.plan import COLLISION_LEVELS
+
+    assert COLLISION_LEVELS == ("none", *LEVELS)
