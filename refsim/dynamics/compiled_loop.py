@@ -86,7 +86,7 @@ def vertex_leaves(vertices: np.ndarray, size: int = LEAF_VERTICES):
     """Groups of at most ``size`` nearby vertices of one mesh and a sphere
     around each, for the kernel's wall stage: a leaf whose sphere is clear
     of a wall has no vertex past it, and its vertices are not looked at
-    (:func:`refsim.dynamics._numba_kernels._vertices_past_wall`).
+    (:func:`refsim.dynamics._numba_walls.vertices_past_wall`).
 
     The groups come from halving: a group of more than ``size`` vertices is
     split at the median of its widest coordinate (a stable sort, so the

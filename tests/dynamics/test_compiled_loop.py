@@ -480,7 +480,7 @@ def _past_by_testing_every_vertex(a, X, o_k, wall, low):
 def test_the_vertices_past_a_wall_are_those_of_testing_every_vertex():
     # the leaves are only passed over when no vertex can be past: the list is
     # the full scan's, in the same order, also for walls through a vertex
-    from refsim.dynamics import _numba_kernels as kernels
+    from refsim.dynamics import _numba_walls as kernels
     from refsim.dynamics.compiled_loop import vertex_leaves
     from refsim.types import random_rotation
 
@@ -504,8 +504,8 @@ def test_the_vertices_past_a_wall_are_those_of_testing_every_vertex():
             for o_k in (wall - target, np.nextafter(wall - target, np.inf),
                         np.nextafter(wall - target, -np.inf)):
                 expected = _past_by_testing_every_vertex(a, X, o_k, wall, low)
-                count = kernels._vertices_past_wall(0, k, low, wall, o_k, R, X, order, start,
-                                                    spheres, first_leaf, past)
+                count = kernels.vertices_past_wall(0, k, low, wall, o_k, R, X, order, start,
+                                                   spheres, first_leaf, past)
                 assert past[:count].tolist() == expected.tolist()
                 checked += 1
                 hits += count > 0
@@ -532,7 +532,7 @@ def test_a_wall_touching_a_leafs_sphere_finds_the_vertices_past_it():
     # rounding. Walls near 0 make that rounding large against the wall's
     # spacing of floats: with CULL_SLACK = 0 this test fails (some leaves
     # are passed over with a vertex past the wall).
-    from refsim.dynamics import _numba_kernels as kernels
+    from refsim.dynamics import _numba_walls as kernels
     from refsim.dynamics.compiled_loop import vertex_leaves
 
     rng = np.random.default_rng(1)
@@ -558,8 +558,8 @@ def test_a_wall_touching_a_leafs_sphere_finds_the_vertices_past_it():
                 for o_k in (through, np.nextafter(through, np.inf),
                             np.nextafter(through, -np.inf)):
                     expected = _past_by_testing_every_vertex(a, X, o_k, wall, low)
-                    count = kernels._vertices_past_wall(0, k, low, wall, o_k, R, X, order,
-                                                        start, spheres, first_leaf, past)
+                    count = kernels.vertices_past_wall(0, k, low, wall, o_k, R, X, order,
+                                                       start, spheres, first_leaf, past)
                     assert past[:count].tolist() == expected.tolist()
                     checked += 1
     assert checked == 3 * 3 * (64 + 64)
@@ -788,7 +788,7 @@ def test_an_exception_in_the_body_stage_puts_the_step_back():
 def test_the_loops_sort_of_vertex_indices_is_numpys():
     """_sort_ascending (the wall stage's vertices past a wall, in increasing
     order) sorts ``a[:n]`` and leaves the rest, for lengths 0 to 300."""
-    from refsim.dynamics import _numba_kernels
+    from refsim.dynamics import _numba_walls
 
     rng = np.random.default_rng(7)
     for _ in range(300):
@@ -796,7 +796,7 @@ def test_the_loops_sort_of_vertex_indices_is_numpys():
         a = rng.permutation(5000)[:n + 3].astype(np.int64)
         expected = a.copy()
         expected[:n] = np.sort(expected[:n])
-        _numba_kernels._sort_ascending(a, n)
+        _numba_walls._sort_ascending(a, n)
         assert np.array_equal(a, expected), n
 
 
