@@ -491,10 +491,10 @@ def test_a_scene_beyond_the_step_limit_is_refused_saying_how_to_raise_it(tmp_pat
 
 
 def test_max_steps_lets_a_long_scene_through_validation(tmp_path, capsys, monkeypatch):
-    import refsim.cli
+    import refsim.cli.run
 
     taken = []
-    monkeypatch.setattr(refsim.cli, "_run_bodies",           # validated, then not run
+    monkeypatch.setattr(refsim.cli.run, "_run_bodies",       # validated, then not run
                         lambda scene, text, out, every: taken.append(scene) or 0)
     scene = write(tmp_path, LONG)
     assert main(["run", str(scene), "-o", str(tmp_path / "o.npz"),

@@ -1,6 +1,6 @@
 """The laws a ``refsim`` command must keep, and the root cause of each breach.
 
-docs/design.md, Errors and ``refsim/cli.py``: a user's mistake prints exactly one
+docs/design.md, Errors and ``refsim/cli/``: a user's mistake prints exactly one
 line ``refsim: error: ...`` naming the file and the line or key, and exits
 with status 2; a diverged run exits with 3 naming the step; success is 0 with
 nothing on stderr but ``refsim: warning:`` lines; no traceback for user
