@@ -104,12 +104,13 @@ def c11(rows: Sequence[InterpenetrationRow]) -> ClaimResult:
 
 
 def c12(spin: Sequence[SpinSeries]) -> ClaimResult:
-    """C12 from the spin runs (models "seed", "impulse" and optionally an
-    external engine, "pybullet"). Confirmed when the seed's model is not at
-    rest at the end and the corrected one is; partly when neither is;
-    refuted when the seed's model comes to rest."""
-    by = {s.model: s for s in spin}
-    seed, corrected, theirs = by["seed"], by["impulse"], by.get("pybullet")
+    """C12 from the spin runs: refsim's (engine "refsim", models "seed" and
+    "impulse") and optionally the oracle's (:data:`ORACLE`). Confirmed when
+    the seed's model is not at rest at the end and the corrected one is;
+    partly when neither is; refuted when the seed's model comes to rest."""
+    ours = {s.model: s for s in spin if s.engine == bounce.REFSIM}
+    seed, corrected = ours["seed"], ours["impulse"]
+    theirs = next((s for s in spin if s.engine == ORACLE), None)
     if not seed.at_rest and corrected.at_rest:
         verdict = "confirmed"
     elif not seed.at_rest:

@@ -157,7 +157,13 @@ class PosedRefsim:
 
     ``simulate`` records every step unless told otherwise (as the oracles'
     do), so that a bounce is read from every frame.
+
+    ``poses_models`` is True: the engine runs the rotation model and body
+    response the scene names, so a study that varies one of them
+    (:mod:`refsim.studies.dynamics`) varies the scene it gives this engine.
     """
+
+    poses_models = True
 
     def __init__(self, wall_speed: str | None = None):
         if wall_speed is not None:

@@ -4,8 +4,8 @@ energy of a bouncing body, the seed's model against the corrected one.
 - :func:`measure_spin` (C12, "the angular velocity does not properly dampen
   and come to a rest"): |w| and the rotational energy over time of a cube
   dropped with spin (``scenes/spinning-cube.toml``), ``rotation = "seed"``
-  against ``"impulse"``; an external trajectory (pybullet's, from the
-  oracle) can be passed in and is measured the same way.
+  against ``"impulse"``; another engine (pybullet) runs the same scene
+  with its own model and is measured the same way.
 - :func:`measure_interpenetration` (C11, "sometimes objects will
   interpenetrate when they are moving slowly or in the same direction"):
   the number of frames in which two bodies intersect (the exact triangle
@@ -14,6 +14,13 @@ energy of a bouncing body, the seed's model against the corrected one.
   ``body_response = "seed"`` against ``"impulse"``.
 - :func:`measure_energy`: the mechanical energy over time of a bouncing,
   spinning cube, seed against corrected.
+
+Each study receives its engines: what it varies is one choice of the scene
+(its rotation model, its body response), so refsim runs as an engine that
+poses the scene's own choices (:func:`refsim.engines.refsim_engines.as_posed`,
+the default; an engine with ``poses_models``), once per value of that choice,
+with everything else as the scene gives it. An engine with a model of its own
+runs the scene once. Every record names its engine.
 
 Every function returns frozen dataclasses of numbers; the report draws them
 and computes nothing itself. ``refsim study dynamics-spin``,
@@ -27,9 +34,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from refsim.dynamics.energy import trajectory_energy
-from refsim.dynamics.simulate import simulate
+from refsim.dynamics.simulate import default_every
 from refsim.dynamics.simulation import Simulation
 from refsim.dynamics.trajectory import Trajectory
+from refsim.engines import engine_name
+from refsim.errors import StateError
 
 #: Below these, a body counts as at rest (the corrected model's resting
 #: cube jitters at ~1e-5 m/s and rad/s: gravity's g h per step undone by the
@@ -51,6 +60,45 @@ def _scene_from(data: dict):
     return scene_from_dict(data)
 
 
+def _with_duration(scene, duration: float | None):
+    """``scene`` run for ``duration`` seconds (a whole number of its steps)
+    instead of its own, when given: every engine receives the same scene."""
+    if duration is None:
+        return scene
+    from refsim.errors import check_number
+    from refsim.solvers.integrate import whole_steps
+
+    duration = check_number("duration", duration)
+    whole_steps(duration, scene.integration.step)          # refused before any run
+    return replace(scene, integration=replace(scene.integration, duration=duration))
+
+
+def _default_engines(engines) -> tuple:
+    """``engines``, or refsim running the scene as posed."""
+    if engines is not None:
+        return tuple(engines)
+    from refsim.engines.refsim_engines import as_posed
+
+    return (as_posed(),)
+
+
+def poses_models(engine) -> bool:
+    """Whether ``engine`` runs the rotation model and body response the scene
+    names (refsim as posed), rather than a model of its own."""
+    return bool(getattr(engine, "poses_models", False))
+
+
+def _posing_engine(engine):
+    """``engine`` (default: refsim as posed), refused unless it poses the
+    scene's own models: the study varies one of them."""
+    (engine,) = _default_engines(None if engine is None else (engine,))
+    if not poses_models(engine):
+        raise StateError(f"engine {engine_name(engine)!r} runs a model of its own; this "
+                         f"study varies the scene's model and needs an engine that poses "
+                         f"it (refsim.engines.refsim_engines.as_posed)")
+    return engine
+
+
 # -- C12 -------------------------------------------------------------------------------
 
 
@@ -58,7 +106,9 @@ def _scene_from(data: dict):
 class SpinSeries:
     """One model's spin over time (body 0)."""
 
-    model: str                  # "seed", "impulse" or the external label
+    engine: str                 # the engine that ran it
+    model: str                  # the scene's rotation model ("seed", "impulse"), or
+                                # the engine's name for an engine with its own model
     t: np.ndarray               # (F,) s
     spin: np.ndarray            # (F,) |w|, rad/s
     spin_normal: np.ndarray     # (F,) w_y, the component along the floor's normal
@@ -69,7 +119,7 @@ class SpinSeries:
     at_rest: bool               # final_spin < REST_SPIN and final_speed < REST_SPEED
 
 
-def _spin_series(label: str, scene, traj: Trajectory) -> SpinSeries:
+def _spin_series(engine: str, label: str, scene, traj: Trajectory) -> SpinSeries:
     rotational = trajectory_energy(scene, traj).rotational.sum(axis=1)
     w = traj.angular_velocity[:, 0]
     v = traj.velocity[:, 0]
@@ -77,28 +127,37 @@ def _spin_series(label: str, scene, traj: Trajectory) -> SpinSeries:
     speed = np.linalg.norm(v, axis=1)
     last = traj.t >= traj.t[-1] - 1.0
     final_spin, final_speed = float(spin[last].mean()), float(speed[last].mean())
-    return SpinSeries(model=label, t=traj.t, spin=spin, spin_normal=w[:, 1].copy(),
+    return SpinSeries(engine=engine, model=label, t=traj.t, spin=spin, spin_normal=w[:, 1].copy(),
                       rotational_energy=rotational, speed=speed, final_spin=final_spin,
                       final_speed=final_speed,
                       at_rest=final_spin < REST_SPIN and final_speed < REST_SPEED)
 
 
-def measure_spin(scene=None, *, duration: float | None = None,
-                 external: Trajectory | None = None, external_label: str = "pybullet"
-                 ) -> list[SpinSeries]:
+def measure_spin(scene=None, *, engines=None, duration: float | None = None,
+                 rotations=("seed", "impulse")) -> list[SpinSeries]:
     """C12: a cube dropped with spin, seed rotation against the corrected one.
 
-    ``scene`` defaults to ``scenes/spinning-cube.toml``; its ``rotation`` is
-    replaced by "seed" and by "impulse". ``external`` is another engine's
-    trajectory of the same scene, measured the same way.
+    ``scene`` defaults to ``scenes/spinning-cube.toml``. Each engine that
+    poses the scene's models (default: refsim as posed) runs it with its
+    ``rotation`` replaced by each of ``rotations``; any other engine runs it
+    once, as its own model, under its own name. Frames are kept every
+    :func:`refsim.dynamics.simulate.default_every` steps for every engine.
     """
-    scene = scene or _scene("spinning-cube.toml")
-    rows = []
-    for model in ("seed", "impulse"):
-        s = replace(scene, dynamics=replace(scene.dynamics, rotation=model))
-        rows.append(_spin_series(model, s, simulate(s, duration=duration)))
-    if external is not None:
-        rows.append(_spin_series(external_label, scene, external))
+    scene = _with_duration(scene or _scene("spinning-cube.toml"), duration)
+    every = default_every(scene.integration.n_steps)
+    rows: list[SpinSeries] = []
+    for engine in _default_engines(engines):
+        name = engine_name(engine)
+        if not poses_models(engine):
+            traj = engine.simulate(scene, every=every)
+            rows.append(_spin_series(name, name, scene, traj))
+            continue
+        for model in rotations:
+            s = replace(scene, dynamics=replace(scene.dynamics, rotation=model))
+            rows.append(_spin_series(name, model, s, engine.simulate(s, every=every)))
+    labels = [row.model for row in rows]
+    if len(set(labels)) != len(labels):
+        raise StateError(f"two engines give a series of one name: {labels}")
     return rows
 
 
@@ -107,6 +166,7 @@ def measure_spin(scene=None, *, duration: float | None = None,
 
 @dataclass(frozen=True)
 class InterpenetrationRow:
+    engine: str                 # the engine that ran it (it poses the scene's response)
     case: str                   # one of C11_CASES
     response: str               # body_response: "seed" or "impulse"
     frames: int                 # frames examined (one per step)
@@ -183,17 +243,21 @@ def count_interpenetrating(scene, traj: Trajectory) -> tuple[int, int]:
 
 
 def measure_interpenetration(cases=C11_CASES, responses=("seed", "impulse"), *,
-                             duration: float = 2.0, step: float = 1e-3
+                             engine=None, duration: float = 2.0, step: float = 1e-3
                              ) -> list[InterpenetrationRow]:
-    """C11: interpenetrating frames per case and body response."""
+    """C11: interpenetrating frames per case and body response, every step
+    recorded, run by ``engine`` (default: refsim as posed; it must pose the
+    scene's body response)."""
+    engine = _posing_engine(engine)
     rows = []
     for case in cases:
         for response in responses:
             scene = c11_scene(case, response, duration=duration, step=step)
-            traj = simulate(scene, every=1)
+            traj = engine.simulate(scene, every=1)
             count, longest = count_interpenetrating(scene, traj)
             contacts = sum(1 for e in traj.events if e.kind == "body")
-            rows.append(InterpenetrationRow(case=case, response=response,
+            rows.append(InterpenetrationRow(engine=engine_name(engine), case=case,
+                                            response=response,
                                             frames=traj.n_frames, interpenetrating=count,
                                             longest_run=longest, contacts=contacts))
     return rows
@@ -204,6 +268,7 @@ def measure_interpenetration(cases=C11_CASES, responses=("seed", "impulse"), *,
 
 @dataclass(frozen=True)
 class EnergySeries:
+    engine: str                 # the engine that ran it (it poses the scene's rotation)
     model: str                  # rotation model
     t: np.ndarray               # (F,) s
     energy: np.ndarray          # (F,) kinetic + rotational + potential, J
@@ -218,19 +283,23 @@ class EnergySeries:
 ENERGY_SLACK = 1e-4
 
 
-def measure_energy(scene=None, *, duration: float | None = None,
+def measure_energy(scene=None, *, engine=None, duration: float | None = None,
                    models=("seed", "impulse")) -> list[EnergySeries]:
     """Energy over time of the bouncing, spinning cube (default
-    ``scenes/spinning-cube.toml``), one series per rotation model."""
-    scene = scene or _scene("spinning-cube.toml")
+    ``scenes/spinning-cube.toml``), one series per rotation model, run by
+    ``engine`` (default: refsim as posed; it must pose the scene's
+    rotation), a frame every 10 steps."""
+    scene = _with_duration(scene or _scene("spinning-cube.toml"), duration)
+    engine = _posing_engine(engine)
     rows = []
     for model in models:
         s = replace(scene, dynamics=replace(scene.dynamics, rotation=model))
-        traj = simulate(s, duration=duration, every=10)
+        traj = engine.simulate(s, every=10)
         parts = trajectory_energy(s, traj)
         energy, rotational = parts.total.sum(axis=1), parts.rotational.sum(axis=1)
         rise = np.diff(energy)
-        rows.append(EnergySeries(model=model, t=traj.t, energy=energy, rotational=rotational,
+        rows.append(EnergySeries(engine=engine_name(engine), model=model, t=traj.t,
+                                 energy=energy, rotational=rotational,
                                  increases=int((rise > ENERGY_SLACK).sum()),
                                  max_rise=float(rise.max(initial=0.0))))
     return rows

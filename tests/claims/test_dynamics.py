@@ -48,7 +48,8 @@ from refsim.studies.dynamics import InterpenetrationRow, SpinSeries
 def rows(seed_runs: dict, impulse_runs: dict | None = None) -> list[InterpenetrationRow]:
     """Interpenetration rows with these longest runs per case and response."""
     impulse_runs = impulse_runs or dict.fromkeys(seed_runs, 0)
-    return [InterpenetrationRow(case, response, 1000, 3 * run, run, 2)
+    return [InterpenetrationRow(engine=bounce.REFSIM, case=case, response=response, frames=1000,
+                                interpenetrating=3 * run, longest_run=run, contacts=2)
             for response, runs in (("seed", seed_runs), ("impulse", impulse_runs))
             for case, run in runs.items()]
 
@@ -77,11 +78,11 @@ def test_c11_facts():
     assert facts["seed"]["chase"] == {"interpenetrating": 120, "frames": 1000, "longest_run": 40}
 
 
-def spin(model, at_rest, final=0.5) -> SpinSeries:
+def spin(model, at_rest, final=0.5, engine=bounce.REFSIM) -> SpinSeries:
     t = np.linspace(0.0, 6.0, 4)
-    return SpinSeries(model=model, t=t, spin=np.full(4, final), spin_normal=np.array([5., 5, 5, 4]),
-                      rotational_energy=np.ones(4), speed=np.zeros(4), final_spin=final,
-                      final_speed=0.0, at_rest=at_rest)
+    return SpinSeries(engine=engine, model=model, t=t, spin=np.full(4, final),
+                      spin_normal=np.array([5., 5, 5, 4]), rotational_energy=np.ones(4),
+                      speed=np.zeros(4), final_spin=final, final_speed=0.0, at_rest=at_rest)
 
 
 @pytest.mark.parametrize(("seed_rest", "corrected_rest", "verdict"), [
@@ -93,11 +94,14 @@ def test_c12_verdict(seed_rest, corrected_rest, verdict):
 
 def test_c12_facts():
     facts = c12([spin("seed", False, 4.2), spin("impulse", True, 1e-4),
-                 spin("pybullet", True, 2e-4)]).facts
+                 spin("pybullet", True, 2e-4, engine="pybullet")]).facts
     assert facts["seed_final_spin"] == 4.2 and facts["corrected_final_spin"] == 1e-4
     assert facts["seed_vertical_spin_start"] == 5.0 and facts["seed_vertical_spin_end"] == 4.0
     assert facts["pybullet_final_spin"] == 2e-4
     assert c12([spin("seed", False), spin("impulse", True)]).facts["pybullet_final_spin"] is None
+    # the models are refsim's: another engine's series of the same name is not the seed's
+    mixed = [spin("seed", True, engine="other"), spin("seed", False), spin("impulse", True)]
+    assert c12(mixed).verdict == "confirmed"
 
 
 def apex(body="sphere-2k.ac", rotation="off", error=1e-3, literal=0.02, ratio=0.64,

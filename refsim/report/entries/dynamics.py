@@ -126,29 +126,30 @@ def dynamics_step_cost(run: Run):
 def dynamics_spin(run: Run):
     """C12 runs its full 6 s in the quick report too: a shorter run stops
     before the corrected model comes to rest and would change the verdict.
-    pybullet runs the same scene in a client of its own (a second engine
-    built from the registry, not the run's shared one)."""
+    refsim runs the scene as posed, once per rotation model; pybullet runs
+    it with its own model, in a client of its own (a second engine built
+    from the registry, not the run's shared one)."""
     from refsim.bundled import scenes_dir
-    from refsim.dynamics.simulate import default_every
     from refsim.engines.registry import build
     from refsim.scenes.loader import load_scene
-    from refsim.studies import dynamics
+    from refsim.studies import bounce, dynamics
 
-    if run.optional("pybullet") is None:
-        return dynamics.measure_spin()
     scene = load_scene(scenes_dir() / SPIN_SCENE)
+    refsim = run.engine(bounce.REFSIM)
+    if run.optional("pybullet") is None:
+        return dynamics.measure_spin(scene, engines=[refsim])
     with build("pybullet") as oracle:
-        external = oracle.simulate(scene, every=default_every(scene.integration.n_steps))
-    return dynamics.measure_spin(scene, external=external)
+        return dynamics.measure_spin(scene, engines=[refsim, oracle])
 
 
 def dynamics_interpenetration(run: Run):
-    from refsim.studies import dynamics
+    from refsim.studies import bounce, dynamics
 
-    return dynamics.measure_interpenetration(duration=run.size(1.0, 2.0))
+    return dynamics.measure_interpenetration(engine=run.engine(bounce.REFSIM),
+                                             duration=run.size(1.0, 2.0))
 
 
 def dynamics_rotation_energy(run: Run):
-    from refsim.studies import dynamics
+    from refsim.studies import bounce, dynamics
 
-    return dynamics.measure_energy()
+    return dynamics.measure_energy(engine=run.engine(bounce.REFSIM))
