@@ -91,13 +91,7 @@ ROOT_NAMES = ("refsim.__version__",)
 
 #: Imports that break a rule today, each with the reason and whose work
 #: removes it: (importing module, imported module) -> why.
-ALLOWANCES: dict[tuple[str, str], str] = {
-    ("refsim.dynamics.simulation", "refsim.scenes.schema"):
-        "the simulation loop runs a Scene, so it belongs above the scenes, while the rest "
-        "of refsim.dynamics (forces, walls, impulses, mass properties) lies below them and "
-        "the scenes use it; the fix is to move the loop (simulation, start, energy, "
-        "compiled_loop, loop_layout) to a package above refsim.scenes",
-}
+ALLOWANCES: dict[tuple[str, str], str] = {}
 
 
 def _is(name: str, prefix: str) -> bool:

@@ -46,6 +46,19 @@ STAGES = ("integrate", "rotation", "check", "bounds", "walls", "broad-phase", "n
           "body-response")
 
 
+#: The types a simulation runs (:func:`refsim.dynamics.simulation.check_scene`).
+#: The scenes lie above the dynamics, which cannot import them, so
+#: :mod:`refsim.scenes.schema` adds its Scene here as it is imported
+#: (:func:`register_scene_type`): any Scene that exists was made after that.
+SCENE_TYPES: list[type] = []
+
+
+def register_scene_type(kind: type) -> None:
+    """Add ``kind`` to :data:`SCENE_TYPES` (once)."""
+    if kind not in SCENE_TYPES:
+        SCENE_TYPES.append(kind)
+
+
 def resolve_wall_response(dynamics) -> str:
     """``dynamics.wall_response`` with "auto" resolved: the corrected wall
     impulses when the rotation model is the corrected one, else the seed's

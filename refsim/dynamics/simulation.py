@@ -92,7 +92,6 @@ from refsim.errors import ArgumentTypeError, StateError, check_count, check_opti
 from refsim.kernels import FREE_ROTATION_STEPS, choose_kernel
 from refsim.limits import MAX_STEPS
 from refsim.models.mesh import Mesh
-from refsim.scenes.schema import Scene
 from refsim.signals import SignalHold, held_signals
 from refsim.solvers.explicit_rk import rk_step
 from refsim.solvers.integrate import resolve_method
@@ -151,8 +150,11 @@ def _plan_field(name: str) -> property:
 
 
 def check_scene(scene) -> None:
-    """Raises ArgumentTypeError unless ``scene`` is a :class:`refsim.Scene`."""
-    if not isinstance(scene, Scene):
+    """Raises ArgumentTypeError unless ``scene`` is a :class:`refsim.Scene`
+    (a type of :data:`refsim.dynamics.plan.SCENE_TYPES`)."""
+    from refsim.dynamics.plan import SCENE_TYPES
+
+    if not isinstance(scene, tuple(SCENE_TYPES)):
         raise ArgumentTypeError(f"scene must be a refsim.Scene (refsim.load_scene(path)), "
                                 f"got {type(scene).__name__}")
 

@@ -166,6 +166,9 @@ class Scene:
         return values[0], values[1]
 
 
+plan.register_scene_type(Scene)       # the loop's check of its argument (it cannot import this)
+
+
 # -- the schema rows -------------------------------------------------------------
 
 Check = Callable[[Any], str | None]

@@ -110,3 +110,23 @@ def test_the_levels_are_none_and_the_collision_querys():
     from refsim.dynamics.plan import COLLISION_LEVELS
 
     assert COLLISION_LEVELS == ("none", *LEVELS)
+
+
+def test_the_loop_runs_the_scenes_type_without_importing_it():
+    # refsim.scenes.schema registers Scene with the loop's check; a copy of
+    # a scene's fields in another type is refused with the one-line message
+    from types import SimpleNamespace
+
+    from refsim.dynamics.plan import SCENE_TYPES
+    from refsim.dynamics.simulation import Simulation, check_scene
+    from refsim.errors import ArgumentTypeError
+    from refsim.scenes.schema import Scene
+
+    assert SCENE_TYPES == [Scene]
+    posed = scene()
+    check_scene(posed)
+    lookalike = SimpleNamespace(**{name: getattr(posed, name)
+                                   for name in posed.__dataclass_fields__})
+    with pytest.raises(ArgumentTypeError, match="scene must be a refsim.Scene .* got "
+                                                "SimpleNamespace"):
+        Simulation(lookalike)
