@@ -61,8 +61,8 @@ def incremental_update_numba(vertices_t, offsets, indices, rotation, translation
     Writes the box to ``lo``, ``hi`` and visits/evaluations to ``counts``.
 
     One flat function on purpose: numba passes arrays to a called function
-    with reference counting, which cost more than the arithmetic here (about
-    8 microseconds per update on the 2000-triangle sphere). So the memoized
+    with reference counting, which cost more than the arithmetic here, as
+    measured on the 2000-triangle sphere. So the memoized
     evaluation of ``r_k(v)`` is written out at its three sites (marked
     "evaluate"), identically.
     """

@@ -84,8 +84,8 @@ and a numba-compiled copy (``refsim[fast]``,
 :func:`refsim.collision._numba_kernels.exact_query`) that also certifies the
 pairs with the float filter as it finds them and can stop at the first hit.
 The compiled copy checks the poses itself (the checks of
-:func:`refsim.types.as_pose`), which keeps a query's fixed cost to a few
-microseconds. The two evaluate the same formulas but not always to the same
+:func:`refsim.types.as_pose`), which keeps a query's fixed cost small
+(docs/decisions/query-fixed-cost.md). The two evaluate the same formulas but not always to the same
 bits (numpy's matmul may sum in another order, or fuse): both errors are
 within the margin's bound, so both are right; their candidate lists differ
 only if a node pair lies within a few ulps of the margin, which the tests'

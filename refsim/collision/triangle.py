@@ -58,7 +58,7 @@ Structure of the test
    coplanarity test then an exact 2D segment test.
 
 Cost: O(1) per pair: at most 6 + 18 orient3d and a few dozen orient2d in the
-coplanar case. Pure Python, about 12 microseconds a pair on random input; use
+coplanar case. Pure Python, so the interpreter's cost per pair dominates; use
 ``refsim.collision.triangle_batch`` for many pairs.
 """
 

@@ -1,10 +1,10 @@
 """The compiled simulation loop: many steps of :meth:`Simulation.step
 <refsim.dynamics.simulation.Simulation.step>` in one numba call.
 
-Why: the readable step costs about 50 microseconds of interpreter work
-(a few dozen numpy calls, each a few hundred nanoseconds to a few
-microseconds) whatever the number of bodies; a step of a few cubes is a few
-hundred floating-point operations. Compiling each stage separately leaves
+Why: the readable step is a few dozen numpy calls, whose interpreter cost
+does not depend on the number of bodies, while a step of a few cubes is a
+few hundred floating-point operations (docs/decisions/compiled-loop.md
+measures both). Compiling each stage separately leaves
 the calls between them; this kernel runs the whole loop, K steps per call,
 for the common choices, and hands the rest back to the readable step.
 
@@ -135,7 +135,7 @@ from refsim.dynamics.rotation_seed import axes_step_seed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "e1e39012ab4c854f"
+SOURCES_DIGEST = "fa34161c2ec802a6"
 
 #: The kernel took every step it was asked for.
 DONE = 0
