@@ -260,7 +260,7 @@ def _particles(kernel):
 
 def _simulation_loop(kernel):
     from refsim.dynamics.simulation import Simulation
-    from refsim.studies.bounce import cubes_scene
+    from refsim.studies.bounce_scenes import cubes_scene
 
     out = []
     for rotation in ("off", "seed"):

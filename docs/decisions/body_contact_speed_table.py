@@ -55,7 +55,7 @@ def stages(count: int, steps: int) -> None:
     from test_bench_dynamics import contact_scene
 
     from refsim.dynamics.simulation import Simulation
-    from refsim.studies.bounce import SETTLE_STEPS
+    from refsim.studies.bounce_scenes import SETTLE_STEPS
 
     sim = Simulation(contact_scene(count), kernel="compiled")
     sim.advance(SETTLE_STEPS["cubes"])
@@ -84,7 +84,7 @@ def narrow(count: int) -> None:
     from refsim.dynamics.body_stage import narrow_phase_compiled
     from refsim.dynamics.products import matvec
     from refsim.dynamics.simulation import Simulation
-    from refsim.studies.bounce import SETTLE_STEPS
+    from refsim.studies.bounce_scenes import SETTLE_STEPS
     from refsim.types import ORTHONORMAL_TOL
 
     sim = Simulation(contact_scene(count), kernel="compiled")

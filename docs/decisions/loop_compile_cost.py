@@ -22,7 +22,7 @@ import tempfile
 PROBE = r"""
 import json, time
 from refsim.dynamics.simulation import Simulation
-from refsim.studies.bounce import cubes_scene
+from refsim.studies.bounce_scenes import cubes_scene
 sim = Simulation(cubes_scene(10, "seed"), kernel="compiled")
 t0, c0 = time.perf_counter(), time.process_time()
 sim.advance(1)

@@ -7,7 +7,7 @@ Each checkout is imported through ``PYTHONPATH`` (its own numba cache: run
 each once first to compile). Each round times, in a fresh process per
 checkout, ``Simulation.advance(2000)`` after 200 warm-up steps on the step
 benchmark's scenes (1, 10 and 40 cubes and the 2000-triangle sphere, each
-rotation model; refsim.studies.bounce.bench_scene), the fastest of three
+rotation model; refsim.studies.bounce_scenes.bench_scene), the fastest of three
 runs. Prints the median microseconds per step of each side and the median
 over the rounds of each scene's after/before ratio.
 """
@@ -23,7 +23,7 @@ import sys
 TIMER = r"""
 import time
 from refsim.dynamics.simulation import Simulation
-from refsim.studies.bounce import bench_scene
+from refsim.studies.bounce_scenes import bench_scene
 out = {}
 for bodies in ("1 cube", "10 cubes", "40 cubes", "sphere-2k"):
     for rotation in ("off", "seed", "impulse"):

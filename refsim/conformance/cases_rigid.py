@@ -98,7 +98,7 @@ centre of mass's, ``angular_velocity`` in the world frame.
 Reading a trajectory (:func:`lowest_height`, :func:`energy`): the height of
 the body's lowest vertex above the floor in every frame (from the frame's
 orientation, so a turning body is read correctly); apexes as
-:func:`refsim.studies.bounce.read_bounces` reads them (bounce where the
+:func:`refsim.studies.bounce_scenes.read_bounces` reads them (bounce where the
 vertical velocity turns upward, apex refined by the parabola through its
 frame and the neighbours); the energy from the centre of mass's height and
 velocity and ``w . I w / 2`` with the uniform solid's inertia.
@@ -729,8 +729,8 @@ def energy(scene: RigidScene, trajectory) -> np.ndarray:
 def apex_ratio(scene: RigidScene, trajectory) -> tuple[float, list[float]]:
     """Geometric-mean apex ratio over :data:`BOUNCES` bounces and the apex
     heights read (release first); nan when fewer bounces are found."""
-    from refsim.studies.bounce import apex_ratio as mean_ratio
-    from refsim.studies.bounce import read_bounces
+    from refsim.studies.bounce_scenes import apex_ratio as mean_ratio
+    from refsim.studies.bounce_scenes import read_bounces
 
     heights = lowest_height(scene, trajectory)
     bounces = read_bounces(trajectory.t, heights,

@@ -1,10 +1,10 @@
 """Speed of a simulation step: refsim (readable and compiled) beside pybullet
 and MuJoCo, the same scenes in the same run.
 
-Scenes (:func:`refsim.studies.bounce.bench_scene`): 1, 10 and 40 unit cubes
-on a grid with seeded random velocities (:func:`~refsim.studies.bounce.cubes_scene`,
+Scenes (:func:`refsim.studies.bounce_scenes.bench_scene`): 1, 10 and 40 unit cubes
+on a grid with seeded random velocities (:func:`~refsim.studies.bounce_scenes.cubes_scene`,
 collision level "aabb", the seed's body response) and one 2000-triangle
-sphere (:func:`~refsim.studies.bounce.sphere_scene`), for rotation "off",
+sphere (:func:`~refsim.studies.bounce_scenes.sphere_scene`), for rotation "off",
 "seed" and "impulse" (pybullet and MuJoCo always rotate: the rotation option
 is refsim's, the oracles run the same scene each time).
 
@@ -37,7 +37,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from refsim.studies.bounce import BENCH_BODIES, BENCH_ROTATIONS, SETTLE_STEPS, bench_scene
+from refsim.studies.bounce_scenes import BENCH_BODIES, BENCH_ROTATIONS, SETTLE_STEPS, bench_scene
 
 STEPS_PER_ROUND = 100
 ROUNDS = 15
@@ -242,7 +242,7 @@ FLIGHT_STEPS = 500
 
 
 def contact_scene(count: int):
-    """``count`` cubes of :func:`refsim.studies.bounce.cubes_scene` (the same
+    """``count`` cubes of :func:`refsim.studies.bounce_scenes.cubes_scene` (the same
     grid, seed and velocities) in the corrected model at the exact level."""
     from dataclasses import replace
 

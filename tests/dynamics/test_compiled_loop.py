@@ -18,7 +18,7 @@ from refsim.dynamics.compiled_loop import loop_support
 from refsim.dynamics.simulation import Simulation
 from refsim.errors import DivergenceError
 from refsim.scenes.loader import load_scene, scene_from_dict
-from refsim.studies.bounce import cubes_scene
+from refsim.studies.bounce_scenes import cubes_scene
 
 pytest.importorskip("numba")
 
@@ -166,7 +166,7 @@ def test_one_step_per_call_is_one_call_and_the_readable_step_bit_for_bit(case):
     # Simulation.advance's fast path (one kernel call, no signal hold) against
     # one advance of all the steps and against the readable step: the same
     # state, counts and events, with wall and body events and hand-backs
-    from refsim.studies.bounce import bench_scene
+    from refsim.studies.bounce_scenes import bench_scene
 
     if case == "exact level":
         scene, n = _two_cubes_at_level_exact(), 1000
@@ -599,7 +599,7 @@ def test_impulse_sphere_rolling_on_the_floor_bit_for_bit(monkeypatch):
     # vertices past it in almost every step (the leaves passed over, the
     # contact solve with a static wall), from the same state on both kernels
     from refsim.dynamics import impulse
-    from refsim.studies.bounce import SETTLE_STEPS, sphere_scene
+    from refsim.studies.bounce_scenes import SETTLE_STEPS, sphere_scene
 
     scene = sphere_scene("impulse")
     compiled = Simulation(scene, kernel="compiled")
@@ -635,7 +635,7 @@ def test_impulse_sphere_rolling_on_the_floor_bit_for_bit(monkeypatch):
 def _contact_scene(count: int, solver: str):
     """The body-contact benchmark's cubes (tests/benchmarks/test_bench_dynamics.py
     ``contact_scene``): exact level, every response "impulse", mu 0.3."""
-    from refsim.studies.bounce import bench_scene
+    from refsim.studies.bounce_scenes import bench_scene
 
     scene = bench_scene(f"{count} cubes", "impulse")[0]
     return replace(

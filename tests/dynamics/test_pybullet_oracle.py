@@ -9,7 +9,7 @@ from refsim.oracles.pybullet_adapter import PybulletOracle, mass_properties
 
 from refsim.dynamics import analytic
 from refsim.scenes.loader import scene_from_dict
-from refsim.studies.bounce import (
+from refsim.studies.bounce_scenes import (
     DROP_HEIGHT,
     GRAVITY,
     SPHERE,

@@ -268,7 +268,7 @@ def test_the_largest_moments_come_from_the_jacobi_frames_not_lapack():
 def test_bodies_with_one_inertia_tensor_share_one_jacobi_solve(monkeypatch):
     from refsim.dynamics import simulation as module
     from refsim.dynamics.rotation_impulse import principal_frame
-    from refsim.studies.bounce import cubes_scene
+    from refsim.studies.bounce_scenes import cubes_scene
 
     calls = []
 

@@ -174,7 +174,7 @@ def test_large_meshes_that_can_meet_are_not_timed(cold, tmp_path, monkeypatch):
 CACHED_LOOP_CHILD = r"""
 import json
 from refsim.dynamics.simulation import Simulation
-from refsim.studies.bounce import cubes_scene
+from refsim.studies.bounce_scenes import cubes_scene
 Simulation(cubes_scene(10, "seed"), kernel="compiled").advance(2)
 from refsim.dynamics._numba_kernels import advance
 print(json.dumps({"hits": sum(advance.stats.cache_hits.values()),
@@ -189,7 +189,7 @@ def test_a_second_process_loads_the_loop_from_numbas_cache():
     without compiling. (Its cold compile is timed by
     docs/decisions/loop_compile_cost.py, not here.)"""
     from refsim.dynamics._numba_kernels import advance
-    from refsim.studies.bounce import cubes_scene
+    from refsim.studies.bounce_scenes import cubes_scene
 
     Simulation(cubes_scene(3, "impulse"), kernel="compiled").advance(2)
     assert len(advance.signatures) == 1

@@ -49,7 +49,7 @@ def test_refsim_as_posed_runs_the_scene_with_its_own_or_the_seeds_wall_speed():
     import numpy as np
 
     from refsim.dynamics.simulate import simulate
-    from refsim.studies.bounce import drop_scene
+    from refsim.studies.bounce_scenes import drop_scene
 
     scene = drop_scene("cube.ac", 0.8, duration=1.2, rotation="seed")
     posed, literal = build("refsim"), build("refsim-seed-wall-speed")

@@ -14,17 +14,10 @@ from refsim.errors import StateError
 from refsim.studies.bounce import (
     ANALYTIC,
     APEX_CASE,
-    BOUNCES,
-    CUBE,
-    DROP_HEIGHT,
-    GRAVITY,
     OBLIQUE_CASES,
     REFSIM,
     REST_CASE,
     SEED_WALL_SPEED,
-    SPHERE,
-    STEP,
-    apex_ratio,
     by_case,
     measure_apex_drop,
     measure_cost,
@@ -32,6 +25,15 @@ from refsim.studies.bounce import (
     measure_oblique,
     measure_rest,
     measure_step_cost,
+)
+from refsim.studies.bounce_scenes import (
+    BOUNCES,
+    CUBE,
+    DROP_HEIGHT,
+    GRAVITY,
+    SPHERE,
+    STEP,
+    apex_ratio,
     read_bounces,
 )
 

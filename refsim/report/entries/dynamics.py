@@ -113,13 +113,14 @@ def dynamics_pybullet_settings(run: Run):
 
 def dynamics_step_cost(run: Run):
     from refsim.studies import bounce
+    from refsim.studies.bounce_scenes import BENCH_COUNTS, LATE_WARMUP
 
     peers = _engines(run, refsim=False)
     rows = bounce.measure_step_cost(steps=run.size(50, 200), warmup=run.size(10, 20),
                                     repeats=run.size(3, 5), engines=peers)
     if not run.quick:
-        rows += bounce.measure_step_cost(counts=(bounce.BENCH_COUNTS[-1],),
-                                         warmup=bounce.LATE_WARMUP, repeats=3, engines=peers)
+        rows += bounce.measure_step_cost(counts=(BENCH_COUNTS[-1],),
+                                         warmup=LATE_WARMUP, repeats=3, engines=peers)
     return rows
 
 
