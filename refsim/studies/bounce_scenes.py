@@ -184,8 +184,6 @@ def settle_time(bounces: Bounces, h0: float, fraction: float = REST_FRACTION) ->
 #: Body counts and rotation models of the step benchmarks (the seed's
 #: "1 to 40 in this simulation"), of the report's and of ``make bench``.
 BENCH_COUNTS = (1, 10, 40)
-
-
 BENCH_ROTATIONS = ("off", "seed", "impulse")
 #: Steps before timing the "late" phase: by then the cubes have settled on
 #: the floor (restitution 0.8, friction 0.1) and Bullet has many contacts.
@@ -199,8 +197,6 @@ def cubes_scene(count: int, rotation: str = "off", *, seed: int = BENCH_SEED,
     """``count`` unit cubes on a grid in the world cube (spacing 2.2, at
     least 1.2 between faces), random velocities in [-3, 3]^3 m/s (seeded),
     collision level "aabb", the seed's body response."""
-    from refsim.scenes.loader import scene_from_dict
-
     rng = np.random.default_rng(seed)
     side = math.ceil(count ** (1.0 / 3.0) - 1e-9)
     spacing = 2.2
@@ -212,6 +208,14 @@ def cubes_scene(count: int, rotation: str = "off", *, seed: int = BENCH_SEED,
                        "position": [offset + spacing * i, offset + spacing * j,
                                     offset + spacing * k],
                        "velocity": [float(x) for x in rng.uniform(-3.0, 3.0, 3)]})
+    return _bench_world(bodies, rotation, step, duration, solver)
+
+
+def _bench_world(bodies: list, rotation: str, step: float, duration: float, solver: str):
+    """The step benchmarks' world (e = 0.8, friction 0.1, level "aabb", the
+    seed's body response) holding the ``[[body]]`` tables ``bodies``."""
+    from refsim.scenes.loader import scene_from_dict
+
     return scene_from_dict({
         "world": {"half_size": HALF_SIZE, "gravity": GRAVITY, "restitution": 0.8,
                   "friction": 0.1},
@@ -235,17 +239,8 @@ def sphere_scene(rotation: str = "off", *, step: float = STEP, duration: float =
     world cube at (2, 1, -1.5) m/s, with :func:`cubes_scene`'s world (e = 0.8,
     friction 0.1), collision level "aabb"; it rests on the floor after about
     10 s."""
-    from refsim.scenes.loader import scene_from_dict
-
-    return scene_from_dict({
-        "world": {"half_size": HALF_SIZE, "gravity": GRAVITY, "restitution": 0.8,
-                  "friction": 0.1},
-        "integration": {"solver": solver, "step": step, "duration": duration},
-        "collision": {"level": "aabb"},
-        "dynamics": {"rotation": rotation, "body_response": "seed"},
-        "body": [{"name": "ball", "model": SPHERE, "position": [0.0, 0.0, 0.0],
-                  "velocity": [2.0, 1.0, -1.5]}],
-    })
+    return _bench_world([{"name": "ball", "model": SPHERE, "position": [0.0, 0.0, 0.0],
+                          "velocity": [2.0, 1.0, -1.5]}], rotation, step, duration, solver)
 
 
 def bench_scene(bodies: str, rotation: str):
