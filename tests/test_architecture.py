@@ -303,6 +303,8 @@ def test_a_name_lies_in_its_package_or_the_root():
     ("refsim.engines.refsim_engines", "refsim.oracles.fcl_adapter", True),
     ("refsim.engines.refsim_engines", "refsim.sweep.run", True),
     ("refsim.conformance.cases_rigid", "refsim.studies.bounce", False),
+    ("refsim.conformance.cases_rigid", "refsim.studies.bounce_scenes", False),
+    ("refsim.studies.bounce_scenes", "refsim.conformance.cases_rigid", True),
     ("refsim.studies.bounce", "refsim.conformance.cases_rigid", True),
     ("refsim.conformance.matrix", "refsim.claims.bounds", True),
     ("refsim.report.tasks", "refsim.viewer.demos", False),

@@ -62,7 +62,8 @@ def incremental_update_numba(vertices_t, offsets, indices, rotation, translation
 
     One flat function on purpose: numba passes arrays to a called function
     with reference counting, which cost more than the arithmetic here, as
-    measured on the 2000-triangle sphere. So the memoized
+    measured on the 2000-triangle sphere (docs/decisions/compiled-loop.md
+    weighs the same counting in the simulation loop). So the memoized
     evaluation of ``r_k(v)`` is written out at its three sites (marked
     "evaluate"), identically.
     """

@@ -47,11 +47,11 @@ STEP_COST_TARGET = 2.0
 #: engine's rows under its name; the findings and divergences speak of this one.
 ORACLE = "pybullet"
 
-#: The cube of the bounce studies (refsim.studies.bounce.CUBE).
+#: The cube of the bounce studies (refsim.studies.bounce_scenes.CUBE).
 CUBE = "cube.ac"
 
 #: refsim's accuracy target for the bounce: with rotation off, at the
-#: reference step and solver (refsim.studies.bounce.STEP, SOLVER), each apex
+#: reference step and solver (refsim.studies.bounce_scenes.STEP, SOLVER), each apex
 #: ratio within this relative error of e^2.
 APEX_RATIO_TARGET = 0.005
 
@@ -109,6 +109,9 @@ def c12(spin: Sequence[SpinSeries]) -> ClaimResult:
     the seed's model is not at rest at the end and the corrected one is;
     partly when neither is; refuted when the seed's model comes to rest."""
     ours = {s.model: s for s in spin if s.engine == bounce.REFSIM}
+    if not {"seed", "impulse"} <= set(ours):
+        raise ValueError(f"C12 needs refsim's seed and impulse spin series; the runs hold "
+                         f"{sorted({(s.engine, s.model) for s in spin})}")
     seed, corrected = ours["seed"], ours["impulse"]
     theirs = next((s for s in spin if s.engine == ORACLE), None)
     if not seed.at_rest and corrected.at_rest:

@@ -9,8 +9,8 @@ tests/dynamics/test_compiled_loop.py checks whole trajectories).
   vertices past it, the push-back, the speed at the wall, the contact
   solve compiled from its readable source, a bounce carried on from its
   instant);
-- :func:`wall_speed`, :func:`origin`, :func:`world_inertia`: the small
-  pieces the loop's own stages share with these.
+- :func:`wall_speed`, :func:`world_inertia`: the small pieces the loop's
+  own stages share with these (:func:`origin` is theirs alone).
 
 Seed sections: S7, S9 and their correction (D1, D6).
 

@@ -26,6 +26,18 @@ def default_every(n_steps: int) -> int:
     return max(1, math.ceil(n_steps / MAX_FRAMES))
 
 
+def with_duration(scene, duration: float | None):
+    """``scene`` run for ``duration`` seconds instead of its
+    ``integration.duration`` (unchanged when ``duration`` is None); refused
+    (StateError) unless it is a whole number of the scene's steps, before
+    any work."""
+    if duration is None:
+        return scene
+    duration = check_number("duration", duration)
+    whole_steps(duration, scene.integration.step)
+    return replace(scene, integration=replace(scene.integration, duration=duration))
+
+
 def simulate(scene, *, every: int | None = None, duration: float | None = None,
              wall_speed: str | None = None, boxes: str = "auto",
              sink: FrameSink | None = None, kernel: str | None = None) -> Trajectory:
@@ -64,10 +76,7 @@ def simulate(scene, *, every: int | None = None, duration: float | None = None,
         ``every`` that is not an integer >= 1.
     """
     check_scene(scene)
-    if duration is not None:
-        duration = check_number("duration", duration)
-        whole_steps(duration, scene.integration.step)          # refuse before any work
-        scene = replace(scene, integration=replace(scene.integration, duration=duration))
+    scene = with_duration(scene, duration)
     n_steps = scene.integration.n_steps
     every = default_every(n_steps) if every is None else check_count("every", every, 1)
     if sink is None:

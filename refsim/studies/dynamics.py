@@ -34,7 +34,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from refsim.dynamics.energy import trajectory_energy
-from refsim.dynamics.simulate import default_every
+from refsim.dynamics.simulate import default_every, with_duration
 from refsim.dynamics.simulation import Simulation
 from refsim.dynamics.trajectory import Trajectory
 from refsim.engines import engine_name
@@ -58,19 +58,6 @@ def _scene_from(data: dict):
     from refsim.scenes.loader import scene_from_dict
 
     return scene_from_dict(data)
-
-
-def _with_duration(scene, duration: float | None):
-    """``scene`` run for ``duration`` seconds (a whole number of its steps)
-    instead of its own, when given: every engine receives the same scene."""
-    if duration is None:
-        return scene
-    from refsim.errors import check_number
-    from refsim.solvers.integrate import whole_steps
-
-    duration = check_number("duration", duration)
-    whole_steps(duration, scene.integration.step)          # refused before any run
-    return replace(scene, integration=replace(scene.integration, duration=duration))
 
 
 def _default_engines(engines) -> tuple:
@@ -143,21 +130,26 @@ def measure_spin(scene=None, *, engines=None, duration: float | None = None,
     once, as its own model, under its own name. Frames are kept every
     :func:`refsim.dynamics.simulate.default_every` steps for every engine.
     """
-    scene = _with_duration(scene or _scene("spinning-cube.toml"), duration)
+    scene = with_duration(scene or _scene("spinning-cube.toml"), duration)
     every = default_every(scene.integration.n_steps)
+    # each series by (engine, its model), refused before any run when two
+    # engines would give a series of one name (the report draws them by name)
+    runs = [(engine, engine_name(engine), model)
+            for engine in _default_engines(engines)
+            for model in (rotations if poses_models(engine) else (engine_name(engine),))]
+    names: dict[str, str] = {}
+    for _, name, model in runs:
+        if model in names:
+            raise StateError(f"engines {names[model]!r} and {name!r} both give a spin "
+                             f"series named {model!r}; give one of them")
+        names[model] = name
     rows: list[SpinSeries] = []
-    for engine in _default_engines(engines):
-        name = engine_name(engine)
+    for engine, name, model in runs:
         if not poses_models(engine):
-            traj = engine.simulate(scene, every=every)
-            rows.append(_spin_series(name, name, scene, traj))
+            rows.append(_spin_series(name, model, scene, engine.simulate(scene, every=every)))
             continue
-        for model in rotations:
-            s = replace(scene, dynamics=replace(scene.dynamics, rotation=model))
-            rows.append(_spin_series(name, model, s, engine.simulate(s, every=every)))
-    labels = [row.model for row in rows]
-    if len(set(labels)) != len(labels):
-        raise StateError(f"two engines give a series of one name: {labels}")
+        s = replace(scene, dynamics=replace(scene.dynamics, rotation=model))
+        rows.append(_spin_series(name, model, s, engine.simulate(s, every=every)))
     return rows
 
 
@@ -289,7 +281,7 @@ def measure_energy(scene=None, *, engine=None, duration: float | None = None,
     ``scenes/spinning-cube.toml``), one series per rotation model, run by
     ``engine`` (default: refsim as posed; it must pose the scene's
     rotation), a frame every 10 steps."""
-    scene = _with_duration(scene or _scene("spinning-cube.toml"), duration)
+    scene = with_duration(scene or _scene("spinning-cube.toml"), duration)
     engine = _posing_engine(engine)
     rows = []
     for model in models:

@@ -296,3 +296,10 @@ def test_divergences_are_classed():
     assert found[2]["bounces"] == [{"v_t": 2.0, "refsim": 1.4, "pybullet": 1.0,
                                     "coulomb": 1.25}]
     assert divergences([], []) == []
+
+
+def test_c12_without_refsims_two_series_says_what_it_has():
+    with pytest.raises(ValueError, match=r"C12 needs refsim's seed and impulse spin series; "
+                                         r"the runs hold \[\('other', 'seed'\), "
+                                         r"\('refsim', 'impulse'\)\]"):
+        c12([spin("seed", False, engine="other"), spin("impulse", True)])

@@ -145,7 +145,7 @@ def test_a_divergence_naming_its_body_twice_is_a_bad_message():
 
 
 TRACEBACK = '''Traceback (most recent call last):
-  File "/x/refsim/cli.py", line 220, in main
+  File "/x/refsim/cli/app.py", line 220, in main
   File "/x/refsim/scenes/loader.py", line 51, in load_scene
   File "/usr/lib/python3.11/tomllib/_parser.py", line 144, in loads
 RecursionError: maximum recursion depth exceeded
@@ -156,7 +156,7 @@ DUMP = '''Fatal Python error: Segmentation fault
 Current thread 0x0001 (most recent call first):
   File "/x/site-packages/scipy/spatial/_qhull.py", line 9 in __init__
   File "/x/refsim/models/mesh.py", line 290 in is_convex
-  File "/x/refsim/cli.py", line 39 in _info
+  File "/x/refsim/cli/run.py", line 39 in info_command
 '''
 
 

@@ -7,7 +7,7 @@ import pytest
 
 from refsim.dynamics.choices import choices
 from refsim.dynamics.simulate import simulate
-from refsim.engines.refsim_engines import as_posed
+from refsim.engines.refsim_engines import as_posed, as_posed_seed_wall_speed
 from refsim.engines.refsim_engines import seed as seed_engine
 from refsim.errors import StateError
 from refsim.studies.dynamics import (
@@ -80,9 +80,14 @@ def test_an_engine_with_its_own_model_runs_the_scene_once_under_its_name():
     assert not np.array_equal(rows[1].spin, rows[0].spin)
 
 
-def test_two_series_of_one_name_are_refused():
-    with pytest.raises(StateError, match="two engines give a series of one name"):
-        measure_spin(engines=[as_posed(), as_posed()], duration=0.1)
+def test_two_series_of_one_name_are_refused_before_any_run():
+    # refsim as posed and with the seed's wall speed both pose the scene's
+    # rotation models: their "seed" series would share a name in the chart
+    own = OwnModel()
+    with pytest.raises(StateError, match="engines 'refsim' and 'refsim-seed-wall-speed' both "
+                                         "give a spin series named 'seed'"):
+        measure_spin(engines=[own, as_posed(), as_posed_seed_wall_speed()], duration=0.1)
+    assert own.given == []                              # nothing ran
 
 
 @pytest.mark.parametrize("study", [measure_interpenetration, measure_energy])
