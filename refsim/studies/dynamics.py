@@ -78,7 +78,10 @@ def poses_models(engine) -> bool:
 def _posing_engine(engine):
     """``engine`` (default: refsim as posed), refused unless it poses the
     scene's own models: the study varies one of them."""
-    (engine,) = _default_engines(None if engine is None else (engine,))
+    if engine is None:
+        from refsim.engines.refsim_engines import as_posed
+
+        engine = as_posed()
     if not poses_models(engine):
         raise StateError(f"engine {engine_name(engine)!r} runs a model of its own; this "
                          f"study varies the scene's model and needs an engine that poses "
@@ -145,11 +148,9 @@ def measure_spin(scene=None, *, engines=None, duration: float | None = None,
         names[model] = name
     rows: list[SpinSeries] = []
     for engine, name, model in runs:
-        if not poses_models(engine):
-            rows.append(_spin_series(name, model, scene, engine.simulate(scene, every=every)))
-            continue
-        s = replace(scene, dynamics=replace(scene.dynamics, rotation=model))
-        rows.append(_spin_series(name, model, s, engine.simulate(s, every=every)))
+        posed = (replace(scene, dynamics=replace(scene.dynamics, rotation=model))
+                 if poses_models(engine) else scene)
+        rows.append(_spin_series(name, model, posed, engine.simulate(posed, every=every)))
     return rows
 
 
