@@ -3,18 +3,26 @@ over trees built by candidate split rules, on the generated family of
 tests/benchmarks/test_bench_mesh_family.py (every mesh and pose) and the
 configurations of docs/decisions/query-fixed-cost.md's split table.
 
-    .venv/bin/python docs/decisions/split_rule_trials.py RULE [TIE]
+    .venv/bin/python docs/decisions/split_rule_trials.py RULE [TIE [SMALL]]
 
 RULE: ``least-volume`` (the rule before its tie-break), ``obb-area`` (the
 least total oriented-box area of the halves), ``volume-then-area`` (among
-the axes within TIE of the least volume, default 0.1, the least area: with
-TIE 0.1 the rule kept in bvh_exact.least_volume_split). Prints ``rule |
-case | node pairs``, one line a case. The trees are built by the readable
-build with the rule (seconds a mesh).
+the axes within TIE of the least volume, default 0.1, the least area, each
+half's box along the half's own principal axes: with TIE 0.1 the rule
+bvh_exact.least_volume_split kept until the node-frame split),
+``node-frame-volume-then-area`` (the same with every half's box along the
+node's principal axes in a node of at most SMALL triangles, default
+bvh_exact.SMALL_NODE: with TIE 0.1 and the default, the rule kept in
+bvh_exact.least_volume_split; with SMALL 0 every half is measured in its
+own frame, the rule before, and with SMALL above the largest mesh every
+half in its node's frame). Prints ``rule | case | node pairs``,
+one line a case. The trees are built by the readable build with the rule
+(seconds a mesh).
 """
 
 from __future__ import annotations
 
+import functools
 import sys
 from pathlib import Path
 
@@ -100,9 +108,11 @@ def _arrays(name):
     return family._arrays(name)
 
 
-def main(rule_name: str, tie: float = 0.1) -> None:
+def main(rule_name: str, tie: float = 0.1, small: int = bvh_exact.SMALL_NODE) -> None:
     rule = {"least-volume": least_volume, "obb-area": obb_area,
-            "volume-then-area": volume_then_area(tie)}[rule_name]
+            "volume-then-area": volume_then_area(tie),
+            "node-frame-volume-then-area": functools.partial(bvh_exact.least_volume_split,
+                                                             tie=tie, small=small)}[rule_name]
     meshes: dict[str, Mesh] = {}
     for label, name_a, name_b, pose_a, pose_b in _cases():
         for name in (name_a, name_b):
@@ -117,4 +127,4 @@ def main(rule_name: str, tie: float = 0.1) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], *(float(x) for x in sys.argv[2:]))
+    main(sys.argv[1], *(float(x) for x in sys.argv[2:3]), *(int(x) for x in sys.argv[3:4]))

@@ -20,7 +20,7 @@ Interference Detection", SIGGRAPH 1996):
    thick as the patch is wide: on the separated sphere benchmark the query
    visited 117 node pairs against 751 with axis-aligned node boxes, 2185
    against 4025 on the deep one (both over the least-area tree of
-   :mod:`refsim.collision.bvh`; the least-volume split visits 127 and 2251
+   :mod:`refsim.collision.bvh`; the least-volume split visits 127 and 2255
    there, and 25 instead of 247 on two linked tori).
 2. A query expresses body b in a's frame, ``x_a = M x_b + u`` with
    ``M = Ra^T Rb`` and ``u = Ra^T (tb - ta)``, and a pair of nodes in the
@@ -110,8 +110,9 @@ twin (:func:`build_frame_tree_compiled`, :mod:`refsim.collision._numba_build`),
 chosen by ``kernel=`` like the query and equal to it bit for bit
 (tests/collision/test_tree_build.py); both without BLAS or LAPACK, so a
 mesh has the same tree on every machine.
-Cost: O(m log m) once per mesh for the tree and its boxes (seven 3x3
-eigenproblems per node: the six candidate halves of the split and the box);
+Cost: O(m log m) once per mesh for the tree and its boxes (3x3
+eigenproblems: seven for a node of more than SMALL_NODE triangles, the six
+candidate halves of the split and the box, two for a smaller one);
 per query about O(k log m) node
 tests for k overlapping node pairs, plus O(1) per vertex and triangle of the
 leaves reached. The speed against FCL is measured in
@@ -292,8 +293,7 @@ def box_volume(points: np.ndarray) -> float:
 def box_sides(points: np.ndarray) -> np.ndarray:
     """(3,): the side lengths of the box about ``points`` (k, 3) along their
     principal axes."""
-    projected = project(points, principal_axes(points))
-    return projected.max(axis=0) - projected.min(axis=0)
+    return _extents(project(points, principal_axes(points)))
 
 
 def box_area(sides: np.ndarray) -> float:
@@ -307,15 +307,22 @@ def box_area(sides: np.ndarray) -> float:
 #: (docs/decisions/tree-build.md, the trials of the split rule).
 VOLUME_TIE = 0.1
 
+#: :func:`least_volume_split` measures the candidate halves of a node of at
+#: most this many triangles along the node's own principal axes
+#: (docs/decisions/tree-build.md, the node-frame split).
+SMALL_NODE = 64
 
-def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int) -> np.ndarray:
+
+def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int, *,
+                       tie: float = VOLUME_TIE, small: int = SMALL_NODE) -> np.ndarray:
     """``members`` ranked by centroid along one of the node's three principal
     axes, chosen by the oriented boxes of its halves ``[:mid]`` and
     ``[mid:]``: among the axes whose halves' total box volume is within
-    VOLUME_TIE of the least, the one whose halves' total box area is least
-    (a split rule for :func:`refsim.collision.bvh.build_tree`; the
-    triangles' vertices stand for the points, shared ones counted once per
-    triangle).
+    ``tie`` of the least, the one whose halves' total box area is least (a
+    split rule for :func:`refsim.collision.bvh.build_tree`; the triangles'
+    vertices stand for the points, shared ones counted once per triangle).
+    The trials of docs/decisions/split_rule_trials.py vary ``tie`` and
+    ``small``.
 
     Splitting across the longest principal axis (OBBTree's rule) keeps a
     tube's segments short, which the least-area split of axis-aligned boxes
@@ -326,22 +333,43 @@ def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int) -> 
     into two flat rings (each as wide as the whole) or into two arcs (each
     half as wide). The area tells them apart; without it the tree of a
     torus about z was a stack of flat rings, and two such tori linked cost
-    20 times the node pairs (docs/decisions/tree-build.md)."""
+    20 times the node pairs (docs/decisions/tree-build.md).
+
+    Each half's box is along the half's own principal axes, except in a node
+    of at most ``small`` triangles, where all six are along the node's: one
+    eigenproblem for such a node's split instead of six, where most of the nodes
+    and most of the build's time are, for about as many node pairs in the
+    queries (docs/decisions/tree-build.md, the node-frame split). Over the
+    whole tree the node's frame chose worse: a sphere's cap cut into
+    halves that rest badly on a cube, half as many node pairs again."""
     points = triangles[members]
-    centroids = project(points.mean(axis=1), principal_axes(points.reshape(-1, 3)))
+    axes = principal_axes(points.reshape(-1, 3))
+    centroids = project(points.mean(axis=1), axes)
+    if len(members) <= small:
+        projected = project(points.reshape(-1, 3), axes).reshape(len(members), 3, 3)
+
+        def sides(part: np.ndarray) -> np.ndarray:
+            return _extents(projected[part].reshape(-1, 3))
+    else:
+        def sides(part: np.ndarray) -> np.ndarray:
+            return box_sides(points[part].reshape(-1, 3))
     volumes, areas, rankings = [], [], []
     for axis in range(3):
         # stable tie-break by index, so the same mesh always gives the same tree
         ranked = np.lexsort((members, centroids[:, axis]))
-        first = box_sides(points[ranked[:mid]].reshape(-1, 3))
-        second = box_sides(points[ranked[mid:]].reshape(-1, 3))
+        first, second = sides(ranked[:mid]), sides(ranked[mid:])
         volumes.append(float(np.prod(first)) + float(np.prod(second)))
         areas.append(box_area(first) + box_area(second))
         rankings.append(ranked)
-    bound = min(volumes) * (1.0 + VOLUME_TIE)
+    bound = min(volumes) * (1.0 + tie)
     tied = [axis for axis in range(3) if volumes[axis] <= bound]
     best = min(tied, key=lambda axis: areas[axis])    # area ties keep the lower axis
     return members[rankings[best]]
+
+
+def _extents(projected: np.ndarray) -> np.ndarray:
+    """(3,): the side lengths of the box about projected points (k, 3)."""
+    return projected.max(axis=0) - projected.min(axis=0)
 
 
 def frame_topology_of(mesh, kernel: str | None = None) -> TriangleTree:

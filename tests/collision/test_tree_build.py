@@ -10,6 +10,8 @@ axes)."""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import pytest
 import trimesh
@@ -165,6 +167,23 @@ def test_any_array_layout_builds_the_same_tree_by_one_compiled_signature():
 
 def test_the_compiled_split_ties_volumes_as_the_readable_one():
     assert bvh.build_kernels().VOLUME_TIE == bvh_exact.VOLUME_TIE
+
+
+def test_the_compiled_split_measures_small_nodes_in_their_frame_as_the_readable_one():
+    """Both builds measure the halves of a node of at most SMALL_NODE
+    triangles in the node's frame; the meshes compared above have nodes on
+    both sides of it (icosphere-3: 1280 triangles, leaves of 4)."""
+    assert bvh.build_kernels().SMALL_NODE == bvh_exact.SMALL_NODE
+    assert bvh.LEAF_SIZE < bvh_exact.SMALL_NODE < 1280
+    mesh = _mesh("icosphere-3")
+    ours = bvh.build_tree(mesh.vertices, mesh.faces, split=bvh_exact.least_volume_split)
+    own_frames = bvh.build_tree(mesh.vertices, mesh.faces,
+                                split=functools.partial(bvh_exact.least_volume_split, small=0))
+    large = ours.count > bvh_exact.SMALL_NODE       # split in the halves' own frames: the same
+    assert large.sum() > 10
+    for array in ("left", "right", "start", "count"):
+        assert np.array_equal(getattr(ours, array)[large], getattr(own_frames, array)[large])
+    assert not np.array_equal(ours.order, own_frames.order)     # the small ones split otherwise
 
 
 def test_a_ring_is_cut_into_arcs_not_into_flat_rings():
