@@ -83,6 +83,30 @@ def test_exact_weld_treats_negative_zero_as_zero():
     assert not np.signbit(mesh.vertices[0]).any()
 
 
+def test_exact_weld_and_edges_are_numpys_unique_of_the_rows():
+    """The weld ranks rows by lexsort and the edges are unique 1-d keys;
+    both give what np.unique of the rows (axis=0) defines: each vertex
+    welded to the lowest index of its equal rows, edges in row order.
+    Seeded soup: 600 triangles over 150 distinct points, drawn from a
+    small grid so that rows tie in one or two coordinates, half of the
+    zeros negative."""
+    rng = np.random.default_rng(11)
+    points = rng.integers(-2, 3, size=(150, 3)).astype(float)
+    points[rng.random(points.shape) < 0.5] *= -1.0             # -0.0 among the zeros
+    faces = rng.integers(0, len(points), size=(600, 3))
+    mesh = Mesh(points, faces)
+    canonical = points + 0.0
+    _, first, inverse = np.unique(canonical, axis=0, return_index=True, return_inverse=True)
+    welded = first[inverse.ravel()][faces]
+    used = np.unique(welded)
+    assert np.array_equal(mesh.vertices, points[used])
+    assert np.array_equal(mesh.faces, np.searchsorted(used, welded))
+    f = mesh.faces
+    pairs = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    assert np.array_equal(mesh.edges, np.unique(pairs[pairs[:, 0] != pairs[:, 1]], axis=0))
+    assert len(mesh.edges) > 500
+
+
 def test_exact_weld_keeps_nearby_vertices_apart():
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [np.nextafter(1.0, 2.0), 0, 0], [1, 1, 0]])
     mesh = Mesh(v, [[0, 1, 2], [3, 4, 2]])
