@@ -49,11 +49,11 @@ Measured against FCL: docs/decisions/tree-build.md.
 
 Cost: the least-volume split forms, at each node of k > SMALL_NODE
 triangles, the covariances of its six candidate halves (a few passes over
-9k points) and solves six 3 x 3 eigenproblems; at a smaller node, one
-covariance and one eigenproblem (the node's own, when its parent was small
-too) and one projection of its 3k points: O(k) a node, O(m log m) for the
-tree of m triangles (ranking is O(k) a node for keys spread evenly, O(k log k) at
-worst); the node boxes add O(k) and one eigenproblem a node. Each function
+9k points) and solves six 3 x 3 eigenproblems; a smaller node measures
+the same halves' points along its own axes, with one covariance and one
+eigenproblem (its own) when its parent was small too: O(k) a node,
+O(m log m) for the tree of m triangles (ranking is O(k) a node for keys
+spread evenly, O(k log k) at worst); the node boxes add O(k) and one eigenproblem a node. Each function
 here says which readable function it mirrors.
 
 This module imports numba at import time; import it only when the compiled
@@ -91,7 +91,7 @@ LEAST_AREA, LEAST_VOLUME = 0, 1
 VOLUME_TIE = 0.1
 
 #: bvh_exact.SMALL_NODE: nodes of at most this many triangles measure their
-#: candidate halves in the node's frame (:func:`halves_in_node_frame`).
+#: candidate halves in the node's frame (:func:`least_volume_split`).
 SMALL_NODE = 64
 
 #: Runs of at most this many keys are ranked by insertion sort.
@@ -273,15 +273,17 @@ NODE = 6
 @numba.njit(cache=True)
 def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
     """Mirrors: bvh_exact.least_volume_split, of ``members[:k]``: returns
-    ``(axis, children_known)``, the chosen axis, whose order (positions in
+    ``(axis, children_known)``: the chosen axis, whose order (positions in
     members) is ``ranked[axis]``, and whether the principal axes of its
-    halves are in ``axes[2 axis]`` and ``axes[2 axis + 1]`` (a node of more
-    than SMALL_NODE triangles: :func:`halves_in_own_frames`) or not
-    (:func:`halves_in_node_frame`).
+    halves were found (``axes[2 axis]`` and ``axes[2 axis + 1]``: a node of
+    more than SMALL_NODE triangles, whose halves are measured each in its
+    own frame; a smaller node measures them in its own, ``axes[NODE]``).
 
     The node's own principal axes are those of the half its parent chose
     (the same triangles in the same order): given in ``axes[NODE]`` when
-    ``known``, else computed."""
+    ``known``, else computed. The six halves' covariances are formed first
+    and their eigenvectors found together (:func:`symmetric_eigenvectors`),
+    then their volumes and areas compared (:func:`chosen_axis`)."""
     x, y, z, keys, ranked, bucket, counts, a, axes = work
     if not known:
         for i in range(k):
@@ -301,37 +303,24 @@ def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
         keys[0, r] = project(c0, c1, c2, a00, a10, a20)
         keys[1, r] = project(c0, c1, c2, a01, a11, a21)
         keys[2, r] = project(c0, c1, c2, a02, a12, a22)
-    if k > SMALL_NODE:
-        return halves_in_own_frames(tx, ty, tz, members, k, mid, work, axes_work), True
-    if known:                                 # the node's points, as the root's are
-        for i in range(k):
-            ranked[0, i] = i
-        gather(tx, ty, tz, members, ranked[0], 0, k, x, y, z)
-    return halves_in_node_frame(members, k, mid, work), False
-
-
-@numba.njit(cache=True)
-def halves_in_own_frames(tx, ty, tz, members, k, mid, work, axes_work):
-    """The choice among the node's axes (keys in ``keys``) with each
-    candidate half's box along the half's own principal axes: the six
-    halves' covariances formed first and their eigenvectors found together
-    (:func:`symmetric_eigenvectors`), then their volumes and areas compared
-    (:func:`chosen_axis`)."""
-    x, y, z, keys, ranked, bucket, counts, a, axes = work
+    own_frames = k > SMALL_NODE
     for axis in range(3):                     # each half's points at 3 lo of its axis's third
         rank(keys[axis], members, k, ranked[axis], bucket, counts)
         for half, (lo, hi) in enumerate(((0, mid), (mid, k))):
             at = 3 * (axis * k + lo)
             n, largest = gather(tx, ty, tz, members, ranked[axis], lo, hi, x[at:], y[at:],
                                 z[at:])
-            covariance(x[at:], y[at:], z[at:], n, largest, a[2 * axis + half], axes_work)
-    symmetric_eigenvectors(a, axes, 6)
+            if own_frames:
+                covariance(x[at:], y[at:], z[at:], n, largest, a[2 * axis + half], axes_work)
+    if own_frames:
+        symmetric_eigenvectors(a, axes, 6)
     v0 = v1 = v2 = s0 = s1 = s2 = 0.0
     for axis in range(3):
         volume = area = 0.0
         for half, (lo, hi) in enumerate(((0, mid), (mid, k))):
             at, n = 3 * (axis * k + lo), 3 * (hi - lo)
-            low, high = extents(x[at:], y[at:], z[at:], n, axes[2 * axis + half])
+            frame = axes[2 * axis + half] if own_frames else node
+            low, high = extents(x[at:], y[at:], z[at:], n, frame)
             d0, d1, d2 = high[0] - low[0], high[1] - low[1], high[2] - low[2]
             part, face = (d0 * d1) * d2, (d0 * d1 + d1 * d2) + d2 * d0
             volume, area = (part, face) if half == 0 else (volume + part, area + face)
@@ -341,57 +330,7 @@ def halves_in_own_frames(tx, ty, tz, members, k, mid, work, axes_work):
             v1, s1 = volume, area
         else:
             v2, s2 = volume, area
-    return chosen_axis(v0, v1, v2, s0, s1, s2)
-
-
-@numba.njit(cache=True)
-def halves_in_node_frame(members, k, mid, work):
-    """The choice among the node's axes (keys in ``keys``, its points in
-    x, y, z, three a triangle in members' order) with every candidate half's
-    box along the node's principal axes ``axes[NODE]``: each point is
-    projected once (in place), and a half's extents are the least and
-    greatest projections of its points, taken in the half's ranked order
-    (of two equal values the later, as numpy's)."""
-    x, y, z, keys, ranked, bucket, counts, _, axes = work
-    node = axes[NODE]
-    a00, a01, a02 = node[0, 0], node[0, 1], node[0, 2]
-    a10, a11, a12 = node[1, 0], node[1, 1], node[1, 2]
-    a20, a21, a22 = node[2, 0], node[2, 1], node[2, 2]
-    for i in range(3 * k):
-        p0, p1, p2 = x[i], y[i], z[i]
-        x[i] = project(p0, p1, p2, a00, a10, a20)
-        y[i] = project(p0, p1, p2, a01, a11, a21)
-        z[i] = project(p0, p1, p2, a02, a12, a22)
-    v0 = v1 = v2 = s0 = s1 = s2 = 0.0
-    for axis in range(3):
-        rank(keys[axis], members, k, ranked[axis], bucket, counts)
-        order = ranked[axis]
-        volume = area = 0.0
-        for half in range(2):
-            lo, hi = (0, mid) if half == 0 else (mid, k)
-            first = 3 * order[lo]
-            lo0 = hi0 = x[first]
-            lo1 = hi1 = y[first]
-            lo2 = hi2 = z[first]
-            for r in range(lo, hi):
-                for v in range(3 * order[r], 3 * order[r] + 3):
-                    p0, p1, p2 = x[v], y[v], z[v]
-                    lo0 = lo0 if lo0 < p0 else p0
-                    lo1 = lo1 if lo1 < p1 else p1
-                    lo2 = lo2 if lo2 < p2 else p2
-                    hi0 = hi0 if hi0 > p0 else p0
-                    hi1 = hi1 if hi1 > p1 else p1
-                    hi2 = hi2 if hi2 > p2 else p2
-            d0, d1, d2 = hi0 - lo0, hi1 - lo1, hi2 - lo2
-            part, face = (d0 * d1) * d2, (d0 * d1 + d1 * d2) + d2 * d0
-            volume, area = (part, face) if half == 0 else (volume + part, area + face)
-        if axis == 0:
-            v0, s0 = volume, area
-        elif axis == 1:
-            v1, s1 = volume, area
-        else:
-            v2, s2 = volume, area
-    return chosen_axis(v0, v1, v2, s0, s1, s2)
+    return chosen_axis(v0, v1, v2, s0, s1, s2), own_frames
 
 
 @numba.njit(cache=True)
