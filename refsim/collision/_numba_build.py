@@ -53,8 +53,9 @@ triangles, the covariances of its six candidate halves (a few passes over
 the same halves' points along its own axes, with one covariance and one
 eigenproblem (its own) when its parent was small too: O(k) a node,
 O(m log m) for the tree of m triangles (ranking is O(k) a node for keys
-spread evenly, O(k log k) at worst); the node boxes add O(k) and one eigenproblem a node. Each function
-here says which readable function it mirrors.
+spread evenly, O(k log k) at worst); the node boxes add O(k) and one
+eigenproblem a node. Each function here says which readable function it
+mirrors.
 
 This module imports numba at import time; import it only when the compiled
 kernel is chosen.
