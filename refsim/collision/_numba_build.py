@@ -278,13 +278,15 @@ def least_volume_split(tx, ty, tz, members, k, mid, known, work, axes_work):
     members) is ``ranked[axis]``, and whether the principal axes of its
     halves were found (``axes[2 axis]`` and ``axes[2 axis + 1]``: a node of
     more than SMALL_NODE triangles, whose halves are measured each in its
-    own frame; a smaller node measures them in its own, ``axes[NODE]``).
+    own frame; a smaller node measures them in the node's frame,
+    ``axes[NODE]``).
 
     The node's own principal axes are those of the half its parent chose
     (the same triangles in the same order): given in ``axes[NODE]`` when
-    ``known``, else computed. The six halves' covariances are formed first
-    and their eigenvectors found together (:func:`symmetric_eigenvectors`),
-    then their volumes and areas compared (:func:`chosen_axis`)."""
+    ``known``, else computed. Above SMALL_NODE, the six halves'
+    covariances are formed first and their eigenvectors found together
+    (:func:`symmetric_eigenvectors`); then the halves' volumes and areas
+    are compared (:func:`chosen_axis`)."""
     x, y, z, keys, ranked, bucket, counts, a, axes = work
     if not known:
         for i in range(k):
@@ -426,7 +428,7 @@ def build_tree(tx, ty, tz, leaf_size, rule):
     ranked, axes = work[4], work[8]
     count[0] = m
     nodes = 1
-    # pending nodes, (node, lo, hi, axes known), each with its principal axes
+    # pending nodes, (node, lo, hi, axes known), with their principal axes if known
     stack = np.empty((capacity, 4), dtype=np.int64)
     stack_axes = np.empty((capacity, 3, 3))
     stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = 0, 0, m, 0
@@ -439,7 +441,7 @@ def build_tree(tx, ty, tz, leaf_size, rule):
         k, mid = hi - lo, (hi - lo) // 2
         for r in range(k):                    # element by element: an array assignment
             members[r] = order[lo + r]        # compiles numba's shape-error text
-        children_known = False                # each child's axes: its half's
+        children_known = False                # each child's axes: its half's, if found
         if rule == LEAST_AREA:
             chosen = least_area_split(tx, ty, tz, members, k, mid, work)
         else:

@@ -111,8 +111,9 @@ chosen by ``kernel=`` like the query and equal to it bit for bit
 (tests/collision/test_tree_build.py); both without BLAS or LAPACK, so a
 mesh has the same tree on every machine.
 Cost: O(m log m) once per mesh for the tree and its boxes (3x3
-eigenproblems: seven for a node of more than SMALL_NODE triangles, the six
-candidate halves of the split and the box, two for a smaller one);
+eigenproblems: seven for a node split above SMALL_NODE triangles, the six
+candidate halves of the split and the box; at most two for a smaller one,
+its own axes and its box; one for a leaf);
 per query about O(k log m) node
 tests for k overlapping node pairs, plus O(1) per vertex and triangle of the
 leaves reached. The speed against FCL is measured in
@@ -309,7 +310,7 @@ VOLUME_TIE = 0.1
 
 #: :func:`least_volume_split` measures the candidate halves of a node of at
 #: most this many triangles along the node's own principal axes
-#: (docs/decisions/tree-build.md, the node-frame split).
+#: (docs/decisions/tree-build.md, "Fourth round").
 SMALL_NODE = 64
 
 
@@ -336,12 +337,13 @@ def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int, *,
     20 times the node pairs (docs/decisions/tree-build.md).
 
     Each half's box is along the half's own principal axes, except in a node
-    of at most ``small`` triangles, where all six are along the node's: one
-    eigenproblem for such a node's split instead of six, where most of the nodes
-    and most of the build's time are, for about as many node pairs in the
-    queries (docs/decisions/tree-build.md, the node-frame split). Over the
-    whole tree the node's frame chose worse: a sphere's cap cut into
-    halves that rest badly on a cube, half as many node pairs again."""
+    of at most ``small`` triangles, where all six are along the node's: the
+    split then solves at most one eigenproblem (the node's axes) instead
+    of six, where most of the nodes and most of the build's time are, for
+    about as many node pairs in the queries (docs/decisions/tree-build.md,
+    "Fourth round"). The node's frame at every node chose worse: the
+    bundled sphere's caps cut so that a cube resting on it cost 505 node
+    pairs instead of 331."""
     points = triangles[members]
     axes = principal_axes(points.reshape(-1, 3))
     centroids = project(points.mean(axis=1), axes)

@@ -419,15 +419,12 @@ def _weld(vertices: np.ndarray, faces: np.ndarray, tolerance: float):
     if n == 0:
         return vertices, faces
     if tolerance == 0.0:
-        # Adding 0.0 turns -0.0 into 0.0, so that byte equality of the rows
-        # (what np.unique compares here) is value equality.
-        # Rows ranked by value with a stable sort, so that equal rows sit
-        # together in index order and each group's first is its lowest index
-        # (as np.unique(axis=0, return_index=True) gives, which sorts a
-        # structured view of the rows, several times slower).
-        canonical = vertices + 0.0
-        order = np.lexsort((canonical[:, 2], canonical[:, 1], canonical[:, 0]))
-        ranked = canonical[order]
+        # Rows ranked by value (-0.0 equals 0.0) with a stable sort, so that
+        # equal rows sit together in index order and each group's first is
+        # its lowest index (as np.unique(axis=0, return_index=True) gives;
+        # it sorts a structured view of the rows, several times slower).
+        order = np.lexsort((vertices[:, 2], vertices[:, 1], vertices[:, 0]))
+        ranked = vertices[order]
         starts = np.empty(n, dtype=bool)
         starts[0] = True
         starts[1:] = (ranked[1:] != ranked[:-1]).any(axis=1)

@@ -10,13 +10,14 @@ answer, by refsim and by python-fcl in the same run.
   ``BVHModel`` (OBBRSS) built from the arrays (beginModel, addSubModel,
   endModel). The readable build runs on the meshes of at most 2048 faces.
 - ``test_first_query``: a new mesh's first boolean query against itself at
-  an overlapping pose, trees included; FCL builds its model, two collision
-  objects and collides.
+  an overlapping pose, from the arrays: the ``refsim.Mesh`` (weld, checks),
+  its trees and the query; FCL builds its model, two collision objects and
+  collides.
 
 Meshes: trimesh icospheres of subdivisions 0 to 6 (20 to 81920 faces),
 tori of 2048, 20000 and 200000 faces, and the bundled meshes. Each round
-builds for a new ``refsim.Mesh`` (made in the round's setup, not timed:
-FCL's timing starts from the arrays as well). Compiled kernels are
+of ``test_tree_build`` builds for a new ``refsim.Mesh`` (made in the
+round's setup, not timed: the trees alone). Compiled kernels are
 compiled before timing (numba's cache); the cold compile is measured on
 its own (docs/decisions/tree-build.md). No speed is asserted: each
 benchmark checks its answer, and the build the readable one's.

@@ -87,9 +87,9 @@ def test_exact_weld_and_edges_are_numpys_unique_of_the_rows():
     """The weld ranks rows by lexsort and the edges are unique 1-d keys;
     both give what np.unique of the rows (axis=0) defines: each vertex
     welded to the lowest index of its equal rows, edges in row order.
-    Seeded soup: 600 triangles over 150 distinct points, drawn from a
-    small grid so that rows tie in one or two coordinates, half of the
-    zeros negative."""
+    Seeded soup: 600 triangles over 150 points drawn from a 5 x 5 x 5 grid,
+    so that many rows repeat and others tie in one or two coordinates,
+    half of the zeros negative."""
     rng = np.random.default_rng(11)
     points = rng.integers(-2, 3, size=(150, 3)).astype(float)
     points[rng.random(points.shape) < 0.5] *= -1.0             # -0.0 among the zeros
@@ -104,7 +104,7 @@ def test_exact_weld_and_edges_are_numpys_unique_of_the_rows():
     f = mesh.faces
     pairs = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
     assert np.array_equal(mesh.edges, np.unique(pairs[pairs[:, 0] != pairs[:, 1]], axis=0))
-    assert len(mesh.edges) > 500
+    assert len(mesh.edges) > 500 and mesh.n_vertices < len(points)   # some rows welded
 
 
 def test_exact_weld_keeps_nearby_vertices_apart():
