@@ -337,13 +337,12 @@ def least_volume_split(triangles: np.ndarray, members: np.ndarray, mid: int, *,
     20 times the node pairs (docs/decisions/tree-build.md).
 
     Each half's box is along the half's own principal axes, except in a node
-    of at most ``small`` triangles, where all six are along the node's: the
-    split then solves at most one eigenproblem (the node's axes) instead
-    of six, where most of the nodes and most of the build's time are, for
-    about as many node pairs in the queries (docs/decisions/tree-build.md,
-    "Fourth round"). The node's frame at every node chose worse: the
-    bundled sphere's caps cut so that a cube resting on it cost 505 node
-    pairs instead of 331."""
+    of at most ``small`` triangles, where all six are along the node's: six
+    eigenproblems fewer for each such split, where most of the nodes and
+    most of the build's time are, for about as many node pairs in the
+    queries (docs/decisions/tree-build.md, "Fourth round"). The node's
+    frame at every node chose worse: the bundled sphere's caps cut so that
+    a cube resting on it cost 505 node pairs instead of 331."""
     points = triangles[members]
     axes = principal_axes(points.reshape(-1, 3))
     centroids = project(points.mean(axis=1), axes)
