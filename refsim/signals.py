@@ -57,10 +57,28 @@ class Interrupted(KeyboardInterrupt):
         return 128 + self.signum
 
 
+#: The signal :func:`_raise` turned into :class:`Interrupted`, kept until
+#: :func:`signals_raise` ends: Python drops an exception raised while a
+#: finalizer runs (a ``__del__`` called by the garbage collector, such as an
+#: unclosed ``ZipFile``'s), printing "Exception ignored"; with further
+#: signals ignored, nothing would then stop the work.
+_delivered: list[int] = []
+
+
 def _raise(signum, frame):
     for s in RAISED:
         signal.signal(s, signal.SIG_IGN)          # once: let the clean-up finish
+    _delivered.append(int(signum))
     raise Interrupted(signum)
+
+
+def raise_if_interrupted() -> None:
+    """Raise :class:`Interrupted` again for a signal whose first one was
+    dropped by a finalizer (see ``_delivered``); nothing otherwise. Long
+    work calls it between its blocks (:meth:`SignalHold.check`, the
+    particle system's fused loop)."""
+    if _delivered:
+        raise Interrupted(_delivered[0])
 
 
 @contextmanager
@@ -76,7 +94,9 @@ def signals_raise() -> Iterator[None]:
             signal.signal(s, _raise)
     try:
         yield
+        raise_if_interrupted()                   # the body ended though a signal came
     finally:
+        _delivered.clear()
         for s, handler in previous.items():
             # None: a handler installed outside Python, not restorable from here
             signal.signal(s, signal.SIG_DFL if handler is None else handler)
@@ -120,8 +140,10 @@ class SignalHold:
         """At a point where the caller's state is whole: act on the first
         signal that came while held, as its own handler would have (a
         ``KeyboardInterrupt`` or :class:`Interrupted` raised from here); a
-        handler that returns lets the work go on, held again."""
+        handler that returns lets the work go on, held again. Also raises
+        again a signal a finalizer dropped (:func:`raise_if_interrupted`)."""
         if not self.caught:
+            raise_if_interrupted()
             return
         signum = self.caught[0]
         self.caught.clear()

@@ -220,6 +220,49 @@ def test_after_the_first_signal_the_next_ones_are_ignored():
     assert finished
 
 
+class _RaisesInItsFinalizer:
+    """An object whose finalizer receives SIGTERM: Python drops an exception
+    raised there ("Exception ignored"), as it dropped SIGHUP's in an
+    unclosed ZipFile's ``__del__`` under load."""
+
+    def __del__(self):
+        signal.raise_signal(signal.SIGTERM)
+
+
+def _dropped_in_a_finalizer() -> None:
+    """SIGTERM raised in a finalizer; asserts Python dropped its exception."""
+    dropped = []
+    hook, sys.unraisablehook = sys.unraisablehook, dropped.append
+    try:
+        _RaisesInItsFinalizer()                  # its finalizer runs at once
+    finally:
+        sys.unraisablehook = hook
+    assert [type(d.exc_value) for d in dropped] == [Interrupted]
+
+
+def test_a_signal_a_finalizer_dropped_is_raised_again_between_blocks():
+    from refsim.signals import held_signals, raise_if_interrupted
+
+    reached = []
+    with pytest.raises(Interrupted) as info:
+        with signals_raise():
+            _dropped_in_a_finalizer()            # the next line still runs
+            reached.append("after the dropped signal")
+            with held_signals() as hold:
+                hold.check()                     # between blocks: raised again
+            reached.append("after check")
+    assert reached == ["after the dropped signal"]
+    assert info.value.signum == signal.SIGTERM
+    raise_if_interrupted()                       # forgotten once signals_raise ends
+
+
+def test_a_signal_a_finalizer_dropped_ends_the_command_with_its_status():
+    with pytest.raises(Interrupted) as info:
+        with signals_raise():
+            _dropped_in_a_finalizer()
+    assert info.value.exit_status == 143
+
+
 def test_held_signals_wait_for_check_and_leave_the_handlers_as_they_were():
     from refsim.signals import held_signals
 

@@ -42,6 +42,7 @@ from refsim.errors import DivergenceError, OptionError, StateError, as_numbers, 
 from refsim.kernels import PARTICLE_STEPS, Tier, choose_kernel
 from refsim.limits import MAX_STEPS
 from refsim.particles.config import ParticleConfig
+from refsim.signals import raise_if_interrupted
 from refsim.solvers.explicit_rk import rk_step, rk_step_into, stages_with_own_state
 from refsim.solvers.integrate import resolve_method
 
@@ -241,6 +242,7 @@ class ParticleSystem:
             block = min(per_call, steps - done)
             non_finite = self._steps_fused(block)
             done += block
+            raise_if_interrupted()            # a signal a finalizer dropped
         return non_finite
 
     def _steps_fused(self, steps: int) -> int:
@@ -317,6 +319,7 @@ class ParticleSystem:
             with self._tier.charged():
                 self._steps_readable(block)
             done += block
+            raise_if_interrupted()            # a signal a finalizer dropped
         return done
 
     def kinetic_energy(self) -> float:
