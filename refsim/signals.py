@@ -75,8 +75,9 @@ def _raise(signum, frame):
 def raise_if_interrupted() -> None:
     """Raise :class:`Interrupted` again for a signal whose first one was
     dropped by a finalizer (see ``_delivered``); nothing otherwise. Long
-    work calls it between its blocks (:meth:`SignalHold.check`, the
-    particle system's fused loop)."""
+    work calls it between its blocks: :meth:`SignalHold.check` (the
+    simulation), and the particle system after each readable step and each
+    fused block, whichever kernel and tier runs it."""
     if _delivered:
         raise Interrupted(_delivered[0])
 

@@ -215,6 +215,7 @@ class ParticleSystem:
         state's finiteness (None)."""
         for _ in range(steps):
             self._step_readable()
+            raise_if_interrupted()            # a signal a finalizer dropped
 
     def _step_readable(self) -> None:
         h = self.config.step
@@ -319,7 +320,6 @@ class ParticleSystem:
             with self._tier.charged():
                 self._steps_readable(block)
             done += block
-            raise_if_interrupted()            # a signal a finalizer dropped
         return done
 
     def kinetic_energy(self) -> float:
