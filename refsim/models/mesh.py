@@ -191,7 +191,8 @@ class Mesh:
 
         Each pair is one integer key ``i n + j`` (``j < n``, so the keys sort
         as the rows do), made unique as a plain 1-d array: ``np.unique`` of
-        the rows themselves sorts a structured view, eight times slower."""
+        the rows themselves sorts a structured view, seven times slower on
+        a 20480-face icosphere's 61440 pairs."""
         f, n = self.faces, np.int64(self.n_vertices)
         pairs = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
         pairs = np.sort(pairs, axis=1)
