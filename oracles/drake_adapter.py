@@ -318,11 +318,15 @@ def contact_parameters(scene, settings: DrakeSettings | None = None) -> ContactP
 
 
 def _matrix(quat_wxyz) -> np.ndarray:
-    """The rotation matrix of a quaternion ``(w, x, y, z)`` (normalised)."""
+    """The rotation matrix of a quaternion ``(w, x, y, z)`` (normalised), in
+    Python floats: read after every step, where numpy's scalar arithmetic
+    cost a quarter of a Drake step, and the norm summed in one order on
+    every processor (a BLAS dot's order is the processor's)."""
     from refsim.types import quaternion_to_rotation
 
-    q = np.asarray(quat_wxyz, dtype=np.float64)
-    return quaternion_to_rotation(q / np.sqrt(q @ q))
+    w, x, y, z = np.asarray(quat_wxyz, dtype=np.float64).tolist()
+    norm = math.sqrt(((w * w + x * x) + y * y) + z * z)
+    return quaternion_to_rotation((w / norm, x / norm, y / norm, z / norm))
 
 
 def _cross(a, b) -> np.ndarray:
@@ -490,8 +494,10 @@ class DrakeEngine:
         from pydrake.multibody.plant import ExternallyAppliedSpatialForce
 
         forces = []
+        q = self.plant.GetPositions(self.plant_context)
+        u = self.plant.GetVelocities(self.plant_context)
         for i, (rigid, props) in enumerate(zip(self.bodies, self.properties, strict=True)):
-            _, v_com, _, _ = self._body_state(i)
+            _, v_com, _, _ = self._body_state(i, q, u)
             k = world.drag * (np.linalg.norm(v_com) if world.drag_model == "quadratic" else 1.0)
             force = ExternallyAppliedSpatialForce()
             force.body_index = rigid.index()
@@ -506,14 +512,16 @@ class DrakeEngine:
         self._step += 1
         self.simulator.AdvanceTo(self._step * self._scene.integration.step)
 
-    def _body_state(self, i: int):
-        """Body ``i``'s (x, v_com, w, R) from the plant's state vectors: a
-        free body's positions are its quaternion ``(w, x, y, z)`` and its
-        origin, its velocities ``w`` and the origin's velocity, in world
+    def _body_state(self, i: int, q=None, u=None):
+        """Body ``i``'s (x, v_com, w, R) from the plant's state vectors ``q``
+        and ``u`` (read from the plant when not given): a free body's
+        positions are its quaternion ``(w, x, y, z)`` and its origin, its
+        velocities ``w`` and the origin's velocity, in world
         (``MultibodyPlant``'s free-body layout; checked against
         ``EvalBodyPoseInWorld`` and ``EvalBodySpatialVelocityInWorld``)."""
-        q = self.plant.GetPositions(self.plant_context)
-        u = self.plant.GetVelocities(self.plant_context)
+        if q is None:
+            q = self.plant.GetPositions(self.plant_context)
+            u = self.plant.GetVelocities(self.plant_context)
         rigid = self.bodies[i]
         k, j = rigid.floating_positions_start(), rigid.floating_velocities_start_in_v()
         r = _matrix(q[k:k + 4])
@@ -525,8 +533,18 @@ class DrakeEngine:
         """(B, 3) positions of the mesh origins, (B, 3) velocities of the
         centres of mass, (B, 3) angular velocities (world frame), (B, 3, 3)
         orientations (columns: body axes)."""
-        parts = [self._body_state(i) for i in range(len(self.bodies))]
-        return tuple(np.array([q[k] for q in parts]) for k in range(4))
+        q = self.plant.GetPositions(self.plant_context)
+        u = self.plant.GetVelocities(self.plant_context)
+        parts = [self._body_state(i, q, u) for i in range(len(self.bodies))]
+        return tuple(np.array([p[k] for p in parts]) for k in range(4))
+
+    def _poses(self) -> tuple[list, list]:
+        """Each body's mesh origin and orientation, from the positions alone
+        (what the wall test needs; :meth:`state` also builds the
+        velocities)."""
+        q = self.plant.GetPositions(self.plant_context)
+        starts = [rigid.floating_positions_start() for rigid in self.bodies]
+        return [q[k + 4:k + 7] for k in starts], [_matrix(q[k:k + 4]) for k in starts]
 
     def _wall_contacts(self, x, r) -> set[tuple[int, int]]:
         """(body, wall) pairs touching in the state ``x`` (B, 3), ``r`` (B,
@@ -538,6 +556,8 @@ class DrakeEngine:
         for i, vertices in enumerate(self._hulls):
             world = vertices @ r[i].T
             lo, hi = world.min(axis=0) + x[i], world.max(axis=0) + x[i]
+            if (lo > -H).all() and (hi < H).all():
+                continue                              # inside: the common case, kept cheap
             touching.update((i, 2 * int(a)) for a in np.flatnonzero(lo <= -H))
             touching.update((i, 2 * int(a) + 1) for a in np.flatnonzero(hi >= H))
         return touching
@@ -552,7 +572,7 @@ class DrakeEngine:
         self.load(scene)
 
         def wall_contacts() -> set[tuple[int, str]]:
-            x, _, _, r = self.state()
+            x, r = self._poses()
             return {(i, WALL_NAMES[j]) for i, j in self._wall_contacts(x, r)}
 
         return run_recorded(self, scene, every, wall_contacts,

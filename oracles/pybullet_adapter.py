@@ -688,13 +688,18 @@ class PybulletOracle:
             contactBreakingThreshold=self.settings.contact_breaking_threshold,
             physicsClientId=c)
 
+        wall_name = dict(zip(self.walls, self.wall_names, strict=True))
+
         def wall_contacts() -> set[tuple[int, str]]:
+            # one query a body (its contacts with anything), kept where the
+            # other body (point[1] or [2]) is a wall and the distance
+            # (point[8]) is <= 0: touching
             now = set()
             for i, uid in enumerate(self.bodies):
-                for j, wall in enumerate(self.walls):
-                    points = p.getContactPoints(uid, wall, physicsClientId=c)
-                    if any(point[8] <= 0.0 for point in points):    # distance <= 0: touching
-                        now.add((i, self.wall_names[j]))
+                for point in p.getContactPoints(uid, physicsClientId=c):
+                    other = point[2] if point[1] == uid else point[1]
+                    if other in wall_name and point[8] <= 0.0:
+                        now.add((i, wall_name[other]))
             return now
 
         settings = asdict(self.settings)
