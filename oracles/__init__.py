@@ -103,6 +103,23 @@ def _flush_c_stdio() -> None:
 WALL_ORDER = ("x-", "x+", "y-", "y+", "z-", "z+")
 
 
+def rotation_of_quaternion(quat_wxyz):
+    """The rotation matrix (3, 3) of a quaternion ``(w, x, y, z)`` that an
+    engine keeps nearly unit, normalised first. In Python floats (numpy's
+    scalars cost more, and the rigid-body adapters read it after every
+    step), the norm summed in a fixed order, not by a BLAS dot, whose
+    order depends on the processor."""
+    import math
+
+    import numpy as np
+
+    from refsim.types import quaternion_to_rotation
+
+    w, x, y, z = np.asarray(quat_wxyz, dtype=np.float64).tolist()
+    norm = math.sqrt(((w * w + x * x) + y * y) + z * z)
+    return quaternion_to_rotation((w / norm, x / norm, y / norm, z / norm))
+
+
 def run_recorded(adapter, scene, every: int, wall_contacts, settings: dict):
     """The loop of a rigid-body adapter whose ``load(scene)`` has run:
     ``adapter.step()`` for the scene's steps, ``adapter.state()`` recorded

@@ -158,7 +158,13 @@ import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from refsim.oracles import import_engine, install_hint, run_recorded, seconds_per_step
+from refsim.oracles import (
+    import_engine,
+    install_hint,
+    rotation_of_quaternion,
+    run_recorded,
+    seconds_per_step,
+)
 
 #: Wall names in the order of refsim's events (x-, x+, y-, y+, z-, z+).
 WALL_NAMES = ("x-", "x+", "y-", "y+", "z-", "z+")
@@ -315,18 +321,6 @@ def contact_parameters(scene, settings: DrakeSettings | None = None) -> ContactP
     return ContactParameters(stiffness=k,
                              dissipation=drake_dv(e, s.contact_steps, s.approximation) / v0,
                              impact_speed=v0, restitution=e)
-
-
-def _matrix(quat_wxyz) -> np.ndarray:
-    """The rotation matrix of a quaternion ``(w, x, y, z)`` (normalised), in
-    Python floats: read after every step, where numpy's scalar arithmetic
-    cost a quarter of a Drake step, and the norm summed in one order on
-    every processor (a BLAS dot's order is the processor's)."""
-    from refsim.types import quaternion_to_rotation
-
-    w, x, y, z = np.asarray(quat_wxyz, dtype=np.float64).tolist()
-    norm = math.sqrt(((w * w + x * x) + y * y) + z * z)
-    return quaternion_to_rotation((w / norm, x / norm, y / norm, z / norm))
 
 
 def _cross(a, b) -> np.ndarray:
@@ -512,19 +506,16 @@ class DrakeEngine:
         self._step += 1
         self.simulator.AdvanceTo(self._step * self._scene.integration.step)
 
-    def _body_state(self, i: int, q=None, u=None):
+    def _body_state(self, i: int, q, u):
         """Body ``i``'s (x, v_com, w, R) from the plant's state vectors ``q``
-        and ``u`` (read from the plant when not given): a free body's
-        positions are its quaternion ``(w, x, y, z)`` and its origin, its
-        velocities ``w`` and the origin's velocity, in world
-        (``MultibodyPlant``'s free-body layout; checked against
-        ``EvalBodyPoseInWorld`` and ``EvalBodySpatialVelocityInWorld``)."""
-        if q is None:
-            q = self.plant.GetPositions(self.plant_context)
-            u = self.plant.GetVelocities(self.plant_context)
+        and ``u``: a free body's positions are its quaternion ``(w, x, y,
+        z)`` and its origin, its velocities ``w`` and the origin's
+        velocity, in world (``MultibodyPlant``'s free-body layout; checked
+        against ``EvalBodyPoseInWorld`` and
+        ``EvalBodySpatialVelocityInWorld``)."""
         rigid = self.bodies[i]
         k, j = rigid.floating_positions_start(), rigid.floating_velocities_start_in_v()
-        r = _matrix(q[k:k + 4])
+        r = rotation_of_quaternion(q[k:k + 4])
         w = np.array(u[j:j + 3])
         v_com = _com_velocity(u[j + 3:j + 6], w, r, self.properties[i].center)
         return np.array(q[k + 4:k + 7]), v_com, w, r
@@ -544,13 +535,15 @@ class DrakeEngine:
         velocities)."""
         q = self.plant.GetPositions(self.plant_context)
         starts = [rigid.floating_positions_start() for rigid in self.bodies]
-        return [q[k + 4:k + 7] for k in starts], [_matrix(q[k:k + 4]) for k in starts]
+        return ([q[k + 4:k + 7] for k in starts],
+                [rotation_of_quaternion(q[k:k + 4]) for k in starts])
 
     def _wall_contacts(self, x, r) -> set[tuple[int, int]]:
-        """(body, wall) pairs touching in the state ``x`` (B, 3), ``r`` (B,
-        3, 3): a hull meets a wall's half-space exactly when one of its
-        vertices does (Drake's contact results would say the same, at the
-        cost of a second contact query per step)."""
+        """(body, wall) pairs touching where each body ``i`` has its mesh
+        origin at ``x[i]`` (3,) and its orientation ``r[i]`` (3, 3): a hull
+        meets a wall's half-space exactly when one of its vertices does
+        (Drake's contact results would say the same, at the cost of a
+        second contact query per step)."""
         H = self._scene.world.half_size
         touching = set()
         for i, vertices in enumerate(self._hulls):

@@ -140,7 +140,12 @@ from dataclasses import asdict, dataclass
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
-from refsim.oracles import import_engine, run_recorded, seconds_per_step
+from refsim.oracles import (
+    import_engine,
+    rotation_of_quaternion,
+    run_recorded,
+    seconds_per_step,
+)
 
 from refsim.dynamics.world import WALL_NAMES
 from refsim.scenes.support import LOAD_KEYS, refuse_unhonoured
@@ -184,13 +189,6 @@ def _quat_wxyz(rotation) -> np.ndarray:
 
     x, y, z, w = Rotation.from_matrix(np.asarray(rotation, dtype=np.float64)).as_quat()
     return np.array([w, x, y, z])
-
-
-def _matrix(quat_wxyz) -> np.ndarray:
-    from refsim.types import quaternion_to_rotation
-
-    q = np.asarray(quat_wxyz, dtype=np.float64)
-    return quaternion_to_rotation(q / np.sqrt(q @ q))
 
 
 class MujocoOracle:
@@ -381,7 +379,7 @@ class MujocoOracle:
                     np.array(body.orientation, dtype=np.float64))
         qpos, qvel = self.data.qpos, self.data.qvel
         q, dof = self._address[i]
-        r = _matrix(qpos[q + 3:q + 7])
+        r = rotation_of_quaternion(qpos[q + 3:q + 7])
         x = np.array(qpos[q:q + 3])
         w = r @ np.array(qvel[dof + 3:dof + 6])
         v_com = np.array(qvel[dof:dof + 3]) + np.cross(w, r @ self.properties[i].center)

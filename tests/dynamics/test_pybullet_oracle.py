@@ -191,7 +191,8 @@ def test_two_bodies_meet_with_the_scene_s_restitution(pybullet, e):
     without changing the velocities; the faceted spheres meet vertex to
     vertex, nearly centrally. (Two cubes meeting face to face leave at
     0.38 m/s for e = 0.5 and 0.70 for e = 0.8, and turn: Bullet solves the
-    four corner contacts one after another.)"""
+    four corner contacts one after another.) Their contact is no wall's:
+    no wall event (the walls are more than 2 m away throughout)."""
     scene = scene_from_dict({
         "world": {"half_size": 5.0, "gravity": 0.0, "restitution": e, "friction": 0.0},
         "integration": {"step": 1e-3, "duration": 1.0},
@@ -199,9 +200,11 @@ def test_two_bodies_meet_with_the_scene_s_restitution(pybullet, e):
                   "velocity": [1.0, 0.0, 0.0]},
                  {"name": "b", "model": SPHERE, "position": [1.5, 0.0, 0.0],
                   "velocity": [-1.0, 0.0, 0.0]}]})
-    v = np.asarray(pybullet.simulate(scene).velocity)
+    trajectory = pybullet.simulate(scene)
+    v = np.asarray(trajectory.velocity)
     np.testing.assert_allclose(v[-1, 0], [-e, 0.0, 0.0], atol=1e-3)
     np.testing.assert_allclose(v[-1, 1], [e, 0.0, 0.0], atol=1e-3)
+    assert trajectory.events == []
 
 
 def test_walls_hold_the_body_inside_the_cube(pybullet):

@@ -98,6 +98,28 @@ def test_the_velocity_is_the_centre_of_mass_s():
     assert np.abs(origin - line).max() > 0.05
 
 
+def test_the_wall_test_reads_the_poses_the_state_reads():
+    """The test for wall contacts after each step reads the positions alone:
+    the same origins and rotations as the recorded state, bit for bit, for
+    each of two bodies (one turning, one resting on the floor), and only
+    the resting one touches a wall (the floor, y-)."""
+    scene = scene_from_dict({
+        "world": {"half_size": 5.0, "gravity": G},
+        "integration": {"step": H, "duration": 0.1},
+        "body": [{"model": "l-beam.ac", "position": [1.5, 0.0, 0.0],
+                  "angular_velocity": [0.0, 2.0, 5.0]},
+                 {"model": "sphere-2k.ac", "position": [-2.0, -5.0 + SPHERE_RADIUS, 0.0]}]})
+    drake = engine()
+    drake.load(scene)
+    for _ in range(50):
+        drake.step()
+    x, _, _, r = drake.state()
+    origins, rotations = drake._poses()
+    assert np.array_equal(np.array(origins), x) and np.array_equal(np.array(rotations), r)
+    assert not np.array_equal(r[0], np.eye(3))
+    assert drake._wall_contacts(origins, rotations) == {(1, 2)}     # body 1, wall 2: y-
+
+
 def test_the_dissipation_meets_e_on_drakes_own_impact():
     """The measured ``d v0`` gives restitution e = 0.5 on the probe impact
     (to the bisection's width); above the discrete step's own restitution
