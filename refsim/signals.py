@@ -22,6 +22,7 @@ runs signal handlers in the main thread only; elsewhere this is a no-op.
 from __future__ import annotations
 
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -60,8 +61,9 @@ class Interrupted(KeyboardInterrupt):
 #: The signal :func:`_raise` turned into :class:`Interrupted`, kept until
 #: :func:`signals_raise` ends: Python drops an exception raised while a
 #: finalizer runs (a ``__del__`` called by the garbage collector, such as an
-#: unclosed ``ZipFile``'s), printing "Exception ignored"; with further
-#: signals ignored, nothing would then stop the work.
+#: unclosed ``ZipFile``'s or llvmlite's), and passes it to
+#: ``sys.unraisablehook``, which prints "Exception ignored" and a traceback;
+#: with further signals ignored, nothing would then stop the work.
 _delivered: list[int] = []
 
 
@@ -90,14 +92,24 @@ def signals_raise() -> Iterator[None]:
         yield
         return
     previous = {s: signal.getsignal(s) for s in RAISED}
+    previous_hook = sys.unraisablehook
+
+    def unraisable(args) -> None:
+        # an Interrupted a finalizer dropped is raised again
+        # (raise_if_interrupted): the one line the command prints says it
+        if not isinstance(args.exc_value, Interrupted):
+            previous_hook(args)
+
     for s, handler in previous.items():
         if handler is not signal.SIG_IGN:
             signal.signal(s, _raise)
+    sys.unraisablehook = unraisable
     try:
         yield
         raise_if_interrupted()                   # the body ended though a signal came
     finally:
         _delivered.clear()
+        sys.unraisablehook = previous_hook
         for s, handler in previous.items():
             # None: a handler installed outside Python, not restorable from here
             signal.signal(s, signal.SIG_DFL if handler is None else handler)
