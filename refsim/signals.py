@@ -62,7 +62,7 @@ class Interrupted(KeyboardInterrupt):
 #: :func:`signals_raise` ends: Python drops an exception raised while a
 #: finalizer runs (a ``__del__`` called by the garbage collector, such as an
 #: unclosed ``ZipFile``'s or llvmlite's), and passes it to
-#: ``sys.unraisablehook``, which prints "Exception ignored" and a traceback;
+#: ``sys.unraisablehook`` (which :func:`signals_raise` keeps quiet for it);
 #: with further signals ignored, nothing would then stop the work.
 _delivered: list[int] = []
 
@@ -96,7 +96,9 @@ def signals_raise() -> Iterator[None]:
 
     def unraisable(args) -> None:
         # an Interrupted a finalizer dropped is raised again
-        # (raise_if_interrupted): the one line the command prints says it
+        # (raise_if_interrupted): the one line the command prints says it.
+        # Once the command has caught it, refsim.cli.app's
+        # _quiet_finalizers drops every later report instead.
         if not isinstance(args.exc_value, Interrupted):
             previous_hook(args)
 
