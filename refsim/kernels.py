@@ -315,6 +315,28 @@ def compile_kernel(function):
     return numba.njit(cache=True)(function)
 
 
+def python_floats(args: tuple) -> tuple:
+    """A readable kernel's arguments as the interpreter computes with them
+    fastest: each float64 array as a ``memoryview`` of it (an item read is
+    a Python float, an item written is stored in the array), each numpy
+    float64 as a Python float; the rest as they are.
+
+    A kernel of scalar arithmetic written for numba (items read one at a
+    time, as ``R[i, j]``) then gives the same bits as on the arrays: a
+    Python float is the IEEE double a numpy float64 is, and ``+ - * /``,
+    comparisons and ``math``'s functions round alike; and it runs faster,
+    as no item read makes a numpy scalar object. A division by zero then
+    raises ZeroDivisionError, as it does in the compiled twin (numba's
+    default error model), where numpy's scalars give an infinity.
+    A ``memoryview`` of a two-dimensional array cannot be sliced: a kernel
+    that slices its arrays is passed them as they are.
+    """
+    import numpy as np
+
+    return tuple(a.data if isinstance(a, np.ndarray) and a.dtype == np.float64
+                 else float(a) if isinstance(a, np.float64) else a for a in args)
+
+
 def _source_file(module: str) -> Path | None:
     """The source file of a refsim module (``refsim.a.b``), or None."""
     base = Path(__file__).parent.joinpath(*module.split(".")[1:])
@@ -413,9 +435,10 @@ class KernelPair:
     ``how``: :data:`COMPILED_FROM_SOURCE` (numba compiles the readable
     source) or :data:`MIRRORS` (a twin written as plain loops, whose
     docstring says "Mirrors" and names the readable function). ``mirror``:
-    the ``(readable, compiled)`` functions whose docstrings tell that, where
-    the dispatched two are thin callers of them (default: the dispatched
-    two).
+    the ``(readable, compiled)`` functions whose docstrings tell that, or
+    whose source numba compiles, where the dispatched two are thin callers
+    of them (default: the dispatched two); a readable caller that passes
+    Python floats (:func:`python_floats`) is one.
 
     :meth:`choose` (also the pair called: ``pair(kernel)``) takes the
     ``kernel=`` a user passes (None: the default of :func:`choose_kernel`,
@@ -528,14 +551,18 @@ PARTICLE_STEPS = KernelPair(
     mirror=("refsim.particles.system:ParticleSystem",
             "refsim.particles._numba_kernels:rk_steps_fused"))
 CONTACT_IMPULSES = KernelPair(
-    "contact impulses", "refsim.dynamics.impulse:solve_contacts_python",
-    "refsim.dynamics.impulse:solve_contacts_compiled", COMPILED_FROM_SOURCE)
+    "contact impulses", "refsim.dynamics.impulse:solve_contacts_readable",
+    "refsim.dynamics.impulse:solve_contacts_compiled", COMPILED_FROM_SOURCE,
+    mirror=("refsim.dynamics.impulse:solve_contacts_python",
+            "refsim.dynamics.impulse:solve_contacts_compiled"))
 ISLAND_IMPULSES = KernelPair(
     "island contact impulses", "refsim.dynamics.impulse:solve_island_python",
     "refsim.dynamics.impulse:solve_island_compiled", COMPILED_FROM_SOURCE)
 FREE_ROTATION_STEPS = KernelPair(
-    "free rotation steps", "refsim.dynamics.rotation_impulse:free_rotation_steps",
-    "refsim.dynamics.rotation_impulse:free_rotation_steps_compiled", COMPILED_FROM_SOURCE)
+    "free rotation steps", "refsim.dynamics.rotation_impulse:free_rotation_steps_readable",
+    "refsim.dynamics.rotation_impulse:free_rotation_steps_compiled", COMPILED_FROM_SOURCE,
+    mirror=("refsim.dynamics.rotation_impulse:free_rotation_steps",
+            "refsim.dynamics.rotation_impulse:free_rotation_steps_compiled"))
 SEED_ORIENTATION_STEP = KernelPair(
     "seed orientation step", "refsim.dynamics.rotation_seed:orientation_step_seed",
     "refsim.dynamics.rotation_seed:orientation_step_seed_compiled")

@@ -26,7 +26,9 @@ _EYE = np.eye(3)
 
 
 def as_pose(pose, *, what: str = "pose") -> Pose:
-    """Check a pose and return it as two float64 arrays.
+    """Check a pose and return it as two float64 arrays, the rotation
+    C-contiguous (a transposed one is copied: a compiled kernel then meets
+    one memory layout and compiles once).
 
     Raises
     ------
@@ -42,6 +44,8 @@ def as_pose(pose, *, what: str = "pose") -> Pose:
     except (TypeError, ValueError):
         raise StateError(f"{what}: expected (rotation, translation)") from None
     rotation = as_numbers(f"{what} rotation", rotation)
+    if not rotation.flags.c_contiguous:
+        rotation = np.ascontiguousarray(rotation)
     translation = as_numbers(f"{what} translation", translation)
     if rotation.shape != (3, 3) or translation.shape != (3,):
         raise StateError(f"{what}: expected shapes (3, 3) and (3,), got "

@@ -73,7 +73,7 @@ import math
 import numpy as np
 
 from refsim.dynamics.products import jitable
-from refsim.kernels import CONTACT_IMPULSES, ISLAND_IMPULSES, compile_kernel
+from refsim.kernels import CONTACT_IMPULSES, ISLAND_IMPULSES, compile_kernel, python_floats
 
 #: Sweeps of phase 1. Gauss-Seidel over the four corners of a face landing
 #: flat converges linearly: the cube's bounce speed is off by 2e-3 (relative)
@@ -454,6 +454,13 @@ def solve_island_compiled(*args):
 def solve_island(*args, kernel: str | None = None):
     """:func:`solve_island_python` on the chosen kernel (:mod:`refsim.kernels`)."""
     return ISLAND_IMPULSES(kernel)(*args)
+
+
+def solve_contacts_readable(*args):
+    """:func:`solve_contacts_python` run by the interpreter on Python floats
+    (:func:`refsim.kernels.python_floats`): the same bits, sooner
+    (docs/decisions/readable-floats.md)."""
+    return solve_contacts_python(*python_floats(args))
 
 
 def solve_contacts_compiled(*args):

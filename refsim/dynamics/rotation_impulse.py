@@ -85,7 +85,7 @@ import math
 import numpy as np
 
 from refsim.dynamics.products import jitable, matmul, orthonormalize_columns
-from refsim.kernels import compile_kernel
+from refsim.kernels import compile_kernel, python_floats
 
 #: Below this ``|theta|^2`` (``|theta| < 1e-4``) :func:`rotation_exp_into`
 #: uses the series of ``sin(a)/a`` and ``(1 - cos(a))/a^2``, whose truncation
@@ -233,6 +233,15 @@ def free_rotation_steps(R, w, Q, moments, h):
     L = np.empty(3)
     for b in range(R.shape[0]):
         free_rotation_step(R[b], w[b], Q[b], moments[b], h, P, L, E)
+
+
+def free_rotation_steps_readable(R, w, Q, moments, h):
+    """:func:`free_rotation_steps` run by the interpreter on Python floats
+    (:func:`refsim.kernels.python_floats`), body by body: the same bits,
+    sooner (docs/decisions/readable-floats.md)."""
+    P, L, E = python_floats((np.empty((3, 3)), np.empty(3), np.empty((3, 3))))
+    for b in range(R.shape[0]):
+        free_rotation_step(*python_floats((R[b], w[b], Q[b], moments[b], h)), P, L, E)
 
 
 def free_rotation_steps_compiled(R, w, Q, moments, h):

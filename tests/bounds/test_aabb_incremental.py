@@ -44,6 +44,28 @@ def test_first_update_is_a_full_scan(kernel):
         assert tracker.extremes[1, k] == np.flatnonzero(v[:, k] == v[:, k].max())[0]
 
 
+def test_a_transposed_rotation_gives_the_same_box_and_no_second_compile():
+    # a rotation given as another's transpose is Fortran-ordered; the pose
+    # check copies it to C order, so the compiled kernels meet one layout
+    # (numba would otherwise compile each again for the other)
+    from refsim.bounds._numba_kernels import aabb_linear_numba, incremental_update_numba
+
+    mesh = shapes.geodesic_sphere(5)
+    poses = measure.pose_sequence(3, "jump", seed=5)
+    c_order = [(np.ascontiguousarray(R), t) for R, t in poses]
+    f_order = [(np.asfortranarray(R), t) for R, t in poses]
+    assert not f_order[0][0].flags.c_contiguous
+    first, second = (IncrementalAABB(mesh, kernel="compiled") for _ in range(2))
+    boxes = [(first.update(p), aabb_linear(mesh, p, kernel="compiled")) for p in c_order]
+    kernels_before = (len(incremental_update_numba.signatures),
+                      len(aabb_linear_numba.signatures))
+    for (box, scan), p in zip(boxes, f_order, strict=True):
+        assert _same(second.update(p), box) and _same(aabb_linear(mesh, p, kernel="compiled"),
+                                                      scan)
+    assert (len(incremental_update_numba.signatures),
+            len(aabb_linear_numba.signatures)) == kernels_before
+
+
 @pytest.mark.parametrize("kernel", KERNELS)
 @pytest.mark.parametrize("motion", ["coherent", "jump"])
 def test_sphere_box_equals_scan_bitwise_over_a_turn(kernel, motion):
