@@ -446,10 +446,18 @@ def frame_tree_of(mesh, kernel: str | None = None) -> FrameTree:
 # -- the readable kernel ------------------------------------------------------------
 
 
-def relative_frame(pose_a, pose_b):
-    """``(M, u)``: body b's coordinates in a's frame are ``M x + u``."""
+def relative_frame(pose_a, pose_b) -> tuple[list, list]:
+    """``(M, u)``: body b's coordinates in a's frame are ``M x + u``, with
+    ``M = Ra^T Rb`` and ``u = Ra^T (tb - ta)``: lists (M by rows) of
+    Python floats, each sum left to right, as the compiled kernel sums
+    them."""
     (ra, ta), (rb, tb) = pose_a, pose_b
-    return ra.T @ rb, ra.T @ (tb - ta)
+    ra, rb, ta, tb = ra.tolist(), rb.tolist(), ta.tolist(), tb.tolist()
+    d = [tb[k] - ta[k] for k in range(3)]
+    M = [[ra[0][i] * rb[0][j] + ra[1][i] * rb[1][j] + ra[2][i] * rb[2][j] for j in range(3)]
+         for i in range(3)]
+    u = [ra[0][i] * d[0] + ra[1][i] * d[1] + ra[2][i] * d[2] for i in range(3)]
+    return M, u
 
 
 def deviation(rotation) -> float:
@@ -467,42 +475,62 @@ def node_margin(frame_a: FrameTree, pose_a, frame_b: FrameTree, pose_b,
     return (rounding + per_deviation * g) * scale
 
 
-def node_pair_frame(frame_a: FrameTree, a: int, frame_b: FrameTree, b: int, M, u):
-    """``(R, T)``: node b's box in the frame of node a's box, whose axes are
-    then the coordinate axes. R's columns are b's axes, T is b's centre:
-    ``R = Aa^T M Ab``, ``T = Aa^T (M cb + u - ca)``."""
-    axes_a = frame_a.axes[a]
-    R = axes_a.T @ (M @ frame_b.axes[b])
-    T = axes_a.T @ (M @ frame_b.centre[b] + u - frame_a.centre[a])
-    return R, T
+def place(box_b: list, M: list, u: list) -> tuple[list, list]:
+    """Node b's box in body a's frame: ``(p, P)``, its centre ``p = M cb + u``
+    and its axes ``P = M Ab`` (rows), from its row of :attr:`FrameTree.boxes`
+    as a list, and M (rows) and u as lists: Python floats, each sum left to
+    right, as the compiled kernel sums them."""
+    p = [M[i][0] * box_b[0] + M[i][1] * box_b[1] + M[i][2] * box_b[2] + u[i]
+         for i in range(3)]
+    P = [[M[i][0] * box_b[6 + j] + M[i][1] * box_b[9 + j] + M[i][2] * box_b[12 + j]
+          for j in range(3)] for i in range(3)]
+    return p, P
 
 
-def boxes_apart(M, T, half_a, half_b, margin: float) -> bool:
+def node_pair_frame(box_a: list, p: list, P: list) -> tuple[list, list]:
+    """``(T, R)``: node b's box in the frame of node a's box, whose axes are
+    then the coordinate axes. ``box_a`` is a's row of :attr:`FrameTree.boxes`
+    as a list (centre ca, half-extents, axes Aa row by row); ``(p, P)`` is
+    b's box in a's body frame (:func:`place`). R's columns are b's axes, T
+    is b's centre: ``R = Aa^T M Ab = Aa^T P``, ``T = Aa^T (M cb + u - ca)
+    = Aa^T (p - ca)``, rows of lists."""
+    d0, d1, d2 = p[0] - box_a[0], p[1] - box_a[1], p[2] - box_a[2]
+    T, R = [], []
+    for i in range(3):
+        a0, a1, a2 = box_a[6 + i], box_a[9 + i], box_a[12 + i]      # column i of Aa
+        T.append(a0 * d0 + a1 * d1 + a2 * d2)
+        R.append([a0 * P[0][j] + a1 * P[1][j] + a2 * P[2][j] for j in range(3)])
+    return T, R
+
+
+def boxes_apart(T: list, R: list, half_a: list, half_b: list, margin: float) -> bool:
     """Whether a separating axis puts the two boxes more than ``margin`` apart.
 
     In box a's frame: box a is axis-aligned about the origin with
-    half-extents ``half_a``; box b has axes the columns of ``M``,
-    half-extents ``half_b`` and its centre at ``T``. The 15 candidate axes
-    of two boxes, in the order of the compiled kernel: a's face normals e_i,
-    b's face normals M[:, j], and the cross products e_i x M[:, j]. Box b's
-    extents along its own normals and the cross products assume M
-    orthonormal; the margin covers an M that is so only to within a
-    tolerance (module docstring).
+    half-extents ``half_a``; box b has axes the columns of ``R``,
+    half-extents ``half_b`` and its centre at ``T`` (:func:`node_pair_frame`;
+    lists of Python floats). The 15 candidate axes of two boxes, in the
+    order of the compiled kernel: a's face normals e_i, b's face normals
+    R[:, j], and the cross products e_i x R[:, j], each sum left to right
+    as the compiled kernel sums it. Box b's extents along its own normals
+    and the cross products assume R orthonormal; the margin covers an R
+    that is so only to within a tolerance (module docstring).
     """
-    absM = np.abs(M)
+    Q = [[abs(x) for x in row] for row in R]                 # |R|
+    h, g = half_a, half_b
     for i in range(3):
-        if abs(T[i]) > half_a[i] + half_b @ absM[i] + margin:
+        if abs(T[i]) > h[i] + g[0] * Q[i][0] + g[1] * Q[i][1] + g[2] * Q[i][2] + margin:
             return True
     for j in range(3):
-        if abs(T @ M[:, j]) > half_a @ absM[:, j] + half_b[j] + margin:
+        if (abs(T[0] * R[0][j] + T[1] * R[1][j] + T[2] * R[2][j])
+                > (h[0] * Q[0][j] + h[1] * Q[1][j] + h[2] * Q[2][j] + g[j]) + margin):
             return True
     for i in range(3):
         i1, i2 = (i + 1) % 3, (i + 2) % 3
         for j in range(3):
             j1, j2 = (j + 1) % 3, (j + 2) % 3
-            projection = T[i2] * M[i1, j] - T[i1] * M[i2, j]
-            radius = (half_a[i1] * absM[i2, j] + half_a[i2] * absM[i1, j]
-                      + half_b[j1] * absM[i, j2] + half_b[j2] * absM[i, j1])
+            projection = T[i2] * R[i1][j] - T[i1] * R[i2][j]
+            radius = h[i1] * Q[i2][j] + h[i2] * Q[i1][j] + g[j1] * Q[i][j2] + g[j2] * Q[i][j1]
             if abs(projection) > radius + margin:
                 return True
     return False
@@ -529,12 +557,27 @@ def descend(mesh_a, pose_a, mesh_b, pose_b, *,
     fa, fb = frame_tree_of(mesh_a, kernel), frame_tree_of(mesh_b, kernel)
     M, u = relative_frame(pose_a, pose_b)
     margin = node_margin(fa, pose_a, fb, pose_b, margin_rounding, margin_per_deviation)
-    lo_a, hi_a = triangle_boxes(world_vertices(mesh_a, pose_a), mesh_a.faces)
-    lo_b, hi_b = triangle_boxes(world_vertices(mesh_b, pose_b), mesh_b.faces)
+    boxes_a = triangle_boxes(world_vertices(mesh_a, pose_a), mesh_a.faces)
+    boxes_b = triangle_boxes(world_vertices(mesh_b, pose_b), mesh_b.faces)
     ta, tb = fa.tree, fb.tree
+    # The tests below on Python floats (lists): the same arithmetic and
+    # comparisons as on numpy's scalars, without an object made per number;
+    # each node and leaf converted once per query, when first visited.
+    placed: dict[int, tuple[list, list]] = {}    # node b -> place()
+    leaves_a: dict[int, list] = {}               # leaf -> its triangles' boxes
+    leaves_b: dict[int, list] = {}
 
-    def members(tree, node):
-        return tree.order[tree.start[node]:tree.start[node] + tree.count[node]]
+    def triangles(tree, node, boxes, seen):
+        """(index, lo, hi) of each triangle of a leaf, lists."""
+        if node not in seen:
+            members = tree.order[tree.start[node]:tree.start[node] + tree.count[node]]
+            seen[node] = list(zip(members.tolist(), boxes[0][members].tolist(),
+                                  boxes[1][members].tolist(), strict=True))
+        return seen[node]
+
+    def boxes_overlap(lo_1, hi_1, lo_2, hi_2):
+        return (lo_1[0] <= hi_2[0] and lo_1[1] <= hi_2[1] and lo_1[2] <= hi_2[2]
+                and lo_2[0] <= hi_1[0] and lo_2[1] <= hi_1[1] and lo_2[2] <= hi_1[2])
 
     found = []
     stack = [(0, 0)]
@@ -542,17 +585,20 @@ def descend(mesh_a, pose_a, mesh_b, pose_b, *,
     while stack:
         a, b = stack.pop()
         visits += 1
-        R, T = node_pair_frame(fa, a, fb, b, M, u)
-        half_a, half_b = fa.half[a], fb.half[b]
-        if boxes_apart(R, T, half_a, half_b, margin):
+        box_a, box_b = fa.boxes[a].tolist(), fb.boxes[b].tolist()
+        if b not in placed:
+            placed[b] = place(box_b, M, u)
+        T, R = node_pair_frame(box_a, *placed[b])
+        half_a, half_b = box_a[3:6], box_b[3:6]
+        if boxes_apart(T, R, half_a, half_b, margin):
             continue
         leaf_a, leaf_b = ta.left[a] < 0, tb.left[b] < 0
         if leaf_a and leaf_b:
-            for i in members(ta, a):
-                for j in members(tb, b):
-                    if (lo_a[i] <= hi_b[j]).all() and (lo_b[j] <= hi_a[i]).all():
-                        found.append((int(i), int(j)))
-        elif leaf_b or (not leaf_a and half_a.sum() >= half_b.sum()):
+            for i, lo_a, hi_a in triangles(ta, a, boxes_a, leaves_a):
+                for j, lo_b, hi_b in triangles(tb, b, boxes_b, leaves_b):
+                    if boxes_overlap(lo_a, hi_a, lo_b, hi_b):
+                        found.append((i, j))
+        elif leaf_b or (not leaf_a and sum(half_a) >= sum(half_b)):
             stack += [(ta.right[a], b), (ta.left[a], b)]          # open the bigger node
         else:
             stack += [(a, tb.right[b]), (a, tb.left[b])]
