@@ -325,9 +325,11 @@ def python_floats(args: tuple) -> tuple:
     time, as ``R[i, j]``) then gives the same bits as on the arrays: a
     Python float is the IEEE double a numpy float64 is, and ``+ - * /``,
     comparisons and ``math``'s functions round alike; and it runs faster,
-    as no item read makes a numpy scalar object. A division by zero then
-    raises ZeroDivisionError, as it does in the compiled twin (numba's
-    default error model), where numpy's scalars give an infinity.
+    as no item read makes a numpy scalar object. Items of arrays the
+    kernel makes itself stay numpy scalars, and a division by zero among
+    them gives numpy's infinity as before; one between two Python floats
+    raises ZeroDivisionError, as the compiled twin does (numba's default
+    error model).
     A ``memoryview`` of a two-dimensional array cannot be sliced: a kernel
     that slices its arrays is passed them as they are.
     """

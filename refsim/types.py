@@ -26,9 +26,10 @@ _EYE = np.eye(3)
 
 
 def as_pose(pose, *, what: str = "pose") -> Pose:
-    """Check a pose and return it as two float64 arrays, the rotation
-    C-contiguous (a transposed one is copied: a compiled kernel then meets
-    one memory layout and compiles once).
+    """Check a pose and return it as two C-contiguous float64 arrays (a
+    transposed rotation, or a translation cut from a column of a 4x4
+    matrix, is copied: a compiled kernel then meets one memory layout and
+    compiles once).
 
     Raises
     ------
@@ -44,9 +45,11 @@ def as_pose(pose, *, what: str = "pose") -> Pose:
     except (TypeError, ValueError):
         raise StateError(f"{what}: expected (rotation, translation)") from None
     rotation = as_numbers(f"{what} rotation", rotation)
+    translation = as_numbers(f"{what} translation", translation)
     if not rotation.flags.c_contiguous:
         rotation = np.ascontiguousarray(rotation)
-    translation = as_numbers(f"{what} translation", translation)
+    if not translation.flags.c_contiguous:
+        translation = np.ascontiguousarray(translation)
     if rotation.shape != (3, 3) or translation.shape != (3,):
         raise StateError(f"{what}: expected shapes (3, 3) and (3,), got "
                          f"{rotation.shape} and {translation.shape}")

@@ -376,16 +376,17 @@ def test_each_pair_resolves_and_each_mirror_names_its_readable_function(name):
         readable_name = readable_path.split(":")[1].split(".")[-1]
         assert doc.startswith("Mirrors") and readable_name in doc, (name, doc[:120])
         return
+    assert pair.mirror[1] == compiled_path, name       # the compiled side is the one dispatched
     readable, compiled = kernels.resolve(pair.mirror[0]), pair.compiled
     if pair.readable is not readable:
-        # a thin readable caller: the source, or the function the source
-        # calls for each body, on Python floats
+        # a thin readable caller: the source itself, or the one function the
+        # source calls for each body, on Python floats
         used = inspect.getclosurevars(pair.readable).globals
         assert used.get("python_floats") is kernels.python_floats, (name, used)
         called = [f for f in used.values() if inspect.isfunction(f) and f is not
                   kernels.python_floats]
         inner = inspect.getclosurevars(readable).globals.values()
-        assert called and all(f is readable or f in inner for f in called), (name, used)
+        assert len(called) == 1 and (called[0] is readable or called[0] in inner), (name, used)
     if hasattr(compiled, "py_func"):
         # compiled from the readable source: numba's dispatcher wraps that very function
         assert compiled.py_func is readable, name

@@ -46,7 +46,7 @@ from refsim.collision.contact import CROSSING_SLACK, DEEPEST_FRACTION, ON_SURFAC
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "c3695e35112923dd"
+SOURCES_DIGEST = "d5c99dfb81b6e2f1"
 
 
 

@@ -364,8 +364,9 @@ def pose_deviation(rotation, translation, tol):
 @numba.njit(cache=True, inline="always")
 def place(boxes_b, M, u, node, placed):
     """Node b's box in body a's frame, kept for the rest of the query:
-    ``placed[node]`` = (M cb + u, then M Ab row by row), the part of
-    bvh_exact.node_pair_frame that depends on node b alone."""
+    ``placed[node]`` = (M cb + u, then M Ab row by row), as
+    bvh_exact.place computes it (the part of a node pair's frame that
+    depends on node b alone)."""
     for i in range(3):
         placed[node, i] = (M[i, 0] * boxes_b[node, 0] + M[i, 1] * boxes_b[node, 1]
                            + M[i, 2] * boxes_b[node, 2] + u[i])

@@ -85,11 +85,11 @@ and a numba-compiled copy (``refsim[fast]``,
 pairs with the float filter as it finds them and can stop at the first hit.
 The compiled copy checks the poses itself (the checks of
 :func:`refsim.types.as_pose`), which keeps a query's fixed cost small
-(docs/decisions/query-fixed-cost.md). The two evaluate the same formulas but not always to the same
-bits (numpy's matmul may sum in another order, or fuse): both errors are
-within the margin's bound, so both are right; their candidate lists differ
-only if a node pair lies within a few ulps of the margin, which the tests'
-poses do not produce.
+(docs/decisions/query-fixed-cost.md). The two evaluate the same formulas
+in the same order, the readable one on Python floats (the relative frame,
+the margin, each node pair's frame and its fifteen axes, the choice of the
+node to open), so they visit the same node pairs and find the same
+candidates; either's rounding is within the margin's bound in any case.
 
 The pairs the compiled filter cannot certify (on touching bodies, nearly
 all of them) are answered by the compiled exact stage
@@ -461,17 +461,30 @@ def relative_frame(pose_a, pose_b) -> tuple[list, list]:
 
 
 def deviation(rotation) -> float:
-    """``max |R^T R - I|``: how far a rotation is from orthonormal."""
-    return float(np.abs(rotation.T @ rotation - np.eye(3)).max())
+    """``max |R^T R - I|``: how far a rotation is from orthonormal (each
+    entry of ``R^T R`` summed left to right, as the compiled pose check
+    sums it)."""
+    R = np.asarray(rotation, dtype=np.float64).tolist()
+    worst = 0.0
+    for i in range(3):
+        for j in range(3):
+            gram = R[0][i] * R[0][j] + R[1][i] * R[1][j] + R[2][i] * R[2][j]
+            worst = max(worst, abs(gram - (1.0 if i == j else 0.0)))
+    return worst
 
 
 def node_margin(frame_a: FrameTree, pose_a, frame_b: FrameTree, pose_b,
                 rounding: float = MARGIN_ROUNDING,
                 per_deviation: float = MARGIN_PER_DEVIATION) -> float:
-    """The node test's margin for these two bodies (module docstring)."""
-    scale = frame_a.reach + frame_b.reach + float(np.max(np.abs(pose_a[1]) + np.abs(pose_b[1])))
-    g = max(deviation(pose_a[0]), deviation(pose_b[0]),
-            frame_a.axes_deviation, frame_b.axes_deviation)
+    """The node test's margin for these two bodies (module docstring), in
+    the compiled kernel's order of operations."""
+    reach = frame_a.reach + frame_b.reach
+    ta, tb = pose_a[1].tolist(), pose_b[1].tolist()
+    scale = reach
+    for k in range(3):
+        scale = max(scale, reach + abs(ta[k]) + abs(tb[k]))
+    g = max(max(deviation(pose_a[0]), deviation(pose_b[0])),
+            max(frame_a.axes_deviation, frame_b.axes_deviation))
     return (rounding + per_deviation * g) * scale
 
 
@@ -598,7 +611,8 @@ def descend(mesh_a, pose_a, mesh_b, pose_b, *,
                 for j, lo_b, hi_b in triangles(tb, b, boxes_b, leaves_b):
                     if boxes_overlap(lo_a, hi_a, lo_b, hi_b):
                         found.append((i, j))
-        elif leaf_b or (not leaf_a and sum(half_a) >= sum(half_b)):
+        elif leaf_b or (not leaf_a and half_a[0] + half_a[1] + half_a[2]
+                                       >= half_b[0] + half_b[1] + half_b[2]):
             stack += [(ta.right[a], b), (ta.left[a], b)]          # open the bigger node
         else:
             stack += [(a, tb.right[b]), (a, tb.left[b])]

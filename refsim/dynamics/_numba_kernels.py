@@ -135,7 +135,7 @@ from refsim.dynamics.rotation_seed import axes_step_seed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "b073f90b8fa8e092"
+SOURCES_DIGEST = "4638f68ea5dcd39a"
 
 #: The kernel took every step it was asked for.
 DONE = 0

@@ -36,7 +36,7 @@ from refsim.dynamics.walls import bounce_advance, crossing_time, deepest_speed
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "c40e528d15ffec88"
+SOURCES_DIGEST = "8ad5793c7a079de3"
 
 #: The contact solve of the corrected wall response, compiled from the
 #: readable source (:func:`refsim.dynamics.impulse.solve_contacts_python`,

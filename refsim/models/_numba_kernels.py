@@ -26,7 +26,7 @@ from refsim.models import ear_index
 #: :func:`refsim.kernels.sources_digest` of the refsim modules this one imports:
 #: an edit there must change this line, so that numba renews its cache of
 #: this module (tests/test_kernels.py checks it).
-SOURCES_DIGEST = "d890603341e62146"
+SOURCES_DIGEST = "8e4159f4b5ec5dca"
 
 for _helper in (ear_index.orient, ear_index.orient_error, ear_index.blocks,
                 ear_index.is_candidate, ear_index.mark_contacts,

@@ -49,6 +49,14 @@ def test_a_transposed_rotation_gives_the_same_box_and_no_second_compile():
     # check copies it to C order, so the compiled kernels meet one layout
     # (numba would otherwise compile each again for the other)
     from refsim.bounds._numba_kernels import aabb_linear_numba, incremental_update_numba
+    from refsim.types import as_pose
+
+    homogeneous = np.eye(4)
+    homogeneous[:3, :3] = turn = measure.pose_sequence(1, "jump", seed=5)[0][0]
+    homogeneous[:3, 3] = [0.5, -1.0, 2.0]
+    checked = as_pose((homogeneous[:3, :3].T, homogeneous[:3, 3]))   # both non-contiguous
+    assert checked[0].flags.c_contiguous and checked[1].flags.c_contiguous
+    assert np.array_equal(checked[0], turn.T) and list(checked[1]) == [0.5, -1.0, 2.0]
 
     mesh = shapes.geodesic_sphere(5)
     poses = measure.pose_sequence(3, "jump", seed=5)

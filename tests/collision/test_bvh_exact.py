@@ -49,6 +49,67 @@ def _as_set(pairs):
     return set(map(tuple, np.asarray(pairs).tolist()))
 
 
+def test_the_readable_node_test_is_the_compiled_kernels_arithmetic_bit_for_bit():
+    """The readable node test against the compiled query's helpers run as
+    plain Python (``py_func``; the helpers they call are numba's): node b
+    placed in a's frame, the pair's frame row by row, a pose's deviation,
+    and the fifteen axes' verdict at the very margin where the compiled
+    verdict turns (found by bisecting the margin's bits) and one ulp above
+    it, so that a sum taken in another order would show."""
+    from refsim.collision import _numba_kernels as nk
+
+    def bits(x: float) -> int:
+        return int(np.float64(x).view(np.int64))
+
+    def from_bits(n: int) -> float:
+        return float(np.int64(n).view(np.float64))
+
+    rng = np.random.default_rng(31)
+    edges = 0
+    for _ in range(300):
+        rotation = random_rotation(rng) + rng.normal(scale=1e-9, size=(3, 3))   # off by rounding
+        M = rotation.tolist()
+        box_a, box_b = (np.concatenate([rng.normal(size=3), rng.uniform(0.1, 1.0, 3),
+                                        random_rotation(rng).ravel()]).tolist()
+                        for _ in range(2))
+        # b's centre lands within about two half-extents of a's: the boxes
+        # are near touching
+        u = (np.array(box_a[:3]) - rotation @ box_b[:3] + rng.normal(size=3)).tolist()
+        p, P = bvh_exact.place(box_b, M, u)
+        placed = np.empty((1, 12))
+        nk.place.py_func(np.array([box_b]), np.array(M), np.array(u), 0, placed)
+        assert [*p, *P[0], *P[1], *P[2]] == placed[0].tolist()
+
+        T, R = bvh_exact.node_pair_frame(box_a, p, P)
+        A = tuple(tuple(box_a[6 + 3 * r:9 + 3 * r]) for r in range(3))
+        d = (p[0] - box_a[0], p[1] - box_a[1], p[2] - box_a[2])
+        for i in range(3):
+            t, r = nk.frame_row.py_func(A, i, d, tuple(map(tuple, P)))
+            assert (T[i], R[i]) == (t, list(r))
+        assert bvh_exact.deviation(rotation) == nk.pose_deviation.py_func(
+            rotation, np.zeros(3), 1.0)
+
+        h, g = box_a[3:6], box_b[3:6]
+
+        node_a, node_b = (tuple(box_a[:3]), tuple(h), A), (tuple(p), tuple(map(tuple, P)),
+                                                           tuple(g))
+
+        def compiled(margin, node_a=node_a, node_b=node_b):
+            return nk.node_boxes_apart.py_func(*node_a, *node_b, margin)
+
+        if not compiled(0.0):
+            continue                                 # overlapping: no margin turns it
+        low, high = bits(0.0), bits(16.0)
+        assert not compiled(16.0)
+        while high - low > 1:                        # the largest margin still apart
+            middle = (low + high) // 2
+            low, high = (middle, high) if compiled(from_bits(middle)) else (low, middle)
+        assert bvh_exact.boxes_apart(T, R, h, g, from_bits(low)) is True
+        assert bvh_exact.boxes_apart(T, R, h, g, from_bits(high)) is False
+        edges += 1
+    assert edges > 100
+
+
 @pytest.mark.parametrize("mesh_a, mesh_b, spread", PAIRS, ids=lambda x: getattr(x, "name", x))
 def test_candidates_compiled_equal_readable_and_lie_between_exact_and_test2(
         mesh_a, mesh_b, spread):

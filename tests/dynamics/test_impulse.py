@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from refsim.dynamics import impulse
+from refsim.kernels import CONTACT_IMPULSES
 
 #: Momentum sums of a handful of impulses of order 1: rounding only.
 MOMENTUM_TOL = 1e-12
@@ -44,8 +45,9 @@ def _solve(kernel, ma, Ia, xa, va, wa, mb, Ib, xb, vb, wb, p, n, e, mu):
 
 
 def _solve_on(kernel: str):
-    """The solve on kernel "readable" (the plain function) or "compiled"."""
-    return impulse.solve_contacts_python if kernel == "readable" else impulse.solve_contacts
+    """The solve on kernel "readable" or "compiled", as the pair dispatches
+    it (the readable one on Python floats, refsim.kernels.python_floats)."""
+    return CONTACT_IMPULSES(kernel)
 
 
 @pytest.mark.parametrize("kernel", ["readable", "compiled"])
